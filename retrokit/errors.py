@@ -1,0 +1,131 @@
+"""Every error retrokit raises, in one flat module.
+
+Messages follow one pattern: what was expected, what was found, and how to fix
+it. Where the user typed a name that is close to a known one, the message ends
+with a did-you-mean suggestion built by :func:`did_you_mean`.
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Iterable
+
+
+def did_you_mean(name: str, choices: Iterable[str], *, n: int = 3) -> str:
+    """Return ``" Did you mean 'x'?"`` for the choices closest to ``name``, or ``""``."""
+    choices = [str(c) for c in choices]
+    close = difflib.get_close_matches(name, choices, n=n, cutoff=0.6)
+    if not close:
+        lowered = {c.lower(): c for c in choices}
+        close = [lowered[c] for c in difflib.get_close_matches(name.lower(), list(lowered), n=n, cutoff=0.6)]
+    if not close:
+        return ""
+    if len(close) == 1:
+        return f" Did you mean {close[0]!r}?"
+    return " Did you mean one of: " + ", ".join(repr(c) for c in close) + "?"
+
+
+class RetrokitError(Exception):
+    """The root of every error retrokit raises on purpose."""
+
+
+# --- Arguments and names -------------------------------------------------------------
+
+
+class InvalidArgumentError(RetrokitError, ValueError):
+    """An argument has the wrong type, shape, dtype or range."""
+
+
+class UnknownNameError(RetrokitError, KeyError):
+    """A name (game, state, field, system, option, button) is not known."""
+
+    def __str__(self) -> str:  # KeyError would quote the whole message
+        return str(self.args[0]) if self.args else ""
+
+
+class GameNotFoundError(UnknownNameError):
+    """No integration folder holds a game of that name."""
+
+
+class StateNotFoundError(UnknownNameError):
+    """The game has no save state of that name."""
+
+
+class FieldNotFoundError(UnknownNameError):
+    """The game's data file names no RAM field of that name."""
+
+
+# --- Cores and the native host -------------------------------------------------------------
+
+
+class CoreError(RetrokitError, RuntimeError):
+    """A libretro core refused a call or could not be loaded."""
+
+
+class CoreNotFoundError(CoreError):
+    """No libretro core for a system was found in any search location."""
+
+
+class UnsupportedSystemError(UnknownNameError):
+    """A ROM, file extension or system name maps to no known system."""
+
+
+# --- Files: data, states, ROMs, movies -----------------------------------------------------
+
+
+class DataFileError(RetrokitError, ValueError):
+    """A game data, system or integration file is malformed."""
+
+
+class FieldTypeError(DataFileError):
+    """A RAM field's type code is not one retrokit can read."""
+
+
+class StateError(RetrokitError, ValueError):
+    """A save state is truncated, corrupt, or made by another core."""
+
+
+class RomError(RetrokitError):
+    """A ROM is missing, unreadable, or not the one a game expects."""
+
+
+class RomNotFoundError(RomError, FileNotFoundError):
+    """A game's ROM has not been imported."""
+
+
+class RomMismatchError(RomError, ValueError):
+    """A ROM's SHA-1 matches none of the game's known hashes."""
+
+
+class FileConflictError(RetrokitError, FileExistsError):
+    """Writing would replace a different file the user already has."""
+
+
+class MovieError(RetrokitError, ValueError):
+    """A .bk2 movie is malformed or does not fit the game it is played on."""
+
+
+# --- Scenarios ---------------------------------------------------------------------------------
+
+
+class ScenarioError(RetrokitError, ValueError):
+    """A scenario file is malformed or cannot be compiled."""
+
+
+class ScenarioSyntaxError(ScenarioError):
+    """A scenario expression does not parse."""
+
+
+class ScenarioCompileError(ScenarioError):
+    """A scenario expression parses but means nothing: unknown name, arity, type."""
+
+
+class ScenarioRuntimeError(RetrokitError, ArithmeticError):
+    """A scenario expression failed while running: division by zero, missing table key."""
+
+
+# --- Environments ------------------------------------------------------------------------------
+
+
+class EnvError(RetrokitError, RuntimeError):
+    """An environment was used out of order, e.g. stepped before reset."""

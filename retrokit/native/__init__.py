@@ -1,0 +1,1 @@
+"""The C host for libretro cores. Its module ``_host`` is private: use :mod:`retrokit.emulator`."""

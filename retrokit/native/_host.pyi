@@ -1,0 +1,72 @@
+"""Private native host for libretro cores. Use :class:`retrokit.emulator.Emulator`.
+
+Every function here is a data-only primitive: it loads, runs, copies or
+converts. Arguments are checked before the core is touched, and a failing core
+call raises :class:`retrokit.errors.CoreError` (or a subclass); nothing aborts.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+MEMORY_SAVE_RAM: int
+MEMORY_RTC: int
+MEMORY_SYSTEM_RAM: int
+MEMORY_VIDEO_RAM: int
+MAX_PORTS: int
+PIXEL_FORMAT_0RGB1555: int
+PIXEL_FORMAT_XRGB8888: int
+PIXEL_FORMAT_RGB565: int
+
+class Emulator:
+    """One libretro core, privately loaded, with at most one game."""
+
+    def __init__(
+        self,
+        core_path: str,
+        system_dir: str,
+        save_dir: str,
+        options: dict[str, str] | None = None,
+        log: Callable[[int, str], None] | None = None,
+    ) -> None: ...
+    def load_game(self, path: str, data: bytes | None) -> None: ...
+    def system_info(self) -> dict[str, object]: ...
+    def av_info(self) -> dict[str, float | int]: ...
+    def options(self) -> dict[str, tuple[str, str, tuple[str, ...]]]:
+        """Map each core option key to (description, current value, allowed values)."""
+    def set_option(self, key: str, value: str) -> None: ...
+    def set_controller(self, port: int, device: int) -> None: ...
+    def set_sticky(self, prob: float, seed: int) -> None: ...
+    def forget_action(self) -> None:
+        """Make the next ``run`` apply its action from the first frame, as after a reset."""
+    def run(self, actions: npt.NDArray[np.uint16], frames: int) -> None: ...
+    def screen_shape(self) -> tuple[int, int]: ...
+    def screen(self, out: npt.NDArray[np.uint8]) -> None: ...
+    def memory(self, kind: int) -> memoryview | None: ...
+    def memory_maps(self) -> list[dict[str, object]]: ...
+    def serialize_size(self) -> int: ...
+    def serialize(self) -> bytes: ...
+    def unserialize(self, data: bytes) -> None: ...
+    def reset(self) -> None: ...
+    def capture_audio(self, enabled: bool) -> None: ...
+    def take_audio(self) -> npt.NDArray[np.int16]: ...
+    @property
+    def frame(self) -> int: ...
+    @property
+    def pixel_format(self) -> int: ...
+    def close(self) -> None: ...
+
+def read_fields(
+    buffers: Sequence[memoryview | bytes | bytearray | npt.NDArray[np.uint8]],
+    plan: npt.NDArray[np.int64],
+    out: npt.NDArray[np.int64],
+) -> None:
+    """Decode every field of a plan from RAM buffers into ``out``.
+
+    ``plan`` has one row per field: ``[buffer, width, kind, mask, off0 .. off7]``
+    with offsets from least to most significant byte, and ``kind`` 0 unsigned,
+    1 signed, 2 BCD, 3 low-nibble BCD.
+    """

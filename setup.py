@@ -1,0 +1,26 @@
+"""Build the private native host, ``retrokit.native._host``.
+
+Everything else about the package is declared in ``pyproject.toml``; this file
+exists only because a C extension needs a setuptools ``Extension``.
+"""
+
+from __future__ import annotations
+
+import numpy
+from setuptools import Extension, setup
+
+host = Extension(
+    "retrokit.native._host",
+    sources=[
+        "retrokit/native/host.c",
+        "retrokit/native/core.c",
+        "retrokit/native/video.c",
+        "retrokit/native/fields.c",
+    ],
+    include_dirs=["retrokit/native", numpy.get_include()],
+    define_macros=[("NPY_NO_DEPRECATED_API", "NPY_1_7_API_VERSION")],
+    extra_compile_args=["-O3", "-std=c11", "-Wall", "-Wextra", "-Wno-unused-parameter"],
+    libraries=["dl"],
+)
+
+setup(ext_modules=[host])

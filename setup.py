@@ -6,7 +6,6 @@ exists only because a C extension needs a setuptools ``Extension``.
 
 from __future__ import annotations
 
-import numpy
 from setuptools import Extension, setup
 
 host = Extension(
@@ -17,8 +16,7 @@ host = Extension(
         "retrokit/native/video.c",
         "retrokit/native/fields.c",
     ],
-    include_dirs=["retrokit/native", numpy.get_include()],
-    define_macros=[("NPY_NO_DEPRECATED_API", "NPY_1_7_API_VERSION")],
+    include_dirs=["retrokit/native"],
     extra_compile_args=["-O3", "-std=c11", "-Wall", "-Wextra", "-Wno-unused-parameter"],
     libraries=["dl"],
 )

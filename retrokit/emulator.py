@@ -1,0 +1,212 @@
+"""The emulator: one console running one game, with arguments checked in Python.
+
+This is the public face of the native host. It finds the system's core,
+applies the system's default core options, checks every argument before the
+core is touched, and maps console addresses for RAM access.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from retrokit.cores import find_core
+from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean
+from retrokit.memory import AddressSpace
+from retrokit.native import _host
+from retrokit.paths import data_dir
+from retrokit.systems import System, get_system, system_for_extension
+
+logger = logging.getLogger("retrokit.core")
+_LOG_LEVELS = (logging.DEBUG, logging.INFO, logging.WARNING, logging.ERROR)
+
+
+def _log_core(level: int, text: str) -> None:
+    logger.log(_LOG_LEVELS[level] if 0 <= level < len(_LOG_LEVELS) else logging.INFO, "%s", text)
+
+
+class Emulator:
+    """A console running one game.
+
+    Args:
+        system: The system's name (``"Genesis"``) or descriptor.
+        rom: The ROM file.
+        options: Core options overriding the system's defaults.
+        ports: How many controller ports receive input.
+        core_path: A core to use instead of the system's.
+
+    Raises:
+        CoreNotFoundError: The system's core is not installed.
+        CoreError: The core failed to load the ROM.
+        UnknownNameError: An option names no option of the core.
+    """
+
+    def __init__(
+        self,
+        system: str | System,
+        rom: str | os.PathLike[str],
+        *,
+        options: Mapping[str, str] | None = None,
+        ports: int = 2,
+        core_path: str | os.PathLike[str] | None = None,
+    ) -> None:
+        self.system = get_system(system)
+        rom = Path(rom)
+        if not rom.is_file():
+            raise InvalidArgumentError(f"Expected a ROM file, found nothing at {rom}.")
+        if not 1 <= ports <= _host.MAX_PORTS:
+            raise InvalidArgumentError(f"Expected 1 to {_host.MAX_PORTS} ports, got {ports}.")
+        self.ports = ports
+        core = Path(core_path) if core_path is not None else find_core(self.system.core)
+        merged = {**self.system.options, **(options or {})}
+        folder = data_dir()
+        system_dir, save_dir = folder / "system", folder / "saves"
+        self._emu = _host.Emulator(str(core), str(system_dir), str(save_dir), merged, _log_core, ports)
+        declared = self._emu.options()
+        for key in options or {}:
+            if key not in declared:
+                self._emu.close()
+                raise UnknownNameError(
+                    f"Expected an option of the {core.name} core, got {key!r}." + did_you_mean(key, declared)
+                )
+            allowed = declared[key][2]
+            if allowed and options[key] not in allowed:  # type: ignore[index]
+                self._emu.close()
+                raise InvalidArgumentError(
+                    f"Expected one of {', '.join(map(repr, allowed))} for core option {key!r}, got {options[key]!r}."  # type: ignore[index]
+                )
+        need_path = bool(self._emu.system_info()["need_fullpath"])
+        self._emu.load_game(str(rom), None if need_path else rom.read_bytes())
+        self.rom = rom
+        self.space = AddressSpace.for_emulator(self.system, self._emu)
+        self._actions = np.zeros(ports, dtype=np.uint16)
+
+    @classmethod
+    def for_rom(cls, rom: str | os.PathLike[str], **kwargs: object) -> Emulator:
+        """Open a ROM on the system its file extension names."""
+        return cls(system_for_extension(Path(rom).suffix), rom, **kwargs)  # type: ignore[arg-type]
+
+    # --- running ---------------------------------------------------------------------
+
+    def run(self, actions: Sequence[int] | np.ndarray | int = 0, frames: int = 1) -> None:
+        """Emulate frames holding one RetroPad button mask per port.
+
+        Args:
+            actions: One mask per port (fewer ports than opened press nothing
+                on the rest), or a single mask for port 1.
+            frames: How many frames to run.
+        """
+        if type(actions) is not np.ndarray or actions.dtype != np.uint16:  # noqa: E721 - exact type is the fast path
+            actions = self._as_actions(actions)
+        self._emu.run(actions, frames)
+
+    def _as_actions(self, actions: Sequence[int] | np.ndarray | int) -> np.ndarray:
+        values = [actions] if isinstance(actions, (int, np.integer)) else list(np.asarray(actions).ravel())
+        if len(values) > self.ports:
+            raise InvalidArgumentError(f"Expected at most {self.ports} button masks (one per port), got {len(values)}.")
+        out = np.zeros(self.ports, dtype=np.uint16)
+        for i, v in enumerate(values):
+            if not 0 <= int(v) <= 0xFFFF:
+                raise InvalidArgumentError(f"Expected button masks from 0 to 0xFFFF, got {v} for port {i + 1}.")
+            out[i] = int(v)
+        return out
+
+    def set_sticky(self, prob: float, seed: int) -> None:
+        """Set the sticky-action probability and seed its random generator.
+
+        On the first frame of each ``run``, with probability ``prob``, the
+        buttons of the previous frame are held instead of the new ones.
+        """
+        if not 0.0 <= float(prob) <= 1.0:
+            raise InvalidArgumentError(f"Expected a sticky-action probability in [0, 1], got {prob}.")
+        self._emu.set_sticky(float(prob), int(seed) & 0xFFFFFFFFFFFFFFFF)
+
+    def forget_action(self) -> None:
+        """Make the next ``run`` apply its buttons from its first frame."""
+        self._emu.forget_action()
+
+    def reset(self) -> None:
+        """Hard-reset the console, as the reset button would."""
+        self._emu.reset()
+
+    @property
+    def frame(self) -> int:
+        """Frames emulated since the emulator was made."""
+        return self._emu.frame
+
+    # --- screen, audio, memory ---------------------------------------------------------
+
+    def screen_shape(self) -> tuple[int, int]:
+        """Return ``(height, width)`` of the current frame."""
+        return self._emu.screen_shape()
+
+    def screen(self, out: np.ndarray | None = None) -> np.ndarray:
+        """Return the current frame as an RGB ``uint8`` array of shape (H, W, 3).
+
+        Args:
+            out: A buffer of that shape to fill instead of allocating one.
+        """
+        if out is None:
+            out = np.empty(self._emu.screen_shape() + (3,), dtype=np.uint8)
+        self._emu.screen(out)
+        return out
+
+    def capture_audio(self, enabled: bool = True) -> None:
+        """Start (or stop) keeping the audio the core produces."""
+        self._emu.capture_audio(bool(enabled))
+
+    def take_audio(self) -> np.ndarray:
+        """Return and forget the captured audio, as int16 stereo frames of shape (N, 2)."""
+        return np.frombuffer(self._emu.take_audio(), dtype=np.int16).reshape(-1, 2)
+
+    @property
+    def ram(self) -> np.ndarray:
+        """The system RAM as a writable zero-copy ``uint8`` array, in the core's byte order."""
+        view = self._emu.memory(_host.MEMORY_SYSTEM_RAM)
+        if view is None:
+            raise InvalidArgumentError(f"The {self.system.name} core exposes no system RAM.")
+        return np.frombuffer(view, dtype=np.uint8)
+
+    def peek(self, address: int, type_code: str = "|u1") -> int:
+        """Read a value at a console address, e.g. ``peek(0xFF0366, ">u2")``."""
+        return self.space.peek(address, type_code)
+
+    def poke(self, address: int, value: int, type_code: str = "|u1") -> None:
+        """Write a value at a console address."""
+        self.space.poke(address, value, type_code)
+
+    # --- states and information -------------------------------------------------------------
+
+    def get_state(self) -> bytes:
+        """Serialize the console's state."""
+        return self._emu.serialize()
+
+    def set_state(self, state: bytes) -> None:
+        """Restore a state made by :meth:`get_state` (or a .state file's contents).
+
+        Raises:
+            StateError: The state does not fit this core.
+        """
+        self._emu.unserialize(state)
+
+    def av_info(self) -> dict[str, float | int]:
+        """Return the frame rate, sample rate and geometry."""
+        return self._emu.av_info()
+
+    def options(self) -> dict[str, str]:
+        """Return the core options' current values."""
+        return {key: value for key, (_, value, _) in self._emu.options().items()}
+
+    def close(self) -> None:
+        """Unload the game and the core. Further calls raise."""
+        self._emu.close()
+
+    def __enter__(self) -> Emulator:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

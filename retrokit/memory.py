@@ -1,0 +1,203 @@
+"""Console addresses, RAM fields, and reading them all after each step.
+
+An :class:`AddressSpace` maps console addresses onto the core's memory buffers
+(the system RAM, or the regions of the core's memory map), undoing the byte
+swap of systems such as the Genesis. A :class:`FieldReader` compiles a game's
+fields once into a plan the native host executes in a single call.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from retrokit.errors import FieldNotFoundError, InvalidArgumentError, did_you_mean
+from retrokit.native import _host
+from retrokit.systems import System
+from retrokit.types import UNSIGNED, FieldType, parse_type
+
+_LITTLE_HOST = sys.byteorder == "little"
+_CONST = 1  # RETRO_MEMDESC_CONST: read-only memory such as ROM
+
+
+@dataclass(frozen=True)
+class FieldSpec:
+    """A named RAM field of a game.
+
+    Attributes:
+        name: The field's name, e.g. ``"lives"``.
+        address: Its console address, e.g. ``0xFF0366``.
+        type: Its Gym Retro type code, e.g. ``">u2"``.
+        mask: Bits kept after decoding, or ``None`` for all.
+    """
+
+    name: str
+    address: int
+    type: str
+    mask: int | None = None
+    field_type: FieldType = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "field_type", parse_type(self.type))
+        if not isinstance(self.address, int) or self.address < 0:
+            raise InvalidArgumentError(
+                f"Expected a non-negative integer address for field {self.name!r}, got {self.address!r}."
+            )
+
+
+@dataclass(frozen=True)
+class Region:
+    """A run of console addresses backed by one memory buffer."""
+
+    start: int
+    length: int
+    buffer: memoryview
+    swap: int = 1
+
+    def offset(self, address: int) -> int:
+        """Return the buffer offset of a console address inside this region."""
+        relative = address - self.start
+        return relative ^ (self.swap - 1) if _LITTLE_HOST else relative
+
+
+class AddressSpace:
+    """Console addresses over a core's memory.
+
+    Args:
+        regions: The mapped regions, searched in order.
+    """
+
+    def __init__(self, regions: Sequence[Region]) -> None:
+        self.regions = list(regions)
+        self.buffers = [r.buffer for r in self.regions]
+
+    @classmethod
+    def for_emulator(cls, system: System, emulator: _host.Emulator) -> AddressSpace:
+        """Build the address space of a loaded emulator.
+
+        The core's memory map is used where it gives one (skipping read-only
+        regions, as Gym Retro does); otherwise the system RAM sits at the
+        system's RAM base.
+        """
+        regions = []
+        for desc in emulator.memory_maps():
+            if desc["flags"] & _CONST or desc["memory"] is None:
+                continue
+            length = desc["length"]
+            if desc["select"]:
+                by_select = ((~desc["select"] & ~desc["start"]) + 1) & desc["select"]
+                length = min(length, by_select) if length else by_select
+            regions.append(Region(desc["start"], length, desc["memory"], system.ram_swap))
+        if not regions:
+            ram = emulator.memory(_host.MEMORY_SYSTEM_RAM)
+            if ram is not None:
+                regions.append(Region(system.ram_base, len(ram), ram, system.ram_swap))
+        return cls(regions)
+
+    def locate(self, address: int, width: int = 1) -> tuple[int, int]:
+        """Return ``(buffer index, region-relative start)`` of ``width`` bytes at ``address``.
+
+        Raises:
+            InvalidArgumentError: The bytes are not all inside one mapped region.
+        """
+        for index, region in enumerate(self.regions):
+            if region.start <= address and address + width <= region.start + region.length:
+                return index, address
+        mapped = ", ".join(f"{r.start:#x}-{r.start + r.length - 1:#x}" for r in self.regions) or "none"
+        raise InvalidArgumentError(
+            f"Expected an address inside the mapped memory ({mapped}), got {address:#x} (width {width}). "
+            f"Check the field's address: it is a console address, not a buffer offset."
+        )
+
+    def offsets(self, address: int, width: int) -> tuple[int, list[int]]:
+        """Return the buffer index and the buffer offset of each byte at ``address``."""
+        index, _ = self.locate(address, width)
+        region = self.regions[index]
+        return index, [region.offset(address + i) for i in range(width)]
+
+    def read_bytes(self, address: int, width: int) -> bytes:
+        """Read ``width`` bytes in console order."""
+        index, offs = self.offsets(address, width)
+        buf = self.buffers[index]
+        return bytes(buf[o] for o in offs)
+
+    def write_bytes(self, address: int, data: bytes) -> None:
+        """Write bytes in console order."""
+        index, offs = self.offsets(address, len(data))
+        buf = self.buffers[index]
+        for o, b in zip(offs, data):
+            buf[o] = b
+
+    def peek(self, address: int, type_code: str = "|u1") -> int:
+        """Read one value of a type at a console address."""
+        ftype = parse_type(type_code)
+        return ftype.decode(self.read_bytes(address, ftype.width))
+
+    def poke(self, address: int, value: int, type_code: str = "|u1") -> None:
+        """Write one value of a type at a console address."""
+        ftype = parse_type(type_code)
+        self.write_bytes(address, ftype.encode(value))
+
+
+class FieldReader:
+    """Reads every field of a game in one native call.
+
+    Args:
+        fields: The fields, as specs or a name-to-spec mapping.
+        space: The address space they live in.
+    """
+
+    def __init__(self, fields: Iterable[FieldSpec] | Mapping[str, FieldSpec], space: AddressSpace) -> None:
+        specs = list(fields.values()) if isinstance(fields, Mapping) else list(fields)
+        self.space = space
+        self.specs = {s.name: s for s in specs}
+        self.names = list(self.specs)
+        self.plan = np.zeros((len(specs), _host.PLAN_COLUMNS), dtype=np.int64)
+        for row, spec in zip(self.plan, specs):
+            ftype = spec.field_type
+            index, offs = space.offsets(spec.address, ftype.width)
+            row[0], row[1], row[2] = index, ftype.width, ftype.kind
+            row[3] = -1 if spec.mask is None else spec.mask
+            row[4 : 4 + ftype.width] = [offs[i] for i in ftype.significance()]
+        self.values = np.zeros(len(specs), dtype=np.int64)
+        # 8-byte unsigned fields do not fit int64; read() gives their true value.
+        self._wide = [s.name for s in specs if s.field_type.kind == UNSIGNED and s.field_type.width == 8]
+
+    def read_array(self) -> np.ndarray:
+        """Decode every field into ``self.values`` (reused between calls) and return it.
+
+        The array is int64: an 8-byte unsigned field of 2**63 or more reads
+        as its two's-complement negative here; :meth:`read` corrects it.
+        """
+        _host.read_fields(self.space.buffers, self.plan, self.values)
+        return self.values
+
+    def read(self) -> dict[str, int]:
+        """Return every field's value by name."""
+        _host.read_fields(self.space.buffers, self.plan, self.values)
+        values = dict(zip(self.names, self.values.tolist()))
+        for name in self._wide:
+            values[name] &= 0xFFFFFFFFFFFFFFFF
+        return values
+
+    def spec(self, name: str) -> FieldSpec:
+        """Return a field's spec by name.
+
+        Raises:
+            FieldNotFoundError: No field has that name.
+        """
+        try:
+            return self.specs[name]
+        except KeyError:
+            raise FieldNotFoundError(
+                f"Expected one of the game's fields ({', '.join(self.names)}), got {name!r}."
+                + did_you_mean(name, self.names)
+            ) from None
+
+    def write(self, name: str, value: int) -> None:
+        """Write a field's value into RAM."""
+        spec = self.spec(name)
+        self.space.poke(spec.address, value, spec.type)

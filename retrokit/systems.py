@@ -1,0 +1,144 @@
+"""System descriptors: each console's buttons, RAM layout, types and core.
+
+The descriptors live in ``systems.yaml`` beside this module.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import yaml
+
+from retrokit.errors import DataFileError, InvalidArgumentError, UnknownNameError, UnsupportedSystemError, did_you_mean
+
+_FILE = Path(__file__).with_name("systems.yaml")
+
+
+@dataclass(frozen=True)
+class System:
+    """What retrokit knows about one console.
+
+    Attributes:
+        name: Gym Retro's name for the system, e.g. ``"Genesis"``.
+        core: The libretro core's library name, e.g. ``"genesis_plus_gx"``.
+        extensions: ROM file extensions, without the dot.
+        ram_base: The console address of the first byte of system RAM.
+        ram_swap: The word size of the RAM buffer's byte swap (1: none).
+        buttons: The console's name for each RetroPad id, ``None`` where unused.
+        types: The type codes integrations of this system usually use.
+        options: Core option defaults for this system.
+        actions: Gym Retro's default groups of button combinations.
+    """
+
+    name: str
+    core: str
+    extensions: tuple[str, ...]
+    ram_base: int
+    ram_swap: int
+    buttons: tuple[str | None, ...]
+    types: tuple[str, ...] = ()
+    options: dict[str, str] = field(default_factory=dict)
+    actions: tuple[tuple[tuple[str, ...], ...], ...] = ()
+
+    @property
+    def button_names(self) -> tuple[str, ...]:
+        """The names of the buttons that exist, in RetroPad id order."""
+        return tuple(b for b in self.buttons if b is not None)
+
+    def button_bit(self, name: str) -> int:
+        """Return the RetroPad id of a button.
+
+        Raises:
+            UnknownNameError: The system has no such button.
+        """
+        try:
+            return self.buttons.index(name)
+        except ValueError:
+            raise UnknownNameError(
+                f"Expected one of {self.name}'s buttons ({', '.join(self.button_names)}), got {name!r}."
+                + did_you_mean(name, self.button_names)
+            ) from None
+
+    def mask(self, buttons: Iterable[str]) -> int:
+        """Return the RetroPad bit mask that presses the named buttons."""
+        if isinstance(buttons, str):
+            raise InvalidArgumentError(f"Expected a list of button names, got the string {buttons!r}; write [{buttons!r}].")
+        value = 0
+        for name in buttons:
+            value |= 1 << self.button_bit(name)
+        return value
+
+    def buttons_of(self, mask: int) -> list[str]:
+        """Return the names of the buttons a bit mask presses."""
+        return [b for i, b in enumerate(self.buttons) if b is not None and mask >> i & 1]
+
+
+def _parse(name: str, entry: object) -> System:
+    if not isinstance(entry, dict):
+        raise DataFileError(f"{_FILE}: expected a mapping for system {name!r}, got {type(entry).__name__}.")
+    try:
+        ram = entry.get("ram", {})
+        return System(
+            name=name,
+            core=str(entry["core"]),
+            extensions=tuple(entry["extensions"]),
+            ram_base=int(ram.get("base", 0)),
+            ram_swap=int(ram.get("swap", 1)),
+            buttons=tuple(entry["buttons"]),
+            types=tuple(entry.get("types", ())),
+            options={str(k): str(v) for k, v in (entry.get("options") or {}).items()},
+            actions=tuple(tuple(tuple(combo) for combo in group) for group in entry.get("actions", ())),
+        )
+    except (KeyError, TypeError, ValueError) as exc:
+        raise DataFileError(f"{_FILE}: system {name!r} is malformed: {exc!r}.") from exc
+
+
+@functools.cache
+def all_systems() -> dict[str, System]:
+    """Return every known system by name."""
+    with open(_FILE, encoding="utf-8") as f:
+        data = yaml.safe_load(f)
+    return {name: _parse(name, entry) for name, entry in data.items()}
+
+
+def get_system(name: str | System) -> System:
+    """Return the descriptor of a system by name (case-insensitive).
+
+    Raises:
+        UnsupportedSystemError: No system has that name.
+    """
+    if isinstance(name, System):
+        return name
+    systems = all_systems()
+    if name in systems:
+        return systems[name]
+    for key, system in systems.items():
+        if key.lower() == str(name).lower():
+            return system
+    raise UnsupportedSystemError(
+        f"Expected a system name ({', '.join(systems)}), got {name!r}." + did_you_mean(str(name), systems)
+    )
+
+
+def system_for_extension(ext: str) -> System:
+    """Return the system whose ROMs have a file extension (``"md"`` or ``".md"``).
+
+    Raises:
+        UnsupportedSystemError: No system uses that extension.
+    """
+    ext = ext.lower().lstrip(".")
+    known: dict[str, System] = {}
+    for system in all_systems().values():
+        for e in system.extensions:
+            known.setdefault(e, system)
+    if ext in known:
+        return known[ext]
+    if ext in ("gen", "smd"):  # other Genesis dumps; .smd is de-interleaved on import
+        return known["md"]
+    raise UnsupportedSystemError(
+        f"Expected a ROM file extension retrokit knows ({', '.join('.' + e for e in sorted(known))}), got "
+        f"{'.' + ext!r}. Rename the file, or pass the system explicitly." + did_you_mean(ext, known)
+    )

@@ -1,0 +1,53 @@
+"""Shared fixtures: the free ROMs that every test machine has.
+
+Airstriker-Genesis ships in the stable-retro wheel with its ROM and a Level1
+state; Dasher-Genesis is our own test cartridge (games/Dasher-Genesis).
+"""
+
+from __future__ import annotations
+
+import gzip
+import json
+from pathlib import Path
+
+import pytest
+
+from retrokit.paths import wheel_dir
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+@pytest.fixture(scope="session")
+def airstriker_dir() -> Path:
+    """The wheel's Airstriker integration folder."""
+    root = wheel_dir()
+    assert root is not None, "the stable-retro wheel is a dependency of retrokit and must be installed"
+    return root / "data" / "stable" / "Airstriker-Genesis-v0"
+
+
+@pytest.fixture(scope="session")
+def airstriker_rom(airstriker_dir: Path) -> Path:
+    return airstriker_dir / "rom.md"
+
+
+@pytest.fixture(scope="session")
+def airstriker_state(airstriker_dir: Path) -> bytes:
+    """Airstriker's Level1 state, uncompressed."""
+    return gzip.decompress((airstriker_dir / "Level1.state").read_bytes())
+
+
+@pytest.fixture(scope="session")
+def airstriker_fields(airstriker_dir: Path) -> dict[str, dict]:
+    """Airstriker's RAM fields as stable-retro's data.json gives them."""
+    return json.loads((airstriker_dir / "data.json").read_text())["info"]
+
+
+@pytest.fixture
+def airstriker(airstriker_rom: Path, airstriker_state: bytes):
+    """A Genesis emulator at the start of Airstriker's Level1."""
+    from retrokit.emulator import Emulator
+
+    emu = Emulator("Genesis", airstriker_rom)
+    emu.set_state(airstriker_state)
+    yield emu
+    emu.close()

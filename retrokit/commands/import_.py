@@ -1,0 +1,77 @@
+"""``retrokit import PATH... [--game NAME]``: copy the ROMs of known games into the data folder."""
+
+from __future__ import annotations
+
+import argparse
+
+from retrokit.commands._common import add_data_dir_option, rom_status
+
+SHOWN = 10
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``import`` command."""
+    parser = subparsers.add_parser(
+        "import",
+        help="import ROMs of known games from folders and zip files",
+        description="Search files, folders and zip files for the ROMs of known games (by SHA-1, "
+        "by stable-retro's rules), and copy each match into the data folder. A different ROM "
+        "already imported is never replaced unless --overwrite is given.",
+    )
+    parser.add_argument("paths", nargs="*", metavar="PATH", help="files, folders or zip files to search")
+    parser.add_argument("--game", metavar="NAME", help="show the SHA-1s this game expects, and whether its ROM is present")
+    parser.add_argument("--overwrite", action="store_true", help="replace a different ROM already imported")
+    parser.add_argument("-v", "--verbose", action="store_true", help="list every file that matched nothing")
+    add_data_dir_option(parser)
+    parser.set_defaults(run=run)
+
+
+def _section(title: str, lines: list[str], verbose: bool) -> None:
+    if not lines:
+        return
+    print(f"{title} ({len(lines)}):")
+    shown = lines if verbose else lines[:SHOWN]
+    for line in shown:
+        print(f"  {line}")
+    if len(shown) < len(lines):
+        print(f"  ... and {len(lines) - len(shown)} more (-v lists them all)")
+
+
+def run(args: argparse.Namespace) -> int:
+    """Import ROMs, and/or show what a game expects."""
+    from retrokit.errors import InvalidArgumentError
+    from retrokit.games import find_game
+    from retrokit.importer import import_roms
+
+    if not args.paths and not args.game:
+        raise InvalidArgumentError(
+            "Expected at least one PATH to search (or --game NAME); found none. "
+            "Run, for example: retrokit import ~/roms"
+        )
+    game = find_game(args.game) if args.game else None
+    status = 0
+    if args.paths:
+        report = import_roms(args.paths, data_dir=args.data_dir, overwrite=args.overwrite)
+        print(f"Imported {len(report.imported)} ROM{'s' * (len(report.imported) != 1)} into {report.data_dir / 'roms'}.")
+        _section("Imported", [f"{r.game} <- {r.source}" for r in report.imported], True)
+        _section("Already imported", [f"{r.game} <- {r.source}" for r in report.already_present], args.verbose)
+        _section(
+            "Not overwritten, a different file is there (pass --overwrite to replace it)",
+            [f"{c.game}: {c.path} has SHA-1 {c.existing_sha1}; {c.source} has {c.sha1}" for c in report.conflicts],
+            True,
+        )
+        _section("Matched no known game", report.unmatched, args.verbose)
+        _section("Skipped", [f"{label}: {why}" for label, why in report.skipped], args.verbose)
+        _section("Games whose data files cannot be read", [f"{n}: {e}" for n, e in report.broken_games], args.verbose)
+        status = 1 if report.conflicts else 0
+    if game is not None:
+        where, path = rom_status(game, args.data_dir)
+        print(f"{game.name} ({game.system}) accepts a ROM with SHA-1:")
+        for sha1 in game.sha1s or ("(none listed in its data file)",):
+            print(f"  {sha1}")
+        if path is not None:
+            print(f"Its ROM is {where}: {path}")
+        else:
+            print(f"Its ROM is missing: expected at {game.imported_rom_path(args.data_dir)}. "
+                  "Import it with: retrokit import /path/to/your/roms")
+    return status

@@ -1,0 +1,151 @@
+"""Where retrokit's files live, and how they are written safely.
+
+Game folders are searched, in order, in:
+
+1. every folder in ``RETROKIT_GAMES`` (separated by :data:`os.pathsep`),
+2. the repository's ``games/`` folder (next to the ``retrokit`` package),
+3. the stable-retro wheel's ``data/stable``, ``data/experimental`` and
+   ``data/contrib`` folders.
+
+The per-user data folder holds imported ROMs (``<data>/roms/<Game>/rom.<ext>``).
+It is ``RETROKIT_DATA`` if set, else ``$XDG_DATA_HOME/retrokit``, else
+``~/.local/share/retrokit``.
+
+The stable-retro wheel is located without importing its Python code.
+"""
+
+from __future__ import annotations
+
+import functools
+import importlib.metadata
+import importlib.util
+import os
+import tempfile
+from pathlib import Path
+
+GAMES_ENV = "RETROKIT_GAMES"
+DATA_ENV = "RETROKIT_DATA"
+WHEEL_DATA_KINDS = ("stable", "experimental", "contrib")
+
+
+@functools.lru_cache(maxsize=1)
+def wheel_dir() -> Path | None:
+    """Return the installed ``stable_retro`` package folder, or ``None``.
+
+    ``importlib.util.find_spec`` on a top-level package locates it without
+    executing its ``__init__``.
+    """
+    try:
+        spec = importlib.util.find_spec("stable_retro")
+    except (ImportError, ValueError):
+        spec = None
+    if spec is not None and spec.submodule_search_locations:
+        return Path(next(iter(spec.submodule_search_locations)))
+    try:
+        located = importlib.metadata.distribution("stable-retro").locate_file("stable_retro")
+    except importlib.metadata.PackageNotFoundError:
+        return None
+    path = Path(str(located))
+    return path if path.is_dir() else None
+
+
+def wheel_cores_dir() -> Path | None:
+    """Return the wheel's ``cores/`` folder (``*.json`` core info and libretro cores)."""
+    root = wheel_dir()
+    return root / "cores" if root is not None and (root / "cores").is_dir() else None
+
+
+def wheel_data_dirs() -> list[Path]:
+    """Return the wheel's integration folders that exist: stable, experimental, contrib."""
+    root = wheel_dir()
+    if root is None:
+        return []
+    return [root / "data" / kind for kind in WHEEL_DATA_KINDS if (root / "data" / kind).is_dir()]
+
+
+def repo_games_dir() -> Path | None:
+    """Return the repository's ``games/`` folder next to the package, if it exists."""
+    path = Path(__file__).resolve().parent.parent / "games"
+    return path if path.is_dir() else None
+
+
+def env_games_dirs() -> list[Path]:
+    """Return the folders named in ``RETROKIT_GAMES``, in order (existing or not)."""
+    value = os.environ.get(GAMES_ENV, "")
+    return [Path(part).expanduser() for part in value.split(os.pathsep) if part.strip()]
+
+
+def game_search_dirs() -> list[Path]:
+    """Return the existing folders that hold game folders, in search order."""
+    candidates = [*env_games_dirs()]
+    repo = repo_games_dir()
+    if repo is not None:
+        candidates.append(repo)
+    candidates.extend(wheel_data_dirs())
+    seen: set[Path] = set()
+    result = []
+    for path in candidates:
+        if path.is_dir() and path not in seen:
+            seen.add(path)
+            result.append(path)
+    return result
+
+
+def data_dir() -> Path:
+    """Return the per-user data folder (it may not exist yet)."""
+    override = os.environ.get(DATA_ENV)
+    if override:
+        return Path(override).expanduser()
+    xdg = os.environ.get("XDG_DATA_HOME")
+    if xdg and Path(xdg).is_absolute():  # the XDG spec says to ignore relative paths
+        return Path(xdg) / "retrokit"
+    return Path.home() / ".local" / "share" / "retrokit"
+
+
+def roms_dir(data: Path | str | None = None) -> Path:
+    """Return the folder of imported ROMs: ``<data>/roms``."""
+    return (Path(data) if data is not None else data_dir()) / "roms"
+
+
+def imported_rom_path(game: str, ext: str, data: Path | str | None = None) -> Path:
+    """Return where the imported ROM of ``game`` lives: ``<data>/roms/<game>/rom.<ext>``."""
+    return roms_dir(data) / game / f"rom.{ext.lstrip('.')}"
+
+
+def atomic_write(path: Path | str, data: bytes, *, overwrite: bool = False) -> None:
+    """Write ``data`` to ``path`` through a temporary file renamed into place.
+
+    Readers never see a half-written file. With ``overwrite=False`` the final
+    step is a hard link, which fails if ``path`` appeared meanwhile, so no file
+    is ever replaced by accident.
+
+    Args:
+        path: The destination; its parent folders are created.
+        data: The bytes to write.
+        overwrite: Replace ``path`` if it exists.
+
+    Raises:
+        FileExistsError: ``path`` exists and ``overwrite`` is false.
+    """
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    tmp = Path(tmp_name)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        if overwrite:
+            os.replace(tmp, path)
+            return
+        try:
+            os.link(tmp, path)
+        except FileExistsError:
+            raise
+        except OSError:  # the file system has no hard links
+            if path.exists():
+                raise FileExistsError(path) from None
+            os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)

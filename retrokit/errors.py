@@ -11,8 +11,8 @@ import difflib
 from collections.abc import Iterable
 
 
-def did_you_mean(name: str, choices: Iterable[str], *, n: int = 3) -> str:
-    """Return ``" Did you mean 'x'?"`` for the choices closest to ``name``, or ``""``."""
+def did_you_mean(name: str, choices: Iterable[str], *, n: int = 1) -> str:
+    """Return ``" Did you mean 'x'?"`` for the ``n`` choices closest to ``name``, or ``""``."""
     choices = [str(c) for c in choices]
     close = difflib.get_close_matches(name, choices, n=n, cutoff=0.6)
     if not close:

@@ -1,0 +1,348 @@
+"""The native host on the real Genesis Plus GX core, with Airstriker."""
+
+from __future__ import annotations
+
+import hashlib
+import logging
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from retrokit.emulator import Emulator
+from retrokit.errors import CoreError, CoreNotFoundError, InvalidArgumentError, StateError, UnknownNameError
+from retrokit.native import _host
+from retrokit.systems import get_system
+
+GENESIS = get_system("Genesis")
+LEFT, RIGHT, FIRE = GENESIS.mask(["LEFT"]), GENESIS.mask(["RIGHT"]), GENESIS.mask(["B"])
+
+
+def script(n: int, seed: int) -> list[int]:
+    """A reproducible input script: ship movement and fire, never START."""
+    rng = np.random.default_rng(seed)
+    choices = [0, LEFT, RIGHT, FIRE, LEFT | FIRE, RIGHT | FIRE]
+    return [choices[i] for i in rng.integers(0, len(choices), n)]
+
+
+def play(emu: Emulator, inputs: list[int], frames: int = 4) -> None:
+    for mask in inputs:
+        emu.run([mask, 0], frames)
+
+
+def digest(emu: Emulator) -> str:
+    return hashlib.sha1(emu.ram.tobytes() + emu.screen().tobytes()).hexdigest()
+
+
+# --- loading and information -------------------------------------------------------------
+
+
+def test_loads_airstriker_with_genesis_geometry(airstriker: Emulator) -> None:
+    airstriker.run(0, 1)
+    assert airstriker.screen_shape() == (224, 320)
+    info = airstriker.av_info()
+    assert 59 < info["fps"] < 61 and info["sample_rate"] == 44100
+    assert len(airstriker.ram) == 0x10000
+
+
+def test_system_option_defaults_are_applied(airstriker: Emulator) -> None:
+    assert airstriker.options()["genesis_plus_gx_addr_error"] == "disabled"
+
+
+def test_option_override_is_applied(airstriker_rom: Path) -> None:
+    with Emulator("Genesis", airstriker_rom, options={"genesis_plus_gx_bios": "enabled"}) as emu:
+        assert emu.options()["genesis_plus_gx_bios"] == "enabled"
+
+
+def test_unknown_option_suggests_the_close_name(airstriker_rom: Path) -> None:
+    with pytest.raises(UnknownNameError, match="Did you mean 'genesis_plus_gx_bios'"):
+        Emulator("Genesis", airstriker_rom, options={"genesis_plus_gx_bois": "enabled"})
+
+
+def test_option_value_outside_allowed_is_refused(airstriker_rom: Path) -> None:
+    with pytest.raises(InvalidArgumentError, match="'disabled', 'enabled'.*got 'maybe'"):
+        Emulator("Genesis", airstriker_rom, options={"genesis_plus_gx_bios": "maybe"})
+
+
+def test_core_log_reaches_python_logging(airstriker_rom: Path, caplog: pytest.LogCaptureFixture) -> None:
+    with caplog.at_level(logging.DEBUG, logger="retrokit.core"):
+        Emulator("Genesis", airstriker_rom).close()
+    assert any(r.name == "retrokit.core" for r in caplog.records)
+
+
+def test_memory_views_are_zero_copy_and_writable(airstriker: Emulator) -> None:
+    ram = airstriker.ram
+    airstriker.poke(0xFF0100, 0xBEEF, ">u2")
+    assert ram[0x101] == 0xBE and ram[0x100] == 0xEF  # the same memory, byte-swapped words
+    ram[0x100] = 0x01
+    assert airstriker.peek(0xFF0100, ">u2") == 0xBE01
+
+
+def test_audio_is_captured_only_when_asked(airstriker: Emulator) -> None:
+    airstriker.run(0, 10)
+    assert airstriker.take_audio().shape == (0, 2)
+    airstriker.capture_audio(True)
+    airstriker.run(0, 60)
+    samples = airstriker.take_audio()
+    assert 43000 < len(samples) < 45500  # about one second at 44.1 kHz
+    assert airstriker.take_audio().shape == (0, 2)
+
+
+# --- determinism, states ------------------------------------------------------------------------
+
+
+def test_same_inputs_give_identical_ram_and_screen(airstriker_rom: Path, airstriker_state: bytes) -> None:
+    digests = []
+    for _ in range(2):
+        with Emulator("Genesis", airstriker_rom) as emu:
+            emu.set_state(airstriker_state)
+            emu.set_sticky(0.25, 7)
+            play(emu, script(300, 1))
+            digests.append(digest(emu))
+    assert digests[0] == digests[1]
+
+
+CHILD = """
+import gzip, hashlib, sys
+import numpy as np
+from retrokit.emulator import Emulator
+from tests.test_host import play, script
+emu = Emulator("Genesis", sys.argv[1])
+emu.set_state(gzip.decompress(open(sys.argv[2], "rb").read()))
+emu.set_sticky(0.25, 7)
+play(emu, script(300, 1))
+print(hashlib.sha1(emu.ram.tobytes() + emu.screen().tobytes()).hexdigest())
+open(sys.argv[3], "wb").write(emu.get_state())
+"""
+
+
+def test_runs_are_identical_across_processes(airstriker_rom: Path, airstriker_dir: Path, airstriker_state: bytes, tmp_path: Path) -> None:
+    repo = Path(__file__).resolve().parent.parent
+    out = subprocess.run(
+        [sys.executable, "-c", CHILD, str(airstriker_rom), str(airstriker_dir / "Level1.state"), str(tmp_path / "s")],
+        capture_output=True, text=True, cwd=repo, check=True,
+    ).stdout.strip()
+    with Emulator("Genesis", airstriker_rom) as emu:
+        emu.set_state(airstriker_state)
+        emu.set_sticky(0.25, 7)
+        play(emu, script(300, 1))
+        assert digest(emu) == out
+        # A state saved in the other process continues here exactly as here.
+        emu.set_sticky(0.0, 0)
+        play(emu, script(100, 2))
+        expected = digest(emu)
+    with Emulator("Genesis", airstriker_rom) as other:
+        other.set_state((tmp_path / "s").read_bytes())
+        play(other, script(100, 2))
+        assert digest(other) == expected
+
+
+def test_serialize_round_trip_continues_identically(airstriker: Emulator) -> None:
+    play(airstriker, script(50, 3))
+    saved = airstriker.get_state()
+    play(airstriker, script(100, 4))
+    expected = digest(airstriker)
+    airstriker.set_state(saved)
+    play(airstriker, script(100, 4))
+    assert digest(airstriker) == expected
+
+
+def test_reset_returns_to_power_on(airstriker_rom: Path) -> None:
+    with Emulator("Genesis", airstriker_rom) as fresh, Emulator("Genesis", airstriker_rom) as played:
+        fresh.run(0, 120)
+        play(played, script(100, 9))
+        played.reset()
+        played.run(0, 120)
+        assert digest(played) == digest(fresh)
+
+
+# --- sticky actions -------------------------------------------------------------------------
+
+
+def test_sticky_one_holds_the_previous_action_for_one_frame(airstriker_rom: Path, airstriker_state: bytes) -> None:
+    inputs = script(80, 5)
+    with Emulator("Genesis", airstriker_rom) as sticky, Emulator("Genesis", airstriker_rom) as manual:
+        sticky.set_state(airstriker_state)
+        manual.set_state(airstriker_state)
+        sticky.set_sticky(1.0, 0)
+        previous = None
+        for mask in inputs:
+            sticky.run([mask, 0], 4)
+            if previous is None:
+                manual.run([mask, 0], 4)
+            else:
+                manual.run([previous, 0], 1)
+                manual.run([mask, 0], 3)
+            previous = mask
+        assert digest(sticky) == digest(manual)
+
+
+def test_sticky_draws_follow_the_seed(airstriker_rom: Path, airstriker_state: bytes) -> None:
+    inputs = script(150, 6)
+
+    def run(seed: int) -> str:
+        with Emulator("Genesis", airstriker_rom) as emu:
+            emu.set_state(airstriker_state)
+            emu.set_sticky(0.5, seed)
+            play(emu, inputs)
+            return digest(emu)
+
+    assert run(11) == run(11)
+    assert len({run(11), run(12), run(13)}) > 1
+
+
+def test_forget_action_applies_the_next_action_at_once(airstriker_rom: Path, airstriker_state: bytes) -> None:
+    with Emulator("Genesis", airstriker_rom) as a, Emulator("Genesis", airstriker_rom) as b:
+        for emu in (a, b):
+            emu.set_state(airstriker_state)
+            emu.run([RIGHT, 0], 4)
+        a.set_sticky(1.0, 0)
+        a.forget_action()
+        a.run([LEFT, 0], 4)
+        b.run([LEFT, 0], 4)
+        assert digest(a) == digest(b)
+
+
+# --- several emulators, threads, the GIL ------------------------------------------------------
+
+
+def test_two_emulators_in_two_threads_match_single_runs(airstriker_rom: Path, airstriker_state: bytes) -> None:
+    scripts = [script(400, 21), script(400, 22)]
+
+    def solo(inputs: list[int]) -> bytes:
+        with Emulator("Genesis", airstriker_rom) as emu:
+            emu.set_state(airstriker_state)
+            play(emu, inputs)
+            return emu.ram.tobytes()
+
+    expected = [solo(s) for s in scripts]
+    emus = [Emulator("Genesis", airstriker_rom) for _ in scripts]
+    for emu in emus:
+        emu.set_state(airstriker_state)
+    threads = [threading.Thread(target=play, args=(emu, s)) for emu, s in zip(emus, scripts)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    got = [emu.ram.tobytes() for emu in emus]
+    assert got[0] != got[1]
+    assert got == expected
+    for emu in emus:
+        emu.close()
+
+
+def test_frames_run_with_the_gil_released(airstriker: Emulator) -> None:
+    started = threading.Event()
+
+    def long_run() -> None:
+        started.set()
+        airstriker.run(0, 600)
+
+    thread = threading.Thread(target=long_run)
+    thread.start()
+    started.wait()
+    count = 0
+    while thread.is_alive():
+        count += 1
+    thread.join()
+    # Holding the GIL through 600 frames would leave this thread a handful of turns.
+    assert count > 10_000
+
+
+def test_an_emulator_used_from_two_threads_at_once_raises(airstriker: Emulator) -> None:
+    errors: list[BaseException] = []
+    started = threading.Event()
+
+    def long_run() -> None:
+        started.set()
+        airstriker.run(0, 900)
+
+    thread = threading.Thread(target=long_run)
+    thread.start()
+    started.wait()
+    while thread.is_alive():
+        try:
+            airstriker.run(0, 1)
+        except CoreError as exc:
+            errors.append(exc)
+            break
+    thread.join()
+    assert errors and "another thread" in str(errors[0])
+
+
+# --- bad input ---------------------------------------------------------------------------------------
+
+
+def test_truncated_state_is_a_clear_error(airstriker: Emulator, airstriker_state: bytes) -> None:
+    with pytest.raises(StateError, match=rf"expected a state of {len(airstriker_state)} bytes.*got 1000 bytes.*truncated"):
+        airstriker.set_state(airstriker_state[:1000])
+
+
+def test_corrupt_state_of_the_right_size_is_refused(airstriker: Emulator, airstriker_state: bytes) -> None:
+    with pytest.raises(StateError, match="refused the state"):
+        airstriker.set_state(b"\xff" * len(airstriker_state))
+
+
+def test_wrong_screen_buffer_says_what_shape_it_needs(airstriker: Emulator) -> None:
+    airstriker.run(0, 1)
+    with pytest.raises(InvalidArgumentError, match=r"shape \(224, 320, 3\)"):
+        airstriker.screen(np.zeros((224, 320, 4), dtype=np.uint8))
+    with pytest.raises(InvalidArgumentError, match="uint8"):
+        airstriker.screen(np.zeros((224, 320, 3), dtype=np.float32))
+
+
+@pytest.mark.parametrize(
+    "actions,message",
+    [([0, 0, 0], "at most 2 button masks"), ([-1], "from 0 to 0xFFFF"), ([0x10000], "from 0 to 0xFFFF")],
+    ids=["too-many-ports", "negative", "too-large"],
+)
+def test_bad_actions_are_refused(airstriker: Emulator, actions: list[int], message: str) -> None:
+    with pytest.raises(InvalidArgumentError, match=message):
+        airstriker.run(actions, 1)
+
+
+def test_bad_sticky_probability_is_refused(airstriker: Emulator) -> None:
+    with pytest.raises(InvalidArgumentError, match=r"in \[0, 1\], got 1.5"):
+        airstriker.set_sticky(1.5, 0)
+
+
+def test_native_run_checks_its_arguments_before_the_core(airstriker: Emulator) -> None:
+    raw = airstriker._emu
+    with pytest.raises(InvalidArgumentError, match="uint16"):
+        raw.run(np.zeros(2, dtype=np.int32), 1)
+    with pytest.raises(InvalidArgumentError, match="frames must be 0 or more"):
+        raw.run(np.zeros(2, dtype=np.uint16), -1)
+
+
+def test_closed_emulator_raises_and_live_views_stay_valid(airstriker_rom: Path) -> None:
+    emu = Emulator("Genesis", airstriker_rom)
+    emu.run(0, 10)
+    ram = emu.ram
+    before = ram.copy()
+    emu.close()
+    assert (ram == before).all()  # the view kept the core loaded
+    with pytest.raises(CoreError, match="closed"):
+        emu.run(0, 1)
+
+
+def test_a_library_that_is_not_a_core_is_refused(airstriker_rom: Path) -> None:
+    with pytest.raises(CoreError, match="not a libretro core: it has no retro_init"):
+        Emulator("Genesis", airstriker_rom, core_path=_host.__file__)
+
+
+def test_missing_core_says_where_it_looked(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
+    from retrokit import cores
+
+    monkeypatch.setattr(cores, "wheel_cores_dir", lambda: None)
+    monkeypatch.setattr(cores, "_DEBIAN_DIRS", ())
+    monkeypatch.setenv("RETROKIT_CORES", str(tmp_path))
+    with pytest.raises(CoreNotFoundError, match=rf"genesis_plus_gx_libretro.so in one of: {tmp_path}.*RETROKIT_CORES"):
+        cores.find_core("genesis_plus_gx")
+
+
+def test_missing_rom_file_is_a_clear_error(tmp_path: Path) -> None:
+    with pytest.raises(InvalidArgumentError, match="Expected a ROM file, found nothing"):
+        Emulator("Genesis", tmp_path / "nothing.md")

@@ -41,6 +41,7 @@ from retrokit.errors import (
     RomNotFoundError,
     StateNotFoundError,
     UnknownNameError,
+    UnsupportedSystemError,
     did_you_mean,
 )
 
@@ -268,9 +269,12 @@ class Game:
             raise _data_error(
                 info.source, f"the default state {info.default_state!r} to be one of the game's states",
                 f"{', '.join(self.states) or 'no states'}",
-                "fix the default state's name" + did_you_mean(info.default_state, self._state_files),
+                "fix the default state's name", did_you_mean(info.default_state, self._state_files),
             )
-        roms.system_extension(self.system)
+        try:
+            roms.system_extension(self.system)
+        except UnsupportedSystemError as exc:
+            raise UnsupportedSystemError(f"{info.source}: {exc}") from exc
         return self
 
 
@@ -411,8 +415,8 @@ _FIELD_KEYS = ("address", "type", "mask")
 _SHA1 = re.compile(r"^[0-9a-fA-F]{40}$")
 
 
-def _data_error(source: Path | str, expected: str, found: str, fix: str) -> DataFileError:
-    return DataFileError(f"{source}: expected {expected}; found {found}. To fix it, {fix}.")
+def _data_error(source: Path | str, expected: str, found: str, fix: str, hint: str = "") -> DataFileError:
+    return DataFileError(f"{source}: expected {expected}; found {found}. To fix it, {fix}.{hint}")
 
 
 def _describe(value: Any) -> str:
@@ -431,7 +435,7 @@ def _check_keys(source: Path, where: str, mapping: Mapping[str, Any], allowed: t
         if key not in allowed:
             raise _data_error(
                 source, f"{where} to have only the keys {', '.join(allowed)}", f"the key {key!r}",
-                "rename or remove it" + did_you_mean(str(key), allowed),
+                "rename or remove it", did_you_mean(str(key), allowed),
             )
 
 
@@ -453,9 +457,9 @@ def _field(source: Path, name: str, entry: Any) -> FieldSpec:
     for key in ("address", "type"):
         if key not in entry:
             raise _data_error(source, f"{where} to have {key!r}", f"the keys {sorted(entry)}", f"add its {key}")
-    address = _int(source, f"{where}'s address", entry["address"])
-    code = _expect(source, f"{where}'s type", entry["type"], str, "a type code string such as '>u2'")
-    mask = None if entry.get("mask") is None else _int(source, f"{where}'s mask", entry["mask"])
+    address = _int(source, f"the address of {where}", entry["address"])
+    code = _expect(source, f"the type of {where}", entry["type"], str, "a type code string such as '>u2'")
+    mask = None if entry.get("mask") is None else _int(source, f"the mask of {where}", entry["mask"])
     if address < 0:  # masks may be negative: Gym Retro's are two's complement (Amidar-Atari2600)
         raise _data_error(source, f"{where} to have a non-negative address", repr(entry), "fix the address")
     try:

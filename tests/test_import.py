@@ -1,0 +1,132 @@
+"""ROM import from folders and zip files, by stable-retro's hashing rules, without silent overwrites."""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import zipfile
+from pathlib import Path
+
+import pytest
+
+from retrokit import games, paths, roms
+from retrokit.errors import RomNotFoundError
+from retrokit.importer import import_roms
+
+AIRSTRIKER_ROM = paths.wheel_dir() / "data" / "stable" / "Airstriker-Genesis-v0" / "rom.md"
+NES_BODY = bytes(range(256)) * 128
+NES_ROM = b"NES\x1a" + bytes([2, 1, 0x10]) + bytes(9) + NES_BODY  # a 16-byte iNES header, then the body
+
+
+@pytest.fixture(autouse=True)
+def data_dir(tmp_path, monkeypatch) -> Path:
+    """An empty RETROKIT_DATA; RETROKIT_GAMES holds one fake NES game whose rom.sha is of NES_BODY."""
+    root = tmp_path / "games"
+    for name in ("FakeQuest-Nes", "FakeQuestTurbo-Nes"):
+        (root / name).mkdir(parents=True)
+        (root / name / "data.json").write_text('{"info": {}}')
+        (root / name / "rom.sha").write_text(hashlib.sha1(NES_BODY).hexdigest() + "\n")
+    monkeypatch.setenv("RETROKIT_GAMES", str(root))
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    return tmp_path / "data"
+
+
+@pytest.fixture
+def src(tmp_path) -> Path:
+    folder = tmp_path / "my roms"
+    folder.mkdir()
+    (folder / "notes.txt").write_text("not a rom")
+    return folder
+
+
+def imported(data_dir: Path, game: str, ext: str) -> Path:
+    return data_dir / "roms" / game / f"rom.{ext}"
+
+
+def test_import_from_a_folder(src, data_dir):
+    (src / "sub").mkdir()
+    (src / "sub" / "Airstriker (homebrew).bin").write_bytes(AIRSTRIKER_ROM.read_bytes())
+    report = import_roms([src])
+    dest = imported(data_dir, "Airstriker-Genesis", "md")
+    assert [(r.game, r.path) for r in report.imported] == [("Airstriker-Genesis", dest)]
+    assert dest.read_bytes() == AIRSTRIKER_ROM.read_bytes()
+    assert report.unmatched == [str(src / "notes.txt")]
+    assert report.conflicts == [] and report.already_present == [] and report.broken_games == []
+    assert sorted(p.name for p in dest.parent.iterdir()) == ["rom.md"]  # no temp file left
+
+
+def _zip(members: dict[str, bytes]) -> bytes:
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+        for name, data in members.items():
+            archive.writestr(name, data)
+    return buffer.getvalue()
+
+
+@pytest.mark.parametrize("nested", [False, True], ids=["zip", "zip-in-zip"])
+def test_import_from_a_zip(src, data_dir, nested):
+    archive = _zip({"readme.txt": b"hello", "Airstriker/Airstriker.md": AIRSTRIKER_ROM.read_bytes()})
+    if nested:
+        archive = _zip({"inner.zip": archive})
+    (src / "collection.zip").write_bytes(archive)
+    report = import_roms([src / "collection.zip"])
+    assert [r.game for r in report.imported] == ["Airstriker-Genesis"]
+    assert report.imported[0].source.endswith("!Airstriker/Airstriker.md")
+    assert imported(data_dir, "Airstriker-Genesis", "md").read_bytes() == AIRSTRIKER_ROM.read_bytes()
+    assert any(u.endswith("!readme.txt") for u in report.unmatched)
+    assert not list(src.glob("**/*.md"))  # zip members are never extracted to disk
+
+
+def test_import_of_an_smd_stores_the_md_form(src, data_dir):
+    (src / "Airstriker.smd").write_bytes(roms.interleave_smd(AIRSTRIKER_ROM.read_bytes()))
+    report = import_roms([src])
+    assert [r.game for r in report.imported] == ["Airstriker-Genesis"]
+    assert imported(data_dir, "Airstriker-Genesis", "md").read_bytes() == AIRSTRIKER_ROM.read_bytes()
+
+
+def test_nes_header_is_left_out_of_the_hash(src, data_dir):
+    (src / "FakeQuest.nes").write_bytes(NES_ROM)
+    (src / "FakeQuest-headered.bin").write_bytes(NES_ROM)  # not .nes: hashed whole, so no match
+    game = games.find_game("FakeQuest-Nes")
+    with pytest.raises(RomNotFoundError):
+        game.require_rom()
+    report = import_roms([src])
+    # Two games accept the same ROM: each gets its copy, stored with its header.
+    assert sorted(r.game for r in report.imported) == ["FakeQuest-Nes", "FakeQuestTurbo-Nes"]
+    assert imported(data_dir, "FakeQuest-Nes", "nes").read_bytes() == NES_ROM
+    assert str(src / "FakeQuest-headered.bin") in report.unmatched
+    assert game.require_rom() == imported(data_dir, "FakeQuest-Nes", "nes")
+
+
+def test_importing_again_reports_already_imported(src, data_dir):
+    (src / "FakeQuest.nes").write_bytes(NES_ROM)
+    import_roms([src])
+    report = import_roms([src])
+    assert report.imported == []
+    assert sorted(r.game for r in report.already_present) == ["FakeQuest-Nes", "FakeQuestTurbo-Nes"]
+
+
+def test_no_silent_overwrite(src, data_dir):
+    dest = imported(data_dir, "FakeQuest-Nes", "nes")
+    dest.parent.mkdir(parents=True)
+    dest.write_bytes(b"NES\x1a" + bytes(12) + b"the user's own hack")
+    (src / "FakeQuest.nes").write_bytes(NES_ROM)
+    report = import_roms([src], games=[games.find_game("FakeQuest-Nes")])
+    assert report.imported == []
+    [conflict] = report.conflicts
+    assert conflict.path == dest
+    assert conflict.sha1 == hashlib.sha1(NES_BODY).hexdigest()
+    assert conflict.existing_sha1 == hashlib.sha1(b"the user's own hack").hexdigest()
+    assert dest.read_bytes().endswith(b"the user's own hack")
+    report = import_roms([src], overwrite=True, games=[games.find_game("FakeQuest-Nes")])
+    assert [r.path for r in report.imported] == [dest]
+    assert dest.read_bytes() == NES_ROM
+
+
+def test_unreadable_inputs_are_reported(src, data_dir):
+    (src / "broken.zip").write_bytes(b"PK\x03\x04 not really a zip")
+    report = import_roms([src, src / "missing-folder"])
+    reasons = dict(report.skipped)
+    assert "not a readable zip file" in reasons[str(src / "broken.zip")]
+    assert reasons[str(src / "missing-folder")] == "no such file or folder"
+    assert report.imported == []

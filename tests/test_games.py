@@ -26,12 +26,12 @@ AIRSTRIKER_DIR = WHEEL / "data" / "stable" / "Airstriker-Genesis-v0"
 AIRSTRIKER_SHA1 = "a8be7b0ca850119b167f9644e6a4a22e983d61a4"
 SHA_NOBODY_HAS = "0123456789abcdef0123456789abcdef01234567"
 
-DASHER_YAML = f"""\
+TESTBED_YAML = f"""\
 system: Genesis
-title: Dasher
+title: Testbed
 roms:
   - sha1: {SHA_NOBODY_HAS}
-    label: Dasher v1 (homebrew)
+    label: Testbed v1 (homebrew)
 fields:
   x:      {{address: 0xFF0010, type: ">i2"}}
   lives:  {{address: 0xFF0012, type: "|u1"}}
@@ -59,7 +59,7 @@ def user_games(tmp_path, monkeypatch) -> Path:
     return root
 
 
-def make_yaml_game(root: Path, name: str = "Dasher-Genesis", text: str = DASHER_YAML, states=("Zone1.Act1",)) -> Path:
+def make_yaml_game(root: Path, name: str = "Testbed-Genesis", text: str = TESTBED_YAML, states=("Zone1.Act1",)) -> Path:
     folder = root / name
     folder.mkdir()
     (folder / "game.yaml").write_text(text)
@@ -163,6 +163,19 @@ def test_multiplayer_metadata():
     assert game.default_player_states == ("Start", "Start.2P")
 
 
+def _repo_folders() -> list[Path]:
+    root = paths.repo_games_dir()
+    return sorted(p for p in root.iterdir() if games._is_game_folder(p)) if root else []
+
+
+@pytest.mark.parametrize("folder", _repo_folders(), ids=lambda p: p.name)
+def test_every_repo_game_folder_loads(folder):
+    game = games.find_game(folder.name)
+    assert game.folders[0] == folder
+    for state in game.states:
+        assert game.state_path(state).is_file()
+
+
 # --- Names that do not exist --------------------------------------------------------------------------
 
 
@@ -176,7 +189,7 @@ def test_misspelled_game_suggests_the_right_one():
 def test_missing_games_folder_is_named(tmp_path, monkeypatch):
     monkeypatch.setenv("RETROKIT_GAMES", str(tmp_path / "nowhere"))
     with pytest.raises(GameNotFoundError, match="RETROKIT_GAMES names folders that do not exist"):
-        games.find_game("Dasher-Genesis")
+        games.find_game("Testbed-Genesis")
 
 
 def test_misspelled_state_suggests_the_right_one():
@@ -196,7 +209,7 @@ def test_unknown_scenario():
 def test_yaml_game(user_games):
     folder = make_yaml_game(user_games)
     (folder / "scenario.yaml").write_text("reward: x\n")
-    game = games.find_game("Dasher-Genesis")
+    game = games.find_game("Testbed-Genesis")
     assert game.folders == (folder,)
     assert game.system == "Genesis"
     assert game.sha1s == (SHA_NOBODY_HAS,)
@@ -205,7 +218,7 @@ def test_yaml_game(user_games):
     assert game.players == 2
     assert game.default_state == "Zone1.Act1"
     assert game.scenarios == {"scenario": folder / "scenario.yaml"}
-    assert game.info.title == "Dasher"
+    assert game.info.title == "Testbed"
     assert game.info.extra == {"notes": "free-form, kept for other tools"}
 
 
@@ -220,9 +233,9 @@ def test_user_folder_comes_first_and_uses_the_wheels_states(user_games):
 
 
 def test_declared_state_list(user_games):
-    text = DASHER_YAML.replace("  default: Zone1.Act1", "  default: Zone1.Act1\n  list: [Zone1.Act1]")
+    text = TESTBED_YAML.replace("  default: Zone1.Act1", "  default: Zone1.Act1\n  list: [Zone1.Act1]")
     make_yaml_game(user_games, text=text, states=("Zone1.Act1", "Scratch"))
-    assert games.find_game("Dasher-Genesis").states == ["Zone1.Act1"]
+    assert games.find_game("Testbed-Genesis").states == ["Zone1.Act1"]
 
 
 @pytest.mark.parametrize(
@@ -248,7 +261,7 @@ def test_declared_state_list(user_games):
 def test_malformed_yaml(user_games, text, message):
     folder = make_yaml_game(user_games, text=text)
     with pytest.raises((DataFileError, UnknownNameError)) as info:
-        games.find_game("Dasher-Genesis")
+        games.find_game("Testbed-Genesis")
     assert message in str(info.value)
     if isinstance(info.value, DataFileError):
         assert str(folder / "game.yaml") in str(info.value)
@@ -257,7 +270,7 @@ def test_malformed_yaml(user_games, text, message):
 def test_bad_type_code(user_games):
     folder = make_yaml_game(user_games, text="fields:\n  lives: {address: 0xFF0012, type: '>x2'}\n")
     with pytest.raises(FieldTypeError) as info:
-        games.find_game("Dasher-Genesis")
+        games.find_game("Testbed-Genesis")
     assert str(folder / "game.yaml") in str(info.value) and "field 'lives'" in str(info.value)
 
 
@@ -324,8 +337,8 @@ def test_missing_rom_says_how_to_import(tmp_path):
 
 def test_wrong_rom_in_place_is_a_mismatch(user_games, tmp_path):
     make_yaml_game(user_games)
-    game = games.find_game("Dasher-Genesis")
-    wrong = tmp_path / "data" / "roms" / "Dasher-Genesis" / "rom.md"
+    game = games.find_game("Testbed-Genesis")
+    wrong = tmp_path / "data" / "roms" / "Testbed-Genesis" / "rom.md"
     wrong.parent.mkdir(parents=True)
     wrong.write_bytes(b"not the game")
     with pytest.raises(RomMismatchError, match=hashlib.sha1(b"not the game").hexdigest()):
@@ -333,11 +346,11 @@ def test_wrong_rom_in_place_is_a_mismatch(user_games, tmp_path):
 
 
 def test_imported_rom_is_found(user_games, tmp_path):
-    body = b"dasher rom" * 100
+    body = b"testbed rom" * 100
     make_yaml_game(user_games, text=f"roms: [{hashlib.sha1(body).hexdigest()}]\n", states=())
-    game = games.find_game("Dasher-Genesis")
+    game = games.find_game("Testbed-Genesis")
     dest = game.imported_rom_path()
-    assert dest == tmp_path / "data" / "roms" / "Dasher-Genesis" / "rom.md"
+    assert dest == tmp_path / "data" / "roms" / "Testbed-Genesis" / "rom.md"
     dest.parent.mkdir(parents=True)
     dest.write_bytes(body)
     assert game.require_rom() == dest

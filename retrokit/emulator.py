@@ -129,6 +129,15 @@ class Emulator:
         """Make the next ``run`` apply its buttons from its first frame."""
         self._emu.forget_action()
 
+    @property
+    def stuck(self) -> bool:
+        """Whether the last ``run``'s first frame kept the previous buttons (a sticky draw)."""
+        return self._emu.stuck
+
+    def held(self) -> tuple[int, ...]:
+        """The buttons of the last frame run, one mask per port."""
+        return self._emu.held()
+
     def reset(self) -> None:
         """Hard-reset the console, as the reset button would."""
         self._emu.reset()

@@ -180,6 +180,16 @@ def test_sticky_one_holds_the_previous_action_for_one_frame(airstriker_rom: Path
         assert digest(sticky) == digest(manual)
 
 
+@pytest.mark.parametrize("prob,expected", [(0.0, False), (1.0, True)], ids=["never", "always"])
+def test_emulator_reports_whether_a_run_stuck(airstriker: Emulator, prob: float, expected: bool) -> None:
+    airstriker.set_sticky(prob, 0)
+    airstriker.run([LEFT, 0], 2)
+    assert not airstriker.stuck  # nothing to stick to on the first run
+    airstriker.run([RIGHT, 0], 1)
+    assert airstriker.stuck is expected
+    assert airstriker.held() == ((LEFT if expected else RIGHT), 0)
+
+
 def test_sticky_draws_follow_the_seed(airstriker_rom: Path, airstriker_state: bytes) -> None:
     inputs = script(150, 6)
 

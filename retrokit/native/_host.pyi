@@ -17,6 +17,7 @@ MEMORY_RTC: int
 MEMORY_SYSTEM_RAM: int
 MEMORY_VIDEO_RAM: int
 MAX_PORTS: int
+PLAN_COLUMNS: int
 PIXEL_FORMAT_0RGB1555: int
 PIXEL_FORMAT_XRGB8888: int
 PIXEL_FORMAT_RGB565: int
@@ -31,6 +32,7 @@ class Emulator:
         save_dir: str,
         options: dict[str, str] | None = None,
         log: Callable[[int, str], None] | None = None,
+        ports: int = 2,
     ) -> None: ...
     def load_game(self, path: str, data: bytes | None) -> None: ...
     def system_info(self) -> dict[str, object]: ...
@@ -52,11 +54,19 @@ class Emulator:
     def unserialize(self, data: bytes) -> None: ...
     def reset(self) -> None: ...
     def capture_audio(self, enabled: bool) -> None: ...
-    def take_audio(self) -> npt.NDArray[np.int16]: ...
+    def take_audio(self) -> bytes:
+        """Return and clear the captured audio: interleaved int16 stereo samples."""
     @property
     def frame(self) -> int: ...
     @property
     def pixel_format(self) -> int: ...
+    @property
+    def stuck(self) -> bool:
+        """Whether the last ``run``'s first frame kept the previous buttons."""
+    def held(self) -> tuple[int, ...]:
+        """The buttons of the last frame run, one mask per port (zeros after a reset)."""
+    @property
+    def closed(self) -> bool: ...
     def close(self) -> None: ...
 
 def read_fields(

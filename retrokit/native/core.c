@@ -548,6 +548,7 @@ void rk_core_run(rk_core *core, const uint16_t *actions, int n_ports, int frames
         double u = (double)(next_u64(core->rng) >> 11) * 0x1.0p-53;
         stick = u < core->sticky_prob;
     }
+    core->last_stuck = stick && frames > 0;
     rk_enter(core);
     for (int f = 0; f < frames; f++) {
         /* The first frame of a new action keeps the last applied one when it sticks. */

@@ -91,6 +91,7 @@ typedef struct rk_core {
     uint16_t buttons[RK_MAX_PORTS];
     uint16_t held[RK_MAX_PORTS];
     int have_held;
+    int last_stuck; /* whether the last run's first frame kept the previous buttons */
     double sticky_prob;
     uint64_t rng[4];
     int n_ports;

@@ -516,6 +516,15 @@ static PyObject *emulator_get_pixel_format(EmulatorObject *self, void *closure) 
     return PyLong_FromLong(self->core.pixel_format);
 }
 
+static PyObject *emulator_get_stuck(EmulatorObject *self, void *closure) { return PyBool_FromLong(self->core.last_stuck); }
+
+static PyObject *emulator_held(EmulatorObject *self, PyObject *unused) {
+    PyObject *out = PyTuple_New(self->core.n_ports);
+    for (int i = 0; out && i < self->core.n_ports; i++)
+        PyTuple_SET_ITEM(out, i, PyLong_FromLong(self->core.have_held ? self->core.held[i] : 0));
+    return out;
+}
+
 static PyObject *emulator_get_closed(EmulatorObject *self, void *closure) { return PyBool_FromLong(self->closed); }
 
 static PyMethodDef emulator_methods[] = {
@@ -527,6 +536,7 @@ static PyMethodDef emulator_methods[] = {
     {"set_controller", (PyCFunction)emulator_set_controller, METH_VARARGS, "Plug a device into a port."},
     {"set_sticky", (PyCFunction)emulator_set_sticky, METH_VARARGS, "Set the sticky-action probability and seed the RNG."},
     {"forget_action", (PyCFunction)emulator_forget_action, METH_NOARGS, "Apply the next action from its first frame."},
+    {"held", (PyCFunction)emulator_held, METH_NOARGS, "The buttons of the last frame run, one mask per port."},
     {"run", (PyCFunction)(void (*)(void))emulator_run, METH_FASTCALL, "Run frames with one button mask per port."},
     {"reset", (PyCFunction)emulator_reset, METH_NOARGS, "Hard-reset the console."},
     {"screen_shape", (PyCFunction)emulator_screen_shape, METH_NOARGS, "(height, width) of the last frame."},
@@ -546,6 +556,7 @@ static PyGetSetDef emulator_getset[] = {
     {"frame", (getter)emulator_get_frame, NULL, "Frames run since the core was loaded.", NULL},
     {"pixel_format", (getter)emulator_get_pixel_format, NULL, "The core's libretro pixel format.", NULL},
     {"closed", (getter)emulator_get_closed, NULL, "Whether close() was called.", NULL},
+    {"stuck", (getter)emulator_get_stuck, NULL, "Whether the last run's first frame kept the previous buttons.", NULL},
     {NULL, NULL, NULL, NULL, NULL},
 };
 

@@ -233,7 +233,13 @@ class Game:
         path = self.rom_path(data_dir)
         if path is not None:
             return path
-        expected = ", ".join(self.sha1s) if self.sha1s else "(the data file lists none)"
+        if not self.sha1s:
+            raise RomNotFoundError(
+                f"Expected the data file of {self.name} ({self.info.source}) to list the SHA-1s of its "
+                "ROM; found none, so no ROM can be imported or checked for it. Add them (rom.sha, or "
+                "'roms' in game.yaml)."
+            )
+        expected = ", ".join(self.sha1s)
         candidates = self._rom_candidates(data_dir)
         if candidates:
             found = "; ".join(f"{p} has SHA-1 {_cached_sha1(p, self.system)}" for p in candidates)

@@ -6,7 +6,8 @@ arcade sets are zips). Each candidate is hashed by stable-retro's rules (see
 :mod:`retrokit.roms`) and matched against the SHA-1s of every known game. A
 match is written, through a temporary file, to ``<data>/roms/<Game>/rom.<ext>``
 (``.smd`` dumps de-interleaved, as ``.md``). A different file already there is
-never replaced unless asked.
+never replaced unless asked. Folders whose names start with ``.`` (``.git``,
+``.cache``) are not walked unless given by name.
 """
 
 from __future__ import annotations

@@ -140,10 +140,10 @@ def atomic_write(path: Path | str, data: bytes, *, overwrite: bool = False) -> N
             os.replace(tmp, path)
             return
         try:
-            os.link(tmp, path)
+            os.link(tmp, path)  # fails if path exists, unlike a rename
         except FileExistsError:
             raise
-        except OSError:  # the file system has no hard links
+        except OSError:  # the file system has no hard links: check, then rename
             if path.exists():
                 raise FileExistsError(path) from None
             os.replace(tmp, path)

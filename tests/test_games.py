@@ -354,3 +354,8 @@ def test_imported_rom_is_found(user_games, tmp_path):
     dest.parent.mkdir(parents=True)
     dest.write_bytes(body)
     assert game.require_rom() == dest
+
+
+def test_game_without_rom_hashes_says_so():
+    with pytest.raises(RomNotFoundError, match="found none, so no ROM can be imported"):
+        games.find_game("VirtuaFighter2-Genesis").require_rom()  # its rom.sha is empty in the wheel

@@ -12,20 +12,19 @@ of the Gym Retro and stable-retro integrations matches:
   offsets 0x80 of the body, the interleaved ``"SEGA"``) is taken as it is.
 - Every other file is hashed whole, up to 32 MiB (the largest game supported).
 
-Systems and their extensions come from the stable-retro wheel's
-``cores/*.json`` (the ``"ext"`` lists).
+Systems and their extensions come from :mod:`retrokit.systems` (whose
+descriptors a test keeps equal to the stable-retro wheel's ``cores/*.json``),
+plus ``.smd`` for Genesis.
 """
 
 from __future__ import annotations
 
-import functools
 import hashlib
-import json
 import os
 from pathlib import Path
 
-from retrokit import paths
-from retrokit.errors import DataFileError, InvalidArgumentError, RomError, UnsupportedSystemError, did_you_mean
+from retrokit.errors import InvalidArgumentError, RomError, UnsupportedSystemError, did_you_mean
+from retrokit.systems import all_systems, systems_by_extension
 
 MAX_ROM_SIZE = 32 * 1024 * 1024
 """The largest ROM hashed or imported, as in stable-retro."""
@@ -38,39 +37,28 @@ SMD_BLOCK_SIZE = 16 * 1024
 _EXTRA_EXTENSIONS = {"smd": "Genesis"}
 
 
-@functools.lru_cache(maxsize=1)
 def system_extensions() -> dict[str, tuple[str, ...]]:
-    """Return each system's ROM extensions (without dots), from the wheel's core info.
+    """Return each system's ROM extensions (without dots), from :mod:`retrokit.systems`.
 
     The first extension of a system is the one its ROMs are stored under.
 
     Raises:
-        DataFileError: A core info file is not valid JSON.
+        DataFileError: ``systems.yaml`` is malformed.
     """
-    cores = paths.wheel_cores_dir()
-    result: dict[str, tuple[str, ...]] = {}
-    if cores is None:
-        return result
-    for info_path in sorted(cores.glob("*.json")):
-        try:
-            info = json.loads(info_path.read_text())
-            for system, entry in info.items():
-                result[system] = tuple(str(ext).lower() for ext in entry["ext"])
-        except (json.JSONDecodeError, AttributeError, KeyError, TypeError) as exc:
-            raise DataFileError(
-                f"{info_path}: expected a JSON object of systems, each with an 'ext' list; "
-                f"found something else ({exc}). Reinstall the stable-retro wheel."
-            ) from exc
-    return result
+    return {name: system.extensions for name, system in all_systems().items()}
 
 
 def extension_systems() -> dict[str, str]:
-    """Return a map from ROM extension (without dot) to system name."""
+    """Return a map from ROM extension (without dot) to system name, ``smd`` included."""
     result = dict(_EXTRA_EXTENSIONS)
-    for system, exts in system_extensions().items():
-        for ext in exts:
-            result.setdefault(ext, system)
+    for ext, system in systems_by_extension().items():
+        result.setdefault(ext, system.name)
     return result
+
+
+def file_extension(filename: str | os.PathLike[str]) -> str:
+    """Return a file name's extension, lowercase and without the dot (``""`` if none)."""
+    return Path(filename).suffix.lower().lstrip(".")
 
 
 def system_extension(system: str) -> str:
@@ -96,7 +84,7 @@ def detect_system(filename: str | os.PathLike[str]) -> str:
     Raises:
         UnsupportedSystemError: The extension belongs to no known system.
     """
-    ext = Path(filename).suffix.lower().lstrip(".")
+    ext = file_extension(filename)
     systems = extension_systems()
     if ext in systems:
         return systems[ext]
@@ -223,5 +211,5 @@ def _source_ext(source: bytes | str | os.PathLike[str]) -> str:
         raise InvalidArgumentError(
             "Expected system_or_ext (a system name or a ROM extension) with raw ROM bytes; found None."
         )
-    ext = Path(source).suffix.lstrip(".")
-    return ext if ext.lower() in extension_systems() else detect_system(source)
+    ext = file_extension(source)
+    return ext if ext in extension_systems() else detect_system(source)

@@ -123,6 +123,18 @@ def get_system(name: str | System) -> System:
     )
 
 
+def systems_by_extension() -> dict[str, System]:
+    """Return the system of each ROM extension (without dot) the descriptors list.
+
+    Where two systems list the same extension, the first in ``systems.yaml`` has it.
+    """
+    known: dict[str, System] = {}
+    for system in all_systems().values():
+        for ext in system.extensions:
+            known.setdefault(ext, system)
+    return known
+
+
 def system_for_extension(ext: str) -> System:
     """Return the system whose ROMs have a file extension (``"md"`` or ``".md"``).
 
@@ -130,10 +142,7 @@ def system_for_extension(ext: str) -> System:
         UnsupportedSystemError: No system uses that extension.
     """
     ext = ext.lower().lstrip(".")
-    known: dict[str, System] = {}
-    for system in all_systems().values():
-        for e in system.extensions:
-            known.setdefault(e, system)
+    known = systems_by_extension()
     if ext in known:
         return known[ext]
     if ext in ("gen", "smd"):  # other Genesis dumps; .smd is de-interleaved on import

@@ -1,14 +1,10 @@
-"""Games: finding integration folders and reading their data files.
+"""Games: finding integration folders, and their states, scenarios and ROMs.
 
 A game is named ``<Name>-<System>`` and lives in a folder of that name in one
-of the search folders of :func:`retrokit.paths.game_search_dirs`. Two folder
-formats are read:
-
-- retrokit's: ``game.yaml`` (see ``docs/architecture.md``), ``*.state``,
-  scenario ``*.yaml`` files and, for free games, ``rom.<ext>``.
-- Gym Retro's and stable-retro's: ``data.json``, ``metadata.json``,
-  ``rom.sha``, ``*.state`` and scenario ``*.json`` files. stable-retro's
-  ``<Name>-<System>-v0`` folders are found as ``<Name>-<System>``.
+of the search folders of :func:`retrokit.paths.game_search_dirs`. stable-retro's
+``<Name>-<System>-v0`` folders are found as ``<Name>-<System>``. The folder's
+data file (``game.yaml``, or Gym Retro's ``data.json``, ``metadata.json`` and
+``rom.sha``) is read by :mod:`retrokit.gamefiles`.
 
 When several search folders hold a game of the same name, the first one's data
 file wins and the others add their states and scenarios: so a ``games/`` folder
@@ -22,20 +18,17 @@ them at once.
 from __future__ import annotations
 
 import fnmatch
-import json
 import os
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 from types import MappingProxyType
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 from retrokit import paths, roms
 from retrokit.errors import (
-    DataFileError,
-    FieldTypeError,
     GameNotFoundError,
     RomMismatchError,
     RomNotFoundError,
@@ -44,20 +37,17 @@ from retrokit.errors import (
     UnsupportedSystemError,
     did_you_mean,
 )
+from retrokit.gamefiles import GameInfo, data_error, read_game_folder
 
 if TYPE_CHECKING:
     from retrokit.memory import FieldSpec
 
 __all__ = [
     "Game",
-    "GameInfo",
     "find_game",
     "list_games",
     "load_game",
     "normalize_name",
-    "read_game_folder",
-    "read_game_yaml",
-    "read_gym_retro_folder",
 ]
 
 STATE_SUFFIX = ".state"
@@ -266,13 +256,13 @@ class Game:
         if info.states is not None:
             missing = [s for s in info.states if s not in self._state_files]
             if missing:
-                raise _data_error(
+                raise data_error(
                     info.source, f"state files for the listed states {missing}",
                     f"no such file in {', '.join(map(str, self.folders))}",
                     "add the .state files or remove the names from the list",
                 )
         if info.default_state is not None and info.default_state not in self._state_files:
-            raise _data_error(
+            raise data_error(
                 info.source, f"the default state {info.default_state!r} to be one of the game's states",
                 f"{', '.join(self.states) or 'no states'}",
                 "fix the default state's name", did_you_mean(info.default_state, self._state_files),
@@ -379,221 +369,3 @@ def _cached_sha1(path: Path, system: str) -> str:
     if key not in _sha1_cache:
         _sha1_cache[key] = roms.rom_sha1(path, system)
     return _sha1_cache[key]
-
-
-
-# --- Data files -------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class GameInfo:
-    """What a game's data file says (``game.yaml``, or Gym Retro's JSON files).
-
-    Attributes:
-        source: The data file (``game.yaml`` or ``data.json``).
-        system: The system named by the data file, or ``None`` for the folder's suffix.
-        sha1s: The SHA-1s of acceptable ROMs, lowercase.
-        fields: RAM fields by name.
-        default_state: The default state's name.
-        states: The listed state names, or ``None`` to use every ``*.state`` file.
-        players: How many players the game supports.
-        default_player_states: Gym Retro's default state per player count.
-        title: A human-readable title.
-        original_rom_name: The file name an FBNeo core needs (``metadata.json``).
-        extra: Other top-level entries, for other layers (tags, notes, ...).
-    """
-
-    source: Path
-    system: str | None
-    sha1s: tuple[str, ...]
-    fields: Mapping[str, FieldSpec]
-    default_state: str | None = None
-    states: tuple[str, ...] | None = None
-    players: int = 1
-    default_player_states: tuple[str, ...] = ()
-    title: str | None = None
-    original_rom_name: str | None = None
-    extra: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
-
-
-_YAML_KEYS = ("system", "title", "roms", "fields", "states", "players")
-_FIELD_KEYS = ("address", "type", "mask")
-_SHA1 = re.compile(r"^[0-9a-fA-F]{40}$")
-
-
-def _data_error(source: Path | str, expected: str, found: str, fix: str, hint: str = "") -> DataFileError:
-    return DataFileError(f"{source}: expected {expected}; found {found}. To fix it, {fix}.{hint}")
-
-
-def _describe(value: Any) -> str:
-    text = repr(value)
-    return f"{type(value).__name__} {text if len(text) <= 60 else text[:57] + '...'}"
-
-
-def _expect(source: Path, where: str, value: Any, kind: type | tuple[type, ...], what: str) -> Any:
-    if isinstance(value, kind) and not (isinstance(value, bool) and kind is not bool):
-        return value
-    raise _data_error(source, f"{where} to be {what}", _describe(value), f"write {where} as {what}")
-
-
-def _check_keys(source: Path, where: str, mapping: Mapping[str, Any], allowed: tuple[str, ...]) -> None:
-    for key in mapping:
-        if key not in allowed:
-            raise _data_error(
-                source, f"{where} to have only the keys {', '.join(allowed)}", f"the key {key!r}",
-                "rename or remove it", did_you_mean(str(key), allowed),
-            )
-
-
-def _int(source: Path, where: str, value: Any) -> int:
-    if isinstance(value, str):
-        try:
-            return int(value, 0)
-        except ValueError:
-            pass
-    return _expect(source, where, value, int, "an integer (e.g. 0xFF0010)")
-
-
-def _field(source: Path, name: str, entry: Any) -> FieldSpec:
-    from retrokit.memory import FieldSpec
-
-    where = f"field {name!r}"
-    entry = _expect(source, where, entry, Mapping, "a mapping with address, type and optionally mask")
-    _check_keys(source, where, entry, _FIELD_KEYS)
-    for key in ("address", "type"):
-        if key not in entry:
-            raise _data_error(source, f"{where} to have {key!r}", f"the keys {sorted(entry)}", f"add its {key}")
-    address = _int(source, f"the address of {where}", entry["address"])
-    code = _expect(source, f"the type of {where}", entry["type"], str, "a type code string such as '>u2'")
-    mask = None if entry.get("mask") is None else _int(source, f"the mask of {where}", entry["mask"])
-    if address < 0:  # masks may be negative: Gym Retro's are two's complement (Amidar-Atari2600)
-        raise _data_error(source, f"{where} to have a non-negative address", repr(entry), "fix the address")
-    try:
-        return FieldSpec(name, address, code, mask)
-    except FieldTypeError as exc:  # the type code; FieldSpec parses it
-        raise FieldTypeError(f"{source}: {where}: {exc}") from exc
-
-
-def _fields(source: Path, where: str, value: Any) -> Mapping[str, FieldSpec]:
-    value = _expect(source, where, value if value is not None else {}, Mapping, "a mapping of field names")
-    return MappingProxyType({str(name): _field(source, str(name), entry) for name, entry in value.items()})
-
-
-def _sha1(source: Path, where: str, value: Any) -> str:
-    if not isinstance(value, str) or not _SHA1.match(value.strip()):
-        raise _data_error(source, f"{where} to be a SHA-1 of 40 hex digits", _describe(value), "fix the hash")
-    return value.strip().lower()
-
-
-def _names(source: Path, where: str, value: Any) -> tuple[str, ...]:
-    items = _expect(source, where, value, list, "a list of names")
-    return tuple(_expect(source, f"each of {where}", item, str, "a name") for item in items)
-
-
-def read_game_yaml(path: str | os.PathLike[str]) -> GameInfo:
-    """Read a retrokit ``game.yaml``.
-
-    Raises:
-        DataFileError: The file is not valid YAML or does not follow the format.
-        FieldTypeError: A field's type code is not one retrokit reads.
-    """
-    import yaml
-
-    source = Path(path)
-    try:
-        doc = yaml.load(source.read_text(encoding="utf-8"), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
-        problem = getattr(exc, "problem", None) or exc
-        raise _data_error(source, "valid YAML", f"a syntax error{at}: {problem}", "fix the YAML syntax") from exc
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _data_error(source, "a readable UTF-8 file", str(exc), "check the file") from exc
-    doc = _expect(source, "the file", doc, dict, "a mapping (system, roms, fields, states, players)")
-    extra = {k: v for k, v in doc.items() if k not in _YAML_KEYS}
-    for key in extra:
-        if did_you_mean(str(key), _YAML_KEYS):  # a typo of a known key
-            _check_keys(source, "the file", doc, _YAML_KEYS)
-    roms_list = _expect(source, "'roms'", doc.get("roms", []), list, "a list of {sha1: ..., label: ...}")
-    sha1s = tuple(
-        _sha1(source, "each rom", r.get("sha1") if isinstance(r, Mapping) else r) for r in roms_list
-    )
-    states = _expect(source, "'states'", doc.get("states") or {}, Mapping, "a mapping with default and list")
-    _check_keys(source, "'states'", states, ("default", "list"))
-    default = states.get("default")
-    players = _expect(source, "'players'", doc.get("players", 1), int, "a positive integer")
-    system = doc.get("system")
-    return GameInfo(
-        source=source,
-        system=None if system is None else _expect(source, "'system'", system, str, "a system name"),
-        sha1s=sha1s,
-        fields=_fields(source, "'fields'", doc.get("fields")),
-        default_state=None if default is None else _expect(source, "the default state", default, str, "a name"),
-        states=None if states.get("list") is None else _names(source, "the state list", states["list"]),
-        players=_positive(source, players),
-        title=doc.get("title"),
-        extra=MappingProxyType(extra),
-    )
-
-
-def _positive(source: Path, players: int) -> int:
-    if players < 1:
-        raise _data_error(source, "'players' to be at least 1", str(players), "fix the player count")
-    return players
-
-
-def _read_json(path: Path, required: bool) -> dict[str, Any]:
-    if not path.is_file() and not required:
-        return {}
-    try:
-        doc = json.loads(path.read_text(encoding="utf-8"))
-    except json.JSONDecodeError as exc:
-        raise _data_error(
-            path, "valid JSON", f"a syntax error at line {exc.lineno}, column {exc.colno}: {exc.msg}",
-            "fix the JSON syntax",
-        ) from exc
-    except (OSError, UnicodeDecodeError) as exc:
-        raise _data_error(path, "a readable UTF-8 JSON file", str(exc), "check the file") from exc
-    return _expect(path, "the file", doc, dict, "a JSON object")
-
-
-def read_gym_retro_folder(folder: str | os.PathLike[str]) -> GameInfo:
-    """Read a Gym Retro / stable-retro integration folder: data.json, metadata.json, rom.sha.
-
-    Raises:
-        DataFileError: A file is not valid JSON or does not follow the format.
-        FieldTypeError: A field's type code is not one retrokit reads.
-    """
-    folder = Path(folder)
-    data_path, meta_path, sha_path = folder / "data.json", folder / "metadata.json", folder / "rom.sha"
-    data = _read_json(data_path, required=data_path.exists())
-    _check_keys(data_path, "the file", data, ("info",))
-    meta = _read_json(meta_path, required=False)
-    sha1s: tuple[str, ...] = ()
-    if sha_path.is_file():
-        lines = [line.strip() for line in sha_path.read_text(encoding="utf-8", errors="replace").splitlines()]
-        sha1s = tuple(_sha1(sha_path, f"line {i + 1}", line) for i, line in enumerate(lines) if line)
-    per_player = _names(meta_path, "'default_player_state'", meta.get("default_player_state", []))
-    players = _expect(meta_path, "'players'", meta.get("players", max(1, len(per_player))), int, "an integer")
-    known = ("default_state", "default_player_state", "players", "system", "title", "original_rom_name")
-    default = meta.get("default_state")
-    return GameInfo(
-        source=data_path,
-        system=meta.get("system"),
-        sha1s=sha1s,
-        fields=_fields(data_path, "'info'", data.get("info")),
-        default_state=None if default is None else _expect(meta_path, "'default_state'", default, str, "a name"),
-        players=_positive(meta_path, players),
-        default_player_states=per_player,
-        title=meta.get("title"),
-        original_rom_name=meta.get("original_rom_name"),
-        extra=MappingProxyType({k: v for k, v in meta.items() if k not in known}),
-    )
-
-
-def read_game_folder(folder: str | os.PathLike[str]) -> GameInfo:
-    """Read a game folder's data file: ``game.yaml`` if there is one, else Gym Retro's files."""
-    folder = Path(folder)
-    if (folder / "game.yaml").is_file():
-        return read_game_yaml(folder / "game.yaml")
-    return read_gym_retro_folder(folder)

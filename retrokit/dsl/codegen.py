@@ -1,0 +1,188 @@
+"""Generate the Python source of a checked scenario.
+
+The output is one function, ``_bind(s)``, that closes over a Run's state list
+``s`` and returns two step functions, ``_first`` (reset) and ``_next`` (every
+later step), each ``(v, frame, step) -> ((reward, ...), done)``. Their bodies
+are straight-line code: read the fields the scenario uses from ``v``, compute
+the definitions and memory arguments in dependency order, then the outputs,
+then store the slots. No user text reaches the code except numbers: fields are
+read by their ``repr``, everything else has a generated name.
+
+Run-time failures are checked inline where they can happen, so the message can
+name the expression: a division tests its divisor (``_divzero(site)``) unless
+it is a constant (never zero: the checker refuses that), and a table lookup
+tests for a missing key (``_nokey(site, key)``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from retrokit.dsl import nodes as n
+from retrokit.dsl.check import COUNTERS, MEMORY, Analysis, constant
+from retrokit.dsl.graph import FIRST, NEXT, Graph
+from retrokit.dsl.source import Snippet
+
+
+@dataclass(frozen=True)
+class Site:
+    """A place that can fail at run time: a division or a table lookup."""
+
+    snippet: Snippet
+    node: n.Node
+
+
+class CodeGen:
+    """Write the ``_bind`` function for one analysed scenario."""
+
+    def __init__(self, analysis: Analysis) -> None:
+        self.a = analysis
+        self.graph = Graph(analysis)
+        self.defs = {name: f"_d{i}" for i, name in enumerate(analysis.defines)}
+        self.table_names = {name: f"_T{i}" for i, name in enumerate(analysis.spec.tables)}
+        self.sites: list[Site] = []
+        self._fields: dict[str, str] = {}
+        self._temps = 0
+
+    def module(self) -> str:
+        """Return the source text of ``_bind``."""
+        lines = ["def _bind(s):"]
+        for name, mode in (("_first", FIRST), ("_next", NEXT)):
+            lines += ["    " + line for line in self.function(name, mode)]
+        lines.append("    return _first, _next")
+        return "\n".join(lines) + "\n"
+
+    def function(self, name: str, mode: str) -> list[str]:
+        """One step function's lines."""
+        self._fields = {}
+        body: list[str] = []
+        writes: list[str] = []
+        slots = {slot.index: slot for slot in self.a.slots.values()}
+        for kind, key in self.graph.order(mode):
+            if kind == "def":
+                snippet = self.a.spec.defines[key]  # type: ignore[index]
+                body.append(f"{self.defs[key]} = {self.expr(self.a.defines[key], mode, snippet)}")  # type: ignore[index]
+                continue
+            slot = slots[key]  # type: ignore[index]
+            i = slot.index
+            body.append(f"_m{i} = {self.expr(slot.arg, mode, slot.snippet)}")
+            if mode == NEXT and slot.kind == "peak":
+                body.append(f"_p{i} = _m{i} if _m{i} > s[{i}] else s[{i}]")
+                writes.append(f"s[{i}] = _p{i}")
+            else:
+                writes.append(f"s[{i}] = _m{i}")
+        rewards = []
+        for i, (root, snippet) in enumerate(zip(self.a.rewards, self.a.spec.rewards)):
+            body.append(f"_r{i} = _float({self.expr(root, mode, snippet)})")
+            rewards.append(f"_r{i}")
+        if self.a.done is not None:
+            assert self.a.spec.done is not None
+            body.append(f"_done = {self.expr(self.a.done, mode, self.a.spec.done)}")
+        else:
+            body.append("_done = False")
+        loads = [f"{local} = v[{field!r}]" for field, local in self._fields.items()]
+        out = [f"def {name}(v, frame, step):", "    try:"]
+        out += ["        " + line for line in loads + body + writes]
+        out.append(f"        return ({', '.join(rewards)},), _done")
+        out += [
+            "    except _RuntimeError:",
+            "        raise",
+            "    except _KeyError as exc:",
+            "        raise _missing(exc) from None",
+            "    except _Errors as exc:",
+            "        raise _fail(exc) from None",
+        ]
+        return out
+
+    def temp(self, prefix: str) -> str:
+        """A fresh local name."""
+        self._temps += 1
+        return f"{prefix}{self._temps}"
+
+    def site(self, snippet: Snippet, node: n.Node) -> int:
+        """Register a place that can fail at run time; return its index."""
+        self.sites.append(Site(snippet, node))
+        return len(self.sites) - 1
+
+    def field(self, name: str) -> str:
+        """The local holding a field's value (read once at the top)."""
+        if name not in self._fields:
+            self._fields[name] = f"_f{len(self._fields)}"
+        return self._fields[name]
+
+    def expr(self, node: n.Node, mode: str, sn: Snippet) -> str:
+        """The Python expression computing ``node`` in ``mode``."""
+        if isinstance(node, n.Number):
+            return repr(node.value)
+        if isinstance(node, n.Bool):
+            return "True" if node.value else "False"
+        if isinstance(node, n.Name):
+            if not node.quoted and node.id in COUNTERS:
+                return node.id
+            if node.id in self.defs:
+                return self.defs[node.id]
+            return self.field(node.id)
+        if isinstance(node, n.Unary):
+            return f"({node.op}{self.expr(node.operand, mode, sn)})"
+        if isinstance(node, n.Binary):
+            left, right = self.expr(node.left, mode, sn), self.expr(node.right, mode, sn)
+            if node.op in ("/", "//", "%") and constant(node.right) is None:
+                z = self.temp("_z")
+                return f"({left} {node.op} {z} if ({z} := {right}) else _divzero({self.site(sn, node)}))"
+            return f"({left} {node.op} {right})"
+        if isinstance(node, n.Compare):
+            parts = [self.expr(node.operands[0], mode, sn)]
+            for op, operand in zip(node.ops, node.operands[1:]):
+                parts += [op, self.expr(operand, mode, sn)]
+            return f"({' '.join(parts)})"
+        if isinstance(node, n.Logic):
+            return f"({self.expr(node.left, mode, sn)} {node.op} {self.expr(node.right, mode, sn)})"
+        if isinstance(node, n.Not):
+            return f"(not {self.expr(node.operand, mode, sn)})"
+        if isinstance(node, n.IfElse):
+            cond, then, other = (self.expr(x, mode, sn) for x in (node.cond, node.then, node.other))
+            return f"({then} if {cond} else {other})"
+        if isinstance(node, n.Lookup):
+            return self._lookup(node, mode, sn)
+        if isinstance(node, n.Call):
+            if node.func in MEMORY:
+                return self._memory(node, mode, sn)
+            return self._function(node, mode, sn)
+        raise AssertionError(node)
+
+    def _lookup(self, node: n.Lookup, mode: str, sn: Snippet) -> str:
+        table = self.a.spec.tables[node.table]
+        keys = [self.expr(key, mode, sn) for key in node.keys]
+        key = keys[0] if len(keys) == 1 else f"({', '.join(keys)})"
+        name = self.table_names[node.table]
+        if table.default is not None:
+            return f"{name}.get({key}, {table.default!r})"
+        t, k = self.temp("_t"), self.temp("_k")
+        return f"({t} if ({t} := {name}.get(({k} := {key}))) is not None else _nokey({self.site(sn, node)}, {k}))"
+
+    def _function(self, node: n.Call, mode: str, sn: Snippet) -> str:
+        args = [self.expr(arg, mode, sn) for arg in node.args]
+        if node.func in ("abs", "min", "max"):
+            return f"_{node.func}({', '.join(args)})"
+        if node.func == "sign":
+            t = self.temp("_s")
+            return f"((({t} := {args[0]}) > 0) - ({t} < 0))"
+        # clip, with Lua's order of tests: below low gives low, else above high gives high.
+        v, lo, hi = self.temp("_v"), self.temp("_lo"), self.temp("_hi")
+        return f"({lo} if ({v} := {args[0]}) < ({lo} := {args[1]}) else ({hi} if {v} > ({hi} := {args[2]}) else {v}))"
+
+    def _memory(self, node: n.Call, mode: str, sn: Snippet) -> str:
+        slot = self.a.slots[node.key()]
+        i = slot.index
+        if mode == FIRST:
+            default = self.expr(slot.default, mode, sn) if slot.default is not None else None
+            if slot.kind == "prev":
+                return default if default is not None else f"_m{i}"
+            if slot.kind == "delta":
+                return f"(_m{i} - {default if default is not None else f'_m{i}'})"
+            return f"_m{i}"
+        if slot.kind in ("prev", "initial"):
+            return f"s[{i}]"
+        if slot.kind == "delta":
+            return f"(_m{i} - s[{i}])"
+        return f"_p{i}"

@@ -1,0 +1,263 @@
+"""Read a retrokit scenario YAML file into a :class:`ScenarioSpec`.
+
+The file is composed with PyYAML into nodes, not loaded into plain values, so
+that each expression keeps the line and column it was written at; every error
+in it points into the file. The format is documented in ``docs/scenarios.md``::
+
+    name: contest
+    include: [levels.yaml]        # more tables and definitions
+    tables:
+      level_end:
+        by: [zone, act]
+        values:
+          0, 0: 0x2560
+    define:
+      progress: clip(x - initial(x), 0, end_x) / end_x
+    reward: delta(progress, 0) * 9000
+    done: lives < prev(lives) or progress >= 1
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import yaml
+
+from retrokit.dsl.check import constant
+from retrokit.dsl.parser import parse
+from retrokit.dsl.source import Snippet, SourceText, align, located
+from retrokit.dsl.spec import Scalar, ScenarioSpec, Table
+from retrokit.errors import ScenarioError, did_you_mean
+
+TOP_KEYS = ("name", "description", "include", "tables", "define", "reward", "rewards", "done", "actions", "crop")
+INCLUDE_KEYS = ("description", "include", "tables", "define")
+TABLE_KEYS = ("by", "default", "values", "description")
+
+_INT_TAG = "tag:yaml.org,2002:int"
+_FLOAT_TAG = "tag:yaml.org,2002:float"
+
+
+class _Reader:
+    """Turn the nodes of one YAML text into spec parts, with located errors."""
+
+    def __init__(self, source: SourceText) -> None:
+        self.source = source
+
+    def error(self, node: yaml.Node, message: str) -> ScenarioError:
+        return located(ScenarioError, self.source, node.start_mark.index, max(node.end_mark.index, node.start_mark.index + 1), message)
+
+    def compose(self) -> yaml.MappingNode | None:
+        try:
+            root = yaml.compose(self.source.text, Loader=yaml.SafeLoader)
+        except yaml.MarkedYAMLError as exc:
+            mark = exc.problem_mark or exc.context_mark
+            index = mark.index if mark is not None else 0
+            raise located(ScenarioError, self.source, index, index + 1, f"this is not valid YAML: {exc.problem or exc}") from None
+        if root is not None and not isinstance(root, yaml.MappingNode):
+            raise self.error(root, "a scenario file holds a mapping (key: value lines) at its top")
+        return root
+
+    def mapping(self, node: yaml.Node, what: str, allowed: tuple[str, ...] | None = None) -> dict[str, tuple[yaml.Node, yaml.Node]]:
+        """The entries of a mapping node, checking for duplicate and unknown keys."""
+        if not isinstance(node, yaml.MappingNode):
+            raise self.error(node, f"{what} must be a mapping (key: value lines)")
+        entries: dict[str, tuple[yaml.Node, yaml.Node]] = {}
+        for key, value in node.value:
+            if not isinstance(key, yaml.ScalarNode):
+                raise self.error(key, f"the keys of {what} must be plain names or numbers")
+            name = key.value
+            if name in entries:
+                line = entries[name][0].start_mark.line + 1
+                raise self.error(key, f"{name!r} is given twice in {what} (first on line {line})")
+            if allowed is not None and name not in allowed:
+                raise self.error(key, f"unknown key {name!r} in {what}." + did_you_mean(name, allowed) + f" Known keys: {', '.join(allowed)}")
+            entries[name] = (key, value)
+        return entries
+
+    def snippet(self, node: yaml.Node, role: str) -> Snippet:
+        """An expression written as a YAML scalar, mapped character by character into the file."""
+        if not isinstance(node, yaml.ScalarNode):
+            raise self.error(node, f"{role} must be an expression (text), not a {'list' if isinstance(node, yaml.SequenceNode) else 'mapping'}")
+        start, end = node.start_mark.index, node.end_mark.index
+        offsets = align(node.value, self.source.text[start:end], start)
+        return Snippet(node.value, self.source, role, offsets)
+
+    def plain(self, node: yaml.Node) -> object:
+        """The Python value of a node (lists, numbers, strings)."""
+        return yaml.constructor.SafeConstructor().construct_document(node)
+
+    def number(self, node: yaml.Node, role: str) -> Scalar:
+        """A number: a YAML int or float, or a constant expression such as ``0x3080 + 0x1049``."""
+        if isinstance(node, yaml.ScalarNode) and node.tag in (_INT_TAG, _FLOAT_TAG):
+            value = self.plain(node)
+            if not isinstance(value, bool):
+                return value  # type: ignore[return-value]
+        snippet = self.snippet(node, role)
+        value = constant(parse(snippet))
+        if value is None:
+            raise self.error(node, f"{role} must be a number or a constant arithmetic expression")
+        return value
+
+    def table(self, key: yaml.Node, node: yaml.Node) -> Table:
+        name = key.value
+        what = f"table {name!r}"
+        entries = self.mapping(node, what, TABLE_KEYS)
+        by = None
+        if "by" in entries:
+            by_value = self.plain(entries["by"][1])
+            if not (isinstance(by_value, list) and by_value and all(isinstance(p, str) for p in by_value)):
+                raise self.error(entries["by"][1], f"'by' of {what} must be a list of names, e.g. [zone, act]")
+            by = tuple(by_value)
+        default = self.number(entries["default"][1], f"the default of {what}") if "default" in entries else None
+        if "values" not in entries:
+            raise self.error(key, f"{what} needs 'values:', a mapping from keys such as '0, 1' to numbers")
+        data: dict[tuple[Scalar, ...], Scalar] = {}
+        arity = len(by) if by else None
+        for text, (k, v) in self.mapping(entries["values"][1], f"the values of {what}").items():
+            parts = tuple(self._key_part(k, part) for part in text.split(","))
+            if arity is None:
+                arity = len(parts)
+            if len(parts) != arity:
+                raise self.error(k, f"{what} is keyed by {arity} value{'s' if arity > 1 else ''}, and this key has {len(parts)}")
+            data[parts] = self.number(v, f"the value of {what} at {text}")
+        if arity is None:
+            raise self.error(key, f"{what} has no values")
+        origin = Snippet(name, self.source, what, tuple(range(key.start_mark.index, key.start_mark.index + len(name) + 1)))
+        return Table(name, data, arity, by, default, origin)
+
+    def _key_part(self, node: yaml.Node, part: str) -> Scalar:
+        text = part.strip().replace("_", "")
+        try:
+            return int(text, 0)
+        except ValueError:
+            pass
+        try:
+            return float(text)
+        except ValueError:
+            raise self.error(node, f"a table key is one or more numbers separated by commas, e.g. '0, 1'; got {node.value!r}") from None
+
+    def name_snippet(self, key: yaml.Node, role: str) -> Snippet:
+        start = key.start_mark.index
+        return Snippet(key.value, self.source, role, tuple(range(start, start + len(key.value) + 1)))
+
+
+class DocumentLoader:
+    """Build a ScenarioSpec from a YAML file and the files it includes."""
+
+    def __init__(self, name: str) -> None:
+        self.spec = ScenarioSpec(name)
+        self._origins: dict[str, Snippet] = {}
+        self._seen: list[Path] = []
+
+    def load_file(self, path: Path, *, top: bool = True) -> None:
+        """Read ``path`` (a scenario, or an included file when ``top`` is false)."""
+        resolved = path.resolve()
+        if resolved in self._seen:
+            raise ScenarioError(f"{path}: included more than once (includes must not loop)")
+        self._seen.append(resolved)
+        try:
+            text = path.read_text()
+        except OSError as exc:
+            raise ScenarioError(f"cannot read scenario file {str(path)!r}: {exc.strerror or exc}") from None
+        self.load_text(text, str(path), path.parent, top=top)
+
+    def load_text(self, text: str, name: str, base: Path | None, *, top: bool = True) -> None:
+        """Read scenario YAML ``text``; ``name`` labels it in messages, ``base`` resolves includes."""
+        reader = _Reader(SourceText(name, text))
+        root = reader.compose()
+        if root is None:
+            return
+        entries = reader.mapping(root, "an included file" if not top else "a scenario", TOP_KEYS if top else INCLUDE_KEYS)
+        spec = self.spec
+        if "include" in entries:
+            for item in self._list(reader, entries["include"][1], "include"):
+                if base is None:
+                    raise reader.error(entries["include"][1], "include needs a folder to look in: pass game_dir")
+                self.load_file(base / str(reader.plain(item)), top=False)
+        if "name" in entries:
+            spec.name = str(reader.plain(entries["name"][1]))
+        if "tables" in entries:
+            for table_name, (key, node) in reader.mapping(entries["tables"][1], "tables").items():
+                table = reader.table(key, node)
+                self._claim(table_name, table.origin, reader, key)
+                spec.tables[table_name] = table
+        if "define" in entries:
+            for def_name, (key, node) in reader.mapping(entries["define"][1], "define").items():
+                where = reader.name_snippet(key, f"define {def_name!r}")
+                self._claim(def_name, where, reader, key)
+                spec.defines[def_name] = reader.snippet(node, f"define {def_name!r}")
+                spec.define_names[def_name] = where
+        if "reward" in entries and "rewards" in entries:
+            raise reader.error(entries["rewards"][0], "give either 'reward' (one player) or 'rewards' (a list, one per player), not both")
+        if "reward" in entries:
+            spec.rewards = [reader.snippet(entries["reward"][1], "reward")]
+        if "rewards" in entries:
+            items = self._list(reader, entries["rewards"][1], "rewards")
+            spec.rewards = [reader.snippet(item, f"reward of player {i + 1}") for i, item in enumerate(items)]
+        if "done" in entries:
+            spec.done = reader.snippet(entries["done"][1], "done")
+        if "actions" in entries:
+            spec.actions = self._actions(reader, entries["actions"][1])
+        if "crop" in entries:
+            crop = reader.plain(entries["crop"][1])
+            if not (isinstance(crop, list) and len(crop) == 4 and all(isinstance(c, int) and not isinstance(c, bool) and c >= 0 for c in crop)):
+                raise reader.error(entries["crop"][1], "crop is [x, y, width, height], four whole numbers of pixels")
+            spec.crop = (crop[0], crop[1], crop[2], crop[3])
+
+    def _claim(self, name: str, where: Snippet, reader: _Reader, key: yaml.Node) -> None:
+        """Record where ``name`` is defined; a second table or definition of it is an error."""
+        if name in self._origins:
+            raise reader.error(key, f"{name!r} is already defined, at {self._origins[name].where()}")
+        self._origins[name] = where
+
+    @staticmethod
+    def _list(reader: _Reader, node: yaml.Node, what: str) -> list[yaml.Node]:
+        if not isinstance(node, yaml.SequenceNode) or not node.value:
+            raise reader.error(node, f"{what} must be a non-empty list")
+        return list(node.value)
+
+    @staticmethod
+    def _actions(reader: _Reader, node: yaml.Node) -> list:
+        actions = reader.plain(node)
+        ok = isinstance(actions, list) and all(
+            isinstance(group, list) and all(isinstance(combo, list) and all(isinstance(b, str) for b in combo) for combo in group)
+            for group in actions
+        )
+        if not ok:
+            raise reader.error(node, "actions is a list of groups, each a list of button combinations: [[[], [LEFT], [RIGHT]], [[], [B]]]")
+        return actions
+
+
+def load_document(path: str | os.PathLike[str], *, name: str | None = None) -> ScenarioSpec:
+    """Read a scenario YAML file (and its includes) into a spec."""
+    path = Path(path)
+    loader = DocumentLoader(name or path.stem)
+    loader.load_file(path)
+    if name:
+        loader.spec.name = name
+    return loader.spec
+
+
+def document_from_dict(data: dict, *, name: str | None = None, game_dir: str | os.PathLike[str] | None = None) -> ScenarioSpec:
+    """Build a spec from an already-parsed scenario dict.
+
+    The dict is written back as YAML and read like a file named
+    ``<scenario NAME>``, so its errors point at lines of that text.
+    """
+    label = name or str(data.get("name", "scenario"))
+    text = yaml.safe_dump(_plain_keys(data), sort_keys=False, default_flow_style=False, width=10_000)
+    loader = DocumentLoader(label)
+    loader.load_text(text, f"<scenario {label!r}>", Path(game_dir) if game_dir is not None else None)
+    if name:
+        loader.spec.name = name
+    return loader.spec
+
+
+def _plain_keys(value: object) -> object:
+    """Make a dict dumpable: tuple keys ``(0, 1)`` become ``"0, 1"``."""
+    if isinstance(value, dict):
+        return {(", ".join(str(p) for p in k) if isinstance(k, tuple) else k): _plain_keys(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain_keys(v) for v in value]
+    return value

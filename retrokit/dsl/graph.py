@@ -1,0 +1,168 @@
+"""The order in which a scenario's definitions and memory slots are computed.
+
+A step computes, in dependency order, every definition that the outputs need
+and every memory call's argument (the value the slot will remember), then the
+outputs, then writes the slots. Two modes differ in what a memory call needs:
+
+- ``FIRST`` (reset, or the first step without a reset) has no past, so
+  ``prev(x)`` and ``initial(x)`` are ``x`` itself, ``peak(x)`` is ``x`` and
+  ``delta(x)`` is 0; ``prev(x, d)`` is ``d`` and ``delta(x, d)`` is ``x - d``.
+- ``NEXT`` (every later step) reads ``prev`` and ``initial`` from the slots, and
+  ``delta`` and ``peak`` from the slot and the argument's current value.
+
+A definition may use its own earlier value only through ``prev(x, d)``: in
+``FIRST`` mode that is ``d``, so no definition needs itself. Any other cycle
+is an error.
+"""
+
+from __future__ import annotations
+
+from retrokit.dsl import nodes as n
+from retrokit.dsl.check import COUNTERS, MEMORY, Analysis, Slot
+from retrokit.errors import ScenarioCompileError
+
+FIRST, NEXT = "first", "next"
+
+Item = tuple[str, object]  # ("def", name) or ("slot", index)
+
+
+def _memory(node: n.Node, analysis: Analysis) -> Slot | None:
+    if isinstance(node, n.Call) and node.func in MEMORY:
+        return analysis.slots[node.key()]
+    return None
+
+
+def deps(node: n.Node, mode: str, analysis: Analysis) -> set[Item]:
+    """Items whose value ``node`` reads now, in ``mode``."""
+    found: set[Item] = set()
+    stack = [node]
+    while stack:
+        current = stack.pop()
+        slot = _memory(current, analysis)
+        if slot is not None:
+            if mode == FIRST:
+                if slot.default is not None:
+                    stack.append(slot.default)
+                if not (slot.kind == "prev" and slot.default is not None):
+                    found.add(("slot", slot.index))
+            elif slot.kind in ("delta", "peak"):
+                found.add(("slot", slot.index))
+            continue
+        if isinstance(current, n.Name) and current.id in analysis.defines:
+            if current.quoted or current.id not in COUNTERS:
+                found.add(("def", current.id))
+        stack.extend(current.children())
+    return found
+
+
+def needs(node: n.Node, mode: str, analysis: Analysis) -> set[Item]:
+    """Items that must be computed in ``mode`` because of ``node``: its deps and its slots' arguments."""
+    found = deps(node, mode, analysis)
+    stack = [node]
+    while stack:
+        current = stack.pop()
+        slot = _memory(current, analysis)
+        if slot is not None:
+            if mode == FIRST or slot.kind != "initial":
+                found.add(("slot", slot.index))
+            if mode == FIRST and slot.default is not None:
+                stack.append(slot.default)
+            continue
+        stack.extend(current.children())
+    return found
+
+
+class Graph:
+    """Dependencies between a scenario's definitions and slots."""
+
+    def __init__(self, analysis: Analysis) -> None:
+        self.a = analysis
+        self._slots = {slot.index: slot for slot in analysis.slots.values()}
+
+    def expression(self, item: Item) -> n.Node:
+        """The expression an item computes."""
+        kind, key = item
+        return self.a.defines[key] if kind == "def" else self._slots[key].arg  # type: ignore[index]
+
+    def roots(self) -> list[n.Node]:
+        """The outputs: rewards, then done."""
+        return [*self.a.rewards, *([self.a.done] if self.a.done is not None else [])]
+
+    def check_cycles(self) -> None:
+        """Raise ScenarioCompileError if something needs itself at reset."""
+        items: list[Item] = [("def", name) for name in self.a.defines]
+        items += [("slot", index) for index in self._slots]
+        state: dict[Item, int] = {}
+        path: list[Item] = []
+
+        def visit(item: Item) -> None:
+            state[item] = 1
+            path.append(item)
+            for dep in sorted(deps(self.expression(item), FIRST, self.a), key=repr):
+                if state.get(dep) == 1:
+                    self._cycle_error(path[path.index(dep):] + [dep])
+                if dep not in state:
+                    visit(dep)
+            path.pop()
+            state[item] = 2
+
+        for item in items:
+            if item not in state:
+                visit(item)
+
+    def order(self, mode: str) -> list[Item]:
+        """The items to compute in ``mode``, each after the items it reads."""
+        live: set[Item] = set()
+        stack = [item for root in self.roots() for item in needs(root, mode, self.a)]
+        while stack:
+            item = stack.pop()
+            if item not in live:
+                live.add(item)
+                stack.extend(needs(self.expression(item), mode, self.a))
+        ordered: list[Item] = []
+        seen: set[Item] = set()
+
+        def visit(item: Item) -> None:
+            seen.add(item)
+            for dep in sorted(deps(self.expression(item), mode, self.a), key=repr):
+                if dep not in seen:
+                    visit(dep)
+            ordered.append(item)
+
+        for item in sorted(live, key=repr):
+            if item not in seen:
+                visit(item)
+        return ordered
+
+    def _label(self, item: Item) -> str:
+        kind, key = item
+        if kind == "def":
+            return str(key)
+        slot = self._slots[key]  # type: ignore[index]
+        return f"{slot.kind}({slot.arg.key()})"
+
+    def _cycle_error(self, cycle: list[Item]) -> None:
+        first = next((item for item in cycle if item[0] == "def"), cycle[0])
+        start = cycle.index(first)
+        cycle = cycle[start:-1] + cycle[:start] + [first]
+        chain = " -> ".join(self._label(item) for item in cycle)
+        target = cycle[1]
+        if first[0] == "def":
+            snippet = self.a.spec.defines[first[1]]  # type: ignore[index]
+        else:
+            snippet = self._slots[first[1]].snippet  # type: ignore[index]
+        node = self._reference(self.expression(first), target) or self.expression(first)
+        name = self._label(first)
+        raise snippet.error(
+            ScenarioCompileError, node.start, node.end,
+            f"{name!r} depends on itself: {chain}. A definition can use its own earlier value "
+            f"only through prev(name, value_at_reset), e.g. prev({name}, 0)",
+        )
+
+    def _reference(self, root: n.Node, target: Item) -> n.Node | None:
+        """The first node under ``root`` that reads ``target`` now."""
+        for node in n.walk(root):
+            if (isinstance(node, (n.Name, n.Call))) and target in deps(node, FIRST, self.a):
+                if node is not root or isinstance(node, n.Name):
+                    return node
+        return None

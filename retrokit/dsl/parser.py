@@ -1,0 +1,183 @@
+"""Parse scenario expressions with lark into :mod:`retrokit.dsl.nodes` trees.
+
+The grammar is ``grammar.lark`` next to this file, parsed with LALR(1). Its
+aliased alternatives map one-to-one onto the methods of :class:`ToAst`. Syntax
+errors become :class:`~retrokit.errors.ScenarioSyntaxError` pointing at the
+offending character, with what was expected; errors raised while building the
+tree (lark wraps them in ``VisitError``) are unwrapped.
+"""
+
+from __future__ import annotations
+
+import functools
+from pathlib import Path
+
+from lark import Lark, Token, Transformer, v_args
+from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
+
+from retrokit.dsl import nodes as n
+from retrokit.dsl.source import Snippet
+from retrokit.errors import ScenarioError, ScenarioSyntaxError
+
+_GRAMMAR = Path(__file__).with_name("grammar.lark")
+
+#: How lark's terminal names read in a message.
+_TERMINALS = {
+    "LPAR": "'('", "RPAR": "')'", "LSQB": "'['", "RSQB": "']'", "COMMA": "','",
+    "NAME": "a name", "QUOTED_NAME": "a name", "INT": "a number", "HEX": "a number",
+    "FLOAT": "a number", "TRUE": "'true'", "FALSE": "'false'", "NOT": "'not'",
+    "IF": "'if'", "ELSE": "'else'", "AND": "'and'", "OR": "'or'",
+    "COMP_OP": "a comparison", "ADD_OP": "'+' or '-'", "MUL_OP": "'*', '/', '//' or '%'",
+    "UNARY_OP": "'-'", "SHIFT_OP": "'<<' or '>>'", "BIT_OR": "'|'", "BIT_XOR": "'^'",
+    "BIT_AND": "'&'", "$END": "the end of the expression",
+}
+
+#: Terminals summed up as "an operator" in messages.
+_OPERATORS = {"COMP_OP", "ADD_OP", "MUL_OP", "SHIFT_OP", "BIT_OR", "BIT_XOR", "BIT_AND", "AND", "OR", "IF"}
+
+#: Hints for characters people bring from other languages.
+_HINTS = {
+    "=": "to compare, write '=='",
+    "!": "write 'not', or '!=' to compare",
+    "&&": "write 'and'",
+    "||": "write 'or'",
+    "?": "write 'a if condition else b'",
+    "'": "names with odd characters are written in backquotes: `my field`",
+    '"': "names with odd characters are written in backquotes: `my field`",
+}
+
+
+@functools.cache
+def _lark() -> Lark:
+    return Lark(_GRAMMAR.read_text(), parser="lalr", propagate_positions=True, maybe_placeholders=True)
+
+
+def _literal(token: Token) -> str:
+    """The digits of a number token, without ``_`` separators."""
+    return str(token).replace("_", "")
+
+
+@v_args(meta=True)
+class ToAst(Transformer):
+    """Turn lark's parse tree into :mod:`retrokit.dsl.nodes` nodes."""
+
+    def __init__(self, snippet: Snippet) -> None:
+        super().__init__()
+        self._snippet = snippet
+
+    def int_literal(self, meta, children):
+        text = _literal(children[0])
+        if len(text) > 1 and text[0] == "0" and text[1] not in "xX":
+            raise self._snippet.error(
+                ScenarioSyntaxError, meta.start_pos, meta.end_pos,
+                f"the number {text} has a leading zero; write {int(text)} (decimal) or 0x{text.lstrip('0') or '0'} (hex)",
+            )
+        return n.Number(start=meta.start_pos, end=meta.end_pos, value=int(text, 0))
+
+    def float_literal(self, meta, children):
+        return n.Number(start=meta.start_pos, end=meta.end_pos, value=float(_literal(children[0])))
+
+    def true(self, meta, children):
+        return n.Bool(start=meta.start_pos, end=meta.end_pos, value=True)
+
+    def false(self, meta, children):
+        return n.Bool(start=meta.start_pos, end=meta.end_pos, value=False)
+
+    def name(self, meta, children):
+        text = str(children[0])
+        quoted = text.startswith("`")
+        return n.Name(start=meta.start_pos, end=meta.end_pos, id=text[1:-1] if quoted else text, quoted=quoted)
+
+    def arguments(self, meta, children):
+        return tuple(children)
+
+    def call(self, meta, children):
+        func, args = children
+        return n.Call(start=meta.start_pos, end=meta.end_pos, func=str(func), name_end=func.end_pos, args=args or ())
+
+    def lookup(self, meta, children):
+        table, keys = children
+        return n.Lookup(start=meta.start_pos, end=meta.end_pos, table=str(table), name_end=table.end_pos, keys=keys)
+
+    def unary(self, meta, children):
+        op, operand = children
+        return n.Unary(start=meta.start_pos, end=meta.end_pos, op=str(op), operand=operand)
+
+    def binary(self, meta, children):
+        left, op, right = children
+        return n.Binary(start=meta.start_pos, end=meta.end_pos, op=str(op), op_start=op.start_pos, left=left, right=right)
+
+    def compare(self, meta, children):
+        return n.Compare(
+            start=meta.start_pos, end=meta.end_pos,
+            ops=tuple(str(op) for op in children[1::2]), operands=tuple(children[0::2]),
+        )
+
+    def and_(self, meta, children):
+        return n.Logic(start=meta.start_pos, end=meta.end_pos, op="and", left=children[0], right=children[1])
+
+    def or_(self, meta, children):
+        return n.Logic(start=meta.start_pos, end=meta.end_pos, op="or", left=children[0], right=children[1])
+
+    def not_(self, meta, children):
+        return n.Not(start=meta.start_pos, end=meta.end_pos, operand=children[1])
+
+    def ifelse(self, meta, children):
+        then, cond, other = children
+        return n.IfElse(start=meta.start_pos, end=meta.end_pos, cond=cond, then=then, other=other)
+
+
+def parse(snippet: Snippet) -> n.Node:
+    """Parse one expression.
+
+    Args:
+        snippet: The expression and where it comes from.
+
+    Returns:
+        The root of its syntax tree.
+
+    Raises:
+        ScenarioSyntaxError: The text is not an expression.
+    """
+    if not snippet.text.strip():
+        raise snippet.error(ScenarioSyntaxError, 0, len(snippet.text), "the expression is empty")
+    try:
+        tree = _lark().parse(snippet.text)
+    except UnexpectedInput as exc:
+        raise _syntax_error(snippet, exc) from None
+    try:
+        return ToAst(snippet).transform(tree)
+    except VisitError as exc:
+        if isinstance(exc.orig_exc, ScenarioError):
+            raise exc.orig_exc from None
+        raise
+
+
+def _syntax_error(snippet: Snippet, exc: UnexpectedInput) -> ScenarioSyntaxError:
+    """Turn a lark error into a message saying what was found and what was expected."""
+    text = snippet.text
+    if isinstance(exc, UnexpectedCharacters):
+        pos = exc.pos_in_stream
+        found = text[pos]
+        expected = exc.allowed
+        width = 1
+    elif isinstance(exc, UnexpectedToken) and exc.token.type != "$END":
+        pos = exc.token.start_pos
+        found = str(exc.token)
+        expected = exc.expected
+        width = max(1, len(found))
+    else:  # the text stopped too early
+        pos = len(text.rstrip())
+        found = ""
+        expected = exc.expected if isinstance(exc, (UnexpectedToken, UnexpectedEOF)) else set()
+        width = 1
+    expected = set(getattr(exc, "accepts", None) or expected)
+    wanted = sorted({_TERMINALS.get(name, name) for name in expected - _OPERATORS})
+    if expected & _OPERATORS:
+        wanted.insert(0, "an operator")
+    what = f"unexpected {found!r}" if found else "the expression ends too early"
+    message = what + (f"; expected {', '.join(wanted)}" if wanted else "")
+    hint = _HINTS.get(text[pos : pos + 2]) or _HINTS.get(found[:1])
+    if hint:
+        message += f" ({hint})"
+    return snippet.error(ScenarioSyntaxError, pos, pos + width, message)

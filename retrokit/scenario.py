@@ -1,0 +1,150 @@
+"""Scenarios: the rewards and done condition of an environment.
+
+A scenario is written in retrokit's expression language (``docs/scenarios.md``)
+in a YAML file, or comes from a Gym Retro ``scenario.json``. Loading compiles
+it once into a :class:`Scenario`; each episode runs in a :class:`Run`::
+
+    scenario = load_scenario("games/SonicTheHedgehog-Genesis/contest.yaml", fields)
+    run = scenario.start()
+    run.reset(values)                         # field values after reset
+    rewards, done = run.step(values, frame, step)
+
+``values`` maps every field name to its value; ``frame`` counts emulator frames
+and ``step`` env steps since reset.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+from retrokit.dsl.compiler import Program
+from retrokit.dsl.document import document_from_dict, load_document
+from retrokit.dsl.gymretro import is_gym_retro, spec_from_json, spec_from_json_dict
+from retrokit.dsl.spec import ScenarioSpec
+from retrokit.errors import ScenarioError
+
+__all__ = ["Run", "Scenario", "load_scenario"]
+
+
+class Scenario:
+    """A compiled scenario. Immutable; start one :class:`Run` per episode stream.
+
+    Attributes:
+        name: The scenario's name (the file's stem unless it says otherwise).
+        players: How many rewards each step returns.
+        actions: Gym Retro-style button combinations (a list of groups, each a
+            list of button-name lists), or ``None``.
+        crop: ``(x, y, width, height)`` of the screen to keep, or ``None``.
+        fields: The fields the scenario reads.
+    """
+
+    def __init__(self, spec: ScenarioSpec, fields: Sequence[str]) -> None:
+        self._program = Program(spec, fields)
+        self.name = spec.name
+        self.players = self._program.players
+        self.actions = spec.actions
+        self.crop = spec.crop
+        self.fields = self._program.fields
+
+    @property
+    def source(self) -> str:
+        """The Python code the scenario was compiled to."""
+        return self._program.source
+
+    def start(self) -> Run:
+        """Return fresh per-episode state; Runs of one Scenario are independent."""
+        return Run(self._program)
+
+    def __repr__(self) -> str:
+        return f"Scenario({self.name!r}, players={self.players})"
+
+
+class Run:
+    """One stream of episodes of a scenario: its memory (``prev``, ``initial``, ...).
+
+    ``reset`` starts an episode. ``step`` returns ``(rewards, done)``: a tuple of
+    ``players`` floats, and a bool. Stepping without a reset treats the first
+    step as the reset point (``initial(x)`` is then the first step's value).
+    """
+
+    def __init__(self, program: Program) -> None:
+        self._state: list = [None] * program.slot_count
+        self._first, self._next = program.bind(self._state)
+        # The hot path: after reset, ``run.step`` is the generated function itself.
+        self.step = self._step_before_reset  # type: ignore[method-assign]
+
+    def reset(self, values: Mapping[str, int]) -> None:
+        """Start an episode from the field values after the emulator's reset.
+
+        Like Gym Retro, which computes reward and done once at reset, this runs
+        the scenario once with ``frame = step = 0`` and keeps only its memory.
+        """
+        self._first(values, 0, 0)
+        self.step = self._next  # type: ignore[method-assign]
+
+    def step(self, values: Mapping[str, int], frame: int, step: int) -> tuple[tuple[float, ...], bool]:  # noqa: F811
+        """Compute this step's rewards (one per player) and done.
+
+        Args:
+            values: Every field's value after the step.
+            frame: Emulator frames since reset.
+            step: Env steps since reset.
+
+        Returns:
+            ``(rewards, done)``.
+
+        Raises:
+            ScenarioRuntimeError: A division by zero, or a table has no entry for a key.
+        """
+        return self._step_before_reset(values, frame, step)  # replaced per instance
+
+    def _step_before_reset(self, values: Mapping[str, int], frame: int, step: int) -> tuple[tuple[float, ...], bool]:
+        result = self._first(values, frame, step)
+        self.step = self._next  # type: ignore[method-assign]
+        return result
+
+
+def load_scenario(
+    source: str | os.PathLike[str] | Mapping,
+    fields: Sequence[str],
+    *,
+    game_dir: str | os.PathLike[str] | None = None,
+    name: str | None = None,
+) -> Scenario:
+    """Load and compile a scenario.
+
+    Args:
+        source: A ``.yaml`` file in retrokit's scenario language, a Gym Retro
+            ``.json`` scenario file, or an already-parsed dict of either format
+            (Gym Retro's is recognised by its ``variables`` objects).
+        fields: The names of the game's RAM fields, for checking names.
+        game_dir: Where ``include`` files of a dict source are looked up.
+        name: The scenario's name in messages; default: the file's stem.
+
+    Returns:
+        The compiled scenario.
+
+    Raises:
+        ScenarioSyntaxError: An expression does not parse.
+        ScenarioCompileError: An unknown name, a wrong argument count, a type
+            error or a division by a constant zero.
+        ScenarioError: The file is malformed or cannot be read.
+    """
+    if isinstance(source, Mapping):
+        data = dict(source)
+        if is_gym_retro(data):
+            spec = spec_from_json_dict(data, fields, name=name or "scenario")
+        else:
+            spec = document_from_dict(data, name=name, game_dir=game_dir)
+        return Scenario(spec, fields)
+    path = Path(source)
+    suffix = path.suffix.lower()
+    if suffix == ".json":
+        spec = spec_from_json(path, fields, name=name)
+    elif suffix in (".yaml", ".yml"):
+        spec = load_document(path, name=name)
+    else:
+        raise ScenarioError(f"{str(path)!r}: a scenario is a .yaml file (retrokit) or a .json file (Gym Retro); got {suffix or 'no suffix'!r}")
+    return Scenario(spec, fields)

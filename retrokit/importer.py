@@ -24,6 +24,7 @@ from retrokit.errors import RetrokitError, RomError
 from retrokit.games import Game, list_games
 
 MAX_ZIP_DEPTH = 3
+_TOO_BIG = f"larger than {roms.MAX_ROM_SIZE // 2**20} MiB"
 
 
 @dataclass(frozen=True)
@@ -109,7 +110,7 @@ _Candidate = tuple[str, str, Callable[[], bytes]]
 
 
 def _too_big(size: int) -> bool:
-    return size > roms.MAX_ROM_SIZE + roms.SMD_HEADER_SIZE
+    return size > roms.MAX_FILE_SIZE
 
 
 def _zip_candidates(label: str, opener: Callable[[], zipfile.ZipFile], report: ImportReport, depth: int) -> Iterator[_Candidate]:
@@ -119,9 +120,9 @@ def _zip_candidates(label: str, opener: Callable[[], zipfile.ZipFile], report: I
                 if info.is_dir():
                     continue
                 member = f"{label}!{info.filename}"
-                ext = Path(info.filename).suffix.lower().lstrip(".")
+                ext = roms.file_extension(info.filename)
                 if _too_big(info.file_size) and ext != "zip":
-                    report.skipped.append((member, f"larger than {roms.MAX_ROM_SIZE // 2**20} MiB"))
+                    report.skipped.append((member, _TOO_BIG))
                     continue
                 try:
                     data = archive.read(info)
@@ -143,7 +144,7 @@ def _blob_candidates(label: str, ext: str, data: bytes, report: ImportReport, de
 
 
 def _file_candidates(path: Path, report: ImportReport) -> Iterator[_Candidate]:
-    label, ext = str(path), path.suffix.lower().lstrip(".")
+    label, ext = str(path), roms.file_extension(path)
     try:
         size = path.stat().st_size
     except OSError as exc:
@@ -154,7 +155,7 @@ def _file_candidates(path: Path, report: ImportReport) -> Iterator[_Candidate]:
             yield label, ext, path.read_bytes
         yield from _zip_candidates(label, lambda: zipfile.ZipFile(path), report, 1)
     elif _too_big(size):
-        report.skipped.append((label, f"larger than {roms.MAX_ROM_SIZE // 2**20} MiB"))
+        report.skipped.append((label, _TOO_BIG))
     else:
         yield label, ext, path.read_bytes
 

@@ -33,6 +33,9 @@ NES_HEADER_SIZE = 16
 SMD_HEADER_SIZE = 512
 SMD_BLOCK_SIZE = 16 * 1024
 
+MAX_FILE_SIZE = MAX_ROM_SIZE + SMD_HEADER_SIZE
+"""The largest file read as a ROM: the largest ROM, as an ``.smd`` dump with its header."""
+
 # Extensions that name a system but hold a form the cores do not load directly.
 _EXTRA_EXTENSIONS = {"smd": "Genesis"}
 
@@ -158,7 +161,7 @@ def _read(source: bytes | str | os.PathLike[str]) -> bytes:
     path = Path(source)
     try:
         size = path.stat().st_size
-        if size > MAX_ROM_SIZE + SMD_HEADER_SIZE:
+        if size > MAX_FILE_SIZE:
             raise RomError(
                 f"Expected a ROM of at most {MAX_ROM_SIZE // 2**20} MiB; found {size} bytes in "
                 f"{str(path)!r}. This file is not a ROM retrokit supports."

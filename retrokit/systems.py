@@ -31,6 +31,7 @@ class System:
         types: The type codes integrations of this system usually use.
         options: Core option defaults for this system.
         actions: Gym Retro's default groups of button combinations.
+        screen: ``(height, width)`` of observations, or ``None`` for the first frame's.
     """
 
     name: str
@@ -42,6 +43,7 @@ class System:
     types: tuple[str, ...] = ()
     options: dict[str, str] = field(default_factory=dict)
     actions: tuple[tuple[tuple[str, ...], ...], ...] = ()
+    screen: tuple[int, int] | None = None
 
     @property
     def button_names(self) -> tuple[str, ...]:
@@ -91,6 +93,7 @@ def _parse(name: str, entry: object) -> System:
             types=tuple(entry.get("types", ())),
             options={str(k): str(v) for k, v in (entry.get("options") or {}).items()},
             actions=tuple(tuple(tuple(combo) for combo in group) for group in entry.get("actions", ())),
+            screen=tuple(entry["screen"]) if "screen" in entry else None,
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise DataFileError(f"{_FILE}: system {name!r} is malformed: {exc!r}.") from exc

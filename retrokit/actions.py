@@ -1,0 +1,124 @@
+"""Action spaces: from what an agent chooses to the button masks a console sees.
+
+Four types, as in Gym Retro:
+
+- ``"all"``: a MultiBinary over every button of the system, in Gym Retro's
+  order (the RetroPad id order), per player.
+- ``"filtered"``: the same MultiBinary, but each group of buttons keeps only
+  the combinations the scenario (or the system) lists; anything else in that
+  group is dropped, as Gym Retro's filter does.
+- ``"discrete"``: one Discrete choice that picks one combination from every
+  group (a product), per player.
+- ``"multi_discrete"``: one choice per group, per player.
+
+Groups come from the scenario's ``actions`` or, failing that, the system's.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from gymnasium import spaces
+
+from retrokit.errors import InvalidArgumentError, did_you_mean
+from retrokit.systems import System
+
+ACTION_TYPES = ("all", "filtered", "discrete", "multi_discrete")
+
+
+class ActionMap:
+    """Translates an action of one type into one RetroPad mask per player.
+
+    Args:
+        system: The console, for its buttons.
+        action_type: One of :data:`ACTION_TYPES`.
+        groups: Groups of button-name combinations; ``None`` uses the system's.
+        players: How many players act.
+    """
+
+    def __init__(
+        self,
+        system: System,
+        action_type: str,
+        groups: Sequence[Sequence[Sequence[str]]] | None = None,
+        players: int = 1,
+    ) -> None:
+        if action_type not in ACTION_TYPES:
+            raise InvalidArgumentError(
+                f"Expected an action type in {ACTION_TYPES}, got {action_type!r}." + did_you_mean(str(action_type), ACTION_TYPES)
+            )
+        self.system, self.action_type, self.players = system, action_type, players
+        groups = system.actions if groups is None else groups
+        if action_type != "all" and not groups:
+            raise InvalidArgumentError(
+                f"Expected button combinations for action type {action_type!r}, but neither the scenario nor the "
+                f"{system.name} system lists any. Use action_type='all', or add 'actions' to the scenario."
+            )
+        # Each group: its combinations as masks, and the mask of every button it mentions.
+        self.combos = [[system.mask(combo) for combo in group] for group in groups]
+        self.group_masks = [int(np.bitwise_or.reduce(c)) if c else 0 for c in self.combos]
+        self.valid = [set(c) for c in self.combos]
+        self.num_buttons = len(system.buttons)
+        self.space = self._player_space()
+
+    def _player_space(self) -> spaces.Space:
+        if self.action_type in ("all", "filtered"):
+            return spaces.MultiBinary(self.num_buttons * self.players)
+        if self.action_type == "discrete":
+            return spaces.Discrete(math.prod(len(c) for c in self.combos) ** self.players)
+        return spaces.MultiDiscrete([len(c) for c in self.combos] * self.players)
+
+    def single_player_space(self) -> spaces.Space:
+        """The action space of one player, for multi-agent envs."""
+        return ActionMap(self.system, self.action_type, self._groups_as_names(), 1).space
+
+    def _groups_as_names(self) -> list[list[list[str]]]:
+        return [[self.system.buttons_of(m) for m in group] for group in self.combos]
+
+    def combine(self, per_player: Sequence[object]) -> object:
+        """Join one action per player (each of :meth:`single_player_space`) into one action of this map."""
+        if len(per_player) != self.players:
+            raise InvalidArgumentError(f"Expected {self.players} actions, one per player, got {len(per_player)}.")
+        if self.action_type == "discrete":
+            size = math.prod(len(c) for c in self.combos)
+            return sum(int(a) * size**p for p, a in enumerate(per_player))  # type: ignore[call-overload]
+        return np.concatenate([np.asarray(a).ravel() for a in per_player]).astype(self.space.dtype)
+
+    def filter(self, mask: int) -> int:
+        """Drop, group by group, any buttons that do not form a listed combination."""
+        out = 0
+        for group_mask, valid in zip(self.group_masks, self.valid):
+            part = mask & group_mask
+            if part in valid:
+                out |= part
+        return out
+
+    def to_masks(self, action: object) -> list[int]:
+        """Return one RetroPad mask per player for an action of this map's type."""
+        if self.action_type == "discrete":
+            index = int(action)  # type: ignore[call-overload]
+            per_player = math.prod(len(c) for c in self.combos)
+            masks = []
+            for _ in range(self.players):
+                index, choice = divmod(index, per_player) if self.players > 1 else (0, index)
+                mask = 0
+                for combos in self.combos:
+                    choice, pick = divmod(choice, len(combos))
+                    mask |= combos[pick]
+                masks.append(mask)
+            return masks
+        flat = np.asarray(action).ravel()
+        if self.action_type == "multi_discrete":
+            n = len(self.combos)
+            return [
+                int(np.bitwise_or.reduce([combos[int(i)] for combos, i in zip(self.combos, flat[p * n : (p + 1) * n])]))
+                for p in range(self.players)
+            ]
+        masks = []
+        for p in range(self.players):
+            bits = flat[p * self.num_buttons : (p + 1) * self.num_buttons]
+            mask = int(np.dot(bits.astype(np.int64) != 0, 1 << np.arange(len(bits), dtype=np.int64)))
+            masks.append(self.filter(mask) if self.action_type == "filtered" else mask)
+        return masks

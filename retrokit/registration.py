@@ -1,0 +1,26 @@
+"""Registering every known game with Gymnasium as ``retrokit/<Game>``.
+
+``gymnasium.make("retrokit/Airstriker-Genesis", state=..., ...)`` then works
+after ``import retrokit`` (or with the id ``"retrokit:retrokit/<Game>"``,
+which imports retrokit first).
+"""
+
+from __future__ import annotations
+
+import gymnasium
+
+from retrokit.games import list_games
+
+NAMESPACE = "retrokit"
+
+
+def register_envs() -> int:
+    """Register every game not registered yet; return how many were added."""
+    added = 0
+    for game in list_games():
+        env_id = f"{NAMESPACE}/{game.name}"
+        if env_id in gymnasium.registry:
+            continue
+        gymnasium.register(id=env_id, entry_point="retrokit.env:RetroEnv", kwargs={"game": game.name})
+        added += 1
+    return added

@@ -1,0 +1,188 @@
+"""The Gymnasium env on the real core: conformance, options, seeding, errors."""
+
+from __future__ import annotations
+
+import gymnasium
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import retrokit
+from retrokit.env import RetroEnv, State
+from retrokit.errors import (
+    GameNotFoundError,
+    InvalidArgumentError,
+    RomNotFoundError,
+    StateNotFoundError,
+)
+
+AIRSTRIKER = "Airstriker-Genesis"
+OBS_TYPES = ["rgb", "ram"]
+ACTION_TYPES = ["all", "filtered", "discrete", "multi_discrete"]
+
+
+def fire_and_wander(env: RetroEnv, step: int) -> object:
+    """An action that makes Airstriker shoot, move and score, in any action type."""
+    names = (["B"] if step % 8 < 4 else []) + [["UP"], ["DOWN"], ["LEFT"], ["RIGHT"]][(step // 16) % 4]
+    mask = env.emulator.system.mask(names)
+    kind = env.actions.action_type
+    if kind in ("all", "filtered"):
+        return np.array([(mask >> i) & 1 for i in range(env.action_space.n)], dtype=np.int8)
+    picks = [combos.index(mask & gmask) if (mask & gmask) in combos else 0 for combos, gmask in zip(env.actions.combos, env.actions.group_masks)]
+    if kind == "multi_discrete":
+        return np.array(picks)
+    index, scale = 0, 1
+    for pick, combos in zip(picks, env.actions.combos):
+        index += pick * scale
+        scale *= len(combos)
+    return index
+
+
+@pytest.mark.parametrize("action_type", ACTION_TYPES)
+@pytest.mark.parametrize("obs_type", OBS_TYPES)
+def test_check_env_passes_on_airstriker(obs_type: str, action_type: str) -> None:
+    env = retrokit.make(AIRSTRIKER, obs_type=obs_type, action_type=action_type, frameskip=4, sticky_prob=0.25)
+    check_env(env, skip_render_check=True)
+    env.close()
+
+
+@pytest.mark.parametrize("action_type", ACTION_TYPES)
+def test_each_action_type_drives_the_game(action_type: str) -> None:
+    env = retrokit.make(AIRSTRIKER, action_type=action_type, frameskip=4)
+    env.reset(seed=0)
+    total = 0.0
+    for step in range(300):
+        _, reward, terminated, truncated, info = env.step(fire_and_wander(env, step))
+        total += reward
+        if terminated:
+            break
+    assert total > 0 and total == info["score"]  # Airstriker's scenario rewards the score's change
+    env.close()
+
+
+def test_action_space_sizes_follow_the_genesis_groups() -> None:
+    sizes = {}
+    for action_type in ACTION_TYPES:
+        env = retrokit.make(AIRSTRIKER, action_type=action_type)
+        sizes[action_type] = env.action_space
+        env.close()
+    assert sizes["all"] == gymnasium.spaces.MultiBinary(12)
+    assert sizes["discrete"] == gymnasium.spaces.Discrete(3 * 3 * 14)
+    assert list(sizes["multi_discrete"].nvec) == [3, 3, 14]
+
+
+def test_filtered_actions_drop_what_gym_retro_drops() -> None:
+    env = retrokit.make(AIRSTRIKER, action_type="filtered")
+    system = env.emulator.system
+    f = lambda names: system.buttons_of(env.actions.filter(system.mask(names)))  # noqa: E731
+    assert f(["UP", "DOWN", "LEFT"]) == ["LEFT"]  # opposite directions are no combination
+    assert f(["A", "B"]) == ["B", "A"]
+    assert f(["A", "C"]) == []
+    assert f(["START", "RIGHT"]) == ["RIGHT"]
+    env.close()
+
+
+def test_info_holds_every_ram_field_by_name() -> None:
+    env = retrokit.make(AIRSTRIKER)
+    _, info = env.reset(seed=0)
+    assert set(info) == {"score", "lives", "gameover"}
+    assert info["lives"] == 3
+    env.close()
+
+
+def test_frameskip_runs_that_many_frames_per_step() -> None:
+    env = retrokit.make(AIRSTRIKER, frameskip=4)
+    env.reset(seed=0)
+    before = env.emulator.frame
+    env.step(env.action_space.sample() * 0)
+    assert env.emulator.frame - before == 4
+    env.close()
+
+
+def test_step_limit_truncates_not_terminates() -> None:
+    env = retrokit.make(AIRSTRIKER, max_episode_steps=5)
+    env.reset(seed=0)
+    flags = [env.step(env.action_space.sample() * 0)[2:4] for _ in range(5)]
+    assert flags[:4] == [(False, False)] * 4 and flags[4] == (False, True)
+    env.close()
+
+
+def rollout(env: RetroEnv, seed: int, steps: int = 200) -> tuple[list[float], bytes, list[dict]]:
+    obs, _ = env.reset(seed=seed)
+    rewards, infos = [], []
+    for step in range(steps):
+        obs, reward, terminated, truncated, info = env.step(fire_and_wander(env, step))
+        rewards.append(reward)
+        infos.append(info)
+        if terminated or truncated:
+            break
+    return rewards, obs.tobytes(), infos
+
+
+def test_same_seed_same_actions_same_trajectory() -> None:
+    env = retrokit.make(AIRSTRIKER, frameskip=4, sticky_prob=0.5)
+    first = rollout(env, seed=3)
+    second = rollout(env, seed=3)
+    other = rollout(env, seed=4)
+    assert first == second
+    assert other != first  # the sticky draws follow the seed
+    env.close()
+
+
+def test_every_frame_scenario_sums_the_frames_rewards() -> None:
+    per_step = retrokit.make(AIRSTRIKER, frameskip=4)
+    per_frame = retrokit.make(AIRSTRIKER, frameskip=4, scenario_every_frame=True)
+    a, b = rollout(per_step, seed=0, steps=300), rollout(per_frame, seed=0, steps=300)
+    # Airstriker's reward is the score's change: summing it per frame or per step agrees.
+    assert sum(a[0]) == sum(b[0]) > 0
+    assert a[2][-1] == b[2][-1]
+    per_step.close()
+    per_frame.close()
+
+
+def test_gymnasium_make_finds_registered_games() -> None:
+    env = gymnasium.make("retrokit/Airstriker-Genesis", frameskip=4, max_episode_steps=3)
+    env.reset(seed=0)
+    for _ in range(3):
+        *_, truncated, _ = env.step(env.action_space.sample())
+    assert truncated
+    env.close()
+
+
+def test_render_rgb_array_returns_the_screen() -> None:
+    env = retrokit.make(AIRSTRIKER, render_mode="rgb_array")
+    obs, _ = env.reset(seed=0)
+    frame = env.render()
+    assert frame.shape == (224, 320, 3) and (frame == obs).all()
+    env.close()
+
+
+def test_power_on_state_boots_the_rom() -> None:
+    env = retrokit.make(AIRSTRIKER, state=State.NONE)
+    obs, _ = env.reset(seed=0)
+    assert obs.shape == (224, 320, 3)
+    env.close()
+
+
+@pytest.mark.parametrize(
+    "kwargs,error,message",
+    [
+        ({"game": "Airstriker-Genesys"}, GameNotFoundError, "Did you mean 'Airstriker-Genesis'"),
+        ({"game": AIRSTRIKER, "state": "Level2"}, StateNotFoundError, "Did you mean 'Level1'"),
+        ({"game": AIRSTRIKER, "obs_type": "rbg"}, InvalidArgumentError, "Did you mean 'rgb'"),
+        ({"game": AIRSTRIKER, "action_type": "discreet"}, InvalidArgumentError, "Did you mean 'discrete'"),
+        ({"game": AIRSTRIKER, "frameskip": 0}, InvalidArgumentError, "frameskip"),
+        ({"game": AIRSTRIKER, "sticky_prob": 2.0}, InvalidArgumentError, r"sticky_prob in \[0, 1\]"),
+        ({"game": AIRSTRIKER, "players": 2}, InvalidArgumentError, "1 to 1 players"),
+    ],
+    ids=["unknown-game", "unknown-state", "obs-type", "action-type", "frameskip", "sticky", "players"],
+)
+def test_bad_options_say_what_was_expected(kwargs: dict, error: type, message: str) -> None:
+    with pytest.raises(error, match=message):
+        retrokit.make(**kwargs)
+
+
+def test_missing_rom_says_how_to_import(monkeypatch: pytest.MonkeyPatch, tmp_path) -> None:
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path))
+    with pytest.raises(RomNotFoundError, match="retrokit import"):
+        retrokit.make("SonicTheHedgehog-Genesis", "GreenHillZone.Act1", "contest")

@@ -1,0 +1,30 @@
+"""``retrokit playback MOVIE.bk2 OUT [--every N] [--overwrite]``: replay a movie into images or a video."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``playback`` command."""
+    parser = subparsers.add_parser(
+        "playback",
+        help="replay a .bk2 movie into PNG frames, a GIF or an MP4",
+        description="Replay a .bk2 movie (recorded by retrokit or stable-retro) on its game's ROM, "
+        "and write the screens: into a folder as frame_000000.png, ... (numbered by movie frame), "
+        "or into OUT.gif, or OUT.mp4 (needs: pip install imageio imageio-ffmpeg).",
+    )
+    parser.add_argument("movie", metavar="MOVIE.bk2", help="the movie to replay")
+    parser.add_argument("out", metavar="OUT", help="a folder for PNG frames, or a .gif or .mp4 file")
+    parser.add_argument("--every", type=int, default=1, metavar="N", help="keep one frame in N (default: 1, all)")
+    parser.add_argument("--overwrite", action="store_true", help="replace an existing output file or frames")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Replay the movie and write its screens."""
+    from retrokit.movie import export
+
+    count = export(args.movie, args.out, every=args.every, overwrite=args.overwrite)
+    print(f"Wrote {count} frame{'s' * (count != 1)} of {args.movie} to {args.out}.")
+    return 0

@@ -1,0 +1,201 @@
+"""Replaying movies on retrokit's emulator, and exporting them as images or video."""
+
+from __future__ import annotations
+
+import io
+import os
+import tempfile
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+
+from retrokit.emulator import Emulator
+from retrokit.errors import FileConflictError, GameNotFoundError, InvalidArgumentError, MovieError, RomError
+from retrokit.movie.bk2 import read_bk2
+from retrokit.movie.model import Movie
+from retrokit.paths import atomic_write
+
+FRAME_PATTERN = "frame_{:06d}.png"
+VIDEO_SUFFIXES = (".gif", ".mp4")
+
+
+def open_emulator(movie: Movie) -> Emulator:
+    """Return an emulator running the movie's game, with a port for every player.
+
+    Raises:
+        GameNotFoundError: No game folder has the movie's game.
+        RomNotFoundError: The game's ROM has not been imported.
+    """
+    from retrokit.games import find_game
+
+    rom = find_game(movie.game).require_rom()
+    return Emulator(movie.system, rom, ports=max(2, movie.players))
+
+
+def play(movie: Movie | str | os.PathLike[str], *, emulator: Emulator | None = None) -> Iterator[np.ndarray]:
+    """Replay a movie, yielding the screen after each of its frames.
+
+    The emulator is set to the movie's start state (or reset to power-on if it
+    has none), then runs one frame per movie frame with that frame's buttons.
+
+    Args:
+        movie: A movie, or the path of a ``.bk2`` file.
+        emulator: An emulator of the movie's game to replay on; its sticky-action
+            probability is set to 0. By default one is opened (and closed after).
+
+    Yields:
+        RGB ``uint8`` arrays of shape (H, W, 3), one per movie frame.
+
+    Raises:
+        MovieError: The movie is malformed, or ``emulator`` runs another system or has too few ports.
+    """
+    if not isinstance(movie, Movie):
+        movie = read_bk2(movie)
+    own = emulator is None
+    emu = open_emulator(movie) if emulator is None else emulator
+    try:
+        if emu.system.name != movie.system or emu.ports < movie.players:
+            raise MovieError(
+                f"Expected an emulator of {movie.system} with at least {movie.players} port(s) to play "
+                f"{movie.game}; found one of {emu.system.name} with {emu.ports}."
+            )
+        emu.set_sticky(0.0, 0)
+        emu.forget_action()
+        if movie.state is not None:
+            emu.set_state(movie.state)
+        else:
+            emu.reset()
+        for frame in movie.frames:
+            emu.run(frame, 1)
+            yield emu.screen()
+    finally:
+        if own:
+            emu.close()
+
+
+def export(
+    movie_path: str | os.PathLike[str],
+    out: str | os.PathLike[str],
+    *,
+    every: int = 1,
+    overwrite: bool = False,
+) -> int:
+    """Replay a movie into PNG frames, an animated GIF or an MP4 video.
+
+    Args:
+        movie_path: The ``.bk2`` file.
+        out: A folder for ``frame_000000.png``, ... (named by movie frame), or a
+            file ending in ``.gif`` (Pillow) or ``.mp4`` (needs ``imageio`` with ffmpeg).
+        every: Keep one frame in ``every`` (the video's frame rate shrinks to match).
+        overwrite: Replace the output file, or frames already in the folder.
+
+    Returns:
+        How many images were written.
+
+    Raises:
+        InvalidArgumentError: ``every`` is below 1, ``out`` names an unknown format,
+            or ``.mp4`` was asked for without imageio's ffmpeg.
+        FileConflictError: The output exists and ``overwrite`` is false.
+        MovieError: The movie is malformed.
+    """
+    if not isinstance(every, int) or every < 1:
+        raise InvalidArgumentError(f"Expected every to be a whole number of frames, 1 or more; found {every!r}.")
+    out = Path(out)
+    kind = _output_kind(out)
+    if kind == ".mp4":
+        imageio = _require_imageio(out)
+    if not overwrite and (out.exists() if kind else any(out.glob("frame_*.png"))):
+        raise FileConflictError(
+            f"Expected {'no file at ' + str(out) if kind else 'no frames in ' + str(out)}; found "
+            f"{'one' if kind else 'frames from an earlier export'}. Choose another path, or pass overwrite (--overwrite)."
+        )
+    movie = read_bk2(movie_path)
+    try:
+        emu = open_emulator(movie)
+    except (GameNotFoundError, RomError) as exc:
+        raise type(exc)(f"{movie_path} plays {movie.game}. {exc}") from None
+    try:
+        fps = float(emu.av_info()["fps"]) / every
+        frames = ((i, f) for i, f in enumerate(play(movie, emulator=emu)) if i % every == 0)
+        if kind is None:
+            return _write_pngs(frames, out)
+        if kind == ".gif":
+            return _write_gif(frames, out, fps, overwrite)
+        return _write_mp4(imageio, frames, out, fps, overwrite)
+    finally:
+        emu.close()
+
+
+def _output_kind(out: Path) -> str | None:
+    """Return ``".gif"`` or ``".mp4"`` for a video file, ``None`` for a folder of PNGs."""
+    if out.is_dir():
+        return None
+    suffix = out.suffix.lower()
+    if suffix in VIDEO_SUFFIXES:
+        return suffix
+    if suffix:
+        raise InvalidArgumentError(
+            f"Expected the output to be a folder (for PNG frames), a .gif or an .mp4 file; found {str(out)!r}."
+        )
+    return None
+
+
+def _require_imageio(out: Path):  # noqa: ANN202 - the imageio.v2 module
+    try:
+        import imageio.v2 as imageio
+        import imageio_ffmpeg  # noqa: F401 - the plugin that writes .mp4
+    except ImportError:
+        raise InvalidArgumentError(
+            f"Expected imageio with its ffmpeg plugin to write {out}; found them not installed. "
+            "Export to a .gif or to a folder of PNG frames instead, or: pip install imageio imageio-ffmpeg"
+        ) from None
+    return imageio
+
+
+def _write_pngs(frames: Iterator[tuple[int, np.ndarray]], folder: Path) -> int:
+    from PIL import Image
+
+    folder.mkdir(parents=True, exist_ok=True)
+    count = 0
+    for index, frame in frames:
+        Image.fromarray(frame).save(folder / FRAME_PATTERN.format(index))
+        count += 1
+    return count
+
+
+def _write_gif(frames: Iterator[tuple[int, np.ndarray]], out: Path, fps: float, overwrite: bool) -> int:
+    from PIL import Image
+
+    images = [Image.fromarray(frame) for _, frame in frames]
+    if not images:
+        raise MovieError(f"Expected a movie with frames to write {out}; found none.")
+    buffer = io.BytesIO()
+    images[0].save(buffer, "GIF", save_all=True, append_images=images[1:], duration=round(1000 / fps), loop=0)
+    _place(out, buffer.getvalue(), overwrite)
+    return len(images)
+
+
+def _write_mp4(imageio, frames: Iterator[tuple[int, np.ndarray]], out: Path, fps: float, overwrite: bool) -> int:  # noqa: ANN001
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp_name = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=".mp4", dir=out.parent)
+    os.close(fd)
+    count = 0
+    try:
+        with imageio.get_writer(tmp_name, fps=fps, codec="libx264", macro_block_size=1) as writer:
+            for _, frame in frames:
+                writer.append_data(frame)
+                count += 1
+        _place(out, Path(tmp_name).read_bytes(), overwrite)
+    finally:
+        Path(tmp_name).unlink(missing_ok=True)
+    return count
+
+
+def _place(out: Path, data: bytes, overwrite: bool) -> None:
+    try:
+        atomic_write(out, data, overwrite=overwrite)
+    except FileExistsError:
+        raise FileConflictError(
+            f"Expected no file at {out}; found one. Choose another path, or pass overwrite (--overwrite)."
+        ) from None

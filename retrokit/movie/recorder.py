@@ -1,0 +1,103 @@
+"""Recording an episode's buttons into a ``.bk2`` movie, one frame at a time."""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+from retrokit.errors import FileConflictError, MovieError
+from retrokit.movie.bk2 import write_bk2
+from retrokit.movie.model import Movie, layout
+
+
+class MovieRecorder:
+    """Collects the buttons of every emulated frame, and writes the movie on :meth:`close`.
+
+    Record every frame the console runs, with the buttons that frame really saw
+    (after sticky actions), starting from ``start_state``; then the movie replays
+    exactly. stable-retro's own recordings begin with the frame its ``reset``
+    runs with no buttons pressed.
+
+    Args:
+        path: The ``.bk2`` file to write.
+        game: The game's name, ``<Name>-<System>``.
+        system: The system's name.
+        players: How many players' buttons each frame holds.
+        start_state: The uncompressed state the episode starts from, or ``None``
+            for power-on (stable-retro cannot open movies without a state).
+        overwrite: Replace a file already at ``path``.
+
+    Raises:
+        FileConflictError: A file is already at ``path`` and ``overwrite`` is false.
+    """
+
+    def __init__(
+        self,
+        path: str | os.PathLike[str],
+        game: str,
+        system: str,
+        players: int = 1,
+        start_state: bytes | None = None,
+        *,
+        overwrite: bool = False,
+    ) -> None:
+        self.path = Path(path)
+        if not overwrite and self.path.exists():  # fail before the episode, not after it
+            raise FileConflictError(
+                f"Expected no file at {self.path} to record a movie into; found one. "
+                "Delete it, choose another name, or pass overwrite=True to replace it."
+            )
+        self.movie = Movie(game, system, players, start_state)
+        self._layout = layout(self.movie.system)
+        self._players = self.movie.players
+        self._overwrite = overwrite
+        self._closed = False
+
+    def record(self, masks: Sequence[int]) -> None:
+        """Append one frame: one RetroPad bit mask per port.
+
+        Masks beyond the movie's players must be 0 (e.g. an emulator's idle second port).
+
+        Raises:
+            MovieError: The recorder is closed, too few masks are given, a port beyond
+                the players presses buttons, or a mask presses a button the format
+                cannot hold.
+        """
+        if self._closed:
+            raise MovieError(f"Expected an open recorder; found it closed after writing {self.path}. Make a new one.")
+        frame = tuple(int(m) for m in masks[: self._players])
+        where = f"{self.path} frame {len(self.movie.frames)}"
+        if len(frame) < self._players or any(int(m) for m in masks[self._players :]):
+            raise MovieError(
+                f"{where}: expected {self._players} mask(s), one per player, then only zeros; found {list(masks)!r}."
+            )
+        if any(m < 0 or m & ~self._layout.allowed for m in frame):
+            self._layout.check_frame(frame, self._players, where)  # raises, naming the button
+        self.movie.frames.append(frame)
+
+    def __len__(self) -> int:
+        """How many frames have been recorded."""
+        return len(self.movie.frames)
+
+    @property
+    def closed(self) -> bool:
+        """Whether :meth:`close` has written the movie."""
+        return self._closed
+
+    def close(self) -> Path:
+        """Write the movie (once; later calls do nothing) and return its path.
+
+        Raises:
+            FileConflictError: A different file appeared at the path meanwhile.
+        """
+        if not self._closed:
+            write_bk2(self.path, self.movie, overwrite=self._overwrite)
+            self._closed = True
+        return self.path
+
+    def __enter__(self) -> MovieRecorder:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

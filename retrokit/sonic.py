@@ -1,0 +1,147 @@
+"""The Sonic benchmark of "Gotta Learn Fast" (Nichol et al., 2018), as a preset.
+
+58 levels of Sonic 1, Sonic 2 and Sonic 3 & Knuckles, split 47 for training
+and 11 for testing. Each env has the benchmark's rules: sticky frame skip 4
+with p = 0.25, episodes of 4500 steps, and the contest scenario, whose reward
+is 9000 for reaching the level's end plus a completion bonus of up to 1000.
+The scenario runs after every frame, as the paper's frame-skip wrapper did.
+
+The ROMs are the user's to import (``retrokit import``); the states are the
+ones the stable-retro wheel ships.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium
+import numpy as np
+from gymnasium import spaces
+
+from retrokit.env import RetroEnv
+from retrokit.errors import InvalidArgumentError, StateNotFoundError, did_you_mean
+from retrokit.games import find_game
+
+GAMES = ("SonicTheHedgehog-Genesis", "SonicTheHedgehog2-Genesis", "SonicAndKnuckles3-Genesis")
+
+#: The paper's test levels; every other state of the three games is a training level.
+TEST_LEVELS = {
+    "SonicTheHedgehog-Genesis": ("SpringYardZone.Act1", "GreenHillZone.Act2", "StarLightZone.Act3", "ScrapBrainZone.Act1"),
+    "SonicTheHedgehog2-Genesis": ("MetropolisZone.Act3", "HillTopZone.Act2", "CasinoNightZone.Act2"),
+    "SonicAndKnuckles3-Genesis": ("LavaReefZone.Act1", "FlyingBatteryZone.Act2", "HydrocityZone.Act1", "AngelIslandZone.Act2"),
+}
+
+#: The baselines' 7 button combinations.
+ACTIONS = (("LEFT",), ("RIGHT",), ("LEFT", "DOWN"), ("RIGHT", "DOWN"), ("DOWN",), ("DOWN", "B"), ("B",))
+#: The same with the no-op first: 8 actions.
+ACTIONS_WITH_NOOP = ((),) + ACTIONS
+
+FRAMESKIP = 4
+STICKY_PROB = 0.25
+MAX_EPISODE_STEPS = 4500
+
+
+def levels() -> list[tuple[str, str]]:
+    """Return every benchmark level as ``(game, state)``, in a stable order."""
+    return [(game, state) for game in GAMES for state in sorted(find_game(game).states)]
+
+
+def test_levels() -> list[tuple[str, str]]:
+    """Return the paper's 11 test levels."""
+    return [(game, state) for game, states in TEST_LEVELS.items() for state in states]
+
+
+def train_levels() -> list[tuple[str, str]]:
+    """Return the paper's 47 training levels."""
+    test = set(test_levels())
+    return [level for level in levels() if level not in test]
+
+
+class Discretizer(gymnasium.ActionWrapper):
+    """Turns a Discrete choice into one of a list of button combinations.
+
+    Args:
+        env: A :class:`RetroEnv` with ``action_type="all"``.
+        combos: Button-name combinations, one per action.
+    """
+
+    def __init__(self, env: gymnasium.Env, combos: tuple[tuple[str, ...], ...]) -> None:
+        super().__init__(env)
+        base: RetroEnv = env.unwrapped  # type: ignore[assignment]
+        if base.actions.action_type != "all":
+            raise InvalidArgumentError(f"Expected an env with action_type='all', got {base.actions.action_type!r}.")
+        width = base.action_space.n  # type: ignore[attr-defined]
+        self._arrays = []
+        for combo in combos:
+            mask = base.emulator.system.mask(combo)
+            self._arrays.append(np.array([(mask >> i) & 1 for i in range(width)], dtype=np.int8))
+        self.combos = combos
+        self.action_space = spaces.Discrete(len(combos))
+
+    def action(self, action: int) -> np.ndarray:
+        return self._arrays[int(action)]
+
+
+class AllowBacktracking(gymnasium.Wrapper):
+    """Rewards only new progress: the step's gain past the best x so far.
+
+    The baselines' preprocessing: with the contest reward (progress), going
+    back and forth no longer costs reward, so agents may backtrack freely.
+    """
+
+    def __init__(self, env: gymnasium.Env) -> None:
+        super().__init__(env)
+        self._current = self._best = 0.0
+
+    def reset(self, **kwargs: Any):
+        self._current = self._best = 0.0
+        return self.env.reset(**kwargs)
+
+    def step(self, action: Any):
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        self._current += reward
+        reward = max(0.0, self._current - self._best)
+        self._best = max(self._best, self._current)
+        return obs, reward, terminated, truncated, info
+
+
+def make(
+    game: str,
+    state: str,
+    *,
+    scenario: str = "contest",
+    noop: bool = False,
+    allow_backtracking: bool = False,
+    **options: Any,
+) -> gymnasium.Env:
+    """Make a benchmark level's env with the paper's rules.
+
+    Args:
+        game: One of :data:`GAMES`.
+        state: The level, e.g. ``"GreenHillZone.Act1"``.
+        scenario: ``"contest"`` (the benchmark's) or ``"xpos"``.
+        noop: Use the 8 actions that include the no-op instead of the 7.
+        allow_backtracking: Reward only progress past the best x so far.
+        **options: Other :class:`RetroEnv` options (``obs_type``, ``render_mode``, ``record``...).
+
+    Raises:
+        RomNotFoundError: The game's ROM has not been imported; the message says how.
+    """
+    if game not in GAMES:
+        raise InvalidArgumentError(f"Expected one of the benchmark's games {GAMES}, got {game!r}." + did_you_mean(game, GAMES))
+    states = find_game(game).states
+    if state not in states:
+        raise StateNotFoundError(f"Expected a level of {game} ({', '.join(sorted(states))}), got {state!r}." + did_you_mean(state, states))
+    settings = {
+        "frameskip": FRAMESKIP,
+        "sticky_prob": STICKY_PROB,
+        "max_episode_steps": MAX_EPISODE_STEPS,
+        "scenario_every_frame": True,
+        **options,
+        "action_type": "all",
+    }
+    env: gymnasium.Env = RetroEnv(game, state, scenario, **settings)
+    env = Discretizer(env, ACTIONS_WITH_NOOP if noop else ACTIONS)
+    if allow_backtracking:
+        env = AllowBacktracking(env)
+    return env

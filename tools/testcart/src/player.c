@@ -16,7 +16,7 @@
 #define JUMP_RELEASE 0x300 /* rising speed kept when jump is let go early */
 #define GRAVITY 0x30
 #define MAX_FALL 0x800
-#define STEP 8            /* rises of up to 8 px are walked up, higher = wall */
+#define STEP 8            /* on foot, rises of up to 8 px are walked up */
 #define DEATH_FRAMES 120  /* death animation before respawning */
 #define HURT_INVULN 120
 #define SPAWN_INVULN 60
@@ -91,22 +91,24 @@ static void run(struct player *p, u8 held)
     }
 }
 
-/* Move along x, stopping at walls (ground rising more than STEP above the
- * feet) and at the level's ends. */
+/* Move along x, stopping at walls and at the level's ends.  On the ground a
+ * rise of up to STEP pixels is a step; in the air any floor above the feet
+ * is a wall, so a player who drops into a pit cannot climb out of it. */
 static void move_x(struct player *p)
 {
     s32 pos = ((s32)p->x << 8) + p->xsub + p->vx;
     s16 nx = (s16)(pos >> 8);
+    s16 limit = p->on_ground ? p->y - STEP : p->y;
     if (p->vx > 0) {
         s16 edge = nx + PLAYER_HALF_W;
-        if (world_ground_y(edge) < p->y - STEP) {
+        if (world_ground_y(edge) < limit) {
             nx = (edge & ~7) - PLAYER_HALF_W - 1;
             pos = (s32)nx << 8;
             p->vx = 0;
         }
     } else if (p->vx < 0) {
         s16 edge = nx - PLAYER_HALF_W;
-        if (world_ground_y(edge) < p->y - STEP) {
+        if (world_ground_y(edge) < limit) {
             nx = (edge | 7) + 1 + PLAYER_HALF_W;
             pos = (s32)nx << 8;
             p->vx = 0;
@@ -150,7 +152,8 @@ static void move_y(struct player *p)
         s32 pos = ((s32)p->y << 8) + p->ysub + p->vy;
         p->y = (s16)(pos >> 8);
         p->ysub = (u8)pos;
-        if (p->vy >= 0 && gnd != NO_GROUND && p->y >= gnd && old <= gnd + STEP) {
+        /* Land only when the feet cross the floor's top this frame. */
+        if (p->vy >= 0 && gnd != NO_GROUND && p->y >= gnd && old <= gnd) {
             p->y = gnd;
             p->ysub = 0;
             p->vy = 0;

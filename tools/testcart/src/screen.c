@@ -16,7 +16,6 @@
 
 static u16 sprites[MAX_SPRITES][4];
 static u16 sprite_count;
-static u8 title_zone_shown;
 
 static void sprite_add(s16 x, s16 y, u16 attr)
 {
@@ -158,10 +157,10 @@ static u16 selected_zone(void)
 /* The title has no HUD, so no dark bar behind it either. */
 static void clear_hud_bar(void)
 {
-    u16 col, row;
-    for (row = 0; row < 2; row++)
-        for (col = 0; col < PLANE_W; col++)
-            vdp_put(VRAM_PLANE_B, col, row, 0);
+    u16 i;
+    vdp_vram_write_addr(VRAM_PLANE_B);
+    for (i = 0; i < 2 * PLANE_W; i++)
+        VDP_DATA = 0;
 }
 
 static void text_centre(u16 row, const char *s)
@@ -175,10 +174,9 @@ static void text_centre(u16 row, const char *s)
 void screen_title_draw(void)
 {
     u16 col, row;
-    title_zone_shown = selected_zone();
     vdp_set_reg(18, 0); /* no HUD window */
     vdp_fill_plane(VRAM_PLANE_A, 0);
-    world_draw_background(title_zone_shown);
+    world_draw_background(selected_zone());
     clear_hud_bar();
     for (col = 0; col < 40; col++) {
         vdp_put(VRAM_PLANE_A, col, 24, TILE_ATTR(PAL_TERRAIN, 0, 0, T_GRASS));
@@ -187,20 +185,18 @@ void screen_title_draw(void)
     }
     text_centre(5, "D A S H E R");
     text_centre(7, "A TINY PLATFORMER");
-    text_centre(21, "RETROKIT TEST CARTRIDGE");
+    text_centre(19, "RETROKIT TEST CARTRIDGE");
     vdp_hscroll(0, 0);
 }
 
+/* Every frame: the level select is shown from RAM, so a zone or act written
+ * by a tool appears at once (the palette follows the zone too).  Kept short
+ * so the loop never misses a frame, and with it a START press. */
 void screen_title_update(void)
 {
     u16 zone = selected_zone();
     char line[] = "ZONE 1  ACT 1";
     u16 act = RAM.act < 2 ? RAM.act : 0;
-    if (zone != title_zone_shown) { /* a tool changed the level select */
-        title_zone_shown = zone;
-        world_draw_background(zone);
-        clear_hud_bar();
-    }
     art_zone_palette(zone);
     line[5] = '1' + zone;
     line[12] = '1' + act;

@@ -136,39 +136,41 @@ static void draw_view(s16 left)
 static const char hills[PLANE_W + 1] =
     "3345665432233455677765443222345566543323456777654322234566554332";
 
+/* Clouds by day, stars by night: (column, row) of each. */
+static const u8 sky[][2] = {{3, 4}, {14, 7}, {24, 3}, {37, 6}, {47, 4}, {57, 8}};
+
+static u16 background_cell(u16 zone, u16 col, u16 row)
+{
+    u16 h = hills[col] - '0', i;
+    if (row < 2)
+        return T_HUD_BG; /* a solid bar behind the HUD's transparent text */
+    if (row == ROWS - h) {
+        u16 hl = hills[(col - 1) & (PLANE_W - 1)] - '0';
+        u16 hr = hills[(col + 1) & (PLANE_W - 1)] - '0';
+        return hl < h ? T_HILL_UP : hr < h ? T_HILL_DOWN : T_HILL;
+    }
+    if (row > ROWS - h)
+        return T_HILL;
+    for (i = 0; i < sizeof(sky) / sizeof(sky[0]); i++) {
+        u16 c = sky[i][0], r = sky[i][1];
+        if (zone == 2) {
+            if ((col == c && row == r) || (col == c + 5 && row == r + 3))
+                return T_STAR;
+        } else if (row == r && col >= c && col < c + 3) {
+            return T_CLOUD_L + (col - c);
+        }
+    }
+    return T_BLANK;
+}
+
+/* Plane B, row by row.  The title clears the HUD bar afterwards. */
 void world_draw_background(u16 zone)
 {
     u16 col, row;
-    vdp_fill_plane(VRAM_PLANE_B, 0);
-    for (col = 0; col < PLANE_W; col++) {
-        u16 h = hills[col] - '0';
-        u16 hl = hills[(col - 1) & (PLANE_W - 1)] - '0';
-        u16 hr = hills[(col + 1) & (PLANE_W - 1)] - '0';
-        u16 top_tile = hl < h ? T_HILL_UP : hr < h ? T_HILL_DOWN : T_HILL;
-        for (row = ROWS - h; row < ROWS; row++)
-            vdp_put(VRAM_PLANE_B, col, row,
-                    TILE_ATTR(PAL_TERRAIN, 0, 0, row == ROWS - h ? top_tile : T_HILL));
-    }
-    /* Clouds by day, stars by night: (column, row) of each. */
-    {
-        static const u8 sky[][2] = {{3, 4}, {14, 7}, {24, 3}, {37, 6}, {47, 4}, {57, 8}};
-        u16 i;
-        for (i = 0; i < sizeof(sky) / sizeof(sky[0]); i++) {
-            u16 c = sky[i][0], r = sky[i][1];
-            if (zone == 2) {
-                vdp_put(VRAM_PLANE_B, c, r, TILE_ATTR(PAL_TERRAIN, 0, 0, T_STAR));
-                vdp_put(VRAM_PLANE_B, c + 5, r + 3, TILE_ATTR(PAL_TERRAIN, 0, 0, T_STAR));
-            } else {
-                vdp_put(VRAM_PLANE_B, c, r, TILE_ATTR(PAL_TERRAIN, 0, 0, T_CLOUD_L));
-                vdp_put(VRAM_PLANE_B, c + 1, r, TILE_ATTR(PAL_TERRAIN, 0, 0, T_CLOUD_M));
-                vdp_put(VRAM_PLANE_B, c + 2, r, TILE_ATTR(PAL_TERRAIN, 0, 0, T_CLOUD_R));
-            }
-        }
-    }
-    /* A solid bar behind the HUD (the window plane's text is transparent). */
-    for (row = 0; row < 2; row++)
+    vdp_vram_write_addr(VRAM_PLANE_B);
+    for (row = 0; row < 32; row++)
         for (col = 0; col < PLANE_W; col++)
-            vdp_put(VRAM_PLANE_B, col, row, TILE_ATTR(PAL_TERRAIN, 0, 0, T_HUD_BG));
+            VDP_DATA = row < ROWS ? TILE_ATTR(PAL_TERRAIN, 0, 0, background_cell(zone, col, row)) : 0;
 }
 
 void world_load(u16 zone, u16 act)

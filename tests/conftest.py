@@ -51,3 +51,9 @@ def airstriker(airstriker_rom: Path, airstriker_state: bytes):
     emu.set_state(airstriker_state)
     yield emu
     emu.close()
+
+
+@pytest.fixture(scope="session")
+def dasher_rom() -> Path:
+    """Dasher, our own test cartridge (built from tools/testcart, committed as a free ROM)."""
+    return REPO / "games" / "Dasher-Genesis" / "rom.md"

@@ -37,6 +37,7 @@ from pathlib import Path
 
 from retrokit.errors import FileConflictError, MovieError, UnsupportedSystemError
 from retrokit.movie.model import Layout, Movie, layout, platform_of, system_of_platform
+from retrokit.paths import atomic_write
 
 INPUT_LOG = "Input Log.txt"
 HEADER = "Header.txt"

@@ -51,31 +51,38 @@ static const char font[][GLYPH_CHARS + 1] = {
     "/" "....#" "....#" "...#." "..#.." ".#..." "#...." "#....",
 };
 
-/* Is pixel (x, y) of the 5x7 glyph inked?  Outside the glyph: no. */
-static int inked(const char *g, s16 x, s16 y)
+/* Glyph rows as bit masks: bit 7 = the cell's leftmost pixel.  The glyph
+ * sits one pixel in from the left. */
+static void glyph_rows(const char *g, u8 *rows)
 {
-    if (x < 0 || x > 4 || y < 0 || y > 6)
-        return 0;
-    return g[1 + y * 5 + x] == '#';
+    u16 x, y;
+    for (y = 0; y < 8; y++) {
+        u8 bits = 0;
+        if (y < 7)
+            for (x = 0; x < 5; x++)
+                if (g[1 + y * 5 + x] == '#')
+                    bits |= 0x40 >> x;
+        rows[y] = bits;
+    }
 }
 
 void font_load(void)
 {
     u16 i, x, y;
-    char art[64];
+    u8 rows[8];
     for (i = 0; i < sizeof(font) / sizeof(font[0]); i++) {
-        const char *g = font[i];
-        /* Glyph at column 1 of the cell; colour F = ink, 1 = shadow. */
-        for (y = 0; y < 8; y++)
+        glyph_rows(font[i], rows);
+        vdp_vram_write_addr((T_FONT + (u8)font[i][0]) * 32);
+        for (y = 0; y < 8; y++) {
+            /* Colour F = ink; 1 = shadow, down and right of the ink. */
+            u8 ink = rows[y];
+            u8 shadow = (u8)((y ? rows[y - 1] : 0) >> 1) & (u8)~ink;
+            u32 line = 0;
             for (x = 0; x < 8; x++) {
-                s16 gx = (s16)x - 1, gy = (s16)y;
-                char c = '.';
-                if (inked(g, gx, gy))
-                    c = 'F';
-                else if (inked(g, gx - 1, gy - 1))
-                    c = '1';
-                art[y * 8 + x] = c;
+                u8 bit = 0x80 >> x;
+                line = (line << 4) | (ink & bit ? 0xF : shadow & bit ? 0x1 : 0x0);
             }
-        vdp_load_tile(T_FONT + (u8)g[0], art);
+            VDP_DATA32 = line;
+        }
     }
 }

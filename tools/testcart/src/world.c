@@ -139,38 +139,44 @@ static const char hills[PLANE_W + 1] =
 /* Clouds by day, stars by night: (column, row) of each. */
 static const u8 sky[][2] = {{3, 4}, {14, 7}, {24, 3}, {37, 6}, {47, 4}, {57, 8}};
 
-static u16 background_cell(u16 zone, u16 col, u16 row)
-{
-    u16 h = hills[col] - '0', i;
-    if (row < 2)
-        return T_HUD_BG; /* a solid bar behind the HUD's transparent text */
-    if (row == ROWS - h) {
-        u16 hl = hills[(col - 1) & (PLANE_W - 1)] - '0';
-        u16 hr = hills[(col + 1) & (PLANE_W - 1)] - '0';
-        return hl < h ? T_HILL_UP : hr < h ? T_HILL_DOWN : T_HILL;
-    }
-    if (row > ROWS - h)
-        return T_HILL;
-    for (i = 0; i < sizeof(sky) / sizeof(sky[0]); i++) {
-        u16 c = sky[i][0], r = sky[i][1];
-        if (zone == 2) {
-            if ((col == c && row == r) || (col == c + 5 && row == r + 3))
-                return T_STAR;
-        } else if (row == r && col >= c && col < c + 3) {
-            return T_CLOUD_L + (col - c);
-        }
-    }
-    return T_BLANK;
-}
-
-/* Plane B, row by row.  The title clears the HUD bar afterwards. */
+/* Plane B, row by row: a dark bar behind the HUD (rows 0-1; the window
+ * plane's text is transparent), then sky with clouds (stars at night), then
+ * hills.  The title clears the HUD bar afterwards. */
 void world_draw_background(u16 zone)
 {
-    u16 col, row;
+    static u16 row_cells[PLANE_W];
+    u16 col, row, i;
     vdp_vram_write_addr(VRAM_PLANE_B);
-    for (row = 0; row < 32; row++)
+    for (row = 0; row < 32; row++) {
+        for (col = 0; col < PLANE_W; col++) {
+            u16 h = hills[col] - '0', t = T_BLANK;
+            if (row < 2) {
+                t = T_HUD_BG;
+            } else if (row == ROWS - h) {
+                u16 hl = hills[(col - 1) & (PLANE_W - 1)] - '0';
+                u16 hr = hills[(col + 1) & (PLANE_W - 1)] - '0';
+                t = hl < h ? T_HILL_UP : hr < h ? T_HILL_DOWN : T_HILL;
+            } else if (row > ROWS - h && row < ROWS) {
+                t = T_HILL;
+            }
+            row_cells[col] = t;
+        }
+        for (i = 0; i < sizeof(sky) / sizeof(sky[0]); i++) {
+            u16 c = sky[i][0], r = sky[i][1];
+            if (zone == 2) {
+                if (row == r)
+                    row_cells[c] = T_STAR;
+                if (row == r + 3)
+                    row_cells[c + 5] = T_STAR;
+            } else if (row == r) {
+                row_cells[c] = T_CLOUD_L;
+                row_cells[c + 1] = T_CLOUD_M;
+                row_cells[c + 2] = T_CLOUD_R;
+            }
+        }
         for (col = 0; col < PLANE_W; col++)
-            VDP_DATA = row < ROWS ? TILE_ATTR(PAL_TERRAIN, 0, 0, background_cell(zone, col, row)) : 0;
+            VDP_DATA = TILE_ATTR(PAL_TERRAIN, 0, 0, row_cells[col]);
+    }
 }
 
 void world_load(u16 zone, u16 act)

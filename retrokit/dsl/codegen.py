@@ -75,6 +75,8 @@ class CodeGen:
         for i, (root, snippet) in enumerate(zip(self.a.rewards, self.a.spec.rewards)):
             body.append(f"_r{i} = _float({self.expr(root, mode, snippet)})")
             rewards.append(f"_r{i}")
+        if not rewards:  # no reward given: 0 for the one player
+            rewards.append("0.0")
         if self.a.done is not None:
             assert self.a.spec.done is not None
             body.append(f"_done = {self.expr(self.a.done, mode, self.a.spec.done)}")

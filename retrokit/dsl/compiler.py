@@ -65,7 +65,7 @@ class Program:
     def _divzero(self, index: int) -> None:
         site: Site = self._sites[index]
         node = site.node
-        divisor = site.snippet.text[node.right.start : node.right.end]  # type: ignore[attr-defined]
+        divisor = site.snippet.text[node.op_start + len(node.op) : node.end].strip()  # type: ignore[attr-defined]
         raise site.snippet.error(
             ScenarioRuntimeError, node.start, node.end,
             f"scenario {self.name!r}: division by zero: the divisor {divisor} is 0",

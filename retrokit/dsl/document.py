@@ -174,7 +174,10 @@ class DocumentLoader:
             for item in self._list(reader, entries["include"][1], "include"):
                 if base is None:
                     raise reader.error(entries["include"][1], "include needs a folder to look in: pass game_dir")
-                self.load_file(base / str(reader.plain(item)), top=False)
+                target = base / str(reader.plain(item))
+                if not target.is_file():
+                    raise reader.error(item, f"no file {str(reader.plain(item))!r} to include (looked for {target})")
+                self.load_file(target, top=False)
         if "name" in entries:
             spec.name = str(reader.plain(entries["name"][1]))
         if "tables" in entries:

@@ -3,9 +3,10 @@
 
 /*
  * Randomness: a 16-bit xorshift whose state is stirred with the frame
- * counter every frame.  Everything random (crawler pauses) therefore depends
- * on when things happen, so sticky or delayed inputs change outcomes while
- * the same inputs from power-on always replay the same game.
+ * counter and both pads every frame.  Everything random (crawler pauses)
+ * therefore depends on what was pressed when, so a delayed START or a sticky
+ * action changes the crawlers' timing, while the same inputs from power-on
+ * (or from a save state) always replay the same game.
  */
 static u16 xorshift(u16 r)
 {
@@ -17,7 +18,8 @@ static u16 xorshift(u16 r)
 
 void rng_stir(void)
 {
-    RAM.rng = xorshift(RAM.rng ^ (u16)RAM.frame ^ 0x2545);
+    u16 pads = ((u16)RAM.pad[0] << 8) | RAM.pad[1];
+    RAM.rng = xorshift(RAM.rng ^ (u16)RAM.frame ^ pads ^ 0x2545);
 }
 
 u16 rng_next(void)

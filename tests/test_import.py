@@ -130,3 +130,16 @@ def test_unreadable_inputs_are_reported(src, data_dir):
     assert "not a readable zip file" in reasons[str(src / "broken.zip")]
     assert reasons[str(src / "missing-folder")] == "no such file or folder"
     assert report.imported == []
+
+
+def test_written_files_get_the_usual_permissions(tmp_path):
+    import os
+
+    from retrokit.paths import atomic_write
+
+    umask = os.umask(0o022)
+    try:
+        atomic_write(tmp_path / "f.bin", b"data")
+    finally:
+        os.umask(umask)
+    assert (tmp_path / "f.bin").stat().st_mode & 0o777 == 0o644

@@ -84,7 +84,6 @@ _start:
     dbra    %d0, 2b
     move.b  %d7, ADDR_HW_VERSION
     move.b  %d6, ADDR_TMSS
-    addq.b  #1, ADDR_BOOTS
 
     /* Copy initialised data from ROM to RAM (.bss was cleared above). */
     lea     _data_load, %a0

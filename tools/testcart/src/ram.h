@@ -38,7 +38,6 @@
 #define ADDR_SELFTEST 0xFF001A   /* |u1 1 = multiply/divide helpers passed at boot */
 #define ADDR_CRASH 0xFF001B      /* |u1 CPU exception vector number, 0 = none */
 #define ADDR_LEVEL_WIDTH 0xFF001C /* >u2 width of the act in pixels */
-#define ADDR_BOOTS 0xFF001E      /* |u1 times the boot code ran (power-on, resets) */
 
 /* --- Players: two 32-byte records ------------------------------------------ */
 #define ADDR_P1 0xFF0020
@@ -151,7 +150,7 @@ struct ram {
     u8 pad[2], pad_new[2];
     u8 hw_version, tmss, selftest, crash;
     u16 level_width;
-    u8 boots, spare1;
+    u8 spare1[2];
     struct player p[2];
     struct enemy enemies[MAX_ENEMIES];
     u8 enemy_count, ring_count;
@@ -183,7 +182,6 @@ _Static_assert(OFF(tmss) == ADDR_TMSS - RAM_BASE, "tmss");
 _Static_assert(OFF(selftest) == ADDR_SELFTEST - RAM_BASE, "selftest");
 _Static_assert(OFF(crash) == ADDR_CRASH - RAM_BASE, "crash");
 _Static_assert(OFF(level_width) == ADDR_LEVEL_WIDTH - RAM_BASE, "level_width");
-_Static_assert(OFF(boots) == ADDR_BOOTS - RAM_BASE, "boots");
 _Static_assert(OFF(p) == ADDR_P1 - RAM_BASE, "p1");
 _Static_assert(OFF(p[1]) == ADDR_P2 - RAM_BASE, "p2");
 _Static_assert(sizeof(struct player) == PLAYER_SIZE, "player size");

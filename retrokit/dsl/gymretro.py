@@ -41,19 +41,19 @@ DONE_KEYS = ("variables", "nodes", "condition", "script")
 VARIABLE_KEYS = ("op", "reference", "measurement", "reward", "penalty")
 MEASUREMENTS = ("absolute", "delta")
 
-#: Comparison ops: the DSL comparison of the measure ``m`` with the reference.
+#: Comparison ops: the DSL text comparing the measure ``m`` with the reference, and the same in Python.
 COMPARISONS = {
-    "equal": "{m} == {ref}",
-    "negative-equal": "{m} == {neg}",
-    "not-equal": "{m} != {ref}",
-    "less-than": "{m} < {ref}",
-    "greater-than": "{m} > {ref}",
-    "less-or-equal": "{m} <= {ref}",
-    "greater-or-equal": "{m} >= {ref}",
-    "nonzero": "{m} != 0",
-    "zero": "{m} == 0",
-    "positive": "{m} > 0",
-    "negative": "{m} < 0",
+    "equal": ("{m} == {ref}", lambda v, r: v == r),
+    "negative-equal": ("{m} == {neg}", lambda v, r: v == -r),
+    "not-equal": ("{m} != {ref}", lambda v, r: v != r),
+    "less-than": ("{m} < {ref}", lambda v, r: v < r),
+    "greater-than": ("{m} > {ref}", lambda v, r: v > r),
+    "less-or-equal": ("{m} <= {ref}", lambda v, r: v <= r),
+    "greater-or-equal": ("{m} >= {ref}", lambda v, r: v >= r),
+    "nonzero": ("{m} != 0", lambda v, r: v != 0),
+    "zero": ("{m} == 0", lambda v, r: v == 0),
+    "positive": ("{m} > 0", lambda v, r: v > 0),
+    "negative": ("{m} < 0", lambda v, r: v < 0),
 }
 OPS = ("", *COMPARISONS, "sign")
 
@@ -79,7 +79,7 @@ def _reward_term(m: str, op: str, reference: int, spec: Mapping) -> str:
     """DSL text of one reward rule on measure ``m``: positive results times reward, negative times penalty."""
     good, bad = float(spec.get("reward", 0) or 0), float(spec.get("penalty", 0) or 0)
     if op in COMPARISONS:  # the result is 1 or 0
-        test = COMPARISONS[op].format(m=m, ref=reference, neg=-reference)
+        test = COMPARISONS[op][0].format(m=m, ref=reference, neg=-reference)
         return f"({_number(good)} if {test} else 0)" if good else ""
     if op == "sign":
         parts = ([f"{_number(good)} if {m} > 0"] if good else []) + ([f"{_number(-bad)} if {m} < 0"] if bad else [])
@@ -88,6 +88,15 @@ def _reward_term(m: str, op: str, reference: int, spec: Mapping) -> str:
         return f"{_number(good)} * {m}" if good else ""
     parts = ([f"{_number(good)} * max({m}, 0)"] if good else []) + ([f"{_number(bad)} * min({m}, 0)"] if bad else [])
     return " + ".join(parts)
+
+
+def _time_factor(op: str, reference: int, spec: Mapping) -> float:
+    """The time term's reward per frame: the rule applied to the constant 1."""
+    if op in COMPARISONS:
+        measured = int(COMPARISONS[op][1](1, reference))
+    else:  # no op, or sign: 1
+        measured = 1
+    return measured * float(spec.get("reward", 0) or 0)  # never negative, so penalty never applies
 
 
 class _Converter:
@@ -172,9 +181,9 @@ class _Converter:
             op = time.get("op", "")
             if op not in OPS:
                 raise self.error([*path, "time", "op"], f"unknown op {op!r}." + did_you_mean(str(op), OPS[1:]))
-            term = _reward_term("1", op, _int(time.get("reference", 0)), time)
-            if term:
-                terms.append(f"({term}) * delta(frame)")
+            factor = _time_factor(op, _int(time.get("reference", 0)), time)
+            if factor:
+                terms.append(f"{_number(factor)} * delta(frame)")
         terms = [t for t in terms if t]
         return " + ".join(terms) if terms else "0"
 
@@ -184,7 +193,7 @@ class _Converter:
         for name, var in (spec.get("variables") or {}).items():
             m, op, reference = self.measure(name, var, [*path, "variables", name], "absolute")
             if op in COMPARISONS:
-                tests.append(COMPARISONS[op].format(m=m, ref=reference, neg=-reference))
+                tests.append(COMPARISONS[op][0].format(m=m, ref=reference, neg=-reference))
             else:  # no op or sign: true when the measure is positive
                 tests.append(f"{m} > 0")
         for name, node in (spec.get("nodes") or {}).items():

@@ -201,12 +201,12 @@ def test_boots_to_the_title_and_starts(dasher_rom: Path, tmss: bool) -> None:
 def test_ram_buffer_holds_byte_swapped_words(playing: Dasher) -> None:
     # Genesis Plus GX keeps 68000 RAM as native 16-bit words: on a
     # little-endian host, console address a is at buffer offset (a & 0xFFFF) ^ 1.
-    playing.run(["RIGHT"], frames=100)
-    x = playing["p1_x"]
-    assert x > 255, "a two-byte value"
-    address = FIELDS["p1_x"][0] & 0xFFFF
     ram = playing.emu.ram
-    assert (ram[address ^ 1], ram[(address + 1) ^ 1]) == (x >> 8, x & 0xFF)
+    for name in ("end_x", "level_width"):
+        value = playing[name]
+        address = FIELDS[name][0] & 0xFFFF
+        assert value > 255, "a two-byte value"
+        assert (ram[address ^ 1], ram[(address + 1) ^ 1]) == (value >> 8, value & 0xFF)
 
 
 def test_main_loop_follows_vblank(dasher: Dasher) -> None:

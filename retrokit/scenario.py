@@ -84,7 +84,7 @@ class Run:
         self._first(values, 0, 0)
         self.step = self._next  # type: ignore[method-assign]
 
-    def step(self, values: Mapping[str, int], frame: int, step: int) -> tuple[tuple[float, ...], bool]:  # noqa: F811
+    def step(self, values: Mapping[str, int], frame: int, step: int) -> tuple[tuple[float, ...], bool]:
         """Compute this step's rewards (one per player) and done.
 
         Args:
@@ -98,7 +98,8 @@ class Run:
         Raises:
             ScenarioRuntimeError: A division by zero, or a table has no entry for a key.
         """
-        return self._step_before_reset(values, frame, step)  # replaced per instance
+        # Each instance replaces this method with the generated function; this is for Run.step(run, ...).
+        return self.__dict__["step"](values, frame, step)
 
     def _step_before_reset(self, values: Mapping[str, int], frame: int, step: int) -> tuple[tuple[float, ...], bool]:
         result = self._first(values, frame, step)

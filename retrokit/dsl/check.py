@@ -95,17 +95,6 @@ class Analysis:
     fields: list[str] = field(default_factory=list)
     slots: dict[str, Slot] = field(default_factory=dict)
     types: dict[str, str] = field(default_factory=dict)
-    reward_types: list[str] = field(default_factory=list)
-
-    def snippet_of(self, item: str) -> Snippet:
-        """The snippet of a definition name, ``reward<i>`` or ``done``."""
-        spec = self.spec
-        if item == "done":
-            assert spec.done is not None
-            return spec.done
-        if item.startswith("reward") and item[6:].isdigit():
-            return spec.rewards[int(item[6:])]
-        return spec.defines[item]
 
 
 def constant(node: n.Node) -> int | float | None:

@@ -18,7 +18,7 @@ is an error.
 from __future__ import annotations
 
 from retrokit.dsl import nodes as n
-from retrokit.dsl.check import COUNTERS, MEMORY, Analysis, Slot
+from retrokit.dsl.check import MEMORY, Analysis, Slot
 from retrokit.errors import ScenarioCompileError
 
 FIRST, NEXT = "first", "next"
@@ -48,9 +48,8 @@ def deps(node: n.Node, mode: str, analysis: Analysis) -> set[Item]:
             elif slot.kind in ("delta", "peak"):
                 found.add(("slot", slot.index))
             continue
-        if isinstance(current, n.Name) and current.id in analysis.defines:
-            if current.quoted or current.id not in COUNTERS:
-                found.add(("def", current.id))
+        if isinstance(current, n.Name) and current.id in analysis.defines:  # never a counter: reserved
+            found.add(("def", current.id))
         stack.extend(current.children())
     return found
 
@@ -160,9 +159,9 @@ class Graph:
         )
 
     def _reference(self, root: n.Node, target: Item) -> n.Node | None:
-        """The first node under ``root`` that reads ``target`` now."""
-        for node in n.walk(root):
-            if (isinstance(node, (n.Name, n.Call))) and target in deps(node, FIRST, self.a):
-                if node is not root or isinstance(node, n.Name):
-                    return node
-        return None
+        """The smallest name or call under ``root`` that reads ``target`` now."""
+        found = [
+            node for node in n.walk(root)
+            if isinstance(node, (n.Name, n.Call)) and target in deps(node, FIRST, self.a)
+        ]
+        return min(found, key=lambda node: node.end - node.start, default=None)

@@ -50,14 +50,12 @@ class TypeChecker:
                 self.define_type(name)
             if self.types == before:
                 break
-        for i, (root, snippet) in enumerate(zip(a.rewards, a.spec.rewards)):
-            kind = self.type_of(root, snippet)
-            if kind == BOOL:
+        for root, snippet in zip(a.rewards, a.spec.rewards):
+            if self.type_of(root, snippet) == BOOL:
                 raise snippet.error(
                     ScenarioCompileError, root.start, root.end,
                     f"a reward must be a number, and this is a condition (boolean); {_COUNT_HINT}",
                 )
-            a.reward_types.append(kind)
         if a.done is not None:
             assert a.spec.done is not None
             if self.type_of(a.done, a.spec.done) != BOOL:

@@ -121,7 +121,8 @@ class RetroEnv(gymnasium.Env):
 
     def _resolve_state(self, state: str | os.PathLike[str] | State | None) -> tuple[str | None, bytes | None]:
         if state is None or state is State.DEFAULT:
-            name = self.game.default_state
+            by_players = self.game.default_player_states
+            name = by_players[self.players - 1] if len(by_players) >= self.players else self.game.default_state
             return (name, read_state(self.game.state_path(name))) if name else (None, None)
         if state is State.NONE:
             return None, None

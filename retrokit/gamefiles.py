@@ -178,8 +178,8 @@ def read_game_yaml(path: str | os.PathLike[str]) -> GameInfo:
     sha1s = tuple(
         _sha1(source, "each rom", r.get("sha1") if isinstance(r, Mapping) else r) for r in roms_list
     )
-    states = _expect(source, "'states'", doc.get("states") or {}, Mapping, "a mapping with default and list")
-    _check_keys(source, "'states'", states, ("default", "list"))
+    states = _expect(source, "'states'", doc.get("states") or {}, Mapping, "a mapping with default, list, by_players")
+    _check_keys(source, "'states'", states, ("default", "list", "by_players"))
     default = states.get("default")
     players = _expect(source, "'players'", doc.get("players", 1), int, "a positive integer")
     system = doc.get("system")
@@ -191,6 +191,7 @@ def read_game_yaml(path: str | os.PathLike[str]) -> GameInfo:
         default_state=None if default is None else _expect(source, "the default state", default, str, "a name"),
         states=None if states.get("list") is None else _names(source, "the state list", states["list"]),
         players=_positive(source, players),
+        default_player_states=_names(source, "'states: by_players'", states.get("by_players", [])),
         title=doc.get("title"),
         extra=MappingProxyType(extra),
     )

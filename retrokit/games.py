@@ -25,7 +25,7 @@ from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
 from types import MappingProxyType
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from retrokit import paths, roms
 from retrokit.errors import (
@@ -147,11 +147,22 @@ class Game:
         if name.endswith(STATE_SUFFIX) and (os.sep in name or "/" in name) and Path(name).is_file():
             return Path(name)
         where = ", ".join(str(f) for f in self.folders)
+        if key in self.state_recipes:
+            raise StateNotFoundError(
+                f"Expected the state file {key}{STATE_SUFFIX} in {where}; it has a recipe but has not been made. "
+                f"Make it with: retrokit integrate {self.name}"
+            )
         raise StateNotFoundError(
             f"Expected a state of {self.name}: one of {', '.join(self.states) or '(none)'}; "
             f"found no file {key}{STATE_SUFFIX} in {where}."
             + did_you_mean(key, self._state_files)
         )
+
+    @property
+    def state_recipes(self) -> Mapping[str, Any]:
+        """The recipes ``retrokit integrate`` makes states from (raw, from game.yaml's ``integrate``)."""
+        recipes = self.info.extra.get("integrate")
+        return recipes if isinstance(recipes, Mapping) else {}
 
     # --- Scenarios ------------------------------------------------------------------------------
 
@@ -261,7 +272,8 @@ class Game:
                     f"no such file in {', '.join(map(str, self.folders))}",
                     "add the .state files or remove the names from the list",
                 )
-        if info.default_state is not None and info.default_state not in self._state_files:
+        made_or_makeable = set(self._state_files) | set(self.state_recipes)
+        if info.default_state is not None and info.default_state not in made_or_makeable:
             raise data_error(
                 info.source, f"the default state {info.default_state!r} to be one of the game's states",
                 f"{', '.join(self.states) or 'no states'}",

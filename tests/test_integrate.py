@@ -1,0 +1,104 @@
+"""Making and checking save states from recipes, on the test cartridge."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+
+from retrokit.cli import main
+from retrokit.emulator import Emulator
+from retrokit.errors import DataFileError, StateError, StateNotFoundError
+from retrokit.games import find_game, load_game
+from retrokit.integrate import integrate, make_state, recipes
+from retrokit.memory import FieldReader
+from retrokit.states import read_state
+
+DASHER = Path(__file__).resolve().parent.parent / "games" / "Dasher-Genesis"
+
+
+@pytest.fixture
+def dasher_copy(tmp_path: Path) -> Path:
+    """Dasher's folder without its states, as a game folder of its own."""
+    folder = tmp_path / "Dasher-Genesis"
+    folder.mkdir()
+    for name in ("game.yaml", "rom.md", "scenario.yaml"):
+        shutil.copy(DASHER / name, folder / name)
+    return folder
+
+
+def fields_after(game, state: bytes) -> dict[str, int]:
+    with Emulator(game.system, game.require_rom()) as emu:
+        emu.set_state(state)
+        return FieldReader(game.fields, emu.space).read()
+
+
+@pytest.mark.parametrize("name,zone,act,players", [("Zone2.Act2", 1, 1, 1), ("Zone3.Act1.2P", 2, 0, 2)], ids=["1p", "2p"])
+def test_a_recipe_reaches_its_level(name: str, zone: int, act: int, players: int) -> None:
+    game = find_game("Dasher-Genesis")
+    values = fields_after(game, make_state(game, recipes(game)[name]))
+    assert values["game_mode"] == 1 and values["zone"] == zone and values["act"] == act
+    assert (values["p2_state"] == 0) == (players == 2)
+
+
+def test_integrate_makes_then_checks_then_keeps_what_differs(dasher_copy: Path) -> None:
+    game = load_game(dasher_copy)
+    first = integrate(game, ["Zone1.Act1", "Zone2.Act1"])
+    assert [o.status for o in first] == ["made", "made"]
+    again = integrate(load_game(dasher_copy), ["Zone1.Act1"])
+    assert [o.status for o in again] == ["up to date"]
+    # Swap in another level's state: it leads elsewhere, so it differs, and is kept.
+    zone2 = (dasher_copy / "Zone2.Act1.state").read_bytes()
+    (dasher_copy / "Zone1.Act1.state").write_bytes(zone2)
+    assert [o.status for o in integrate(load_game(dasher_copy), ["Zone1.Act1"])] == ["differs"]
+    assert (dasher_copy / "Zone1.Act1.state").read_bytes() == zone2
+    assert [o.status for o in integrate(load_game(dasher_copy), ["Zone1.Act1"], force=True)] == ["replaced"]
+    assert fields_after(game, read_state(dasher_copy / "Zone1.Act1.state"))["zone"] == 0
+
+
+def test_the_committed_states_match_their_recipes() -> None:
+    outcomes = integrate(find_game("Dasher-Genesis"))
+    assert {o.status for o in outcomes} == {"up to date"}
+    assert len(outcomes) == 9
+
+
+def test_cli_exits_1_when_a_state_differs(dasher_copy: Path, monkeypatch: pytest.MonkeyPatch, capsys) -> None:
+    monkeypatch.setenv("RETROKIT_GAMES", str(dasher_copy.parent))
+    assert main(["integrate", "Dasher-Genesis", "--state", "Zone1.Act1", "--state", "Zone1.Act2"]) == 0
+    shutil.copy(dasher_copy / "Zone1.Act2.state", dasher_copy / "Zone1.Act1.state")
+    assert main(["integrate", "Dasher-Genesis", "--state", "Zone1.Act1"]) == 1
+    assert "--force" in capsys.readouterr().out
+
+
+def test_a_missing_state_with_a_recipe_says_how_to_make_it(dasher_copy: Path) -> None:
+    with pytest.raises(StateNotFoundError, match="retrokit integrate Dasher-Genesis"):
+        load_game(dasher_copy).state_path("Zone1.Act1")
+
+
+def write_recipe(folder: Path, recipe: str) -> None:
+    text = (folder / "game.yaml").read_text()
+    text = text[: text.index("integrate:")] + "integrate:\n" + recipe
+    (folder / "game.yaml").write_text(text)
+
+
+@pytest.mark.parametrize(
+    "recipe,message",
+    [
+        ("  Zone1.Act1: {set: {zon: 0}, until: {game_mode: 1}}\n", "Did you mean 'zone'"),
+        ("  Zone1.Act1: {set: {zone: 0}}\n", "expected 'until'"),
+        ("  Zone1.Act1: {set: {zone: 0}, untill: {game_mode: 1}}\n", "Did you mean 'until'"),
+    ],
+    ids=["unknown-field", "no-until", "unknown-key"],
+)
+def test_bad_recipes_say_what_is_wrong(dasher_copy: Path, recipe: str, message: str) -> None:
+    write_recipe(dasher_copy, recipe)
+    with pytest.raises(DataFileError, match=message):
+        recipes(load_game(dasher_copy))
+
+
+def test_a_recipe_that_never_arrives_is_a_clear_error(dasher_copy: Path) -> None:
+    write_recipe(dasher_copy, "  Zone1.Act1: {press: [START], until: {game_mode: 3}, max_frames: 120}\n")
+    game = load_game(dasher_copy)
+    with pytest.raises(StateError, match=r"reach \{'game_mode': 3\} within 120 frames; it ended at \{'game_mode': 1\}"):
+        make_state(game, recipes(game)["Zone1.Act1"])

@@ -15,10 +15,11 @@ host = Extension(
         "retrokit/native/core.c",
         "retrokit/native/video.c",
         "retrokit/native/fields.c",
+        "retrokit/native/runner.c",
     ],
     include_dirs=["retrokit/native"],
     extra_compile_args=["-O3", "-std=c11", "-Wall", "-Wextra", "-Wno-unused-parameter"],
-    libraries=["dl"],
+    libraries=["dl", "pthread"],
 )
 
 setup(ext_modules=[host])

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import enum
 import os
-import sys
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -21,6 +20,7 @@ import numpy as np
 from gymnasium import spaces
 
 from retrokit.actions import ActionMap
+from retrokit.buffers import BufferPool
 from retrokit.emulator import Emulator
 from retrokit.errors import EnvError, InvalidArgumentError, did_you_mean
 from retrokit.games import Game, find_game
@@ -204,22 +204,39 @@ class RetroEnv(gymnasium.Env):
         return obs, values
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        before = self.prepare_step(action)
+        if self.scenario_every_frame:
+            rewards, done, values = self._frames_one_by_one()
+            return self._end_step(rewards, done, values, self._observe())
+        self._emu.run(self._masks, self.frameskip)
+        return self.finish_step(before)
+
+    # The vector env runs many envs' frames in one native call between these two.
+
+    def prepare_step(self, action: Any) -> tuple[int, ...] | None:
+        """Set the buttons for a step's frames; return what a movie needs to know of the last frame."""
         if self._run is None and self.scenario is not None:
             raise EnvError("Expected reset() before the first step(); call env.reset() first.")
         masks = self.actions.to_masks(action)
         self._masks[: len(masks)] = masks
         self._steps += 1
         self._at_start = False
-        if self.scenario_every_frame:
-            rewards, done, values = self._frames_one_by_one()
-        else:
-            before = self._emu.held() if self._recorder is not None else None
-            self._emu.run(self._masks, self.frameskip)
-            self._frame += self.frameskip
-            if before is not None:
-                self._record_step(before, self.frameskip)
-            values = self.reader.read()
-            rewards, done = self._evaluate(values)
+        return self._emu.held() if self._recorder is not None else None
+
+    def finish_step(
+        self, before: tuple[int, ...] | None, obs: np.ndarray | None = None
+    ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """Account for a step's frames once they ran: fields, scenario, observation."""
+        self._frame += self.frameskip
+        if before is not None:
+            self._record_step(before, self.frameskip)
+        values = self.reader.read()
+        rewards, done = self._evaluate(values)
+        return self._end_step(rewards, done, values, self._observe() if obs is None else obs)
+
+    def _end_step(
+        self, rewards: tuple[float, ...], done: bool, values: dict[str, Any], obs: np.ndarray
+    ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         truncated = self.max_episode_steps is not None and self._steps >= self.max_episode_steps and not done
         if self.players > 1:
             values["rewards"] = rewards
@@ -227,7 +244,7 @@ class RetroEnv(gymnasium.Env):
             self._end_movie()
         if self.render_mode == "human":
             self.render()
-        return self._observe(), float(sum(rewards)), done, truncated, values
+        return obs, float(sum(rewards)), done, truncated, values
 
     def _evaluate(self, values: dict[str, int]) -> tuple[tuple[float, ...], bool]:
         if self._run is None:
@@ -323,31 +340,6 @@ class RetroEnv(gymnasium.Env):
     def _end_movie(self) -> None:
         self._recorder.close()
         self._recorder = None
-
-
-class BufferPool:
-    """Observation arrays, reused once nobody else holds them.
-
-    A fresh 200 KiB array every step costs page faults worth a sixth of a
-    Genesis step when the last one was just freed. An array here is handed
-    out again only when the pool's own reference is the last one, so an
-    observation the caller keeps (or views) is never overwritten.
-    """
-
-    def __init__(self, shape: tuple[int, ...], size: int = 4) -> None:
-        self.shape, self.size = shape, size
-        self.arrays: list[np.ndarray] = []
-
-    def take(self) -> np.ndarray:
-        """Return an array of the pool's shape that nothing outside the pool refers to."""
-        for array in self.arrays:
-            # References: the list, this loop's name, and getrefcount's argument.
-            if sys.getrefcount(array) == 3:
-                return array
-        array = np.empty(self.shape, dtype=np.uint8)
-        if len(self.arrays) < self.size:
-            self.arrays.append(array)
-        return array
 
 
 def _check_choice(name: str, value: object, choices: tuple[object, ...]) -> None:

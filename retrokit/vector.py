@@ -1,10 +1,15 @@
 """A vector env that steps N emulators in one process, on threads.
 
-The native host releases the GIL while frames run, so N threads emulate on N
-CPU cores; only the short Python part of each step is serial. It follows
-``gymnasium.vector.VectorEnv`` with next-step autoreset, like Gymnasium's own
-vector envs: the step after an episode ends resets that env and returns its
-first observation with reward 0.
+For retrokit's own envs a step is one native call: a pool of native threads
+runs every emulator's frames at once and converts each screen straight into
+the batch, with the GIL released throughout; Python only reads the fields and
+evaluates the scenarios around it. Other envs (wrapped ones, or ones that
+evaluate their scenario every frame) are stepped on Python threads, which
+also overlap because the host releases the GIL while frames run.
+
+It follows ``gymnasium.vector.VectorEnv`` with next-step autoreset, like
+Gymnasium's own vector envs: the step after an episode ends resets that env
+and returns its first observation with reward 0.
 """
 
 from __future__ import annotations
@@ -18,7 +23,9 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, concatenate, create_empty_array, iterate
 
+from retrokit.buffers import BufferPool
 from retrokit.errors import InvalidArgumentError
+from retrokit.native import _host
 
 
 class ThreadedVectorEnv(VectorEnv):
@@ -49,12 +56,32 @@ class ThreadedVectorEnv(VectorEnv):
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self._observations = create_empty_array(self.single_observation_space, self.num_envs)
+        space = self.observation_space
+        self._batches = BufferPool(space.shape, space.dtype) if isinstance(space, gymnasium.spaces.Box) else None
+        self._direct_screens = False
         self._rewards = np.zeros(self.num_envs, dtype=np.float64)
         self._terminations = np.zeros(self.num_envs, dtype=np.bool_)
         self._truncations = np.zeros(self.num_envs, dtype=np.bool_)
         self._autoreset = np.zeros(self.num_envs, dtype=np.bool_)
         # The calling thread steps env 0 itself; the pool steps the rest.
         self._pool = ThreadPoolExecutor(max_workers=max(self.num_envs - 1, 1), thread_name_prefix="retrokit-env")
+        self._runner = self._native_runner()
+
+    def _native_runner(self) -> _host.Runner | None:
+        """A native runner when every env is a plain RetroEnv that can share one."""
+        from retrokit.env import RetroEnv
+
+        envs = self.envs
+        if not all(type(env) is RetroEnv and not env.scenario_every_frame for env in envs):
+            return None
+        if len({(env.frameskip, env.emulator.ports) for env in envs}) != 1:
+            return None
+        # Each env's buttons become a row of one array the runner reads.
+        self._actions = np.zeros((self.num_envs, envs[0].emulator.ports), dtype=np.uint16)
+        for i, env in enumerate(envs):
+            env._masks = self._actions[i]
+        self._direct_screens = all(env.obs_type == "rgb" and env._crop is None for env in envs) and self._batches is not None
+        return _host.Runner(self.num_envs - 1)
 
     def _each(self, job: Callable[[int], Any]) -> list[Any]:
         futures = [self._pool.submit(job, i) for i in range(1, self.num_envs)]
@@ -69,32 +96,61 @@ class ThreadedVectorEnv(VectorEnv):
         for i, (_, info) in enumerate(results):
             infos = self._add_info(infos, info, i)
         self._autoreset[:] = False
-        self._observations = concatenate(self.single_observation_space, [r[0] for r in results], self._observations)
-        return self._observations.copy(), infos
+        return self._batch([r[0] for r in results]), infos
+
+    def _batch(self, observations: list[Any]) -> Any:
+        """Stack the envs' observations into an array the caller may keep."""
+        if self._batches is None:
+            self._observations = concatenate(self.single_observation_space, observations, self._observations)
+            return self._observations.copy()
+        return concatenate(self.single_observation_space, observations, self._batches.take())
 
     def step(self, actions: Any):
         actions = list(iterate(self.action_space, actions))
+        if self._runner is not None:
+            results, observations = self._step_native(actions)
+        else:
+            results = self._step_threads(actions)
+            observations = self._batch([r[0] for r in results])
+        infos: dict[str, Any] = {}
+        for i, (_, reward, terminated, truncated, info) in enumerate(results):
+            self._rewards[i], self._terminations[i], self._truncations[i] = reward, terminated, truncated
+            infos = self._add_info(infos, info, i)
+        self._autoreset = np.logical_or(self._terminations, self._truncations)
+        return observations, self._rewards.copy(), self._terminations.copy(), self._truncations.copy(), infos
 
+    def _step_native(self, actions: list[Any]) -> tuple[list[tuple], np.ndarray]:
+        envs = self.envs
+        batch = self._batches.take() if self._batches is not None else None
+        stepping = [i for i in range(self.num_envs) if not self._autoreset[i]]
+        befores = [envs[i].prepare_step(actions[i]) for i in stepping]
+        screens = [batch[i] for i in stepping] if self._direct_screens else None
+        rows = self._actions if len(stepping) == self.num_envs else self._actions[stepping]
+        converted = self._runner.run([envs[i]._emu for i in stepping], rows, envs[0].frameskip, screens) if stepping else ()
+        results: list[tuple] = [()] * self.num_envs
+        for k, i in enumerate(stepping):
+            direct = screens is not None and converted[k]
+            results[i] = envs[i].finish_step(befores[k], batch[i] if direct else None)
+            if not direct and batch is not None:
+                batch[i] = results[i][0]
+        for i in range(self.num_envs):
+            if self._autoreset[i]:
+                obs, info = envs[i].reset()
+                results[i] = (obs, 0.0, False, False, info)
+                if batch is not None:
+                    batch[i] = obs
+        if batch is None:
+            return results, self._batch([r[0] for r in results])
+        return results, batch
+
+    def _step_threads(self, actions: list[Any]) -> list[tuple]:
         def one(i: int) -> tuple[Any, float, bool, bool, dict[str, Any]]:
             if self._autoreset[i]:
                 obs, info = self.envs[i].reset()
                 return obs, 0.0, False, False, info
             return self.envs[i].step(actions[i])
 
-        results = self._each(one)
-        infos: dict[str, Any] = {}
-        for i, (_, reward, terminated, truncated, info) in enumerate(results):
-            self._rewards[i], self._terminations[i], self._truncations[i] = reward, terminated, truncated
-            infos = self._add_info(infos, info, i)
-        self._observations = concatenate(self.single_observation_space, [r[0] for r in results], self._observations)
-        self._autoreset = np.logical_or(self._terminations, self._truncations)
-        return (
-            self._observations.copy(),
-            self._rewards.copy(),
-            self._terminations.copy(),
-            self._truncations.copy(),
-            infos,
-        )
+        return self._each(one)
 
     def render(self) -> tuple[Any, ...] | None:
         return tuple(env.render() for env in self.envs)

@@ -356,3 +356,45 @@ def test_missing_core_says_where_it_looked(monkeypatch: pytest.MonkeyPatch, tmp_
 def test_missing_rom_file_is_a_clear_error(tmp_path: Path) -> None:
     with pytest.raises(InvalidArgumentError, match="Expected a ROM file, found nothing"):
         Emulator("Genesis", tmp_path / "nothing.md")
+
+
+# --- the native runner: several emulators in one call -----------------------------------------
+
+
+def test_runner_steps_match_single_runs_and_screens_land_in_the_batch(airstriker_rom: Path, airstriker_state: bytes) -> None:
+    scripts = [script(100, 31), script(100, 32)]
+    emus = [Emulator("Genesis", airstriker_rom) for _ in scripts]
+    solo = [Emulator("Genesis", airstriker_rom) for _ in scripts]
+    for emu in emus + solo:
+        emu.set_state(airstriker_state)
+        emu.set_sticky(0.25, 5)
+    runner = _host.Runner(1)
+    batch = np.zeros((2, 224, 320, 3), dtype=np.uint8)
+    for step in range(100):
+        actions = np.array([[scripts[0][step], 0], [scripts[1][step], 0]], dtype=np.uint16)
+        converted = runner.run([e._emu for e in emus], actions, 4, [batch[0], batch[1]])
+        for emu, row in zip(solo, actions):
+            emu.run(row, 4)
+        assert converted == (True, True)
+    for i in range(2):
+        assert emus[i].ram.tobytes() == solo[i].ram.tobytes()
+        assert (batch[i] == solo[i].screen()).all()
+    assert emus[0].ram.tobytes() != emus[1].ram.tobytes()
+    for emu in emus + solo:
+        emu.close()
+
+
+def test_runner_checks_its_arguments_first(airstriker: Emulator) -> None:
+    runner = _host.Runner(1)
+    actions = np.zeros((1, 2), dtype=np.uint16)
+    with pytest.raises(InvalidArgumentError, match="not a native Emulator"):
+        runner.run([airstriker], actions, 4)
+    with pytest.raises(InvalidArgumentError, match=r"shape \(1, 2\)"):
+        runner.run([airstriker._emu], np.zeros((1, 3), dtype=np.uint16), 4)
+    with pytest.raises(InvalidArgumentError, match="at most 2 emulators"):
+        runner.run([airstriker._emu] * 3, np.zeros((3, 2), dtype=np.uint16), 4)
+    with pytest.raises(CoreError, match="another thread"):  # the same emulator twice
+        runner.run([airstriker._emu] * 2, np.zeros((2, 2), dtype=np.uint16), 4)
+    with pytest.raises(InvalidArgumentError, match=r"shape \(height, width, 3\)"):
+        runner.run([airstriker._emu], actions, 4, [np.zeros((224, 320), dtype=np.uint8)])
+    airstriker.run(0, 1)  # every emulator was released again

@@ -69,6 +69,24 @@ class Emulator:
     def closed(self) -> bool: ...
     def close(self) -> None: ...
 
+class Runner:
+    """A pool of native threads that run several emulators' frames in one call."""
+
+    def __init__(self, threads: int) -> None: ...
+    def run(
+        self,
+        emulators: Sequence[Emulator],
+        actions: npt.NDArray[np.uint16],
+        frames: int,
+        screens: Sequence[npt.NDArray[np.uint8]] | None = None,
+    ) -> tuple[bool, ...]:
+        """Run every emulator's frames at once (at most ``threads + 1``), one thread each, the GIL released.
+
+        ``actions`` has one row of port masks per emulator. Each screen is
+        converted into its buffer when its shape fits the frame; the result
+        says, per emulator, whether it was.
+        """
+
 def read_fields(
     buffers: Sequence[memoryview | bytes | bytearray | npt.NDArray[np.uint8]],
     plan: npt.NDArray[np.int64],

@@ -40,8 +40,9 @@ def fire_and_wander(env: RetroEnv, step: int) -> object:
 
 @pytest.mark.parametrize("action_type", ACTION_TYPES)
 @pytest.mark.parametrize("obs_type", OBS_TYPES)
-def test_check_env_passes_on_airstriker(obs_type: str, action_type: str) -> None:
-    env = retrokit.make(AIRSTRIKER, obs_type=obs_type, action_type=action_type, frameskip=4, sticky_prob=0.25)
+@pytest.mark.parametrize("game", [AIRSTRIKER, "Dasher-Genesis"])
+def test_check_env_passes(game: str, obs_type: str, action_type: str) -> None:
+    env = retrokit.make(game, obs_type=obs_type, action_type=action_type, frameskip=4, sticky_prob=0.25)
     check_env(env, skip_render_check=True)
     env.close()
 
@@ -186,3 +187,38 @@ def test_missing_rom_says_how_to_import(monkeypatch: pytest.MonkeyPatch, tmp_pat
     monkeypatch.setenv("RETROKIT_DATA", str(tmp_path))
     with pytest.raises(RomNotFoundError, match="retrokit import"):
         retrokit.make("SonicTheHedgehog-Genesis", "GreenHillZone.Act1", "contest")
+
+
+@pytest.mark.parametrize("every_frame", [False, True], ids=["per-step", "per-frame"])
+def test_recorded_movies_replay_what_the_agent_saw(tmp_path, every_frame: bool) -> None:
+    from retrokit.movie import play, read_bk2
+
+    env = retrokit.make(
+        "Dasher-Genesis", frameskip=4, sticky_prob=0.5, max_episode_steps=40, record=tmp_path,
+        action_type="all", scenario_every_frame=every_frame,
+    )
+    system = env.emulator.system
+    seen, ends = [], []  # each step's observation, and its last frame's index in its movie
+    for episode in range(2):
+        env.reset(seed=episode)
+        frames = 0
+        for step in range(40):
+            names = ["RIGHT"] + (["B"] if step % 5 < 2 else []) if step % 7 else ["LEFT"]
+            before = env.emulator.frame
+            obs, _, terminated, truncated, _ = env.step(np.array([(system.mask(names) >> i) & 1 for i in range(12)]))
+            frames += env.emulator.frame - before  # fewer than 4 when the scenario ends a step early
+            seen.append(obs.copy())
+            ends.append((episode, frames - 1))
+            if terminated or truncated:
+                break
+    env.close()
+    movies = sorted(tmp_path.glob("*.bk2"))
+    assert [m.name for m in movies] == [f"Dasher-Genesis-Zone1.Act1-{i:06d}.bk2" for i in range(2)]
+    replays = [list(play(movie)) for movie in movies]
+    frames = [replays[episode][index] for episode, index in ends]
+    lengths = {episode: index + 1 for episode, index in ends}  # each episode's last step wins
+    assert [len(r) for r in replays] == [lengths[0], lengths[1]]
+    assert all((a == b).all() for a, b in zip(frames, seen))
+    # With p=0.5 some steps' first frames kept the previous buttons, and the movie says so.
+    inputs = read_bk2(movies[0]).frames
+    assert any(inputs[i] != inputs[i + 1] for i in range(0, len(inputs) - 4, 4))

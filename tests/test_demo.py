@@ -1,0 +1,21 @@
+"""The README's main job: ``retrokit demo`` on the bundled test cartridge."""
+
+from __future__ import annotations
+
+from PIL import Image
+
+from retrokit.cli import main
+
+
+def test_demo_plays_and_saves_a_gif_and_a_png(tmp_path, capsys) -> None:
+    assert main(["demo", "--episodes", "2", "--max-steps", "60", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "mean score" in out and out.count("done") + out.count("time limit") == 2
+    gif = Image.open(tmp_path / "Dasher-Genesis.gif")
+    assert gif.n_frames > 5 and gif.size == (320, 224)
+    assert Image.open(tmp_path / "Dasher-Genesis.png").size == (320, 224)
+
+
+def test_demo_refuses_zero_episodes(tmp_path, capsys) -> None:
+    assert main(["demo", "--episodes", "0", "--out", str(tmp_path)]) == 2
+    assert "--episodes and --max-steps of 1 or more" in capsys.readouterr().err

@@ -85,3 +85,18 @@ def test_allow_backtracking_rewards_only_new_progress() -> None:
         out.append(env.step(None)[1])
     assert out == [5.0, 0.0, 3.0, 0.0, 4.0]
     env.close()
+
+
+@pytest.mark.parametrize("level", sonic.levels(), ids=lambda level: f"{level[0].split('-')[0]}/{level[1]}")
+def test_every_level_is_ready_but_for_the_rom(level: tuple[str, str], monkeypatch: pytest.MonkeyPatch, tmp_path) -> None:
+    from retrokit.scenario import load_scenario
+    from retrokit.states import read_state
+
+    game_name, state = level
+    game = find_game(game_name)
+    assert len(read_state(game.state_path(state))) == 1_036_288  # Genesis Plus GX's state size
+    for scenario in ("contest", "xpos"):
+        load_scenario(game.scenario_path(scenario), list(game.fields), game_dir=game.folders[0])
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path))
+    with pytest.raises(RomNotFoundError, match=f"SHA-1 {game.sha1s[0]}.*retrokit import"):
+        sonic.make(game_name, state)

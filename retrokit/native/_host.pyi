@@ -87,6 +87,9 @@ class Runner:
         says, per emulator, whether it was.
         """
 
+def convert_frame(data: bytes, width: int, height: int, pitch: int, format: int, out: npt.NDArray[np.uint8]) -> None:
+    """Convert a frame in a libretro pixel format to RGB, as screens are (for tests and tools)."""
+
 def read_fields(
     buffers: Sequence[memoryview | bytes | bytearray | npt.NDArray[np.uint8]],
     plan: npt.NDArray[np.int64],

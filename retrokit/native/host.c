@@ -787,8 +787,42 @@ done:
     return result;
 }
 
+static PyObject *host_convert_frame(PyObject *module, PyObject *args) {
+    Py_buffer src, dst;
+    unsigned width, height;
+    Py_ssize_t pitch;
+    int format;
+    PyObject *out;
+    if (!PyArg_ParseTuple(args, "y*IIniO", &src, &width, &height, &pitch, &format, &out)) return NULL;
+    int bytes_per_pixel = format == RK_RETRO_PIXEL_FORMAT_XRGB8888 ? 4 : 2;
+    if (format < 0 || format > 2) {
+        PyBuffer_Release(&src);
+        return PyErr_Format(InvalidArgumentError, "format must be 0 (0RGB1555), 1 (XRGB8888) or 2 (RGB565), got %d", format);
+    }
+    if (pitch < (Py_ssize_t)width * bytes_per_pixel || (height > 0 && src.len < pitch * (Py_ssize_t)(height - 1) + (Py_ssize_t)width * bytes_per_pixel)) {
+        PyBuffer_Release(&src);
+        return PyErr_Format(InvalidArgumentError, "a %ux%u frame with rows %zd bytes apart needs more than the %zd bytes given",
+                            width, height, pitch, src.len);
+    }
+    if (PyObject_GetBuffer(out, &dst, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) < 0) {
+        PyBuffer_Release(&src);
+        return NULL;
+    }
+    if (dst.len != (Py_ssize_t)width * height * 3) {
+        PyBuffer_Release(&src);
+        PyBuffer_Release(&dst);
+        return PyErr_Format(InvalidArgumentError, "the output must hold %u x %u x 3 bytes, got %zd", height, width, dst.len);
+    }
+    rk_frame_to_rgb(src.buf, (size_t)pitch, width, height, format, dst.buf);
+    PyBuffer_Release(&src);
+    PyBuffer_Release(&dst);
+    Py_RETURN_NONE;
+}
+
 static PyMethodDef module_methods[] = {
     {"read_fields", (PyCFunction)(void (*)(void))host_read_fields, METH_FASTCALL, "Decode RAM fields by a plan."},
+    {"convert_frame", (PyCFunction)host_convert_frame, METH_VARARGS,
+     "convert_frame(data, width, height, pitch, format, out): a frame in a libretro pixel format to RGB."},
     {NULL, NULL, 0, NULL},
 };
 

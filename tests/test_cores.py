@@ -1,0 +1,75 @@
+"""Every core the wheel ships loads in our host; every pixel format converts right."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from retrokit.errors import InvalidArgumentError
+from retrokit.native import _host
+from retrokit.paths import wheel_cores_dir
+
+CORES = sorted(wheel_cores_dir().glob("*_libretro.so"))
+
+
+@pytest.mark.parametrize("core", CORES, ids=lambda p: p.name.removesuffix("_libretro.so"))
+def test_core_loads_declares_its_options_and_unloads(core, tmp_path) -> None:
+    emu = _host.Emulator(str(core), str(tmp_path), str(tmp_path))
+    info = emu.system_info()
+    assert info["library_name"] and info["valid_extensions"]
+    for key, (_, value, allowed) in emu.options().items():
+        assert isinstance(value, str)  # every option always has a string value
+        assert not allowed or value in allowed, key
+    emu.close()
+
+
+def test_two_copies_of_one_core_are_independent(tmp_path) -> None:
+    core = next(p for p in CORES if p.name.startswith("gambatte"))
+    a = _host.Emulator(str(core), str(tmp_path), str(tmp_path))
+    b = _host.Emulator(str(core), str(tmp_path), str(tmp_path))
+    key = next(iter(a.options()))
+    allowed = a.options()[key][2]
+    a.set_option(key, allowed[-1])
+    b.set_option(key, allowed[0])
+    assert a.options()[key][1] == allowed[-1] and b.options()[key][1] == allowed[0]
+    a.close()
+    b.close()
+
+
+def reference(pixels: np.ndarray, fmt: int) -> np.ndarray:
+    """The expected RGB of pixels, written with numpy, channels widened by shifting as stable-retro does."""
+    p = pixels.astype(np.uint32)
+    if fmt == _host.PIXEL_FORMAT_XRGB8888:
+        r, g, b = (p >> 16) & 0xFF, (p >> 8) & 0xFF, p & 0xFF
+    elif fmt == _host.PIXEL_FORMAT_RGB565:
+        r, g, b = ((p >> 11) & 0x1F) << 3, ((p >> 5) & 0x3F) << 2, (p & 0x1F) << 3
+    else:
+        r, g, b = ((p >> 10) & 0x1F) << 3, ((p >> 5) & 0x1F) << 3, (p & 0x1F) << 3
+    return np.stack([r, g, b], axis=-1).astype(np.uint8)
+
+
+FORMATS = [
+    (_host.PIXEL_FORMAT_0RGB1555, np.uint16),
+    (_host.PIXEL_FORMAT_XRGB8888, np.uint32),
+    (_host.PIXEL_FORMAT_RGB565, np.uint16),
+]
+
+
+@pytest.mark.parametrize("fmt,dtype", FORMATS, ids=["0rgb1555", "xrgb8888", "rgb565"])
+@pytest.mark.parametrize("width", [320, 37], ids=["wide", "odd-width"])
+def test_pixel_format_converts_with_row_padding(fmt: int, dtype: type, width: int) -> None:
+    rng = np.random.default_rng(fmt)
+    height, pad = 11, 5  # rows padded, as cores' frames are
+    frame = rng.integers(0, np.iinfo(dtype).max, (height, width + pad), dtype=dtype, endpoint=True)
+    out = np.zeros((height, width, 3), dtype=np.uint8)
+    _host.convert_frame(frame.tobytes(), width, height, frame.strides[0], fmt, out)
+    assert (out == reference(frame[:, :width], fmt)).all()
+
+
+def test_convert_frame_checks_sizes() -> None:
+    with pytest.raises(InvalidArgumentError, match="needs more than"):
+        _host.convert_frame(b"\0" * 10, 4, 4, 8, _host.PIXEL_FORMAT_RGB565, np.zeros((4, 4, 3), np.uint8))
+    with pytest.raises(InvalidArgumentError, match="format must be"):
+        _host.convert_frame(b"\0" * 32, 4, 4, 8, 7, np.zeros((4, 4, 3), np.uint8))
+    with pytest.raises(InvalidArgumentError, match="must hold"):
+        _host.convert_frame(b"\0" * 32, 4, 4, 8, _host.PIXEL_FORMAT_RGB565, np.zeros((4, 3, 3), np.uint8))

@@ -12,7 +12,13 @@ host = Extension(
     "retrokit.native._host",
     sources=[
         "retrokit/native/host.c",
+        "retrokit/native/host_emulator.c",
+        "retrokit/native/host_data.c",
+        "retrokit/native/host_runner.c",
+        "retrokit/native/host_functions.c",
         "retrokit/native/core.c",
+        "retrokit/native/environment.c",
+        "retrokit/native/isolate.c",
         "retrokit/native/video.c",
         "retrokit/native/fields.c",
         "retrokit/native/runner.c",

@@ -73,3 +73,14 @@ def test_convert_frame_checks_sizes() -> None:
         _host.convert_frame(b"\0" * 32, 4, 4, 8, 7, np.zeros((4, 4, 3), np.uint8))
     with pytest.raises(InvalidArgumentError, match="must hold"):
         _host.convert_frame(b"\0" * 32, 4, 4, 8, _host.PIXEL_FORMAT_RGB565, np.zeros((4, 3, 3), np.uint8))
+
+
+@pytest.mark.parametrize("seed", [0, 1, 42, 2**31 + 5], ids=["zero", "default", "42", "large"])
+def test_the_cores_rand_is_glibcs(seed: int) -> None:
+    import ctypes
+
+    libc = ctypes.CDLL(None)
+    libc.random.restype = ctypes.c_long
+    libc.srandom(ctypes.c_uint(seed))
+    expected = [libc.random() for _ in range(1000)]
+    assert _host.rand_sequence(seed, 1000) == expected

@@ -398,3 +398,61 @@ def test_runner_checks_its_arguments_first(airstriker: Emulator) -> None:
     with pytest.raises(InvalidArgumentError, match=r"shape \(height, width, 3\)"):
         runner.run([airstriker._emu], actions, 4, [np.zeros((224, 320), dtype=np.uint8)])
     airstriker.run(0, 1)  # every emulator was released again
+
+
+# --- each core copy has its own rand() ---------------------------------------------------------
+
+SCHEDULE = """
+import hashlib, sys
+import numpy as np
+{setup}
+for frame in range(600):
+    press({{0: 0, 1: 8}}[(frame // 10) % 2] if frame < 300 else 1 << (frame % 8))
+print(hashlib.sha1(screen()).hexdigest())
+"""
+
+# stable-retro's emulator runs one frame of its own when it is made, so ours
+# runs one idle frame first; its emulator has no reset.
+STABLE_RETRO = """
+import stable_retro
+em = stable_retro.RetroEmulator(sys.argv[1])
+def press(mask):
+    em.set_button_mask(np.array([(mask >> i) & 1 for i in range(12)], dtype=np.uint8), 0)
+    em.step()
+screen = lambda: em.get_screen().tobytes()
+"""
+
+RETROKIT = """
+from retrokit.emulator import Emulator
+emu = Emulator("Genesis", sys.argv[1])
+emu.run([0, 0], 1)
+press = lambda mask: emu.run([mask, 0], 1)
+screen = lambda: emu.screen().tobytes()
+"""
+
+def digest_in_fresh_process(setup: str, rom: Path) -> str:
+    repo = Path(__file__).resolve().parent.parent
+    code = SCHEDULE.format(setup=setup)
+    return subprocess.run([sys.executable, "-c", code, str(rom)], capture_output=True, text=True, cwd=repo, check=True).stdout.strip()
+
+
+def test_power_on_matches_stable_retro_in_a_fresh_process(airstriker_rom: Path) -> None:
+    pytest.importorskip("stable_retro")
+    assert digest_in_fresh_process(RETROKIT, airstriker_rom) == digest_in_fresh_process(STABLE_RETRO, airstriker_rom)
+
+
+def test_libc_rand_in_the_process_does_not_reach_the_cores(airstriker_rom: Path) -> None:
+    import ctypes
+
+    def reset_after(seed: int | None) -> str:
+        with Emulator("Genesis", airstriker_rom) as emu:
+            emu.run([0, 0], 120)
+            if seed is not None:
+                libc.srand(seed)  # as any other library or core in the process may
+            emu.reset()  # Genesis Plus GX draws rand() numbers here
+            emu.run([0, 0], 240)
+            return hashlib.sha1(emu.ram.tobytes() + emu.screen().tobytes()).hexdigest()
+
+    libc = ctypes.CDLL(None)
+    untouched = reset_after(None)
+    assert [reset_after(seed) for seed in (42, 4242, 12345)] == [untouched] * 3

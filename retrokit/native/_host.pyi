@@ -90,6 +90,9 @@ class Runner:
 def convert_frame(data: bytes, width: int, height: int, pitch: int, format: int, out: npt.NDArray[np.uint8]) -> None:
     """Convert a frame in a libretro pixel format to RGB, as screens are (for tests and tools)."""
 
+def rand_sequence(seed: int, n: int) -> list[int]:
+    """The first ``n`` numbers a core's ``rand()`` gives after ``srand(seed)`` (glibc's generator)."""
+
 def read_fields(
     buffers: Sequence[memoryview | bytes | bytearray | npt.NDArray[np.uint8]],
     plan: npt.NDArray[np.int64],

@@ -39,6 +39,14 @@ typedef struct {
     char *text;
 } rk_log_entry;
 
+/* glibc's random() state (TYPE_3): one per emulator, see isolate.c. */
+#define RK_RAND_DEGREE 31
+#define RK_RAND_SEP 3
+typedef struct {
+    int32_t state[RK_RAND_DEGREE];
+    int front, rear;
+} rk_rand;
+
 /* The core's entry points, resolved with dlsym. */
 typedef struct {
     void (*init)(void);
@@ -109,6 +117,7 @@ typedef struct rk_core {
     int n_log;
     int log_dropped;
 
+    rk_rand rand; /* what the core's rand() draws from */
     uint64_t frame;
     atomic_int busy;
     char error[512];

@@ -1,0 +1,166 @@
+/*
+ * The Runner type of retrokit.native._host: several emulators' frames in
+ * one call, on native threads (runner.c).
+ */
+#include "host.h"
+
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include "runner.h"
+
+/* ---- Runner: several emulators' frames in one call ------------------------------------------------ */
+
+typedef struct {
+    PyObject_HEAD
+    rk_runner runner;
+    int threads;
+    pid_t pid;
+    atomic_int busy;
+} RunnerObject;
+
+static int runner_init(RunnerObject *self, PyObject *args, PyObject *kwargs) {
+    static char *kwlist[] = {"threads", NULL};
+    int threads;
+    if (!PyArg_ParseTupleAndKeywords(args, kwargs, "i", kwlist, &threads)) return -1;
+    if (self->runner.workers) {
+        PyErr_SetString(InvalidArgumentError, "Runner.__init__ was called twice; make a new Runner instead");
+        return -1;
+    }
+    if (threads < 0 || threads > 256) {
+        PyErr_Format(InvalidArgumentError, "threads must be 0 to 256, got %d", threads);
+        return -1;
+    }
+    if (rk_runner_init(&self->runner, threads)) {
+        PyErr_SetString(CoreError, "cannot start the runner's threads");
+        return -1;
+    }
+    self->threads = threads;
+    self->pid = getpid();
+    return 0;
+}
+
+static void runner_dealloc(RunnerObject *self) {
+    if (self->runner.workers && self->pid == getpid()) {
+        Py_BEGIN_ALLOW_THREADS
+        rk_runner_close(&self->runner);
+        Py_END_ALLOW_THREADS
+    }
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+static PyObject *runner_run(RunnerObject *self, PyObject *args) {
+    PyObject *emus, *actions_obj, *screens = Py_None;
+    int frames;
+    if (!PyArg_ParseTuple(args, "OOi|O", &emus, &actions_obj, &frames, &screens)) return NULL;
+    if (self->pid != getpid())
+        return PyErr_Format(CoreError, "this runner was made in another process; make a new one after fork");
+    if (frames < 0) return PyErr_Format(InvalidArgumentError, "frames must be 0 or more, got %d", frames);
+    PyObject *seq = PySequence_Fast(emus, "emulators must be a sequence of Emulator objects");
+    if (!seq) return NULL;
+    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
+    PyObject *screen_seq = NULL, *result = NULL;
+    rk_task *tasks = NULL;
+    Py_buffer actions = {0}, *views = NULL;
+    Py_ssize_t claimed = 0, viewed = 0;
+    int runner_claimed = 0, expected = 0;
+    if (n > self->threads + 1) {
+        PyErr_Format(InvalidArgumentError, "this runner has %d threads, so at most %d emulators, got %zd",
+                     self->threads, self->threads + 1, n);
+        goto done;
+    }
+    if (!atomic_compare_exchange_strong(&self->busy, &expected, 1)) {
+        PyErr_SetString(CoreError, "this runner is running in another thread; use one runner per thread");
+        goto done;
+    }
+    runner_claimed = 1;
+    if (PyObject_GetBuffer(actions_obj, &actions, PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0) goto done;
+    tasks = calloc((size_t)(n > 0 ? n : 1), sizeof(rk_task));
+    views = calloc((size_t)(n > 0 ? n : 1), sizeof(Py_buffer));
+    if (!tasks || !views) {
+        PyErr_NoMemory();
+        goto done;
+    }
+    for (Py_ssize_t i = 0; i < n; i++) {
+        PyObject *item = PySequence_Fast_GET_ITEM(seq, i);
+        if (!Py_IS_TYPE(item, &EmulatorType)) {
+            PyErr_Format(InvalidArgumentError, "emulator %zd is a %s, not a native Emulator", i, Py_TYPE(item)->tp_name);
+            goto done;
+        }
+    }
+    int ports = n > 0 ? ((EmulatorObject *)PySequence_Fast_GET_ITEM(seq, 0))->core.n_ports : 0;
+    if (actions.itemsize != 2 || actions.ndim != 2 || actions.shape[0] != n || actions.shape[1] != ports) {
+        PyErr_Format(InvalidArgumentError, "actions must be a uint16 array of shape (%zd, %d): one mask per port "
+                     "per emulator", n, ports);
+        goto done;
+    }
+    if (screens != Py_None) {
+        screen_seq = PySequence_Fast(screens, "screens must be a sequence of buffers, or None");
+        if (!screen_seq) goto done;
+        if (PySequence_Fast_GET_SIZE(screen_seq) != n) {
+            PyErr_Format(InvalidArgumentError, "expected %zd screen buffers, got %zd", n, PySequence_Fast_GET_SIZE(screen_seq));
+            goto done;
+        }
+    }
+    for (Py_ssize_t i = 0; i < n; i++) {
+        EmulatorObject *emu = (EmulatorObject *)PySequence_Fast_GET_ITEM(seq, i);
+        if (emu->core.n_ports != ports) {
+            PyErr_Format(InvalidArgumentError, "every emulator must have %d ports; emulator %zd has %d", ports, i,
+                         emu->core.n_ports);
+            goto done;
+        }
+        if (screen_seq) {
+            PyObject *buf = PySequence_Fast_GET_ITEM(screen_seq, i);
+            if (PyObject_GetBuffer(buf, &views[i], PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0)
+                goto done;
+            viewed++;
+            if (views[i].ndim != 3 || views[i].shape[2] != 3 || views[i].itemsize != 1) {
+                PyErr_Format(InvalidArgumentError, "screen buffer %zd must be a uint8 array of shape (height, width, 3)", i);
+                goto done;
+            }
+            tasks[i].screen = views[i].buf;
+            tasks[i].screen_height = (unsigned)views[i].shape[0];
+            tasks[i].screen_width = (unsigned)views[i].shape[1];
+        }
+        if (rk_py_enter(emu, 1)) goto done;
+        claimed++;
+        tasks[i].core = &emu->core;
+        tasks[i].actions = (const uint16_t *)actions.buf + i * ports;
+        tasks[i].frames = frames;
+    }
+    Py_BEGIN_ALLOW_THREADS
+    rk_runner_run(&self->runner, tasks, (int)n);
+    Py_END_ALLOW_THREADS
+    result = PyTuple_New(n);
+    for (Py_ssize_t i = 0; result && i < n; i++) PyTuple_SET_ITEM(result, i, PyBool_FromLong(tasks[i].converted));
+done:
+    for (Py_ssize_t i = 0; i < claimed; i++) rk_py_leave((EmulatorObject *)PySequence_Fast_GET_ITEM(seq, i));
+    for (Py_ssize_t i = 0; i < viewed; i++) PyBuffer_Release(&views[i]);
+    if (actions.obj) PyBuffer_Release(&actions);
+    if (runner_claimed) atomic_store(&self->busy, 0);
+    free(tasks);
+    free(views);
+    Py_XDECREF(screen_seq);
+    Py_DECREF(seq);
+    return result;
+}
+
+static PyMethodDef runner_methods[] = {
+    {"run", (PyCFunction)runner_run, METH_VARARGS,
+     "run(emulators, actions, frames, screens=None): run every emulator's frames at once, each on its own "
+     "thread, and convert each screen into its buffer; return whether each screen was converted."},
+    {NULL, NULL, 0, NULL},
+};
+
+PyTypeObject RunnerType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "retrokit.native._host.Runner",
+    .tp_basicsize = sizeof(RunnerObject),
+    .tp_dealloc = (destructor)runner_dealloc,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "A pool of native threads that run several emulators' frames in one call.",
+    .tp_methods = runner_methods,
+    .tp_init = (initproc)runner_init,
+    .tp_new = PyType_GenericNew,
+};
+

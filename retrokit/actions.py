@@ -61,6 +61,7 @@ class ActionMap:
         self.group_masks = [int(np.bitwise_or.reduce(c)) if c else 0 for c in self.combos]
         self.valid = [set(c) for c in self.combos]
         self.num_buttons = len(system.buttons)
+        self._weights = np.left_shift(1, np.arange(self.num_buttons, dtype=np.int64))
         self.space = self._player_space()
 
     def _player_space(self) -> spaces.Space:
@@ -116,9 +117,6 @@ class ActionMap:
                 int(np.bitwise_or.reduce([combos[int(i)] for combos, i in zip(self.combos, flat[p * n : (p + 1) * n])]))
                 for p in range(self.players)
             ]
-        masks = []
-        for p in range(self.players):
-            bits = flat[p * self.num_buttons : (p + 1) * self.num_buttons]
-            mask = int(np.dot(bits.astype(np.int64) != 0, 1 << np.arange(len(bits), dtype=np.int64)))
-            masks.append(self.filter(mask) if self.action_type == "filtered" else mask)
-        return masks
+        pressed = flat.reshape(self.players, self.num_buttons) != 0
+        masks = (pressed @ self._weights).tolist()  # one bit per button, every player at once
+        return [self.filter(m) for m in masks] if self.action_type == "filtered" else masks

@@ -78,6 +78,20 @@ class ActionMap:
     def _groups_as_names(self) -> list[list[list[str]]]:
         return [[self.system.buttons_of(m) for m in group] for group in self.combos]
 
+    def press(self, buttons: Sequence[str]) -> np.ndarray:
+        """The one-player ``"all"``/``"filtered"`` action that presses the named buttons.
+
+        Raises:
+            InvalidArgumentError: This map's actions are not button arrays.
+        """
+        if self.action_type not in ("all", "filtered"):
+            raise InvalidArgumentError(
+                f"Expected an action type of 'all' or 'filtered' to press buttons by name, got {self.action_type!r}; "
+                f"its actions pick button combinations by index."
+            )
+        mask = self.system.mask(buttons)
+        return ((mask >> np.arange(self.num_buttons)) & 1).astype(np.int8)
+
     def combine(self, per_player: Sequence[object]) -> object:
         """Join one action per player (each of :meth:`single_player_space`) into one action of this map."""
         if len(per_player) != self.players:

@@ -70,11 +70,7 @@ class Discretizer(gymnasium.ActionWrapper):
         base: RetroEnv = env.unwrapped  # type: ignore[assignment]
         if base.actions.action_type != "all":
             raise InvalidArgumentError(f"Expected an env with action_type='all', got {base.actions.action_type!r}.")
-        width = base.action_space.n  # type: ignore[attr-defined]
-        self._arrays = []
-        for combo in combos:
-            mask = base.emulator.system.mask(combo)
-            self._arrays.append(np.array([(mask >> i) & 1 for i in range(width)], dtype=np.int8))
+        self._arrays = [base.actions.press(combo) for combo in combos]
         self.combos = combos
         self.action_space = spaces.Discrete(len(combos))
 

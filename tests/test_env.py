@@ -27,7 +27,7 @@ def fire_and_wander(env: RetroEnv, step: int) -> object:
     mask = env.emulator.system.mask(names)
     kind = env.actions.action_type
     if kind in ("all", "filtered"):
-        return np.array([(mask >> i) & 1 for i in range(env.action_space.n)], dtype=np.int8)
+        return env.actions.press(names)
     picks = [combos.index(mask & gmask) if (mask & gmask) in combos else 0 for combos, gmask in zip(env.actions.combos, env.actions.group_masks)]
     if kind == "multi_discrete":
         return np.array(picks)
@@ -70,6 +70,16 @@ def test_action_space_sizes_follow_the_genesis_groups() -> None:
     assert sizes["all"] == gymnasium.spaces.MultiBinary(12)
     assert sizes["discrete"] == gymnasium.spaces.Discrete(3 * 3 * 14)
     assert list(sizes["multi_discrete"].nvec) == [3, 3, 14]
+
+
+def test_press_names_buttons_in_gym_retros_order() -> None:
+    env = retrokit.make(AIRSTRIKER, action_type="all")
+    assert env.actions.press(["B", "RIGHT", "Z"]).tolist() == [1, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1]
+    env.close()
+    env = retrokit.make(AIRSTRIKER, action_type="discrete")
+    with pytest.raises(InvalidArgumentError, match="by index"):
+        env.actions.press(["B"])
+    env.close()
 
 
 def test_filtered_actions_drop_what_gym_retro_drops() -> None:
@@ -197,7 +207,6 @@ def test_recorded_movies_replay_what_the_agent_saw(tmp_path, every_frame: bool) 
         "Dasher-Genesis", frameskip=4, sticky_prob=0.5, max_episode_steps=40, record=tmp_path,
         action_type="all", scenario_every_frame=every_frame,
     )
-    system = env.emulator.system
     seen, ends = [], []  # each step's observation, and its last frame's index in its movie
     for episode in range(2):
         env.reset(seed=episode)
@@ -205,7 +214,7 @@ def test_recorded_movies_replay_what_the_agent_saw(tmp_path, every_frame: bool) 
         for step in range(40):
             names = ["RIGHT"] + (["B"] if step % 5 < 2 else []) if step % 7 else ["LEFT"]
             before = env.emulator.frame
-            obs, _, terminated, truncated, _ = env.step(np.array([(system.mask(names) >> i) & 1 for i in range(12)]))
+            obs, _, terminated, truncated, _ = env.step(env.actions.press(names))
             frames += env.emulator.frame - before  # fewer than 4 when the scenario ends a step early
             seen.append(obs.copy())
             ends.append((episode, frames - 1))

@@ -43,9 +43,7 @@ def test_spaces_are_the_same_object_every_call() -> None:
 
 
 def right(env, agent: str, jump: bool = False) -> np.ndarray:
-    system = env._env.emulator.system
-    mask = system.mask(["RIGHT", "B"] if jump else ["RIGHT"])
-    return np.array([(mask >> i) & 1 for i in range(env.action_space(agent).n)], dtype=np.int8)
+    return env._env.actions.press(["RIGHT", "B"] if jump else ["RIGHT"])
 
 
 def test_each_player_is_rewarded_for_its_own_progress() -> None:

@@ -34,13 +34,11 @@ class RunAndJump:
     """Hold RIGHT; now and then hold a jump button for a few steps."""
 
     def __init__(self, env, rng) -> None:  # noqa: ANN001 - a RetroEnv and a numpy Generator
-        system = env.unwrapped.emulator.system
-        width = env.action_space.n
-        bits = lambda names: [(system.mask(names) >> i) & 1 for i in range(width)]  # noqa: E731
-        self.run, self.jump = bits(["RIGHT"]), bits(["RIGHT", "B"])
+        actions = env.unwrapped.actions
+        self.run, self.jump = actions.press(["RIGHT"]), actions.press(["RIGHT", "B"])
         self.rng, self.jumping = rng, 0
 
-    def act(self) -> list[int]:
+    def act(self):  # noqa: ANN201 - an action of the env
         if self.jumping == 0 and self.rng.random() < 0.2:
             self.jumping = int(self.rng.integers(2, 6))
         if self.jumping:

@@ -36,9 +36,6 @@ SMD_BLOCK_SIZE = 16 * 1024
 MAX_FILE_SIZE = MAX_ROM_SIZE + SMD_HEADER_SIZE
 """The largest file read as a ROM: the largest ROM, as an ``.smd`` dump with its header."""
 
-# Extensions that name a system but hold a form the cores do not load directly.
-_EXTRA_EXTENSIONS = {"smd": "Genesis"}
-
 
 def system_extensions() -> dict[str, tuple[str, ...]]:
     """Return each system's ROM extensions (without dots), from :mod:`retrokit.systems`.
@@ -52,11 +49,8 @@ def system_extensions() -> dict[str, tuple[str, ...]]:
 
 
 def extension_systems() -> dict[str, str]:
-    """Return a map from ROM extension (without dot) to system name, ``smd`` included."""
-    result = dict(_EXTRA_EXTENSIONS)
-    for ext, system in systems_by_extension().items():
-        result.setdefault(ext, system.name)
-    return result
+    """Return a map from ROM extension (without dot) to system name, aliases such as ``smd`` included."""
+    return {ext: system.name for ext, system in systems_by_extension().items()}
 
 
 def file_extension(filename: str | os.PathLike[str]) -> str:

@@ -25,6 +25,7 @@ class System:
         name: Gym Retro's name for the system, e.g. ``"Genesis"``.
         core: The libretro core's library name, e.g. ``"genesis_plus_gx"``.
         extensions: ROM file extensions, without the dot.
+        aliases: Other extensions its ROM dumps come in.
         ram_base: The console address of the first byte of system RAM.
         ram_swap: The word size of the RAM buffer's byte swap (1: none).
         buttons: The console's name for each RetroPad id, ``None`` where unused.
@@ -44,6 +45,7 @@ class System:
     options: dict[str, str] = field(default_factory=dict)
     actions: tuple[tuple[tuple[str, ...], ...], ...] = ()
     screen: tuple[int, int] | None = None
+    aliases: tuple[str, ...] = ()
 
     @property
     def button_names(self) -> tuple[str, ...]:
@@ -94,6 +96,7 @@ def _parse(name: str, entry: object) -> System:
             options={str(k): str(v) for k, v in (entry.get("options") or {}).items()},
             actions=tuple(tuple(tuple(combo) for combo in group) for group in entry.get("actions", ())),
             screen=tuple(entry["screen"]) if "screen" in entry else None,
+            aliases=tuple(entry.get("aliases", ())),
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise DataFileError(f"{_FILE}: system {name!r} is malformed: {exc!r}.") from exc
@@ -129,11 +132,15 @@ def get_system(name: str | System) -> System:
 def systems_by_extension() -> dict[str, System]:
     """Return the system of each ROM extension (without dot) the descriptors list.
 
-    Where two systems list the same extension, the first in ``systems.yaml`` has it.
+    Where two systems list the same extension, the first in ``systems.yaml`` has
+    it; aliases come after every system's own extensions.
     """
     known: dict[str, System] = {}
     for system in all_systems().values():
         for ext in system.extensions:
+            known.setdefault(ext, system)
+    for system in all_systems().values():
+        for ext in system.aliases:
             known.setdefault(ext, system)
     return known
 
@@ -148,8 +155,6 @@ def system_for_extension(ext: str) -> System:
     known = systems_by_extension()
     if ext in known:
         return known[ext]
-    if ext in ("gen", "smd"):  # other Genesis dumps; .smd is de-interleaved on import
-        return known["md"]
     raise UnsupportedSystemError(
         f"Expected a ROM file extension retrokit knows ({', '.join('.' + e for e in sorted(known))}), got "
         f"{'.' + ext!r}. Rename the file, or pass the system explicitly." + did_you_mean(ext, known)

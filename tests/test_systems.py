@@ -74,3 +74,12 @@ def test_unknown_button_suggests() -> None:
         get_system("Genesis").mask(["STRAT"])
     with pytest.raises(InvalidArgumentError, match=r"list of button names.*\['RIGHT'\]"):
         get_system("Genesis").mask("RIGHT")
+
+
+def test_genesis_dump_aliases_are_known_to_both_lookups() -> None:
+    from retrokit.roms import detect_system
+
+    for ext in ("gen", "smd"):
+        assert system_for_extension(ext).name == "Genesis"
+        assert detect_system(f"game.{ext}") == "Genesis"
+    assert system_for_extension("bin").name == "N64"  # a system's own extension wins over an alias

@@ -174,3 +174,37 @@ def test_corrupt_plan_is_refused_before_reading() -> None:
     plan[0, :5] = [0, 1, 0, -1, 10]  # offset 10 is outside a 4-byte buffer
     with pytest.raises(InvalidArgumentError, match="outside its buffer"):
         _host.read_fields([ram], plan, np.zeros(1, dtype=np.int64))
+
+
+class MappedEmulator:
+    """Stands in for a core that gives a memory map (SET_MEMORY_MAPS), as SNES cores do."""
+
+    def __init__(self) -> None:
+        self.wram, self.rom, self.sram = bytearray(0x20000), bytearray(0x100), bytearray(0x800)
+
+    def memory_maps(self) -> list[dict]:
+        return [
+            {"flags": 1, "start": 0x000000, "select": 0, "disconnect": 0, "length": 0x100,
+             "addrspace": "", "memory": memoryview(self.rom)},  # read-only: skipped
+            {"flags": 4, "start": 0x7E0000, "select": 0xFE0000, "disconnect": 0, "length": 0x20000,
+             "addrspace": "", "memory": memoryview(self.wram)},
+            {"flags": 8, "start": 0x700000, "select": 0xFFF800, "disconnect": 0, "length": 0,
+             "addrspace": "", "memory": memoryview(self.sram)},  # length from select: 0x800
+        ]
+
+    def memory(self, kind: int) -> None:
+        raise AssertionError("the memory map should be used instead of the system RAM")
+
+
+def test_memory_maps_are_honoured() -> None:
+    from retrokit.systems import get_system
+
+    emu = MappedEmulator()
+    space = AddressSpace.for_emulator(get_system("Snes"), emu)
+    assert [(r.start, r.length) for r in space.regions] == [(0x7E0000, 0x20000), (0x700000, 0x800)]
+    emu.wram[0x1234:0x1236] = (0x34).to_bytes(1, "little") + (0x12).to_bytes(1, "little")
+    emu.sram[0x10] = 0x99
+    reader = FieldReader([FieldSpec("a", 0x7E1234, "<u2"), FieldSpec("b", 0x700010, "|u1")], space)
+    assert reader.read() == {"a": 0x1234, "b": 0x99}
+    with pytest.raises(InvalidArgumentError, match="0x7e0000-0x7fffff, 0x700000-0x7007ff"):
+        space.locate(0x000010)  # ROM is not mapped for fields

@@ -1,7 +1,7 @@
 """A window that shows frames, for ``render_mode="human"``.
 
-It uses pygame, which retrokit does not require: install it (``pip install
-pygame``) where a display exists.
+It uses pygame, which retrokit does not require: install it where a display
+exists (``pip install 'retrokit[human]'``).
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ class Viewer:
         except ImportError:
             raise EnvError(
                 "Expected pygame for render_mode='human', but it is not installed. "
-                "Install it (pip install pygame), or use render_mode='rgb_array'."
+                "Install it (pip install 'retrokit[human]'), or use render_mode='rgb_array'."
             ) from None
         self._pygame = pygame
         try:

@@ -148,7 +148,7 @@ def _require_imageio(out: Path):  # noqa: ANN202 - the imageio.v2 module
     except ImportError:
         raise InvalidArgumentError(
             f"Expected imageio with its ffmpeg plugin to write {out}; found them not installed. "
-            "Export to a .gif or to a folder of PNG frames instead, or: pip install imageio imageio-ffmpeg"
+            "Export to a .gif or to a folder of PNG frames instead, or: pip install 'retrokit[video]'"
         ) from None
     return imageio
 

@@ -231,3 +231,17 @@ def test_recorded_movies_replay_what_the_agent_saw(tmp_path, every_frame: bool) 
     # With p=0.5 some steps' first frames kept the previous buttons, and the movie says so.
     inputs = read_bk2(movies[0]).frames
     assert any(inputs[i] != inputs[i + 1] for i in range(0, len(inputs) - 4, 4))
+
+
+def test_human_rendering_draws_into_a_window(monkeypatch: pytest.MonkeyPatch) -> None:
+    pygame = pytest.importorskip("pygame")
+    monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")  # a real SDL window, with no screen needed
+    env = retrokit.make("Dasher-Genesis", render_mode="human", frameskip=4)
+    obs, _ = env.reset(seed=0)
+    for _ in range(3):
+        obs, *_ = env.step(env.actions.press(["RIGHT"]))
+    surface = pygame.display.get_surface()
+    assert surface.get_size() == (640, 448)  # the frame, scaled twice
+    shown = pygame.surfarray.array3d(surface).swapaxes(0, 1)[::2, ::2]
+    assert (shown == obs).all()
+    env.close()

@@ -16,6 +16,14 @@ def test_demo_plays_and_saves_a_gif_and_a_png(tmp_path, capsys) -> None:
     assert Image.open(tmp_path / "Dasher-Genesis.png").size == (320, 224)
 
 
+def test_demo_never_replaces_earlier_pictures(tmp_path, capsys) -> None:
+    mine = tmp_path / "Dasher-Genesis.gif"
+    mine.write_bytes(b"mine")
+    assert main(["demo", "--episodes", "1", "--max-steps", "20", "--out", str(tmp_path)]) == 0
+    assert mine.read_bytes() == b"mine"
+    assert (tmp_path / "Dasher-Genesis-1.gif").is_file() and (tmp_path / "Dasher-Genesis-1.png").is_file()
+
+
 def test_demo_refuses_zero_episodes(tmp_path, capsys) -> None:
     assert main(["demo", "--episodes", "0", "--out", str(tmp_path)]) == 2
     assert "--episodes and --max-steps of 1 or more" in capsys.readouterr().err

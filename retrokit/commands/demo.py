@@ -3,7 +3,8 @@
 It needs no ROM import: Dasher, retrokit's own Genesis game, ships in
 ``games/``. A scripted agent runs right and jumps now and then (sticky frame
 skip 4, as in the Sonic benchmark); the command prints each episode's score
-and saves a GIF of the best episode and a PNG of its last frame.
+and saves a GIF of the best episode and a PNG of its last frame (under new
+names if earlier ones are there: nothing is replaced).
 """
 
 from __future__ import annotations
@@ -47,14 +48,27 @@ class RunAndJump:
         return self.run
 
 
+def free_names(folder: Path, stem: str) -> tuple[Path, Path]:
+    """A GIF and a PNG name in ``folder`` that are both unused: nothing there is replaced."""
+    for n in range(10_000):
+        base = stem if n == 0 else f"{stem}-{n}"
+        gif, png = folder / f"{base}.gif", folder / f"{base}.png"
+        if not gif.exists() and not png.exists():
+            return gif, png
+    raise FileExistsError(f"Expected a free file name for {stem} in {folder}; all 10000 are taken.")
+
+
 def run(args: argparse.Namespace) -> int:
     """Play, print the scores, save the pictures."""
+    import io
+
     import numpy as np
     from PIL import Image
     from tqdm import tqdm
 
     import retrokit
     from retrokit.errors import InvalidArgumentError
+    from retrokit.paths import atomic_write
 
     if args.episodes < 1 or args.max_steps < 1:
         raise InvalidArgumentError(
@@ -94,10 +108,12 @@ def run(args: argparse.Namespace) -> int:
     scores = [r[1] for r in results]
     print(f"mean score {np.mean(scores):.1f}, best {max(scores):.0f}")
 
-    args.out.mkdir(parents=True, exist_ok=True)
-    gif, png = args.out / f"{args.game}.gif", args.out / f"{args.game}.png"
+    gif, png = free_names(args.out, args.game)
     pictures = [Image.fromarray(f) for f in best_frames]
-    pictures[0].save(gif, save_all=True, append_images=pictures[1:], duration=2 * 4 * 1000 // 60, loop=0)
-    pictures[-1].save(png)
+    gif_bytes, png_bytes = io.BytesIO(), io.BytesIO()
+    pictures[0].save(gif_bytes, "GIF", save_all=True, append_images=pictures[1:], duration=2 * 4 * 1000 // 60, loop=0)
+    pictures[-1].save(png_bytes, "PNG")
+    atomic_write(gif, gif_bytes.getvalue())
+    atomic_write(png, png_bytes.getvalue())
     print(f"saved {gif} ({len(pictures)} frames) and {png}")
     return 0

@@ -107,6 +107,7 @@ class RetroEnv(gymnasium.Env):
         self._screen_shape = self.emulator.system.screen or self._first_frame_shape()
         self.observation_space = self._make_observation_space()
         self._buffers = BufferPool(self.observation_space.shape)
+        self._direct = obs_type == "rgb" and self._crop is None
         self.record_dir = Path(record) if record is not None else None
         self._recorder = None
         self._episode = 0
@@ -208,6 +209,9 @@ class RetroEnv(gymnasium.Env):
         if self.scenario_every_frame:
             rewards, done, values = self._frames_one_by_one()
             return self._end_step(rewards, done, values, self._observe())
+        if self._direct:  # the host converts the screen right after the frames
+            obs = self._buffers.take()
+            return self.finish_step(before, obs if self._emu.run(self._masks, self.frameskip, obs) else None)
         self._emu.run(self._masks, self.frameskip)
         return self.finish_step(before)
 

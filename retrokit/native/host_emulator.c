@@ -9,6 +9,8 @@
 
 #include <string.h>
 
+#include "video.h"
+
 /* ---- helpers ----------------------------------------------------------------------------- */
 
 static void flush_log(EmulatorObject *self) {
@@ -235,11 +237,12 @@ static PyObject *emulator_forget_action(EmulatorObject *self, PyObject *unused) 
 }
 
 static PyObject *emulator_run(EmulatorObject *self, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 2) return PyErr_Format(PyExc_TypeError, "run() takes (actions, frames), got %zd arguments", nargs);
+    if (nargs != 2 && nargs != 3)
+        return PyErr_Format(PyExc_TypeError, "run() takes (actions, frames[, screen]), got %zd arguments", nargs);
     long frames = PyLong_AsLong(args[1]);
     if (frames == -1 && PyErr_Occurred()) return NULL;
     if (frames < 0) return PyErr_Format(InvalidArgumentError, "frames must be 0 or more, got %ld", frames);
-    Py_buffer buf;
+    Py_buffer buf, screen = {0};
     if (PyObject_GetBuffer(args[0], &buf, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0) return NULL;
     int ok = buf.itemsize == 2 && buf.format && (strcmp(buf.format, "H") == 0 || strcmp(buf.format, "=H") == 0 ||
                                                  strcmp(buf.format, "<H") == 0);
@@ -255,11 +258,34 @@ static PyObject *emulator_run(EmulatorObject *self, PyObject *const *args, Py_ss
     uint16_t actions[RK_MAX_PORTS] = {0};
     memcpy(actions, buf.buf, (size_t)n * 2);
     PyBuffer_Release(&buf);
-    if (rk_py_enter(self, 1)) return NULL;
+    int want_screen = nargs == 3 && args[2] != Py_None;
+    if (want_screen) {
+        if (PyObject_GetBuffer(args[2], &screen, PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0)
+            return NULL;
+        if (screen.ndim != 3 || screen.shape[2] != 3 || screen.itemsize != 1) {
+            PyBuffer_Release(&screen);
+            return PyErr_Format(InvalidArgumentError, "the screen buffer must be a uint8 array of shape (height, width, 3)");
+        }
+    }
+    if (rk_py_enter(self, 1)) {
+        if (want_screen) PyBuffer_Release(&screen);
+        return NULL;
+    }
+    int converted = 0;
+    rk_core *c = &self->core;
     Py_BEGIN_ALLOW_THREADS
-    rk_core_run(&self->core, actions, self->core.n_ports, (int)frames);
+    rk_core_run(c, actions, c->n_ports, (int)frames);
+    /* Convert while the frame is still in the cache, if it fits the buffer. */
+    if (want_screen && c->frame_data && (Py_ssize_t)c->frame_height == screen.shape[0] &&
+        (Py_ssize_t)c->frame_width == screen.shape[1])
+        converted = rk_frame_to_rgb(c->frame_data, c->frame_pitch, c->frame_width, c->frame_height, c->pixel_format,
+                                    screen.buf) == 0;
     Py_END_ALLOW_THREADS
     rk_py_leave(self);
+    if (want_screen) {
+        PyBuffer_Release(&screen);
+        return PyBool_FromLong(converted);
+    }
     Py_RETURN_NONE;
 }
 
@@ -302,7 +328,9 @@ static PyMethodDef emulator_methods[] = {
     {"set_sticky", (PyCFunction)emulator_set_sticky, METH_VARARGS, "Set the sticky-action probability and seed the RNG."},
     {"forget_action", (PyCFunction)emulator_forget_action, METH_NOARGS, "Apply the next action from its first frame."},
     {"held", (PyCFunction)emulator_held, METH_NOARGS, "The buttons of the last frame run, one mask per port."},
-    {"run", (PyCFunction)(void (*)(void))emulator_run, METH_FASTCALL, "Run frames with one button mask per port."},
+    {"run", (PyCFunction)(void (*)(void))emulator_run, METH_FASTCALL,
+     "run(actions, frames[, screen]): run frames with one button mask per port; with a screen buffer, convert "
+     "the last frame into it and return whether it fitted."},
     {"reset", (PyCFunction)emulator_reset, METH_NOARGS, "Hard-reset the console."},
     {"screen_shape", (PyCFunction)emulator_screen_shape, METH_NOARGS, "(height, width) of the last frame."},
     {"screen", (PyCFunction)emulator_screen, METH_O, "Write the last frame as RGB into a uint8 array."},

@@ -4,6 +4,7 @@
 #define _GNU_SOURCE
 #include "callbacks.h"
 #include "isolate.h"
+#include "video.h"
 
 #include <dlfcn.h>
 #include <errno.h>
@@ -223,4 +224,9 @@ void rk_core_run(rk_core *core, const uint16_t *actions, int n_ports, int frames
         memcpy(core->held, core->buttons, sizeof core->held);
         core->have_held = 1;
     }
+}
+
+int rk_core_screen_into(rk_core *core, uint8_t *dst, unsigned width, unsigned height) {
+    if (!core->frame_data || core->frame_width != width || core->frame_height != height) return 0;
+    return rk_frame_to_rgb(core->frame_data, core->frame_pitch, width, height, core->pixel_format, dst) == 0;
 }

@@ -134,5 +134,8 @@ void rk_enter(rk_core *core);
 void rk_leave(void);
 void rk_core_run(rk_core *core, const uint16_t *actions, int n_ports, int frames);
 void rk_core_seed(rk_core *core, double prob, uint64_t seed);
+/* Convert the last frame into an RGB buffer of height x width x 3, if the
+ * frame has that size; returns whether it did. */
+int rk_core_screen_into(rk_core *core, uint8_t *dst, unsigned width, unsigned height);
 
 #endif

@@ -9,8 +9,6 @@
 
 #include <string.h>
 
-#include "video.h"
-
 /* ---- helpers ----------------------------------------------------------------------------- */
 
 static void flush_log(EmulatorObject *self) {
@@ -276,10 +274,8 @@ static PyObject *emulator_run(EmulatorObject *self, PyObject *const *args, Py_ss
     Py_BEGIN_ALLOW_THREADS
     rk_core_run(c, actions, c->n_ports, (int)frames);
     /* Convert while the frame is still in the cache, if it fits the buffer. */
-    if (want_screen && c->frame_data && (Py_ssize_t)c->frame_height == screen.shape[0] &&
-        (Py_ssize_t)c->frame_width == screen.shape[1])
-        converted = rk_frame_to_rgb(c->frame_data, c->frame_pitch, c->frame_width, c->frame_height, c->pixel_format,
-                                    screen.buf) == 0;
+    if (want_screen)
+        converted = rk_core_screen_into(c, screen.buf, (unsigned)screen.shape[1], (unsigned)screen.shape[0]);
     Py_END_ALLOW_THREADS
     rk_py_leave(self);
     if (want_screen) {

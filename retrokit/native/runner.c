@@ -29,13 +29,8 @@ static inline void cpu_relax(void) {
 
 static void do_task(rk_task *task) {
     rk_core_run(task->core, task->actions, task->core->n_ports, task->frames);
-    task->converted = 0;
-    if (task->screen) {
-        rk_core *c = task->core;
-        if (c->frame_data && c->frame_width == task->screen_width && c->frame_height == task->screen_height)
-            task->converted = rk_frame_to_rgb(c->frame_data, c->frame_pitch, c->frame_width, c->frame_height,
-                                              c->pixel_format, task->screen) == 0;
-    }
+    task->converted = task->screen && rk_core_screen_into(task->core, task->screen, task->screen_width,
+                                                          task->screen_height);
 }
 
 static void *worker_main(void *arg) {

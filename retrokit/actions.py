@@ -23,6 +23,7 @@ import numpy as np
 from gymnasium import spaces
 
 from retrokit.errors import InvalidArgumentError, did_you_mean
+from retrokit.native import _host
 from retrokit.systems import System
 
 ACTION_TYPES = ("all", "filtered", "discrete", "multi_discrete")
@@ -63,6 +64,9 @@ class ActionMap:
         self.num_buttons = len(system.buttons)
         self._weights = np.left_shift(1, np.arange(self.num_buttons, dtype=np.int64))
         self.space = self._player_space()
+        self._packs = action_type in ("all", "filtered")
+        self._size = self.num_buttons * players
+        self._filter_table = self._make_filter_table() if action_type == "filtered" else None
 
     def _player_space(self) -> spaces.Space:
         if self.action_type in ("all", "filtered"):
@@ -101,6 +105,15 @@ class ActionMap:
             return sum(int(a) * size**p for p, a in enumerate(per_player))  # type: ignore[call-overload]
         return np.concatenate([np.asarray(a).ravel() for a in per_player]).astype(self.space.dtype)
 
+    def _make_filter_table(self) -> np.ndarray:
+        """What :meth:`filter` makes of every possible mask, for the native packer."""
+        masks = np.arange(1 << self.num_buttons, dtype=np.int64)
+        out = np.zeros_like(masks)
+        for group_mask, valid in zip(self.group_masks, self.valid):
+            part = masks & group_mask
+            out |= np.where(np.isin(part, list(valid)), part, 0)
+        return out.astype(np.uint16)
+
     def filter(self, mask: int) -> int:
         """Drop, group by group, any buttons that do not form a listed combination."""
         out = 0
@@ -109,6 +122,21 @@ class ActionMap:
             if part in valid:
                 out |= part
         return out
+
+    def write_masks(self, action: object, out: np.ndarray) -> None:
+        """Write one RetroPad mask per player into ``out`` (uint16) for an action of this map's type.
+
+        A button array is packed natively, the common case of every step;
+        anything else goes through :meth:`to_masks`.
+        """
+        if (
+            self._packs
+            and type(action) is np.ndarray
+            and action.size == self._size
+            and _host.pack_buttons(action, self.num_buttons, out, self._filter_table)
+        ):
+            return
+        out[: self.players] = self.to_masks(action)
 
     def to_masks(self, action: object) -> list[int]:
         """Return one RetroPad mask per player for an action of this map's type."""
@@ -131,6 +159,11 @@ class ActionMap:
                 int(np.bitwise_or.reduce([combos[int(i)] for combos, i in zip(self.combos, flat[p * n : (p + 1) * n])]))
                 for p in range(self.players)
             ]
+        if flat.size != self._size:
+            raise InvalidArgumentError(
+                f"Expected an action of {self._size} buttons ({self.players} player(s) x {self.num_buttons}), got "
+                f"{flat.size} items. Pass an array shaped like env.action_space.sample()."
+            )
         pressed = flat.reshape(self.players, self.num_buttons) != 0
         masks = (pressed @ self._weights).tolist()  # one bit per button, every player at once
         return [self.filter(m) for m in masks] if self.action_type == "filtered" else masks

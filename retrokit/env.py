@@ -221,8 +221,7 @@ class RetroEnv(gymnasium.Env):
         """Set the buttons for a step's frames; return what a movie needs to know of the last frame."""
         if self._run is None and self.scenario is not None:
             raise EnvError("Expected reset() before the first step(); call env.reset() first.")
-        masks = self.actions.to_masks(action)
-        self._masks[: len(masks)] = masks
+        self.actions.write_masks(action, self._masks)
         self._steps += 1
         self._at_start = False
         return self._emu.held() if self._recorder is not None else None

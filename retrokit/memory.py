@@ -17,7 +17,7 @@ import numpy as np
 from retrokit.errors import FieldNotFoundError, InvalidArgumentError, did_you_mean
 from retrokit.native import _host
 from retrokit.systems import System
-from retrokit.types import UNSIGNED, FieldType, parse_type
+from retrokit.types import FieldType, parse_type
 
 _LITTLE_HOST = sys.byteorder == "little"
 _CONST = 1  # RETRO_MEMDESC_CONST: read-only memory such as ROM
@@ -163,8 +163,7 @@ class FieldReader:
             row[3] = -1 if spec.mask is None else spec.mask
             row[4 : 4 + ftype.width] = [offs[i] for i in ftype.significance()]
         self.values = np.zeros(len(specs), dtype=np.int64)
-        # 8-byte unsigned fields do not fit int64; read() gives their true value.
-        self._wide = [s.name for s in specs if s.field_type.kind == UNSIGNED and s.field_type.width == 8]
+        self._names = tuple(self.names)
 
     def read_array(self) -> np.ndarray:
         """Decode every field into ``self.values`` (reused between calls) and return it.
@@ -177,11 +176,7 @@ class FieldReader:
 
     def read(self) -> dict[str, int]:
         """Return every field's value by name."""
-        _host.read_fields(self.space.buffers, self.plan, self.values)
-        values = dict(zip(self.names, self.values.tolist()))
-        for name in self._wide:
-            values[name] &= 0xFFFFFFFFFFFFFFFF
-        return values
+        return _host.read_fields(self.space.buffers, self.plan, self.values, self._names)
 
     def spec(self, name: str) -> FieldSpec:
         """Return a field's spec by name.

@@ -8,6 +8,7 @@ call raises :class:`retrokit.errors.CoreError` (or a subclass); nothing aborts.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import Any, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -96,12 +97,40 @@ def convert_frame(data: bytes, width: int, height: int, pitch: int, format: int,
 def rand_sequence(seed: int, n: int) -> list[int]:
     """The first ``n`` numbers a core's ``rand()`` gives after ``srand(seed)`` (glibc's generator)."""
 
+def pack_buttons(
+    action: npt.NDArray[Any], buttons: int, out: npt.NDArray[np.uint16], table: npt.NDArray[np.uint16] | None = None
+) -> bool:
+    """Pack a button array, ``buttons`` items per player, into one mask per player in ``out``.
+
+    A nonzero item presses its button. With ``table`` (``2**buttons`` masks),
+    each player's mask is replaced by its entry there. Returns False, writing
+    nothing, when the array's item format is not a number.
+    """
+
+@overload
 def read_fields(
     buffers: Sequence[memoryview | bytes | bytearray | npt.NDArray[np.uint8]],
     plan: npt.NDArray[np.int64],
     out: npt.NDArray[np.int64],
-) -> None:
-    """Decode every field of a plan from RAM buffers into ``out``.
+    names: None = None,
+) -> None: ...
+@overload
+def read_fields(
+    buffers: Sequence[memoryview | bytes | bytearray | npt.NDArray[np.uint8]],
+    plan: npt.NDArray[np.int64],
+    out: npt.NDArray[np.int64],
+    names: tuple[str, ...],
+) -> dict[str, int]: ...
+def read_fields(
+    buffers: Sequence[memoryview | bytes | bytearray | npt.NDArray[np.uint8]],
+    plan: npt.NDArray[np.int64],
+    out: npt.NDArray[np.int64],
+    names: tuple[str, ...] | None = None,
+) -> dict[str, int] | None:
+    """Decode every field of a plan from RAM buffers into ``out``; with ``names``, also return them by name.
+
+    In the dict, an 8-byte unsigned field keeps its true value (``out`` holds
+    its two's complement).
 
     ``plan`` has one row per field: ``[buffer, width, kind, mask, off0 .. off7]``
     with offsets from least to most significant byte, and ``kind`` 0 unsigned,

@@ -12,6 +12,9 @@ PyObject *CoreError, *StateError, *InvalidArgumentError;
 
 static PyMethodDef module_methods[] = {
     {"read_fields", (PyCFunction)(void (*)(void))rk_py_read_fields, METH_FASTCALL, "Decode RAM fields by a plan."},
+    {"pack_buttons", (PyCFunction)(void (*)(void))rk_py_pack_buttons, METH_FASTCALL,
+     "pack_buttons(action, buttons, out[, table]): one bit per nonzero item, a mask per player, looked up in table if "
+     "given; False for an unknown format."},
     {"rand_sequence", (PyCFunction)rk_py_rand_sequence, METH_VARARGS,
      "rand_sequence(seed, n): the first n numbers a core's rand() gives after srand(seed)."},
     {"convert_frame", (PyCFunction)rk_py_convert_frame, METH_VARARGS,

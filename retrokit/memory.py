@@ -17,7 +17,7 @@ import numpy as np
 from retrokit.errors import FieldNotFoundError, InvalidArgumentError, did_you_mean
 from retrokit.native import _host
 from retrokit.systems import System
-from retrokit.types import FieldType, parse_type
+from retrokit.types import UNSIGNED, FieldType, parse_type
 
 _LITTLE_HOST = sys.byteorder == "little"
 _CONST = 1  # RETRO_MEMDESC_CONST: read-only memory such as ROM
@@ -164,6 +164,17 @@ class FieldReader:
             row[4 : 4 + ftype.width] = [offs[i] for i in ftype.significance()]
         self.values = np.zeros(len(specs), dtype=np.int64)
         self._names = tuple(self.names)
+        # 8-byte unsigned fields may not fit int64: values then holds their two's complement.
+        self.fits_int64 = not any(s.field_type.kind == UNSIGNED and s.field_type.width == 8 for s in specs)
+
+    def decode_into(self, out: np.ndarray) -> None:
+        """Decode into ``out`` from now on (an int64 array of one item per field), in place of ``self.values``."""
+        if out.dtype != np.int64 or out.shape != self.values.shape or not out.flags.c_contiguous:
+            raise InvalidArgumentError(
+                f"Expected a contiguous int64 array of shape {self.values.shape}, got {out.dtype} {out.shape}."
+            )
+        out[:] = self.values
+        self.values = out
 
     def read_array(self) -> np.ndarray:
         """Decode every field into ``self.values`` (reused between calls) and return it.

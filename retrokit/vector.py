@@ -59,10 +59,9 @@ class ThreadedVectorEnv(VectorEnv):
         space = self.observation_space
         self._batches = BufferPool(space.shape, space.dtype) if isinstance(space, gymnasium.spaces.Box) else None
         self._direct_screens = False
-        self._rewards = np.zeros(self.num_envs, dtype=np.float64)
-        self._terminations = np.zeros(self.num_envs, dtype=np.bool_)
-        self._truncations = np.zeros(self.num_envs, dtype=np.bool_)
-        self._autoreset = np.zeros(self.num_envs, dtype=np.bool_)
+        self._field_keys: tuple[str, ...] | None = None
+        self._mask_keys: tuple[str, ...] = ()
+        self._autoreset = [False] * self.num_envs
         # The calling thread steps env 0 itself; the pool steps the rest.
         self._pool = ThreadPoolExecutor(max_workers=max(self.num_envs - 1, 1), thread_name_prefix="retrokit-env")
         self._runner = self._native_runner()
@@ -81,6 +80,13 @@ class ThreadedVectorEnv(VectorEnv):
         for i, env in enumerate(envs):
             env._masks = self._actions[i]
         self._direct_screens = all(env.obs_type == "rgb" and env._crop is None for env in envs) and self._batches is not None
+        names = {tuple(env.reader.names) for env in envs}
+        if len(names) == 1 and all(env.players == 1 and env.reader.fits_int64 for env in envs):
+            self._field_keys = names.pop()
+            self._mask_keys = tuple(f"_{key}" for key in self._field_keys)
+            self._fields = np.zeros((self.num_envs, len(self._field_keys)), dtype=np.int64)
+            for i, env in enumerate(envs):
+                env.reader.decode_into(self._fields[i])
         return _host.Runner(self.num_envs - 1)
 
     def _each(self, job: Callable[[int], Any]) -> list[Any]:
@@ -95,7 +101,7 @@ class ThreadedVectorEnv(VectorEnv):
         infos: dict[str, Any] = {}
         for i, (_, info) in enumerate(results):
             infos = self._add_info(infos, info, i)
-        self._autoreset[:] = False
+        self._autoreset = [False] * self.num_envs
         return self._batch([r[0] for r in results]), infos
 
     def _batch(self, observations: list[Any]) -> Any:
@@ -106,18 +112,34 @@ class ThreadedVectorEnv(VectorEnv):
         return concatenate(self.single_observation_space, observations, self._batches.take())
 
     def step(self, actions: Any):
-        actions = list(iterate(self.action_space, actions))
-        if self._runner is not None:
-            results, observations = self._step_native(actions)
+        if isinstance(actions, np.ndarray) and actions.shape[:1] == (self.num_envs,):
+            rows: Sequence[Any] = actions  # row i is env i's action, as iterate() would give it
         else:
-            results = self._step_threads(actions)
+            rows = list(iterate(self.action_space, actions))
+        if self._runner is not None:
+            results, observations = self._step_native(rows)
+        else:
+            results = self._step_threads(rows)
             observations = self._batch([r[0] for r in results])
-        infos: dict[str, Any] = {}
-        for i, (_, reward, terminated, truncated, info) in enumerate(results):
-            self._rewards[i], self._terminations[i], self._truncations[i] = reward, terminated, truncated
-            infos = self._add_info(infos, info, i)
-        self._autoreset = np.logical_or(self._terminations, self._truncations)
-        return observations, self._rewards.copy(), self._terminations.copy(), self._truncations.copy(), infos
+        self._autoreset = [r[2] or r[3] for r in results]
+        rewards = np.array([r[1] for r in results], dtype=np.float64)
+        terminations = np.array([r[2] for r in results], dtype=np.bool_)
+        truncations = np.array([r[3] for r in results], dtype=np.bool_)
+        return observations, rewards, terminations, truncations, self._infos([r[4] for r in results])
+
+    def _infos(self, infos: list[dict[str, Any]]) -> dict[str, Any]:
+        """Gymnasium's batched info: an array per key, and a ``_key`` mask of the envs that have it."""
+        if self._field_keys is None:
+            batched: dict[str, Any] = {}
+            for i, info in enumerate(infos):
+                batched = self._add_info(batched, info, i)
+            return batched
+        # Every env is a one-player RetroEnv whose info is exactly its fields, all of
+        # which fit int64, and their readers decode into the rows of one array.
+        values = self._fields.T.copy()
+        batched = dict(zip(self._field_keys, values))
+        batched.update(zip(self._mask_keys, np.ones(values.shape, dtype=np.bool_)))
+        return batched
 
     def _step_native(self, actions: list[Any]) -> tuple[list[tuple], np.ndarray]:
         envs = self.envs

@@ -2,11 +2,13 @@
 
 from __future__ import annotations
 
+import gymnasium
 import numpy as np
 import pytest
 
 import retrokit
 from retrokit.errors import InvalidArgumentError
+from retrokit.vector import ThreadedVectorEnv
 
 OPTIONS = {"frameskip": 4, "sticky_prob": 0.25, "max_episode_steps": 25, "action_type": "discrete"}
 
@@ -56,3 +58,52 @@ def test_vector_spaces_are_batched() -> None:
 def test_vector_needs_at_least_one_env() -> None:
     with pytest.raises(InvalidArgumentError, match="num_envs of 1 or more"):
         retrokit.make_vec("Airstriker-Genesis", 0)
+
+
+def reference_infos(vec, infos: list[dict]) -> dict:
+    """What Gymnasium's own batching makes of the single envs' infos."""
+    batched: dict = {}
+    for i, info in enumerate(infos):
+        batched = gymnasium.vector.VectorEnv._add_info(vec, batched, info, i)
+    return batched
+
+
+@pytest.mark.parametrize("wrapped", [False, True], ids=["native-runner", "python-threads"])
+def test_vector_infos_are_batched_as_gymnasium_batches_them(wrapped: bool) -> None:
+    n = 3
+    make = lambda: retrokit.make("Airstriker-Genesis", **OPTIONS)  # noqa: E731
+    fns = [(lambda: gymnasium.wrappers.RecordEpisodeStatistics(make())) if wrapped else make for _ in range(n)]
+    vec = ThreadedVectorEnv(fns)
+    assert (vec._runner is None) == wrapped
+    singles = [fn() for fn in fns]
+    vec.reset(seed=3)
+    for i, env in enumerate(singles):
+        env.reset(seed=3 + i)
+    done = [False] * n
+    for step in range(40):
+        acts = actions_for(step, n)
+        _, _, terms, truncs, infos = vec.step(acts)
+        expected = []
+        for i, env in enumerate(singles):
+            expected.append(env.reset()[1] if done[i] else env.step(acts[i])[4])
+            done[i] = bool(terms[i] or truncs[i])
+        reference = reference_infos(vec, expected)
+        assert infos.keys() == reference.keys()
+        for key, value in reference.items():
+            if key == "episode":
+                continue  # its times differ between the two runs
+            assert infos[key].dtype == value.dtype and (infos[key] == value).all(), (step, key)
+    vec.close()
+    for env in singles:
+        env.close()
+
+
+def test_vector_takes_actions_as_a_list_too() -> None:
+    vec = retrokit.make_vec("Airstriker-Genesis", 2, **OPTIONS)
+    vec.reset(seed=0)
+    from_list = vec.step([5, 7])
+    vec.reset(seed=0)
+    from_array = vec.step(np.array([5, 7]))
+    for a, b in zip(from_list[:4], from_array[:4]):
+        assert (a == b).all()
+    vec.close()

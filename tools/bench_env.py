@@ -11,7 +11,9 @@ These machines are noisy and their speed drifts from one second to the
 next, so each ratio alternates its own kinds in short bursts (short enough
 that both see the same machine, long enough that each runs with its own data
 in the caches, as in real use, and with no third kind's data in the way). A
-round measures every ratio; the median over rounds is reported.
+round measures every ratio; the median over rounds is reported. Every kind
+plays the same frames: the bare emulators restart from the start state as
+often as the envs' no-op episodes end.
 
 Beside the third figure it prints the machine's own ceiling for it, from the
 same rounds: two bare emulators run at once by the native runner against one.
@@ -100,8 +102,24 @@ def vector_stepper(vec) -> Callable[[], int]:
     return step
 
 
-def raw_steppers(state: bytes, rom) -> tuple[Callable[[], int], Callable[[], int], list[Emulator]]:
-    """4-frame native runs of one bare emulator, and of two at once with the native runner."""
+def episode_length(env) -> int:
+    """Steps of one no-op episode of the env (the game is deterministic from its state)."""
+    action = env.action_space.sample() * 0
+    env.reset(seed=0)
+    steps, done = 0, False
+    while not done:
+        _, _, terminated, truncated, _ = env.step(action)
+        steps, done = steps + 1, terminated or truncated
+    return steps
+
+
+def raw_steppers(state: bytes, rom, episode: int) -> tuple[Callable[[], int], Callable[[], int], list[Emulator]]:
+    """4-frame native runs of one bare emulator, and of two at once with the native runner.
+
+    They restart from the state every ``episode`` steps, as the envs do when
+    their episode ends, so that all kinds emulate the same frames: the frames
+    after Airstriker's game over cost a few percent less than its play.
+    """
     emus = [Emulator("Genesis", rom) for _ in range(3)]
     for emu in emus:
         emu.set_state(state)
@@ -109,13 +127,22 @@ def raw_steppers(state: bytes, rom) -> tuple[Callable[[], int], Callable[[], int
     two = np.zeros((2, 2), dtype=np.uint16)
     runner = _host.Runner(1)
     natives = [emu._emu for emu in emus]
+    counts = [0, 0]
+
+    def restart(which: int, group: list[Emulator]) -> None:
+        counts[which] += 1
+        if counts[which] % episode == 0:
+            for emu in group:
+                emu.set_state(state)
 
     def raw() -> int:
         natives[0].run(one, 4)
+        restart(0, emus[:1])
         return 1
 
     def raw2() -> int:
         runner.run(natives[1:], two, 4)
+        restart(1, emus[1:])
         return 2
 
     return raw, raw2, emus
@@ -133,7 +160,7 @@ def main() -> int:
     state = gzip.decompress((folder / "Level1.state").read_bytes())
     env = retrokit.make(GAME, **OPTIONS)
     vec = retrokit.make_vec(GAME, 2, **OPTIONS)
-    raw, raw2, bare = raw_steppers(state, folder / "rom.md")
+    raw, raw2, bare = raw_steppers(state, folder / "rom.md", episode_length(env))
     kinds: dict[str, Callable[[], int]] = {"raw": raw, "raw2": raw2, "env": env_stepper(env), "vector2": vector_stepper(vec)}
     try:
         import stable_retro

@@ -167,15 +167,6 @@ class FieldReader:
         # 8-byte unsigned fields may not fit int64: values then holds their two's complement.
         self.fits_int64 = not any(s.field_type.kind == UNSIGNED and s.field_type.width == 8 for s in specs)
 
-    def decode_into(self, out: np.ndarray) -> None:
-        """Decode into ``out`` from now on (an int64 array of one item per field), in place of ``self.values``."""
-        if out.dtype != np.int64 or out.shape != self.values.shape or not out.flags.c_contiguous:
-            raise InvalidArgumentError(
-                f"Expected a contiguous int64 array of shape {self.values.shape}, got {out.dtype} {out.shape}."
-            )
-        out[:] = self.values
-        self.values = out
-
     def read_array(self) -> np.ndarray:
         """Decode every field into ``self.values`` (reused between calls) and return it.
 

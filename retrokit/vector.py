@@ -23,7 +23,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, concatenate, create_empty_array, iterate
 
-from retrokit.buffers import BufferPool
+from retrokit.buffers import BufferPool, Pool, StepArrays
 from retrokit.errors import InvalidArgumentError
 from retrokit.native import _host
 
@@ -59,8 +59,7 @@ class ThreadedVectorEnv(VectorEnv):
         space = self.observation_space
         self._batches = BufferPool(space.shape, space.dtype) if isinstance(space, gymnasium.spaces.Box) else None
         self._direct_screens = False
-        self._field_keys: tuple[str, ...] | None = None
-        self._mask_keys: tuple[str, ...] = ()
+        self._step_arrays: Pool[StepArrays] | None = None
         self._autoreset = [False] * self.num_envs
         # The calling thread steps env 0 itself; the pool steps the rest.
         self._pool = ThreadPoolExecutor(max_workers=max(self.num_envs - 1, 1), thread_name_prefix="retrokit-env")
@@ -82,11 +81,9 @@ class ThreadedVectorEnv(VectorEnv):
         self._direct_screens = all(env.obs_type == "rgb" and env._crop is None for env in envs) and self._batches is not None
         names = {tuple(env.reader.names) for env in envs}
         if len(names) == 1 and all(env.players == 1 and env.reader.fits_int64 for env in envs):
-            self._field_keys = names.pop()
-            self._mask_keys = tuple(f"_{key}" for key in self._field_keys)
-            self._fields = np.zeros((self.num_envs, len(self._field_keys)), dtype=np.int64)
-            for i, env in enumerate(envs):
-                env.reader.decode_into(self._fields[i])
+            keys = names.pop()
+            self._step_arrays = Pool(lambda: StepArrays(self.num_envs, keys))
+            self._field_values = [memoryview(env.reader.values) for env in envs]
         return _host.Runner(self.num_envs - 1)
 
     def _each(self, job: Callable[[int], Any]) -> list[Any]:
@@ -116,43 +113,49 @@ class ThreadedVectorEnv(VectorEnv):
             rows: Sequence[Any] = actions  # row i is env i's action, as iterate() would give it
         else:
             rows = list(iterate(self.action_space, actions))
-        if self._runner is not None:
-            results, observations = self._step_native(rows)
-        else:
+        if self._runner is None:
             results = self._step_threads(rows)
             observations = self._batch([r[0] for r in results])
+        else:
+            results, observations = self._step_native(rows)
         self._autoreset = [r[2] or r[3] for r in results]
+        if self._step_arrays is not None:
+            return self._fields_step(results, observations)
         rewards = np.array([r[1] for r in results], dtype=np.float64)
         terminations = np.array([r[2] for r in results], dtype=np.bool_)
         truncations = np.array([r[3] for r in results], dtype=np.bool_)
-        return observations, rewards, terminations, truncations, self._infos([r[4] for r in results])
+        infos: dict[str, Any] = {}
+        for i, result in enumerate(results):
+            infos = self._add_info(infos, result[4], i)
+        return observations, rewards, terminations, truncations, infos
 
-    def _infos(self, infos: list[dict[str, Any]]) -> dict[str, Any]:
-        """Gymnasium's batched info: an array per key, and a ``_key`` mask of the envs that have it."""
-        if self._field_keys is None:
-            batched: dict[str, Any] = {}
-            for i, info in enumerate(infos):
-                batched = self._add_info(batched, info, i)
-            return batched
-        # Every env is a one-player RetroEnv whose info is exactly its fields, all of
-        # which fit int64, and their readers decode into the rows of one array.
-        values = self._fields.T.copy()
-        batched = dict(zip(self._field_keys, values))
-        batched.update(zip(self._mask_keys, np.ones(values.shape, dtype=np.bool_)))
-        return batched
+    def _fields_step(self, results: list[tuple], observations: Any) -> tuple:
+        """The step's arrays, when every env is a one-player RetroEnv whose info is exactly its fields.
+
+        They come from a pool (see :mod:`retrokit.buffers`) and are filled
+        through memoryviews, so a step touches none of numpy's code.
+        """
+        arrays = self._step_arrays.take()
+        rewards, terminations, truncations = arrays.flags
+        for i, result in enumerate(results):
+            rewards[i], terminations[i], truncations[i] = result[1], result[2], result[3]
+        for row, values in zip(arrays.rows, self._field_values):
+            row[:] = values  # the env's reader decoded this step's fields into it
+        arrays.refill_masks()
+        return observations, arrays.rewards, arrays.terminations, arrays.truncations, dict(arrays.info)
 
     def _step_native(self, actions: list[Any]) -> tuple[list[tuple], np.ndarray]:
         envs = self.envs
-        batch = self._batches.take() if self._batches is not None else None
+        batch, views = self._batches.take_rows() if self._batches is not None else (None, [])
         stepping = [i for i in range(self.num_envs) if not self._autoreset[i]]
         befores = [envs[i].prepare_step(actions[i]) for i in stepping]
-        screens = [batch[i] for i in stepping] if self._direct_screens else None
+        screens = [views[i] for i in stepping] if self._direct_screens else None
         rows = self._actions if len(stepping) == self.num_envs else self._actions[stepping]
         converted = self._runner.run([envs[i]._emu for i in stepping], rows, envs[0].frameskip, screens) if stepping else ()
         results: list[tuple] = [()] * self.num_envs
         for k, i in enumerate(stepping):
             direct = screens is not None and converted[k]
-            results[i] = envs[i].finish_step(befores[k], batch[i] if direct else None)
+            results[i] = envs[i].finish_step(befores[k], views[i] if direct else None)
             if not direct and batch is not None:
                 batch[i] = results[i][0]
         for i in range(self.num_envs):

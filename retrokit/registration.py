@@ -2,7 +2,8 @@
 
 ``gymnasium.make("retrokit/Airstriker-Genesis", state=..., ...)`` then works
 after ``import retrokit`` (or with the id ``"retrokit:retrokit/<Game>"``,
-which imports retrokit first).
+which imports retrokit first), and ``gymnasium.make_vec(..., num_envs=N)``
+gives retrokit's threaded vector env unless another vectorization mode is asked for.
 """
 
 from __future__ import annotations
@@ -21,6 +22,11 @@ def register_envs() -> int:
         env_id = f"{NAMESPACE}/{game.name}"
         if env_id in gymnasium.registry:
             continue
-        gymnasium.register(id=env_id, entry_point="retrokit.env:RetroEnv", kwargs={"game": game.name})
+        gymnasium.register(
+            id=env_id,
+            entry_point="retrokit.env:RetroEnv",
+            vector_entry_point="retrokit.vector:make_vec",
+            kwargs={"game": game.name},
+        )
         added += 1
     return added

@@ -107,3 +107,14 @@ def test_vector_takes_actions_as_a_list_too() -> None:
     for a, b in zip(from_list[:4], from_array[:4]):
         assert (a == b).all()
     vec.close()
+
+
+@pytest.mark.parametrize("mode, kind", [(None, ThreadedVectorEnv), ("sync", gymnasium.vector.SyncVectorEnv)], ids=["default", "sync"])
+def test_gymnasium_make_vec_gives_the_threaded_vector_by_default(mode: str | None, kind: type) -> None:
+    vec = gymnasium.make_vec("retrokit/Airstriker-Genesis", num_envs=2, vectorization_mode=mode, frameskip=4, max_episode_steps=3)
+    assert isinstance(vec, kind) and vec.num_envs == 2
+    vec.reset(seed=0)
+    for _ in range(3):
+        _, _, _, truncated, _ = vec.step(np.zeros((2, 12), dtype=np.int8))
+    assert truncated.all()
+    vec.close()

@@ -1,11 +1,13 @@
 """A vector env that steps N emulators in one process, on threads.
 
-For retrokit's own envs a step is one native call: a pool of native threads
-runs every emulator's frames at once and converts each screen straight into
-the batch, with the GIL released throughout; Python only reads the fields and
-evaluates the scenarios around it. Other envs (wrapped ones, or ones that
-evaluate their scenario every frame) are stepped on Python threads, which
-also overlap because the host releases the GIL while frames run.
+For retrokit's own envs a step is one native call: one native thread per CPU
+(the calling one included) takes the emulators one at a time, runs their
+frames and converts each screen straight into the batch, with the GIL
+released throughout; Python only reads the fields and evaluates the
+scenarios around it. More envs than CPUs share the threads, so they never
+crowd the machine. Other envs (wrapped ones, or ones that evaluate their
+scenario every frame) are stepped on as many Python threads, which also
+overlap because the host releases the GIL while frames run.
 
 It follows ``gymnasium.vector.VectorEnv`` with next-step autoreset, like
 Gymnasium's own vector envs: the step after an episode ends resets that env
@@ -14,6 +16,7 @@ and returns its first observation with reward 0.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
@@ -33,13 +36,19 @@ class ThreadedVectorEnv(VectorEnv):
 
     Args:
         env_fns: Functions that each make one env; all must have the same spaces.
+        threads: Threads that step them, the calling one included; ``None``
+            uses one per CPU this process may run on (never more than envs).
+            More envs than threads share them.
     """
 
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP}
 
-    def __init__(self, env_fns: Sequence[Callable[[], gymnasium.Env]]) -> None:
+    def __init__(self, env_fns: Sequence[Callable[[], gymnasium.Env]], threads: int | None = None) -> None:
         if not env_fns:
             raise InvalidArgumentError("Expected at least one env function, got none.")
+        if threads is not None and (not isinstance(threads, int) or threads < 1):
+            raise InvalidArgumentError(f"Expected threads of 1 or more (or None for one per CPU), got {threads!r}.")
+        self.threads = min(len(env_fns), threads or available_cpus())
         self.envs = [fn() for fn in env_fns]
         self.num_envs = len(self.envs)
         first = self.envs[0]
@@ -61,8 +70,8 @@ class ThreadedVectorEnv(VectorEnv):
         self._direct_screens = False
         self._step_arrays: Pool[StepArrays] | None = None
         self._autoreset = [False] * self.num_envs
-        # The calling thread steps env 0 itself; the pool steps the rest.
-        self._pool = ThreadPoolExecutor(max_workers=max(self.num_envs - 1, 1), thread_name_prefix="retrokit-env")
+        # The calling thread steps envs too; the pool's threads step the rest.
+        self._pool = ThreadPoolExecutor(max_workers=max(self.threads - 1, 1), thread_name_prefix="retrokit-env")
         self._runner = self._native_runner()
 
     def _native_runner(self) -> _host.Runner | None:
@@ -84,11 +93,16 @@ class ThreadedVectorEnv(VectorEnv):
             keys = names.pop()
             self._step_arrays = Pool(lambda: StepArrays(self.num_envs, keys))
             self._field_values = [memoryview(env.reader.values) for env in envs]
-        return _host.Runner(self.num_envs - 1)
+        return _host.Runner(self.threads - 1)
 
     def _each(self, job: Callable[[int], Any]) -> list[Any]:
-        futures = [self._pool.submit(job, i) for i in range(1, self.num_envs)]
-        return [job(0)] + [f.result() for f in futures]
+        """Run ``job(i)`` for every env: the pool takes all but every ``threads``-th, which this thread runs."""
+        if self.threads == 1:
+            return [job(i) for i in range(self.num_envs)]
+        mine = range(0, self.num_envs, self.threads)
+        futures = {i: self._pool.submit(job, i) for i in range(self.num_envs) if i % self.threads}
+        done = {i: job(i) for i in mine}
+        return [done[i] if i in done else futures[i].result() for i in range(self.num_envs)]
 
     def reset(self, *, seed: int | Sequence[int | None] | None = None, options: dict[str, Any] | None = None):
         seeds = [None if seed is None else seed + i for i in range(self.num_envs)] if not isinstance(seed, Sequence) else list(seed)
@@ -186,11 +200,21 @@ class ThreadedVectorEnv(VectorEnv):
             env.close()
 
 
-def make_vec(game: str, num_envs: int, state: Any = None, scenario: Any = None, **options: Any) -> ThreadedVectorEnv:
-    """Make ``num_envs`` copies of a game's env stepped on threads."""
+def available_cpus() -> int:
+    """The CPUs this process may run on."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not on Linux
+        return os.cpu_count() or 1
+
+
+def make_vec(
+    game: str, num_envs: int, state: Any = None, scenario: Any = None, *, threads: int | None = None, **options: Any
+) -> ThreadedVectorEnv:
+    """Make ``num_envs`` copies of a game's env stepped on threads (one per CPU unless ``threads`` says)."""
     from retrokit.env import State, make
 
     if num_envs < 1:
         raise InvalidArgumentError(f"Expected num_envs of 1 or more, got {num_envs}.")
     start = State.DEFAULT if state is None else state
-    return ThreadedVectorEnv([lambda: make(game, start, scenario, **options) for _ in range(num_envs)])
+    return ThreadedVectorEnv([lambda: make(game, start, scenario, **options) for _ in range(num_envs)], threads)

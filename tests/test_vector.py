@@ -8,7 +8,7 @@ import pytest
 
 import retrokit
 from retrokit.errors import InvalidArgumentError
-from retrokit.vector import ThreadedVectorEnv
+from retrokit.vector import ThreadedVectorEnv, available_cpus
 
 OPTIONS = {"frameskip": 4, "sticky_prob": 0.25, "max_episode_steps": 25, "action_type": "discrete"}
 
@@ -18,9 +18,11 @@ def actions_for(step: int, n: int) -> np.ndarray:
     return rng.integers(0, 126, n)
 
 
-def test_vector_equals_single_envs_through_autoreset() -> None:
-    n, seed, steps = 2, 10, 60
-    vec = retrokit.make_vec("Airstriker-Genesis", n, **OPTIONS)
+@pytest.mark.parametrize("n, threads", [(2, None), (5, 2), (3, 1)], ids=["2-envs", "5-envs-2-threads", "3-envs-1-thread"])
+def test_vector_equals_single_envs_through_autoreset(n: int, threads: int | None) -> None:
+    seed, steps = 10, 60
+    vec = retrokit.make_vec("Airstriker-Genesis", n, threads=threads, **OPTIONS)
+    assert vec.threads == min(n, threads or available_cpus())
     singles = [retrokit.make("Airstriker-Genesis", **OPTIONS) for _ in range(n)]
     obs, infos = vec.reset(seed=seed)
     single_obs = [env.reset(seed=seed + i)[0] for i, env in enumerate(singles)]
@@ -55,6 +57,12 @@ def test_vector_spaces_are_batched() -> None:
     vec.close()
 
 
+@pytest.mark.parametrize("threads", [0, -1, 1.5], ids=["zero", "negative", "float"])
+def test_vector_threads_must_be_a_positive_count(threads: object) -> None:
+    with pytest.raises(InvalidArgumentError, match="threads of 1 or more"):
+        retrokit.make_vec("Airstriker-Genesis", 2, threads=threads)
+
+
 def test_vector_needs_at_least_one_env() -> None:
     with pytest.raises(InvalidArgumentError, match="num_envs of 1 or more"):
         retrokit.make_vec("Airstriker-Genesis", 0)
@@ -73,7 +81,7 @@ def test_vector_infos_are_batched_as_gymnasium_batches_them(wrapped: bool) -> No
     n = 3
     make = lambda: retrokit.make("Airstriker-Genesis", **OPTIONS)  # noqa: E731
     fns = [(lambda: gymnasium.wrappers.RecordEpisodeStatistics(make())) if wrapped else make for _ in range(n)]
-    vec = ThreadedVectorEnv(fns)
+    vec = ThreadedVectorEnv(fns, threads=2)  # more envs than threads
     assert (vec._runner is None) == wrapped
     singles = [fn() for fn in fns]
     vec.reset(seed=3)

@@ -74,9 +74,10 @@ class Emulator:
     def close(self) -> None: ...
 
 class Runner:
-    """A pool of native threads that run several emulators' frames in one call."""
+    """A pool of native worker threads that, with the calling thread, run several emulators' frames in one call."""
 
-    def __init__(self, threads: int) -> None: ...
+    def __init__(self, threads: int) -> None:
+        """Start ``threads`` workers (0 runs everything on the calling thread)."""
     def run(
         self,
         emulators: Sequence[Emulator],
@@ -84,11 +85,12 @@ class Runner:
         frames: int,
         screens: Sequence[npt.NDArray[np.uint8]] | None = None,
     ) -> tuple[bool, ...]:
-        """Run every emulator's frames at once (at most ``threads + 1``), one thread each, the GIL released.
+        """Run every emulator's frames, the GIL released, on the calling thread and the workers.
 
-        ``actions`` has one row of port masks per emulator. Each screen is
-        converted into its buffer when its shape fits the frame; the result
-        says, per emulator, whether it was.
+        Any number of emulators: the threads take them one at a time until
+        none is left. ``actions`` has one row of port masks per emulator. Each
+        screen is converted into its buffer when its shape fits the frame; the
+        result says, per emulator, whether it was.
         """
 
 def convert_frame(data: bytes, width: int, height: int, pitch: int, format: int, out: npt.NDArray[np.uint8]) -> None:

@@ -15,7 +15,6 @@
 typedef struct {
     PyObject_HEAD
     rk_runner runner;
-    int threads;
     pid_t pid;
     atomic_int busy;
 } RunnerObject;
@@ -36,7 +35,6 @@ static int runner_init(RunnerObject *self, PyObject *args, PyObject *kwargs) {
         PyErr_SetString(CoreError, "cannot start the runner's threads");
         return -1;
     }
-    self->threads = threads;
     self->pid = getpid();
     return 0;
 }
@@ -65,11 +63,6 @@ static PyObject *runner_run(RunnerObject *self, PyObject *args) {
     Py_buffer actions = {0}, *views = NULL;
     Py_ssize_t claimed = 0, viewed = 0;
     int runner_claimed = 0, expected = 0;
-    if (n > self->threads + 1) {
-        PyErr_Format(InvalidArgumentError, "this runner has %d threads, so at most %d emulators, got %zd",
-                     self->threads, self->threads + 1, n);
-        goto done;
-    }
     if (!atomic_compare_exchange_strong(&self->busy, &expected, 1)) {
         PyErr_SetString(CoreError, "this runner is running in another thread; use one runner per thread");
         goto done;
@@ -148,8 +141,8 @@ done:
 
 static PyMethodDef runner_methods[] = {
     {"run", (PyCFunction)runner_run, METH_VARARGS,
-     "run(emulators, actions, frames, screens=None): run every emulator's frames at once, each on its own "
-     "thread, and convert each screen into its buffer; return whether each screen was converted."},
+     "run(emulators, actions, frames, screens=None): run every emulator's frames, shared among the calling "
+     "thread and the workers, and convert each screen into its buffer; return whether each screen was converted."},
     {NULL, NULL, 0, NULL},
 };
 
@@ -158,7 +151,8 @@ PyTypeObject RunnerType = {
     .tp_basicsize = sizeof(RunnerObject),
     .tp_dealloc = (destructor)runner_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "A pool of native threads that run several emulators' frames in one call.",
+    .tp_doc = "Runner(threads): a pool of worker threads that, with the calling thread, run several emulators' "
+              "frames in one call.",
     .tp_methods = runner_methods,
     .tp_init = (initproc)runner_init,
     .tp_new = PyType_GenericNew,

@@ -1,15 +1,21 @@
 /*
  * Running several emulators' frames at once on a pool of native threads.
  *
- * A vector env's step is one call: the GIL is released once, each emulator
- * runs its frames on its own thread (the calling thread takes the first),
- * and each converts its screen straight into the caller's batch buffer.
- * Between calls a worker spins for a while before it sleeps: a step's
- * Python part is short, and waking a sleeping thread (on a virtual machine,
- * a halted vCPU) costs more than the step gains. The caller announces a task
- * by bumping `start` and posts the semaphore only if the worker says it
- * sleeps; both sides write their flag before reading the other's, so no
- * wake-up is lost.
+ * A vector env's step is one call: the GIL is released once, and the calling
+ * thread and the workers take the emulators' tasks one at a time from a
+ * shared counter until none is left, each converting its screen straight into
+ * the caller's batch. There are no more threads than the caller asked for
+ * (a vector env asks for one per CPU), so a vector of more envs than CPUs
+ * shares them instead of crowding them, and a thread held up by the machine
+ * leaves its share to the others.
+ *
+ * Between calls a worker spins for a while before it sleeps: a step's Python
+ * part is short, and waking a sleeping thread (on a virtual machine, a halted
+ * vCPU) costs more than the step gains. The caller announces a call by
+ * bumping `start` and posts the semaphore only if the worker says it sleeps;
+ * both sides write their flag before reading the other's, so no wake-up is
+ * lost. The caller returns only once every worker it woke has said it takes
+ * no more tasks, so none touches them after.
  */
 #include "runner.h"
 
@@ -33,6 +39,10 @@ static void do_task(rk_task *task) {
                                                           task->screen_height);
 }
 
+static void take_tasks(rk_runner *r) {
+    for (int i; (i = atomic_fetch_add(&r->next, 1)) < r->n_tasks;) do_task(&r->tasks[i]);
+}
+
 static void *worker_main(void *arg) {
     rk_worker *w = arg;
     unsigned seen = 0;
@@ -50,7 +60,7 @@ static void *worker_main(void *arg) {
         }
         if (atomic_load(&w->quit)) return NULL;
         seen = atomic_load(&w->start);
-        do_task(w->task);
+        take_tasks(w->runner);
         atomic_store(&w->done, seen);
     }
 }
@@ -65,6 +75,7 @@ int rk_runner_init(rk_runner *r, int threads) {
     if (!r->workers) return -1;
     for (int i = 0; i < threads; i++) {
         rk_worker *w = &r->workers[i];
+        w->runner = r;
         sem_init(&w->wake, 0, 0);
         if (pthread_create(&w->thread, NULL, worker_main, w) != 0) {
             sem_destroy(&w->wake);
@@ -77,16 +88,18 @@ int rk_runner_init(rk_runner *r, int threads) {
 }
 
 void rk_runner_run(rk_runner *r, rk_task *tasks, int n) {
-    /* Task 0 runs on the calling thread; task i on worker i-1. */
-    for (int i = 1; i < n; i++) {
-        rk_worker *w = &r->workers[i - 1];
-        w->task = &tasks[i];
+    r->tasks = tasks;
+    r->n_tasks = n;
+    atomic_store(&r->next, 0);
+    int helpers = n - 1 < r->n_workers ? n - 1 : r->n_workers;
+    for (int i = 0; i < helpers; i++) {
+        rk_worker *w = &r->workers[i];
         atomic_fetch_add(&w->start, 1);
         wake(w);
     }
-    if (n > 0) do_task(&tasks[0]);
-    for (int i = 1; i < n; i++) {
-        rk_worker *w = &r->workers[i - 1];
+    take_tasks(r);
+    for (int i = 0; i < helpers; i++) {
+        rk_worker *w = &r->workers[i];
         unsigned target = atomic_load(&w->start);
         for (int spins = 0; atomic_load(&w->done) != target; spins++) {
             if (spins < RK_SPINS) cpu_relax();

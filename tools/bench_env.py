@@ -7,6 +7,10 @@
    wrapper like the paper's (target >= 1.3; the core caps it near 1.36).
 3. A 2-env threaded vector against 1 env, in env steps/s (target >= 1.85).
 
+Beside them, with no target: an 8-env vector against the 2-env one. The
+machine has two CPUs, so 8 envs share 2 threads; the figure shows that more
+envs than CPUs keep the throughput (it was 0.4 when each env had a thread).
+
 These machines are noisy and their speed drifts from one second to the
 next, so each ratio alternates its own kinds in short bursts (short enough
 that both see the same machine, long enough that each runs with its own data
@@ -25,7 +29,7 @@ The same two emulators run without waiting for each other after every step
 (one runner call per burst) show what the lockstep itself costs there: when
 either vCPU is held up, a vector env's other thread waits for it.
 
-Usage: python tools/bench_env.py [--ticks 4] [--burst 25] [--rounds 25] [--check]
+Usage: python tools/bench_env.py [--ticks 4] [--burst 25] [--rounds 25] [--many 8] [--check]
 """
 
 from __future__ import annotations
@@ -173,6 +177,7 @@ def main() -> int:
     parser.add_argument("--ticks", type=int, default=4, help="ticks per round")
     parser.add_argument("--burst", type=int, default=25, help="steps of each kind per tick")
     parser.add_argument("--rounds", type=int, default=25, help="rounds")
+    parser.add_argument("--many", type=int, default=8, help="envs of the many-env vector (0: skip it)")
     parser.add_argument("--check", action="store_true", help="exit 1 if a ratio misses its target")
     args = parser.parse_args()
 
@@ -186,6 +191,9 @@ def main() -> int:
         "raw": bares[0].lockstep, "raw2": bares[1].lockstep, "raw2-free": bares[2].free,
         "env": env_stepper(env), "vector2": vector_stepper(vec),
     }
+    many = retrokit.make_vec(GAME, args.many, **OPTIONS) if args.many else None
+    if many is not None:
+        kinds[f"vector{args.many}"] = vector_stepper(many)
     try:
         import stable_retro
 
@@ -195,6 +203,8 @@ def main() -> int:
 
     groups = {"env/raw": ["env", "raw"], "env/stable-retro": ["env", "stable-retro"],
               "vector2/env": ["vector2", "env", "raw2", "raw", "raw2-free"]}  # the vector's ceilings, same bursts
+    if many is not None:
+        groups[f"vector{args.many}/vector2"] = [f"vector{args.many}", "vector2"]
     groups = {name: kinds_ for name, kinds_ in groups.items() if all(k in kinds for k in kinds_)}
     rates: dict[str, dict[str, list[float]]] = {name: {k: [] for k in ks} for name, ks in groups.items()}
     for round_ in range(args.rounds + 1):  # round 0 warms up
@@ -236,8 +246,16 @@ def main() -> int:
                       f"(ceiling >= {FULL_CORES})")
             else:
                 print(f"{'':>18}  no round had two full cores (ceiling >= {FULL_CORES})")
+    for name in groups:
+        if name not in RATIOS:
+            group = rates[name]
+            top, bottom = groups[name]
+            ratio = statistics.median(t / b for t, b in zip(group[top], group[bottom]))
+            print(f"{name:>18}: {ratio:6.3f}  (no target: {args.many} envs sharing this machine's CPUs)")
     env.close()
     vec.close()
+    if many is not None:
+        many.close()
     for bare in bares:
         bare.close()
     return 1 if args.check and failed else 0

@@ -22,7 +22,7 @@ from gymnasium import spaces
 from retrokit.actions import ActionMap
 from retrokit.buffers import BufferPool
 from retrokit.emulator import Emulator
-from retrokit.errors import EnvError, InvalidArgumentError, did_you_mean
+from retrokit.errors import EnvError, FileConflictError, InvalidArgumentError, did_you_mean
 from retrokit.games import Game, find_game
 from retrokit.memory import FieldReader
 from retrokit.states import read_state
@@ -110,7 +110,6 @@ class RetroEnv(gymnasium.Env):
         self._direct = obs_type == "rgb" and self._crop is None
         self.record_dir = Path(record) if record is not None else None
         self._recorder = None
-        self._episode = 0
         self._run = None
         self._viewer = None
         self._frame = self._steps = 0
@@ -207,15 +206,21 @@ class RetroEnv(gymnasium.Env):
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         before = self.prepare_step(action)
         if self.scenario_every_frame:
-            rewards, done, values = self._frames_one_by_one()
-            return self._end_step(rewards, done, values, self._observe())
+            for i in range(self.frameskip):
+                before = self.start_frame(i)
+                self._emu.run(self._masks, 1)
+                if self.end_frame(before):
+                    break
+            return self.finish_frames()
         if self._direct:  # the host converts the screen right after the frames
             obs = self._buffers.take()
             return self.finish_step(before, obs if self._emu.run(self._masks, self.frameskip, obs) else None)
         self._emu.run(self._masks, self.frameskip)
         return self.finish_step(before)
 
-    # The vector env runs many envs' frames in one native call between these two.
+    # The vector env runs many envs' frames in one native call between these two
+    # (or, with the scenario evaluated every frame, one frame at a time between
+    # start_frame and end_frame, then finish_frames).
 
     def prepare_step(self, action: Any) -> tuple[int, ...] | None:
         """Set the buttons for a step's frames; return what a movie needs to know of the last frame."""
@@ -255,23 +260,30 @@ class RetroEnv(gymnasium.Env):
         rewards, done = self._run.step(values, self._frame, self._steps)
         return tuple(rewards[: self.players]), bool(done)
 
-    def _frames_one_by_one(self) -> tuple[tuple[float, ...], bool, dict[str, int]]:
-        total = [0.0] * self.players
-        done, values = False, {}
-        for i in range(self.frameskip):
-            before = self._emu.held() if self._recorder is not None else None
-            if i > 0:
-                self._emu.forget_action()  # only a step's first frame may stick
-            self._emu.run(self._masks, 1)
-            self._frame += 1
-            if before is not None:
-                self._record_step(before, 1)
-            values = self.reader.read()
-            rewards, done = self._evaluate(values)
-            total = [t + r for t, r in zip(total, rewards)]
-            if done:
-                break
-        return tuple(total), done, values
+    def start_frame(self, i: int) -> tuple[int, ...] | None:
+        """Before frame ``i`` of a step whose scenario runs every frame; return what a movie needs."""
+        if i == 0:
+            self._frame_rewards, self._frame_done, self._frame_values = [0.0] * self.players, False, {}
+        before = self._emu.held() if self._recorder is not None else None
+        if i > 0:
+            self._emu.forget_action()  # only a step's first frame may stick
+        return before
+
+    def end_frame(self, before: tuple[int, ...] | None) -> bool:
+        """After one frame of such a step: read the fields and add the frame's rewards; return done."""
+        self._frame += 1
+        if before is not None:
+            self._record_step(before, 1)
+        values = self._frame_values = self.reader.read()
+        rewards, done = self._evaluate(values)
+        self._frame_rewards = [t + r for t, r in zip(self._frame_rewards, rewards)]
+        self._frame_done = done
+        return done
+
+    def finish_frames(self, obs: np.ndarray | None = None) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """End such a step once its frames ran (all of them, or up to the one that ended the episode)."""
+        rewards = tuple(self._frame_rewards)
+        return self._end_step(rewards, self._frame_done, self._frame_values, self._observe() if obs is None else obs)
 
     def _observe(self) -> np.ndarray:
         if self.obs_type == "ram":
@@ -321,15 +333,17 @@ class RetroEnv(gymnasium.Env):
     def _begin_movie(self) -> None:
         if self.record_dir is None:
             return
-        from retrokit.movie import MovieRecorder
+        from retrokit.movie.recorder import MovieRecorder, claim_movie_path
 
         if self._recorder is not None:
             self._end_movie()
         self.record_dir.mkdir(parents=True, exist_ok=True)
-        name = f"{self.game.name}-{self.state_name or 'power-on'}-{self._episode:06d}.bk2"
-        self._episode += 1
         self._recorder = MovieRecorder(
-            self.record_dir / name, self.game.name, self.emulator.system.name, self.players, self._state
+            claim_movie_path(self.record_dir, self._movie_stem),
+            self.game.name,
+            self.emulator.system.name,
+            self.players,
+            self._state,
         )
 
     def _record_step(self, before: tuple[int, ...], frames: int) -> None:
@@ -340,9 +354,19 @@ class RetroEnv(gymnasium.Env):
         for _ in range(frames - 1):
             self._recorder.record(applied)
 
+    @property
+    def _movie_stem(self) -> str:
+        return f"{self.game.name}-{self.state_name or 'power-on'}"
+
     def _end_movie(self) -> None:
-        self._recorder.close()
-        self._recorder = None
+        from retrokit.movie.recorder import claim_movie_path
+
+        recorder, self._recorder = self._recorder, None
+        try:
+            recorder.close()
+        except FileConflictError:  # another process wrote a movie of that name meanwhile
+            recorder.path = claim_movie_path(self.record_dir, self._movie_stem)
+            recorder.close()
 
 
 def _check_choice(name: str, value: object, choices: tuple[object, ...]) -> None:

@@ -79,9 +79,9 @@ class ThreadedVectorEnv(VectorEnv):
         from retrokit.env import RetroEnv
 
         envs = self.envs
-        if not all(type(env) is RetroEnv and not env.scenario_every_frame for env in envs):
+        if not all(type(env) is RetroEnv for env in envs):
             return None
-        if len({(env.frameskip, env.emulator.ports) for env in envs}) != 1:
+        if len({(env.frameskip, env.emulator.ports, env.scenario_every_frame) for env in envs}) != 1:
             return None
         # Each env's buttons become a row of one array the runner reads.
         self._actions = np.zeros((self.num_envs, envs[0].emulator.ports), dtype=np.uint16)
@@ -158,29 +158,64 @@ class ThreadedVectorEnv(VectorEnv):
         arrays.refill_masks()
         return observations, arrays.rewards, arrays.terminations, arrays.truncations, dict(arrays.info)
 
-    def _step_native(self, actions: list[Any]) -> tuple[list[tuple], np.ndarray]:
+    def _step_native(self, actions: Sequence[Any]) -> tuple[list[tuple], np.ndarray]:
         envs = self.envs
         batch, views = self._batches.take_rows() if self._batches is not None else (None, [])
         stepping = [i for i in range(self.num_envs) if not self._autoreset[i]]
         befores = [envs[i].prepare_step(actions[i]) for i in stepping]
-        screens = [views[i] for i in stepping] if self._direct_screens else None
-        rows = self._actions if len(stepping) == self.num_envs else self._actions[stepping]
-        converted = self._runner.run([envs[i]._emu for i in stepping], rows, envs[0].frameskip, screens) if stepping else ()
-        results: list[tuple] = [()] * self.num_envs
-        for k, i in enumerate(stepping):
-            direct = screens is not None and converted[k]
-            results[i] = envs[i].finish_step(befores[k], views[i] if direct else None)
-            if not direct and batch is not None:
-                batch[i] = results[i][0]
+        if envs[0].scenario_every_frame:
+            results = self._run_frames(stepping, views)
+        else:
+            screens = [views[i] for i in stepping] if self._direct_screens else None
+            converted = self._run(stepping, envs[0].frameskip, screens)
+            results = {
+                i: envs[i].finish_step(befores[k], views[i] if screens is not None and converted[k] else None)
+                for k, i in enumerate(stepping)
+            }
         for i in range(self.num_envs):
             if self._autoreset[i]:
                 obs, info = envs[i].reset()
                 results[i] = (obs, 0.0, False, False, info)
-                if batch is not None:
-                    batch[i] = obs
+        ordered = [results[i] for i in range(self.num_envs)]
         if batch is None:
-            return results, self._batch([r[0] for r in results])
-        return results, batch
+            return ordered, self._batch([r[0] for r in ordered])
+        for i, result in enumerate(ordered):
+            if result[0] is not views[i]:  # not converted straight into the batch
+                batch[i] = result[0]
+        return ordered, batch
+
+    def _run(self, envs: list[int], frames: int, screens: list[np.ndarray] | None) -> tuple[bool, ...]:
+        """Run these envs' emulators for some frames in one native call."""
+        if not envs:
+            return ()
+        rows = self._actions if len(envs) == self.num_envs else self._actions[envs]
+        return self._runner.run([self.envs[i]._emu for i in envs], rows, frames, screens)
+
+    def _run_frames(self, stepping: list[int], views: list[np.ndarray]) -> dict[int, tuple]:
+        """A step of envs whose scenario runs every frame: one native call per frame, for the envs still going.
+
+        An env whose episode ends on a frame runs no more frames this step, as
+        a single env's step does; the others' screens are converted on the
+        last frame.
+        """
+        envs, frameskip = self.envs, self.envs[0].frameskip
+        results: dict[int, tuple] = {}
+        live = stepping
+        for f in range(frameskip):
+            befores = [envs[i].start_frame(f) for i in live]
+            last = f == frameskip - 1
+            screens = [views[i] for i in live] if self._direct_screens and last else None
+            converted = self._run(live, 1, screens)
+            going = []
+            for k, i in enumerate(live):
+                if envs[i].end_frame(befores[k]):
+                    results[i] = envs[i].finish_frames()
+                elif last:
+                    results[i] = envs[i].finish_frames(views[i] if screens is not None and converted[k] else None)
+                else:
+                    going.append(i)
+            live = going
+        return results
 
     def _step_threads(self, actions: list[Any]) -> list[tuple]:
         def one(i: int) -> tuple[Any, float, bool, bool, dict[str, Any]]:

@@ -18,12 +18,19 @@ def actions_for(step: int, n: int) -> np.ndarray:
     return rng.integers(0, 126, n)
 
 
+# Ends an episode on the second frame of a step, so per-frame envs stop mid-step.
+MID_STEP = {"reward": "delta(score)", "done": "frame >= 37 or gameover == 1"}
+
+
+@pytest.mark.parametrize("every_frame", [False, True], ids=["per-step", "per-frame"])
 @pytest.mark.parametrize("n, threads", [(2, None), (5, 2), (3, 1)], ids=["2-envs", "5-envs-2-threads", "3-envs-1-thread"])
-def test_vector_equals_single_envs_through_autoreset(n: int, threads: int | None) -> None:
+def test_vector_equals_single_envs_through_autoreset(n: int, threads: int | None, every_frame: bool) -> None:
     seed, steps = 10, 60
-    vec = retrokit.make_vec("Airstriker-Genesis", n, threads=threads, **OPTIONS)
+    options = {**OPTIONS, "scenario_every_frame": every_frame, "scenario": MID_STEP if every_frame else None}
+    vec = retrokit.make_vec("Airstriker-Genesis", n, threads=threads, **options)
     assert vec.threads == min(n, threads or available_cpus())
-    singles = [retrokit.make("Airstriker-Genesis", **OPTIONS) for _ in range(n)]
+    assert vec._runner is not None  # both kinds run on the native runner
+    singles = [retrokit.make("Airstriker-Genesis", **options) for _ in range(n)]
     obs, infos = vec.reset(seed=seed)
     single_obs = [env.reset(seed=seed + i)[0] for i, env in enumerate(singles)]
     assert all((obs[i] == single_obs[i]).all() for i in range(n))
@@ -126,3 +133,35 @@ def test_gymnasium_make_vec_gives_the_threaded_vector_by_default(mode: str | Non
         _, _, _, truncated, _ = vec.step(np.zeros((2, 12), dtype=np.int8))
     assert truncated.all()
     vec.close()
+
+
+@pytest.mark.parametrize("every_frame", [False, True], ids=["per-step", "per-frame"])
+def test_vector_movies_replay_what_each_env_saw(tmp_path, every_frame: bool) -> None:
+    from retrokit.movie import play
+
+    theirs = tmp_path / "Dasher-Genesis-Zone1.Act1-000000.bk2"
+    theirs.write_bytes(b"a file the user made")
+    vec = retrokit.make_vec(
+        "Dasher-Genesis", 2, frameskip=4, sticky_prob=0.5, max_episode_steps=12, record=tmp_path,
+        action_type="all", scenario_every_frame=every_frame,
+    )
+    vec.reset(seed=0)
+    rng = np.random.default_rng(1)
+    seen = []  # (movie, index of the step's last frame in it, what the env saw)
+    frames_in: dict = {}
+    for _ in range(30):
+        movies = [env._recorder.path if env._recorder is not None else None for env in vec.envs]
+        before = [env.emulator.frame for env in vec.envs]
+        obs = vec.step((rng.random((2, 12)) < 0.3).astype(np.int8))[0]
+        for i, env in enumerate(vec.envs):
+            if movies[i] is None:
+                continue  # this step reset the env
+            frames_in[movies[i]] = frames_in.get(movies[i], 0) + env.emulator.frame - before[i]
+            seen.append((movies[i], frames_in[movies[i]] - 1, obs[i].copy()))
+    vec.close()
+    assert theirs.read_bytes() == b"a file the user made"
+    written = sorted(p for p in tmp_path.glob("*.bk2") if p != theirs)
+    assert set(written) == set(frames_in) and len(written) >= 4  # both envs, two episodes or more each
+    replays = {movie: list(play(movie)) for movie in written}
+    assert all(len(replays[movie]) == count for movie, count in frames_in.items())
+    assert all((replays[movie][index] == frame).all() for movie, index, frame in seen)

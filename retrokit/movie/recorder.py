@@ -3,12 +3,33 @@
 from __future__ import annotations
 
 import os
+import threading
 from collections.abc import Sequence
 from pathlib import Path
 
 from retrokit.errors import FileConflictError, MovieError
 from retrokit.movie.bk2 import write_bk2
 from retrokit.movie.model import Movie, layout
+
+
+_claims: dict[tuple[Path, str], int] = {}
+_claims_lock = threading.Lock()
+
+
+def claim_movie_path(folder: str | os.PathLike[str], stem: str) -> Path:
+    """The first ``<stem>-NNNNNN.bk2`` in ``folder`` that no file has and no earlier call in this process gave.
+
+    Envs that record into one folder (a vector env's, or a second run's)
+    each get their own names, so none writes over another's movies or a
+    file already there.
+    """
+    folder = Path(folder).resolve()
+    with _claims_lock:
+        n = _claims.get((folder, stem), 0)
+        while (folder / f"{stem}-{n:06d}.bk2").exists():
+            n += 1
+        _claims[folder, stem] = n + 1
+        return folder / f"{stem}-{n:06d}.bk2"
 
 
 class MovieRecorder:

@@ -11,6 +11,7 @@ import logging
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Self
 
 import numpy as np
 
@@ -100,7 +101,7 @@ class Emulator:
                 on the rest), or a single mask for port 1.
             frames: How many frames to run.
         """
-        if type(actions) is not np.ndarray or actions.dtype != np.uint16:  # noqa: E721 - exact type is the fast path
+        if type(actions) is not np.ndarray or actions.dtype != np.uint16:  # the exact type is the fast path
             actions = self._as_actions(actions)
         self._emu.run(actions, frames)
 
@@ -214,7 +215,7 @@ class Emulator:
         """Unload the game and the core. Further calls raise."""
         self._emu.close()
 
-    def __enter__(self) -> Emulator:
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *exc: object) -> None:

@@ -141,7 +141,7 @@ class Game:
                     f"Expected {self.name} to name a default state; found none in its data file. "
                     f"Pass a state name: one of {', '.join(self.states) or '(no states)'}."
                 )
-        key = name[: -len(STATE_SUFFIX)] if name.endswith(STATE_SUFFIX) else name
+        key = name.removesuffix(STATE_SUFFIX)
         if key in self._state_files:
             return self._state_files[key]
         if name.endswith(STATE_SUFFIX) and (os.sep in name or "/" in name) and Path(name).is_file():

@@ -69,7 +69,7 @@ def _recipe(game: Game, name: str, spec: Any) -> Recipe:
         raise DataFileError(f"{where}: expected a mapping with set, press, until, got {spec!r}.")
     unknown = set(spec) - {"set", "press", "until", "settle", "max_frames"}
     if unknown:
-        key = sorted(unknown)[0]
+        key = min(unknown)
         raise DataFileError(
             f"{where}: expected only the keys set, press, until, settle, max_frames; got {key!r}."
             + did_you_mean(key, ["set", "press", "until", "settle", "max_frames"])

@@ -61,7 +61,7 @@ class FieldType:
             return tuple(range(w - 1, -1, -1))
         half = w // 2
         if order == "><":  # big-endian words of little-endian bytes: low word last
-            return tuple(range(half, w)) + tuple(range(0, half))
+            return tuple(range(half, w)) + tuple(range(half))
         # "<>": little-endian words of big-endian bytes: low word first
         return tuple(range(half - 1, -1, -1)) + tuple(range(w - 1, half - 1, -1))
 

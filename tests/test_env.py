@@ -53,7 +53,7 @@ def test_each_action_type_drives_the_game(action_type: str) -> None:
     env.reset(seed=0)
     total = 0.0
     for step in range(300):
-        _, reward, terminated, truncated, info = env.step(fire_and_wander(env, step))
+        _, reward, terminated, _truncated, info = env.step(fire_and_wander(env, step))
         total += reward
         if terminated:
             break
@@ -85,7 +85,7 @@ def test_press_names_buttons_in_gym_retros_order() -> None:
 def test_filtered_actions_drop_what_gym_retro_drops() -> None:
     env = retrokit.make(AIRSTRIKER, action_type="filtered")
     system = env.emulator.system
-    f = lambda names: system.buttons_of(env.actions.filter(system.mask(names)))  # noqa: E731
+    f = lambda names: system.buttons_of(env.actions.filter(system.mask(names)))
     assert f(["UP", "DOWN", "LEFT"]) == ["LEFT"]  # opposite directions are no combination
     assert f(["A", "B"]) == ["B", "A"]
     assert f(["A", "C"]) == []

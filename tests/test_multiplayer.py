@@ -48,12 +48,12 @@ def right(env, agent: str, jump: bool = False) -> np.ndarray:
 
 def test_each_player_is_rewarded_for_its_own_progress() -> None:
     env = make_parallel(action_type="all", max_episode_steps=None)
-    observations, infos = env.reset(seed=0)
+    _observations, infos = env.reset(seed=0)
     assert infos["player_2"]["p2_state"] == 0  # the two-player state has player 2 in the game
     idle = np.zeros(env.action_space("player_1").n, dtype=np.int8)
     totals = {"player_1": 0.0, "player_2": 0.0}
     for _ in range(25):  # only player 2 runs
-        _, rewards, terminations, _, infos = env.step({"player_1": idle, "player_2": right(env, "player_2")})
+        _, rewards, _terminations, _, infos = env.step({"player_1": idle, "player_2": right(env, "player_2")})
         for agent, reward in rewards.items():
             totals[agent] += reward
     assert totals["player_2"] > 0 and totals["player_1"] == 0

@@ -90,7 +90,7 @@ class Sonic1Lua:
         self.xpos_last_x = None
 
     def level_key(self) -> str:
-        return "zone=%d,act=%d" % (self.data["zone"], self.data["act"])
+        return f"zone={self.data['zone']},act={self.data['act']}"
 
     def max_x(self):
         return self.level_max_x.get(self.level_key())  # nil when missing
@@ -99,9 +99,7 @@ class Sonic1Lua:
         if self.data["lives"] < self.prev_lives:
             return True
         self.prev_lives = self.data["lives"]
-        if self.calc_progress() >= 1:
-            return True
-        return False
+        return self.calc_progress() >= 1
 
     def calc_progress(self):
         if self.offset_x is None:

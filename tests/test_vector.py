@@ -86,7 +86,7 @@ def reference_infos(vec, infos: list[dict]) -> dict:
 @pytest.mark.parametrize("wrapped", [False, True], ids=["native-runner", "python-threads"])
 def test_vector_infos_are_batched_as_gymnasium_batches_them(wrapped: bool) -> None:
     n = 3
-    make = lambda: retrokit.make("Airstriker-Genesis", **OPTIONS)  # noqa: E731
+    make = lambda: retrokit.make("Airstriker-Genesis", **OPTIONS)
     fns = [(lambda: gymnasium.wrappers.RecordEpisodeStatistics(make())) if wrapped else make for _ in range(n)]
     vec = ThreadedVectorEnv(fns, threads=2)  # more envs than threads
     assert (vec._runner is None) == wrapped

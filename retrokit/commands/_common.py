@@ -17,7 +17,7 @@ def rom_status(game: Game, data_dir: str | os.PathLike[str] | None = None) -> tu
     return ("imported" if path.is_relative_to(paths.roms_dir(data_dir)) else "bundled"), path
 
 
-def add_data_dir_option(parser) -> None:  # noqa: ANN001 - an argparse parser
+def add_data_dir_option(parser) -> None:  # an argparse parser
     """Add ``--data-dir``, the per-user data folder override."""
     parser.add_argument(
         "--data-dir",

@@ -34,12 +34,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 class RunAndJump:
     """Hold RIGHT; now and then hold a jump button for a few steps."""
 
-    def __init__(self, env, rng) -> None:  # noqa: ANN001 - a RetroEnv and a numpy Generator
+    def __init__(self, env, rng) -> None:  # a RetroEnv and a numpy Generator
         actions = env.unwrapped.actions
         self.run, self.jump = actions.press(["RIGHT"]), actions.press(["RIGHT", "B"])
         self.rng, self.jumping = rng, 0
 
-    def act(self):  # noqa: ANN201 - an action of the env
+    def act(self):  # an action of the env
         if self.jumping == 0 and self.rng.random() < 0.2:
             self.jumping = int(self.rng.integers(2, 6))
         if self.jumping:
@@ -87,7 +87,7 @@ def run(args: argparse.Namespace) -> int:
             env.reset(seed=args.seed + episode)
             frames, score, steps = [env.render()], 0.0, 0
             while True:
-                _, reward, terminated, truncated, info = env.step(agent.act())
+                _, reward, terminated, truncated, _info = env.step(agent.act())
                 score += reward
                 steps += 1
                 bar.update(1)

@@ -200,7 +200,7 @@ def encode_bk2(movie: Movie) -> bytes:
     encode: dict[tuple[int, ...], str] = {}
     lines = ["[Input]", key_line]
     for index, frame in enumerate(movie.frames):
-        frame = frame if type(frame) is tuple else tuple(frame)  # noqa: E721 - lists and arrays become keys
+        frame = frame if type(frame) is tuple else tuple(frame)  # lists and arrays become keys
         text = encode.get(frame)
         if text is None:
             masks = lay.check_frame(frame, movie.players, f"{movie.game} frame {index}")

@@ -141,7 +141,7 @@ def _output_kind(out: Path) -> str | None:
     return None
 
 
-def _require_imageio(out: Path):  # noqa: ANN202 - the imageio.v2 module
+def _require_imageio(out: Path):  # the imageio.v2 module
     try:
         import imageio.v2 as imageio
         import imageio_ffmpeg  # noqa: F401 - the plugin that writes .mp4
@@ -176,7 +176,7 @@ def _write_gif(frames: Iterator[tuple[int, np.ndarray]], out: Path, fps: float, 
     return len(images)
 
 
-def _write_mp4(imageio, frames: Iterator[tuple[int, np.ndarray]], out: Path, fps: float, overwrite: bool) -> int:  # noqa: ANN001
+def _write_mp4(imageio, frames: Iterator[tuple[int, np.ndarray]], out: Path, fps: float, overwrite: bool) -> int:
     out.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp_name = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=".mp4", dir=out.parent)
     os.close(fd)

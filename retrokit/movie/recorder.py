@@ -6,11 +6,11 @@ import os
 import threading
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Self
 
 from retrokit.errors import FileConflictError, MovieError
 from retrokit.movie.bk2 import write_bk2
 from retrokit.movie.model import Movie, layout
-
 
 _claims: dict[tuple[Path, str], int] = {}
 _claims_lock = threading.Lock()
@@ -117,7 +117,7 @@ class MovieRecorder:
             self._closed = True
         return self.path
 
-    def __enter__(self) -> MovieRecorder:
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *exc: object) -> None:

@@ -5,8 +5,6 @@ converts. Arguments are checked before the core is touched, and a failing core
 call raises :class:`retrokit.errors.CoreError` (or a subclass); nothing aborts.
 """
 
-from __future__ import annotations
-
 from collections.abc import Callable, Sequence
 from typing import Any, overload
 

@@ -44,10 +44,11 @@ class Program:
         self.source = gen.module()
         self._sites = gen.sites
         self._tables = spec.tables
+        self._rewards = spec.rewards
         namespace = {
             "__builtins__": {},
             "_abs": abs, "_min": min, "_max": max, "_float": float,
-            "_divzero": self._divzero, "_nokey": self._nokey, "_missing": self._missing, "_fail": self._fail,
+            "_divzero": self._divzero, "_nonfinite": self._nonfinite, "_nokey": self._nokey, "_missing": self._missing, "_fail": self._fail,
             "_RuntimeError": ScenarioRuntimeError, "_KeyError": KeyError,
             "_Errors": (ArithmeticError, TypeError, ValueError),
         }
@@ -69,6 +70,14 @@ class Program:
         raise site.snippet.error(
             ScenarioRuntimeError, node.start, node.end,
             f"scenario {self.name!r}: division by zero: the divisor {divisor} is 0",
+        )
+
+    def _nonfinite(self, player: int, value: float) -> None:
+        snippet = self._rewards[player]
+        raise snippet.error(
+            ScenarioRuntimeError, 0, len(snippet.text),
+            f"scenario {self.name!r}: expected the {snippet.role} to be a finite number, got {value}: a value "
+            f"overflowed past 1.8e308, or a division or product met NaN; bound the expression, e.g. with clip()",
         )
 
     def _nokey(self, index: int, key: object) -> None:

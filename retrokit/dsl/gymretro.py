@@ -31,7 +31,7 @@ import yaml
 
 from retrokit.dsl.check import RESERVED
 from retrokit.dsl.document import document_from_dict
-from retrokit.dsl.source import SourceText, located
+from retrokit.dsl.source import SourceText, located, read_source
 from retrokit.dsl.spec import ScenarioSpec
 from retrokit.errors import ScenarioCompileError, ScenarioError, did_you_mean
 
@@ -220,15 +220,13 @@ def _find_key(text: str, path: Sequence[str]) -> int:
 
 
 def _read_json(path: Path) -> tuple[dict, SourceText]:
+    source = read_source(path)
     try:
-        text = path.read_text()
-    except OSError as exc:
-        raise ScenarioError(f"cannot read scenario file {str(path)!r}: {exc.strerror or exc}") from None
-    source = SourceText(str(path), text)
-    try:
-        data = json.loads(text)
+        data = json.loads(source.text)
     except json.JSONDecodeError as exc:
         raise located(ScenarioError, source, exc.pos, exc.pos + 1, f"this is not valid JSON: {exc.msg}") from None
+    except (ValueError, RecursionError) as exc:  # an integer of over 4300 digits; arrays nested thousands deep
+        raise located(ScenarioError, source, 0, 1, f"this JSON cannot be read: {exc}") from None
     if not isinstance(data, dict):
         raise located(ScenarioError, source, 0, 1, "a scenario.json file holds an object ({...})")
     return data, source

@@ -15,8 +15,9 @@ from __future__ import annotations
 import bisect
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 
-from retrokit.errors import RetrokitError
+from retrokit.errors import RetrokitError, ScenarioError
 
 
 @dataclass(frozen=True)
@@ -142,3 +143,27 @@ def choices_text(names: Sequence[str], limit: int = 12) -> str:
     shown = ", ".join(repr(n) for n in list(names)[:limit])
     more = len(names) - limit
     return shown + (f" (and {more} more)" if more > 0 else "")
+
+
+def read_source(path: Path) -> SourceText:
+    """Read a scenario file as UTF-8 text (a leading byte-order mark is allowed).
+
+    Raises:
+        ScenarioError: The file cannot be read, or is not UTF-8; the error
+            points at the first byte that is not.
+    """
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ScenarioError(f"cannot read scenario file {str(path)!r}: {exc.strerror or exc}") from None
+    try:
+        return SourceText(str(path), data.decode("utf-8-sig"))
+    except UnicodeDecodeError as exc:
+        # Locate the bad byte in the text as far as it decodes, so the message shows its line.
+        bom = 3 if data.startswith(b"\xef\xbb\xbf") else 0
+        good = data[bom : exc.start].decode("utf-8")
+        shown = SourceText(str(path), good + data[exc.start :].decode("utf-8", errors="replace"))
+        raise located(
+            ScenarioError, shown, len(good), len(good) + 1,
+            f"expected UTF-8 text, got the byte 0x{data[exc.start]:02x}; save the file as UTF-8",
+        ) from None

@@ -213,7 +213,11 @@ class DocumentLoader:
                 if base is None:
                     raise reader.error(entries["include"][1], "include needs a folder to look in: pass game_dir")
                 target = base / str(reader.plain(item))
-                if not target.is_file():
+                try:
+                    found = target.is_file()
+                except (OSError, ValueError):  # a name too long for the file system, or holding NUL
+                    found = False
+                if not found:
                     raise reader.error(item, f"no file {str(reader.plain(item))!r} to include (looked for {target})")
                 self.load_file(target, top=False)
         if "name" in entries:

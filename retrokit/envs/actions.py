@@ -17,12 +17,13 @@ Groups come from the scenario's ``actions`` or, failing that, the system's.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 
 import numpy as np
 from gymnasium import spaces
 
-from retrokit.errors import InvalidArgumentError, did_you_mean
+from retrokit.errors import InvalidArgumentError, did_you_mean, shown
 from retrokit.host.systems import System
 from retrokit.native import _host
 
@@ -138,10 +139,44 @@ class ActionMap:
             return
         out[: self.players] = self.to_masks(action)
 
+    def _discrete_index(self, action: object) -> int:
+        """A Discrete action as an int, refused unless it is a whole number in the space."""
+        if isinstance(action, np.ndarray) and action.size == 1:
+            action = action.reshape(()).item()
+        if isinstance(action, (bool, np.bool_)) or not isinstance(action, numbers.Integral):
+            raise InvalidArgumentError(
+                f"Expected a discrete action, a whole number from 0 to {self.space.n - 1}, got {shown(action)} "  # type: ignore[attr-defined]
+                f"({type(action).__name__}); pass e.g. env.action_space.sample()."
+            )
+        index = int(action)
+        if not 0 <= index < self.space.n:  # type: ignore[attr-defined]
+            raise InvalidArgumentError(
+                f"Expected a discrete action from 0 to {self.space.n - 1}, got {index}; "  # type: ignore[attr-defined]
+                f"other values would press other buttons."
+            )
+        return index
+
+    def _check_choices(self, flat: np.ndarray) -> None:
+        """Refuse a multi-discrete action of the wrong length, or choosing past a group's combinations."""
+        nvec = self.space.nvec  # type: ignore[attr-defined]
+        values = flat.tolist()
+        if flat.size != nvec.size or not all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in values):
+            raise InvalidArgumentError(
+                f"Expected a multi-discrete action of {nvec.size} whole numbers (one per button group and player), "
+                f"got {shown(values)}; pass an array like env.action_space.sample()."
+            )
+        bad = [(i, int(v), int(n)) for i, (v, n) in enumerate(zip(values, nvec.tolist())) if not 0 <= v < n]
+        if bad:
+            i, value, n = bad[0]
+            raise InvalidArgumentError(
+                f"Expected choice {i} of the multi-discrete action from 0 to {n - 1}, got {value}; "
+                f"the space is {self.space}."
+            )
+
     def to_masks(self, action: object) -> list[int]:
         """Return one RetroPad mask per player for an action of this map's type."""
         if self.action_type == "discrete":
-            index = int(action)  # type: ignore[call-overload]
+            index = self._discrete_index(action)
             per_player = math.prod(len(c) for c in self.combos)
             masks = []
             for _ in range(self.players):
@@ -155,6 +190,7 @@ class ActionMap:
         flat = np.asarray(action).ravel()
         if self.action_type == "multi_discrete":
             n = len(self.combos)
+            self._check_choices(flat)
             return [
                 int(np.bitwise_or.reduce([combos[int(i)] for combos, i in zip(self.combos, flat[p * n : (p + 1) * n])]))
                 for p in range(self.players)

@@ -23,6 +23,7 @@ from retrokit.data.games import Game, find_game
 from retrokit.data.states import read_state
 from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
+from retrokit.envs.options import check_crop, make_arguments
 from retrokit.errors import EnvError, FileConflictError, InvalidArgumentError, did_you_mean
 from retrokit.host.emulator import Emulator
 from retrokit.host.memory import FieldReader
@@ -105,6 +106,7 @@ class RetroEnv(gymnasium.Env):
         self._masks = np.zeros(self.emulator.ports, dtype=np.uint16)
         self._crop = getattr(self.scenario, "crop", None)
         self._screen_shape = self.emulator.system.screen or self._first_frame_shape()
+        check_crop(self._crop, self._screen_shape)
         self.observation_space = self._make_observation_space()
         self._buffers = BufferPool(self.observation_space.shape)
         self._direct = obs_type == "rgb" and self._crop is None
@@ -384,4 +386,4 @@ def make(
     **options: Any,
 ) -> RetroEnv:
     """Make the Gymnasium environment of a game: see :class:`RetroEnv` for the options."""
-    return RetroEnv(game, state, scenario, **options)
+    return RetroEnv(**make_arguments(game, state, scenario, options))

@@ -1,7 +1,8 @@
 """Generate the Python source of a checked scenario.
 
-The output is one function, ``_bind(s)``, that closes over a Run's state list
-``s`` and returns two step functions, ``_first`` (reset) and ``_next`` (every
+The output is one function, ``_bind(s, d)``, that closes over a Run's state list
+``s`` and its list of per-player dones ``d`` (written each step when the
+scenario has ``dones``), and returns two step functions, ``_first`` (reset) and ``_next`` (every
 later step), each ``(v, frame, step) -> ((reward, ...), done)``. Their bodies
 are straight-line code: read the fields the scenario uses from ``v``, compute
 the definitions and memory arguments in dependency order, then the outputs,
@@ -65,7 +66,7 @@ class CodeGen:
 
     def module(self) -> str:
         """Return the source text of ``_bind``."""
-        lines = ["def _bind(s):"]
+        lines = ["def _bind(s, d):"]
         for name, mode in (("_first", FIRST), ("_next", NEXT)):
             lines += ["    " + line for line in self.function(name, mode)]
         lines.append("    return _first, _next")
@@ -98,11 +99,18 @@ class CodeGen:
             rewards.append(f"_r{i}")
         if not rewards:  # no reward given: 0 for the one player
             rewards.append("0.0")
+        players = []
+        for i, (root, snippet) in enumerate(zip(self.a.dones, self.a.spec.dones)):
+            body.append(f"_pd{i} = {self.whole(root, mode, snippet)}")
+            writes.append(f"d[{i}] = _pd{i}")
+            players.append(f"_pd{i}")
+        everyone_out = " and ".join(players)  # the episode also ends once every player is out
         if self.a.done is not None:
             assert self.a.spec.done is not None
-            body.append(f"_done = {self.whole(self.a.done, mode, self.a.spec.done)}")
+            done = self.whole(self.a.done, mode, self.a.spec.done)
+            body.append(f"_done = {done} or ({everyone_out})" if players else f"_done = {done}")
         else:
-            body.append("_done = False")
+            body.append(f"_done = {everyone_out}" if players else "_done = False")
         loads = [f"{local} = v[{field!r}]" for field, local in self._fields.items()]
         out = [f"def {name}(v, frame, step):", "    try:"]
         out += ["        " + line for line in loads + body + writes]

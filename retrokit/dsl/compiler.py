@@ -57,9 +57,9 @@ class Program:
         exec(compile(self.source, f"<scenario {self.name!r}>", "exec"), namespace)  # noqa: S102 - our own generated code
         self._bind = namespace["_bind"]
 
-    def bind(self, state: list) -> tuple[StepFunction, StepFunction]:
-        """Return ``(first, next)`` step functions working on ``state``."""
-        return self._bind(state)
+    def bind(self, state: list, dones: list) -> tuple[StepFunction, StepFunction]:
+        """Return ``(first, next)`` step functions working on ``state``, writing players' dones into ``dones``."""
+        return self._bind(state, dones)
 
     # --- run-time errors -------------------------------------------------------------
 

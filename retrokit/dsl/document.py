@@ -15,6 +15,7 @@ in it points into the file. The format is documented in ``docs/scenarios.md``::
       progress: clip(x - initial(x), 0, end_x) / end_x
     reward: delta(progress, 0) * 9000
     done: lives < prev(lives) or progress >= 1
+    # or, per player: rewards: [...], dones: [p1_lives == 0, p2_lives == 0]
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ from retrokit.dsl.source import Snippet, SourceText, align, located, read_source
 from retrokit.dsl.spec import Scalar, ScenarioSpec, Table
 from retrokit.errors import ScenarioError, did_you_mean
 
-TOP_KEYS = ("name", "description", "include", "tables", "define", "reward", "rewards", "done", "actions", "crop")
+TOP_KEYS = ("name", "description", "include", "tables", "define", "reward", "rewards", "done", "dones", "actions", "crop")
 INCLUDE_KEYS = ("description", "include", "tables", "define")
 TABLE_KEYS = ("by", "default", "values", "description")
 
@@ -242,6 +243,15 @@ class DocumentLoader:
             spec.rewards = [reader.snippet(item, f"reward of player {i + 1}") for i, item in enumerate(items)]
         if "done" in entries:
             spec.done = reader.snippet(entries["done"][1], "done")
+        if "dones" in entries:
+            items = self._list(reader, entries["dones"][1], "dones")
+            players = max(1, len(spec.rewards))
+            if len(items) != players:
+                raise reader.error(
+                    entries["dones"][1],
+                    f"expected one done condition per player ({players}, as many as the rewards), got {len(items)}",
+                )
+            spec.dones = [reader.snippet(item, f"done of player {i + 1}") for i, item in enumerate(items)]
         if "actions" in entries:
             spec.actions = self._actions(reader, entries["actions"][1])
         if "crop" in entries:

@@ -86,8 +86,8 @@ class Graph:
         return self.a.defines[key] if kind == "def" else self._slots[key].arg  # type: ignore[index]
 
     def roots(self) -> list[n.Node]:
-        """The outputs: rewards, then done."""
-        return [*self.a.rewards, *([self.a.done] if self.a.done is not None else [])]
+        """The outputs: rewards, done, then the players' dones."""
+        return [*self.a.rewards, *([self.a.done] if self.a.done is not None else []), *self.a.dones]
 
     def check_cycles(self) -> None:
         """Raise ScenarioCompileError if something needs itself at reset."""

@@ -65,13 +65,16 @@ class Run:
     """One stream of episodes of a scenario: its memory (``prev``, ``initial``, ...).
 
     ``reset`` starts an episode. ``step`` returns ``(rewards, done)``: a tuple of
-    ``players`` floats, and a bool. Stepping without a reset treats the first
+    ``players`` floats, and a bool; :attr:`dones` then holds each player's own
+    done condition (a scenario's ``dones:``), which ``done`` includes once all hold. Stepping without a reset treats the first
     step as the reset point (``initial(x)`` is then the first step's value).
     """
 
     def __init__(self, program: Program) -> None:
         self._state: list = [None] * program.slot_count
-        self._first, self._next = program.bind(self._state)
+        #: Each player's done condition after the last step (``dones:``); all False without one.
+        self.dones: list[bool] = [False] * program.players
+        self._first, self._next = program.bind(self._state, self.dones)
         # The hot path: after reset, ``run.step`` is the generated function itself.
         self.step = self._step_before_reset  # type: ignore[method-assign]
 

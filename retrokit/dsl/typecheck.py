@@ -67,6 +67,12 @@ class TypeChecker:
                     ScenarioCompileError, a.done.start, a.done.end,
                     f"done must be a condition (boolean), and this is a number; {_TEST_HINT}",
                 )
+        for root, snippet in zip(a.dones, a.spec.dones):
+            if self.type_of(root, snippet) != BOOL:
+                raise snippet.error(
+                    ScenarioCompileError, root.start, root.end,
+                    f"a player's done must be a condition (boolean), and this is a number; {_TEST_HINT}",
+                )
         a.types = dict(self.types)
 
     def define_type(self, name: str) -> str:

@@ -250,6 +250,7 @@ class RetroEnv(gymnasium.Env):
         truncated = self.max_episode_steps is not None and self._steps >= self.max_episode_steps and not done
         if self.players > 1:
             values["rewards"] = rewards
+            values["dones"] = tuple(self._run.dones[: self.players]) if self._run else (False,) * self.players
         if (done or truncated) and self._recorder is not None:
             self._end_movie()
         if self.render_mode == "human":

@@ -23,6 +23,7 @@ from retrokit.data.games import Game, find_game
 from retrokit.data.states import read_state
 from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
+from retrokit.envs.compat import StableRetroCompat
 from retrokit.envs.options import check_crop, make_arguments
 from retrokit.errors import EnvError, FileConflictError, InvalidArgumentError, did_you_mean
 from retrokit.host.emulator import Emulator
@@ -38,7 +39,7 @@ class State(enum.Enum):
     NONE = "none"  #: power on, no state
 
 
-class RetroEnv(gymnasium.Env):
+class RetroEnv(StableRetroCompat, gymnasium.Env):
     """A game as a Gymnasium environment.
 
     Args:

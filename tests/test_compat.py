@@ -28,7 +28,7 @@ def test_buttons_are_stable_retros_names_in_its_order(dasher) -> None:
         pytest.param("all", np.eye(12, dtype=np.int8)[7] + np.eye(12, dtype=np.int8)[0], ["B", "RIGHT"], id="all"),
         pytest.param("filtered", np.ones(12, dtype=np.int8), [], id="filtered_drops_impossible_combinations"),
         pytest.param("discrete", 0, [], id="discrete_noop"),
-        pytest.param("multi_discrete", np.array([2, 2, 1]), ["B", "DOWN", "RIGHT"], id="multi_discrete"),
+        pytest.param("multi_discrete", np.array([2, 2, 1]), ["A", "DOWN", "RIGHT"], id="multi_discrete"),
     ],
 )
 def test_get_action_meaning_names_the_buttons_the_console_sees(action_type: str, action, meaning: list[str]) -> None:

@@ -6,7 +6,10 @@ import numpy as np
 import pytest
 
 import retrokit
+from retrokit.data.games import find_game
+from retrokit.data.states import read_state
 from retrokit.errors import StateNotFoundError
+from retrokit.movie.bk2 import read_bk2
 
 GENESIS_BUTTONS = ["B", "A", "MODE", "START", "UP", "DOWN", "LEFT", "RIGHT", "C", "Y", "X", "Z"]
 
@@ -66,6 +69,21 @@ def test_load_state_starts_the_next_episode_there(dasher) -> None:
     assert not np.array_equal(obs, first)  # the first observation is the new state's too
     dasher.load_state("Zone1.Act1")
     assert np.array_equal(dasher.reset(seed=0)[0], first)
+
+
+def test_movies_recorded_after_load_state_start_from_the_new_state(tmp_path) -> None:
+    env = retrokit.make("Dasher-Genesis", record=tmp_path)
+    env.reset(seed=0)
+    env.step(env.action_space.sample())
+    env.load_state("Zone2.Act1")
+    env.reset(seed=0)
+    env.step(env.action_space.sample())
+    env.close()
+    movies = sorted(tmp_path.glob("*.bk2"))
+    assert [m.name.rsplit("-", 1)[0] for m in movies] == ["Dasher-Genesis-Zone1.Act1", "Dasher-Genesis-Zone2.Act1"]
+    game = find_game("Dasher-Genesis")
+    for movie, state in zip(movies, ("Zone1.Act1", "Zone2.Act1")):
+        assert read_bk2(movie).state == read_state(game.state_path(state))
 
 
 def test_load_state_of_an_unknown_name_says_so(dasher) -> None:

@@ -16,6 +16,8 @@ from typing import Any
 
 import numpy as np
 
+from retrokit.movie.recorder import EpisodeMovies
+
 
 class StableRetroCompat:
     """Mixed into RetroEnv: stable-retro's ``buttons``, ``get_action_meaning``, ``get_ram``, ``load_state``."""
@@ -46,3 +48,12 @@ class StableRetroCompat:
         """
         self.state_name, self._state = self._resolve_state(state)  # type: ignore[attr-defined]
         self._first_frame = self._first_obs = None  # the first observation is the new state's
+        old = self.movies  # type: ignore[attr-defined]
+        if old is not None:  # later movies start from the new state, under its name
+            old.end()
+            game, stepper = self.game, self.stepper  # type: ignore[attr-defined]
+            self.movies = EpisodeMovies(
+                old.folder, f"{game.name}-{self.state_name or 'power-on'}", game.name,
+                self.emulator.system.name, self.players, self._state,  # type: ignore[attr-defined]
+            )
+            stepper.observers[stepper.observers.index(old)] = self.movies

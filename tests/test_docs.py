@@ -10,7 +10,6 @@ reason.
 
 from __future__ import annotations
 
-import os
 import re
 from pathlib import Path
 
@@ -33,22 +32,38 @@ def test_the_documents_have_python_blocks() -> None:
     assert counted["from-stable-retro.md"] >= 1
 
 
-@pytest.mark.parametrize("path", DOCUMENTS, ids=lambda p: p.name)
-def test_every_python_block_runs(path: Path, tmp_path, monkeypatch) -> None:
-    found = blocks(path)
-    if not found:
-        pytest.skip(f"{path.name} has no Python block")
-    monkeypatch.chdir(tmp_path)
-    skipped = []
-    for line, code in found:
-        first = code.lstrip().splitlines()[0] if code.strip() else ""
-        if first.startswith("# needs"):
-            skipped.append(f"line {line}: {first[2:]}")
-            continue
-        try:
-            exec(compile(code, f"{path.name}:{line}", "exec"), {"__name__": f"doc_{path.stem}"})  # noqa: S102
-        except Exception as exc:
-            raise AssertionError(f"{path.relative_to(REPO)}, the block at line {line} fails: {exc!r}") from exc
-    assert os.getcwd() == str(tmp_path)
-    if skipped:
-        pytest.skip("; ".join(skipped))
+BLOCKS = [(path, line, code) for path in DOCUMENTS for line, code in blocks(path)]
+
+
+@pytest.fixture(scope="module")
+def folders(tmp_path_factory) -> dict[Path, tuple[Path, int]]:
+    """Per document: its working folder, and how many of its blocks ran there."""
+    return {path: (tmp_path_factory.mktemp(path.stem), 0) for path in DOCUMENTS}
+
+
+def _run(path: Path, line: int, code: str) -> None:
+    try:
+        exec(compile(code, f"{path.name}:{line}", "exec"), {"__name__": f"doc_{path.stem}"})  # noqa: S102
+    except Exception as exc:
+        raise AssertionError(f"{path.relative_to(REPO)}, the block at line {line} fails: {exc!r}") from exc
+
+
+def _needs(code: str) -> str | None:
+    first = code.lstrip().splitlines()[0] if code.strip() else ""
+    return first[2:] if first.startswith("# needs") else None
+
+
+@pytest.mark.parametrize("path,line,code", BLOCKS, ids=[f"{p.name}:{line}" for p, line, _ in BLOCKS])
+def test_every_python_block_runs(path: Path, line: int, code: str, folders, monkeypatch) -> None:
+    folder, done = folders[path]
+    monkeypatch.chdir(folder)
+    mine = blocks(path)
+    index = mine.index((line, code))
+    for earlier_line, earlier in mine[done:index]:  # a block may use what the ones above it made
+        if _needs(earlier) is None:
+            _run(path, earlier_line, earlier)
+    folders[path] = (folder, index + 1)
+    reason = _needs(code)
+    if reason is not None:
+        pytest.skip(reason)
+    _run(path, line, code)

@@ -11,6 +11,8 @@ def test_demo_plays_and_saves_a_gif_and_a_png(tmp_path, capsys) -> None:
     assert main(["demo", "--episodes", "2", "--max-steps", "60", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
     assert "mean score" in out and out.count("done") + out.count("time limit") == 2
+    header = next(line for line in out.splitlines() if line.lstrip().startswith("episode"))
+    assert header.split()[:3] == ["episode", "reward", "steps"]  # the scenario's reward, not the game's score
     gif = Image.open(tmp_path / "Dasher-Genesis.gif")
     assert gif.n_frames > 5 and gif.size == (320, 224)
     assert Image.open(tmp_path / "Dasher-Genesis.png").size == (320, 224)

@@ -102,7 +102,7 @@ def run(args: argparse.Namespace) -> int:
                 best_score, best_frames = score, frames
     env.close()
 
-    print(f"\n{'episode':>7}  {'score':>8}  {'steps':>5}  ended by")
+    print(f"\n{'episode':>7}  {'reward':>8}  {'steps':>5}  ended by  (the scenario's reward, not the game's score)")
     for episode, score, steps, ended in results:
         print(f"{episode:>7}  {score:>8.0f}  {steps:>5}  {ended}")
     scores = [r[1] for r in results]

@@ -159,6 +159,11 @@ def test_misspelled_keyword_gets_a_did_you_mean(keyword: str, suggestion: str) -
         retrokit.make(AIRSTRIKER, **{keyword: 4})
 
 
+def test_the_sonic_preset_checks_keywords_before_looking_for_its_rom() -> None:
+    with pytest.raises(UnknownNameError, match="Did you mean 'frameskip'"):
+        gymnasium.make("retrokit/SonicTheHedgehog-GreenHillZone.Act1-v0", framskip=4)
+
+
 def test_gymnasium_make_checks_keywords_too() -> None:
     with pytest.raises(UnknownNameError, match="Did you mean 'frameskip'"):
         gymnasium.make("retrokit/Airstriker-Genesis-v0", framskip=4)

@@ -20,6 +20,7 @@ from gymnasium import spaces
 
 from retrokit.data.games import find_game
 from retrokit.envs.env import RetroEnv
+from retrokit.envs.options import check_options
 from retrokit.errors import InvalidArgumentError, StateNotFoundError, did_you_mean
 
 GAMES = ("SonicTheHedgehog-Genesis", "SonicTheHedgehog2-Genesis", "SonicAndKnuckles3-Genesis")
@@ -136,7 +137,7 @@ def make(
         **options,
         "action_type": "all",
     }
-    env: gymnasium.Env = RetroEnv(game, state, scenario, **settings)
+    env: gymnasium.Env = RetroEnv(game, state, scenario, **check_options(settings))
     env = Discretizer(env, ACTIONS_WITH_NOOP if noop else ACTIONS)
     if allow_backtracking:
         env = AllowBacktracking(env)

@@ -241,7 +241,7 @@ static PyObject *emulator_run(EmulatorObject *self, PyObject *const *args, Py_ss
     long frames = PyLong_AsLong(args[1]);
     if (frames == -1 && PyErr_Occurred()) return NULL;
     if (frames < 0 || frames > INT_MAX) /* the core loop counts in an int: never wrap to 0 or a few frames */
-        return PyErr_Format(InvalidArgumentError, "frames must be 0 to %d, got %ld", INT_MAX, frames);
+        return PyErr_Format(InvalidArgumentError, "frames must be 0 or more and at most %d, got %ld", INT_MAX, frames);
     Py_buffer buf, screen = {0};
     if (PyObject_GetBuffer(args[0], &buf, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0) return NULL;
     int ok = buf.itemsize == 2 && buf.format && (strcmp(buf.format, "H") == 0 || strcmp(buf.format, "=H") == 0 ||

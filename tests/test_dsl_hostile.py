@@ -174,6 +174,28 @@ def test_large_finite_rewards_pass(tmp_path) -> None:
     assert _step(scenario) == 2e307
 
 
+@pytest.mark.parametrize(
+    "variable,message",
+    [
+        pytest.param({"reward": "abc"}, "reward to be a finite number, got 'abc'", id="string_reward"),
+        pytest.param({"penalty": [1]}, "penalty to be a finite number", id="list_penalty"),
+        pytest.param({"reward": 1, "op": "equal", "reference": "x"}, "reference to be an integer", id="string_reference"),
+        pytest.param({"reward": True}, "finite number, got True", id="bool_reward"),
+    ],
+)
+def test_json_variable_with_a_wrong_number_is_located(tmp_path, variable: dict, message: str) -> None:
+    path = tmp_path / "scenario.json"
+    path.write_text(json.dumps({"reward": {"variables": {"x": variable}}}, indent=2))
+    with pytest.raises(ScenarioError, match=message) as info:
+        load_scenario(path, FIELDS)
+    assert info.value.file == str(path)  # type: ignore[attr-defined]
+
+
+def test_json_time_reward_that_is_no_number_is_refused() -> None:
+    with pytest.raises(ScenarioError, match="reward to be a finite number"):
+        load_scenario({"reward": {"time": {"reward": "z"}}}, FIELDS)
+
+
 def test_json_scenario_written_as_dict_with_nan_multiplier_is_refused() -> None:
     data = {"reward": {"variables": {"x": {"reward": float("nan")}}}}
     with pytest.raises(ScenarioError):

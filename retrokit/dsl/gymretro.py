@@ -22,6 +22,7 @@ rewritten by hand in ``games/*/contest.yaml``.
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 from collections.abc import Mapping, Sequence
@@ -157,9 +158,21 @@ class _Converter:
             out["crop"] = list(data["crop"])
         return out
 
+    def check_numbers(self, spec: Mapping, path: list[str]) -> None:
+        """Refuse a variable's reward or penalty that is no finite number, or a reference that is no integer."""
+        for key in ("reward", "penalty", "reference"):
+            value = spec.get(key)
+            if value is None:
+                continue
+            whole = key == "reference"
+            if isinstance(value, bool) or not isinstance(value, int if whole else (int, float)) or not math.isfinite(value):
+                wanted = "an integer" if whole else "a finite number"
+                raise self.error([*path, key], f"expected {key} to be {wanted}, got {value!r}")
+
     def measure(self, name: str, spec: Mapping, path: list[str], default: str) -> tuple[str, str, int]:
         """The DSL text of a variable's measure, its op, and its reference."""
         spec = self.check_keys(spec, VARIABLE_KEYS, path)
+        self.check_numbers(spec, path)
         if self.fields is not None and name not in self.fields:
             raise self.error(path, f"unknown variable {name!r}: the game has no such field." + did_you_mean(name, self.fields), ScenarioCompileError)
         measurement = spec.get("measurement", default)
@@ -178,6 +191,7 @@ class _Converter:
             terms.append(_reward_term(m, op, reference, var))
         if "time" in spec:  # the rule applied to the constant 1, each frame
             time = self.check_keys(spec["time"], VARIABLE_KEYS, [*path, "time"])
+            self.check_numbers(time, [*path, "time"])
             op = time.get("op", "")
             if op not in OPS:
                 raise self.error([*path, "time", "op"], f"unknown op {op!r}." + did_you_mean(str(op), OPS[1:]))

@@ -13,8 +13,8 @@ from pathlib import Path
 import pytest
 
 import retrokit
-from retrokit import paths
-from retrokit.errors import RetrokitError
+from retrokit import cli, paths
+from retrokit.errors import RetrokitError, ScenarioError
 from retrokit.games import find_game, list_games
 from retrokit.scenario import load_scenario
 
@@ -74,3 +74,64 @@ def test_scenario_folder_on_the_real_emulator(tmp_path, monkeypatch) -> None:
         assert info["score"] > score and total == 2 * (info["score"] - score)
     finally:
         env.close()
+
+
+# --- retrokit games: the scenarios column ------------------------------------------------------------
+
+
+def games_command(capsys, *argv: str) -> tuple[int, str]:
+    status = cli.main(["games", *argv])
+    out, err = capsys.readouterr()
+    assert err == ""
+    return status, out
+
+
+def line_of(out: str, game: str) -> str:
+    return next(line for line in out.splitlines() if line.startswith(game + " "))
+
+
+def test_games_command_says_every_scenario_compiles(capsys, monkeypatch, tmp_path) -> None:
+    monkeypatch.setenv(paths.DATA_ENV, str(tmp_path))
+    status, out = games_command(capsys, "Atari2600")
+    assert status == 0
+    assert "scenarios ok" in line_of(out, "Tennis-Atari2600")  # Lua in the wheel, ours in games/
+    assert all("scenarios ok" in line for line in out.splitlines()[:-1])
+    assert "does not compile" not in out.splitlines()[-1]
+
+
+@pytest.mark.parametrize(
+    "name,text",
+    [("typo.yaml", "reward: delta(scroe)\n"), ("lua.json", '{"reward": {"script": "lua:f"}, "scripts": ["f.lua"]}'),
+     ("binary.json", b"\x00\xff\xfe garbage"), ("binary.yaml", b"\xff\xfe\x00reward"), ("list.yaml", "- 1\n- 2\n")],
+    ids=["unknown_field", "lua_script", "binary_json", "binary_yaml", "not_a_mapping"],
+)
+def test_games_command_names_scenarios_that_do_not_compile(capsys, monkeypatch, tmp_path, name: str, text) -> None:
+    (tmp_path / "games" / "Airstriker-Genesis").mkdir(parents=True)
+    target = tmp_path / "games" / "Airstriker-Genesis" / name
+    target.write_bytes(text) if isinstance(text, bytes) else target.write_text(text)
+    monkeypatch.setenv(paths.GAMES_ENV, str(tmp_path / "games"))
+    monkeypatch.setenv(paths.DATA_ENV, str(tmp_path / "data"))
+    status, out = games_command(capsys, "Airstriker")
+    assert status == 0
+    line = line_of(out, "Airstriker-Genesis")
+    assert f"scenarios refused: {Path(name).stem}  states: Level1*" in line and "ROM bundled" in line
+    assert out.splitlines()[-1].startswith("1 game shown; 1 of 1 have their ROM; 1 shown have a scenario that does not compile.")
+
+
+def test_games_command_game_without_scenarios(capsys, monkeypatch, tmp_path) -> None:
+    folder = tmp_path / "games" / "Plain-Genesis"
+    folder.mkdir(parents=True)
+    (folder / "data.json").write_text('{"info": {"lives": {"address": 16712282, "type": ">u2"}}}')
+    (folder / "rom.sha").write_text("0" * 40 + "\n")
+    monkeypatch.setenv(paths.GAMES_ENV, str(tmp_path / "games"))
+    monkeypatch.setenv(paths.DATA_ENV, str(tmp_path / "data"))
+    status, out = games_command(capsys, "Plain-Genesis")
+    assert status == 0 and "ROM missing   scenarios none  states: (none)" in line_of(out, "Plain-Genesis")
+
+
+@pytest.mark.parametrize("suffix", [".yaml", ".json"])
+def test_a_scenario_that_is_not_utf8_is_refused_with_a_message(tmp_path, suffix: str) -> None:
+    path = tmp_path / f"scenario{suffix}"
+    path.write_bytes(b"reward: 1 # caf\xe9\n")  # Latin-1, as an old editor may save it
+    with pytest.raises(ScenarioError, match=r"expected a UTF-8 text file; found a byte that is not UTF-8 at offset 15"):
+        load_scenario(path, ["x"])

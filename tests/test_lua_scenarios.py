@@ -116,7 +116,7 @@ def rule_reward(spec: dict, values: dict, deltas: dict) -> float:
 
 HOST = """
 local fields, frame = {}, 0
-function __retrokit_set(values, f) fields, frame = values, f end
+function retrokit_set_step(values, f) fields, frame = values, f end
 data = setmetatable({}, {
   __index = function(_, name)
     local value = fields[name]
@@ -162,7 +162,7 @@ def run_gym_retro(path: Path, reset: dict, steps: list[dict]) -> list:
     last = reset
     for frame, values in enumerate([reset, *steps]):
         deltas = {name: values[name] - last[name] for name in values}
-        lua.__retrokit_set(runtime.table_from(values), frame)
+        lua.retrokit_set_step(runtime.table_from(values), frame)
         try:
             done = lua[done_fn]() if done_fn else rule_done(done_spec, values, deltas)
             reward = lua[reward_fn]() if reward_fn else rule_reward(reward_spec, values, deltas)

@@ -31,7 +31,7 @@ import yaml
 
 from retrokit.dsl.check import RESERVED
 from retrokit.dsl.document import document_from_dict
-from retrokit.dsl.source import SourceText, located
+from retrokit.dsl.source import SourceText, located, read_source
 from retrokit.dsl.spec import ScenarioSpec
 from retrokit.errors import ScenarioCompileError, ScenarioError, did_you_mean
 
@@ -220,10 +220,7 @@ def _find_key(text: str, path: Sequence[str]) -> int:
 
 
 def _read_json(path: Path) -> tuple[dict, SourceText]:
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise ScenarioError(f"cannot read scenario file {str(path)!r}: {exc.strerror or exc}") from None
+    text = read_source(path)
     source = SourceText(str(path), text)
     try:
         data = json.loads(text)

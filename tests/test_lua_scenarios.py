@@ -66,6 +66,7 @@ def lua_scenario_files() -> list[tuple[str, Path]]:
 
 
 CASES = lua_scenario_files()
+CUSTOM_SONIC = [(g, p) for g, p in CASES if g.startswith("Sonic")]
 
 
 # --- Gym Retro's rules for what a script does not compute (data.cpp, utils.cpp) ----------------------
@@ -134,10 +135,6 @@ scenario = setmetatable({}, {
   __newindex = function() end,
 })
 """
-
-
-class LuaError(Exception):
-    """The Lua raised an error, or computed NaN."""
 
 
 def script_function(spec: dict) -> str | None:
@@ -312,9 +309,6 @@ def test_rewrite_matches_the_lua(game: str, path: Path) -> None:
 
 def _first_difference(a: list, b: list) -> int:
     return next((i for i, (x, y) in enumerate(zip(a, b)) if x != y), min(len(a), len(b)))
-
-
-CUSTOM_SONIC = [(g, p) for g, p in CASES if g.startswith("Sonic")]
 
 
 @pytest.mark.parametrize("game,path", CUSTOM_SONIC, ids=[g for g, _ in CUSTOM_SONIC])

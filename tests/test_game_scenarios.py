@@ -14,9 +14,9 @@ import pytest
 
 import retrokit
 from retrokit import cli, paths
+from retrokit.data.games import find_game, list_games
+from retrokit.dsl.scenario import load_scenario
 from retrokit.errors import RetrokitError, ScenarioError
-from retrokit.games import find_game, list_games
-from retrokit.scenario import load_scenario
 
 REPO = Path(__file__).resolve().parents[1]
 

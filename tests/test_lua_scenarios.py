@@ -35,9 +35,9 @@ from pathlib import Path
 import pytest
 
 from retrokit import paths
+from retrokit.data.games import find_game
+from retrokit.dsl.scenario import load_scenario
 from retrokit.errors import ScenarioRuntimeError
-from retrokit.games import find_game
-from retrokit.scenario import load_scenario
 
 lupa = pytest.importorskip("lupa")
 try:

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 from retrokit.commands._common import add_data_dir_option, rom_status
 
 if TYPE_CHECKING:
-    from retrokit.games import Game
+    from retrokit.data.games import Game
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -69,8 +69,8 @@ def run(args: argparse.Namespace) -> int:
 
 def scenarios_refused(game: Game) -> list[str]:
     """The names of the game's scenarios that do not load and compile (empty if all do, or it has none)."""
+    from retrokit.dsl.scenario import load_scenario
     from retrokit.errors import RetrokitError
-    from retrokit.scenario import load_scenario
 
     fields = list(game.fields)
     refused = []

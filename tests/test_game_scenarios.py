@@ -115,7 +115,7 @@ def test_games_command_names_scenarios_that_do_not_compile(capsys, monkeypatch, 
     assert status == 0
     line = line_of(out, "Airstriker-Genesis")
     assert f"scenarios refused: {Path(name).stem}  states: Level1*" in line and "ROM bundled" in line
-    assert out.splitlines()[-1].startswith("1 game shown; 1 of 1 have their ROM; 1 shown have a scenario that does not compile.")
+    assert out.splitlines()[-1].startswith("1 game shown; 1 of 1 have their ROM; 1 shown has a scenario that does not compile.")
 
 
 def test_games_command_game_without_scenarios(capsys, monkeypatch, tmp_path) -> None:

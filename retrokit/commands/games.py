@@ -62,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
         shown += 1
         print(line)
     print(f"{shown} game{'s' * (shown != 1)} shown; {available} of {len(games)} have their ROM"
-          + (f"; {refused} shown have a scenario that does not compile" if refused else "")
+          + (f"; {refused} shown {'has' if refused == 1 else 'have'} a scenario that does not compile" if refused else "")
           + ". Import ROMs with: retrokit import /path/to/your/roms")
     return 0
 

@@ -15,8 +15,9 @@ Gym Retro's rules (its ``src/data.cpp``), which the conversion keeps:
   nested ``nodes``; an empty ``all`` is always true, an empty ``any`` never.
 - ``rewards`` is a list of per-player rewards; ``reward`` also fills player 1.
 
-Lua ``script`` rewards cannot be converted; the Sonic contest scripts are
-rewritten by hand in ``games/*/contest.yaml``.
+Lua ``script`` rewards cannot be converted; every Lua scenario of the
+stable-retro wheel is rewritten by hand in ``games/<Game>/`` under its own
+name (``docs/scenarios.md``).
 """
 
 from __future__ import annotations
@@ -124,7 +125,7 @@ class _Converter:
             raise self.error(
                 [*path, "script"],
                 "Lua scripts cannot be converted; write the reward and done in retrokit's language "
-                "(docs/scenarios.md; the Sonic contest scripts are in games/*/contest.yaml)",
+                "(docs/scenarios.md; the wheel's Lua scenarios are rewritten in games/<Game>/)",
             )
         return obj
 

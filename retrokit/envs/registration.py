@@ -20,7 +20,7 @@ from __future__ import annotations
 import gymnasium
 
 from retrokit.data.games import list_games
-from retrokit.envs import sonic
+from retrokit.data.sonic_levels import levels
 
 NAMESPACE = "retrokit"
 VERSION = "v0"
@@ -46,7 +46,7 @@ def register_envs() -> int:
             vector_entry_point="retrokit.envs.vector:make_vec",
             kwargs={"game": game.name},
         )
-    for game, state in sonic.levels():
+    for game, state in levels():
         added += _register(level_id(game, state), entry_point="retrokit.envs.sonic:make", kwargs={"game": game, "state": state})
     return added
 

@@ -69,18 +69,41 @@ def _mutate(data: bytes, rng: random.Random) -> bytes:
     return data
 
 
-def _targets(tmp_path: Path) -> list[tuple[Path, Path, list[str]]]:
-    """(file to mutate, scenario to load, fields) for every shipped YAML scenario and include, in a copy."""
+class Target:
+    """A shipped file to mutate, and the scenario that reads it (itself, or one including it)."""
+
+    def __init__(self, folder: Path, mutated: str, loaded: str, fields: list[str]) -> None:
+        self.folder, self.mutated, self.loaded, self.fields = folder, mutated, loaded, fields
+        self.original = (folder / mutated).read_bytes()
+
+    def write(self, number: int, mutant: bytes) -> list[Path]:
+        """Write the mutant, and the scenario to load if another, under new names; the scenario is last.
+
+        New names, never a rewrite: rewriting a file in place makes some file
+        systems flush it (ext4's auto_da_alloc), which costs milliseconds.
+        """
+        mutated = self.folder / self.mutated.replace(".yaml", f".{number}.yaml")
+        mutated.write_bytes(mutant)
+        if self.mutated == self.loaded:
+            return [mutated]
+        loaded = self.folder / self.loaded.replace(".yaml", f".{number}.yaml")
+        text = (self.folder / self.loaded).read_bytes()
+        loaded.write_bytes(text.replace(self.mutated.encode(), mutated.relative_to(self.folder).as_posix().encode()))
+        return [mutated, loaded]
+
+
+def _targets(tmp_path: Path) -> list[Target]:
+    """Every shipped YAML scenario, and every file one includes, in a copy of its game's folder."""
     targets = []
     for name in GAMES:
         game = find_game(name)
         copy = tmp_path / name
-        shutil.copytree(game.folders[0], copy, ignore=shutil.ignore_patterns("*.state", "rom.*"))
-        for scenario in sorted(p for p in game.scenarios.values() if p.suffix == ".yaml"):
-            loaded = copy / scenario.name
-            targets.append((loaded, loaded, list(game.fields)))
-            for included in sorted((copy / "include").glob("*.yaml")) if scenario.name == "contest.yaml" else ():
-                targets.append((included, loaded, list(game.fields)))
+        shutil.copytree(game.folders[0], copy, ignore=shutil.ignore_patterns("*.state", "rom.*", "*.md"))
+        for scenario in sorted(p.name for p in game.scenarios.values() if p.suffix == ".yaml"):
+            targets.append(Target(copy, scenario, scenario, list(game.fields)))
+            if scenario == "contest.yaml":
+                included = sorted(p.relative_to(copy).as_posix() for p in (copy / "include").glob("*.yaml"))
+                targets += [Target(copy, n, scenario, list(game.fields)) for n in included]
     return targets
 
 
@@ -97,22 +120,22 @@ def test_mutated_shipped_scenarios_raise_only_retrokit_errors(tmp_path) -> None:
     rng = random.Random(SEED)
     targets = _targets(tmp_path)
     assert len(targets) >= 10  # every game's scenarios, and the Sonic level tables
-    originals = {mutated: mutated.read_bytes() for mutated, _, _ in targets}
     escaped, outcomes = [], {"loaded": 0, "refused": 0}
     for number in range(MUTANTS):
-        mutated, loaded, fields = targets[number % len(targets)]
-        mutant = _mutate(originals[mutated], rng)
-        mutated.write_bytes(mutant)
+        target = targets[number % len(targets)]
+        mutant = _mutate(target.original, rng)
+        written = target.write(number, mutant)
         try:
-            _run(load_scenario(loaded, fields), fields, rng)
+            _run(load_scenario(written[-1], target.fields), target.fields, rng)
             outcomes["loaded"] += 1
         except RetrokitError:
             outcomes["refused"] += 1
         except Exception as exc:  # noqa: BLE001 - the point: anything else is a fault
             where = "".join(traceback.format_exception(exc)[-3:-1])
-            escaped.append(f"mutant {number} of {mutated.name}: {type(exc).__name__}: {str(exc)[:200]}\n{where[:600]}")
+            escaped.append(f"mutant {number} of {target.mutated}: {type(exc).__name__}: {str(exc)[:200]}\n{where[:600]}")
         finally:
-            mutated.write_bytes(originals[mutated])
+            for path in written:
+                path.unlink()
     assert not escaped, f"{len(escaped)} of {MUTANTS} mutants escaped:\n" + "\n".join(escaped[:5])
     # Both sides are exercised: many mutants still load and run, many are refused.
     assert outcomes["loaded"] > MUTANTS // 10 and outcomes["refused"] > MUTANTS // 10, outcomes

@@ -123,6 +123,25 @@ def test_bad_file_is_a_located_scenario_error(tmp_path, data: bytes, error: type
     assert (err.file, err.line, err.column) == (str(tmp_path / "s.yaml"), *place)  # type: ignore[attr-defined]
 
 
+def _alias_bomb(key: str) -> str:
+    """Ten lines standing for 10**9 values: each list holds the one above it ten times."""
+    lines = ["      a0: &a0 [x, x, x, x, x, x, x, x, x, x]"]
+    lines += [f"      a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 10)}]" for i in range(1, 9)]
+    return "tables:\n  t:\n    values: {1: 2}\n    description:\n" + "\n".join(lines) + f"\n{key}: *a8\nreward: x\n"
+
+
+@pytest.mark.timeout(20)
+@pytest.mark.parametrize("key", ["actions", "crop", "rewards"])
+def test_an_alias_bomb_is_refused_quickly(tmp_path, key: str) -> None:
+    with pytest.raises(ScenarioError, match="at most 100000 YAML values"):
+        _load(tmp_path, _alias_bomb(key))
+
+
+def test_aliases_that_repeat_a_little_are_fine(tmp_path) -> None:
+    _, scenario = _load(tmp_path, "rewards:\n  - &r delta(x)\n  - *r\n")
+    assert scenario.players == 2
+
+
 def test_an_included_file_that_is_not_utf8_is_located(tmp_path) -> None:
     (tmp_path / "inc.yaml").write_bytes("define:\n  a: x  # é\n".encode("latin-1"))
     with pytest.raises(ScenarioError, match="expected UTF-8") as info:

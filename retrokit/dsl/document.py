@@ -36,6 +36,9 @@ TOP_KEYS = ("name", "description", "include", "tables", "define", "reward", "rew
 INCLUDE_KEYS = ("description", "include", "tables", "define")
 TABLE_KEYS = ("by", "default", "values", "description")
 
+#: The most values a scenario file may hold, aliases expanded: the Sonic level tables hold a few hundred.
+MAX_VALUES = 100_000
+
 _INT_TAG = "tag:yaml.org,2002:int"
 _FLOAT_TAG = "tag:yaml.org,2002:float"
 #: The tags YAML gives plain values by itself; any other was written on purpose (``!!python/...``).
@@ -74,10 +77,22 @@ class _Reader:
         return root
 
     def _check_tags(self, root: yaml.Node) -> None:
-        """Refuse explicit tags (``!!python/...``, ``!!binary``, ``!foo``): a scenario is plain YAML."""
+        """Refuse explicit tags (``!!python/...``, ``!!binary``, ``!foo``): a scenario is plain YAML.
+
+        Aliases are followed, so the walk also counts the values the file
+        holds once they are expanded: a few lines of nested aliases can stand
+        for billions, and reading them would never end.
+        """
         stack = [root]
+        count = 0
         while stack:
             node = stack.pop()
+            count += 1
+            if count > MAX_VALUES:
+                raise self.error(
+                    root, f"expected a scenario of at most {MAX_VALUES} YAML values, aliases expanded, got more; "
+                    f"write out what the aliases (*name) repeat, or drop them",
+                )
             if node.tag not in _PLAIN_TAGS:
                 raise self.error(node, f"expected plain YAML values, got one tagged {node.tag!r}; remove the tag")
             if isinstance(node, yaml.SequenceNode):

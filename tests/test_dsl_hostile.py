@@ -142,6 +142,15 @@ def test_aliases_that_repeat_a_little_are_fine(tmp_path) -> None:
     assert scenario.players == 2
 
 
+@pytest.mark.parametrize("suffix", [".yaml", ".json"])
+def test_a_huge_scenario_file_is_refused_before_it_is_read(tmp_path, suffix: str) -> None:
+    path = tmp_path / f"huge{suffix}"
+    with path.open("wb") as file:
+        file.truncate(64 * 2**20)  # 64 MiB of NULs, sparse
+    with pytest.raises(ScenarioError, match="at most 4 MiB"):
+        load_scenario(path, FIELDS)
+
+
 def test_an_included_file_that_is_not_utf8_is_located(tmp_path) -> None:
     (tmp_path / "inc.yaml").write_bytes("define:\n  a: x  # é\n".encode("latin-1"))
     with pytest.raises(ScenarioError, match="expected UTF-8") as info:

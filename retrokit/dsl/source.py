@@ -138,6 +138,11 @@ def located(cls: type[RetrokitError], source: SourceText, start: int, end: int, 
 
 
 
+#: The largest scenario file read: the shipped ones are a few kilobytes, and YAML
+#: takes tens of times a file's size in memory.
+MAX_SOURCE_BYTES = 4 * 2**20
+
+
 def read_source(path: Path) -> SourceText:
     """Read a scenario file as UTF-8 text (a leading byte-order mark is allowed).
 
@@ -146,9 +151,15 @@ def read_source(path: Path) -> SourceText:
             points at the first byte that is not.
     """
     try:
-        data = path.read_bytes()
+        with path.open("rb") as file:
+            data = file.read(MAX_SOURCE_BYTES + 1)  # never more: a scenario is a few kilobytes
     except OSError as exc:
         raise ScenarioError(f"cannot read scenario file {str(path)!r}: {exc.strerror or exc}") from None
+    if len(data) > MAX_SOURCE_BYTES:
+        raise ScenarioError(
+            f"{path}: expected a scenario file of at most {MAX_SOURCE_BYTES // 2**20} MiB, got a larger one; "
+            f"is it the right file?"
+        )
     try:
         return SourceText(str(path), data.decode("utf-8-sig"))
     except UnicodeDecodeError as exc:

@@ -176,8 +176,8 @@ def test_make_vec_checks_keywords_too() -> None:
 
 @pytest.mark.parametrize(
     "crop",
-    [[400, 0, 10, 10], [0, 300, 10, 10], [0, 0, 0, 10], [0, 0, 10, 0]],
-    ids=["right_of_the_screen", "below_the_screen", "no_width", "no_height"],
+    [[400, 0, 10, 10], [0, 300, 10, 10], [320, 0, 0, 0], [0, 224, 0, 10]],
+    ids=["right_of_the_screen", "below_the_screen", "at_the_right_edge_to_the_edge", "at_the_bottom_edge"],
 )
 def test_off_screen_crop_is_refused(crop: list[int]) -> None:
     with pytest.raises(InvalidArgumentError, match="crop .* to keep part of the 320x224 screen"):

@@ -174,13 +174,17 @@ def make_arguments(game: object, state: object, scenario: object, options: Mappi
 
 
 def check_crop(crop: tuple[int, int, int, int] | None, screen: tuple[int, int]) -> None:
-    """Refuse a scenario's crop ``(x, y, width, height)`` that leaves nothing of a ``(height, width)`` screen."""
+    """Refuse a scenario's crop ``(x, y, width, height)`` that leaves nothing of a ``(height, width)`` screen.
+
+    A width or height of 0 reaches the screen's edge, as in Gym Retro, so only
+    a corner past the screen's right or bottom edge leaves nothing.
+    """
     if crop is None:
         return
-    x, y, w, h = crop
+    x, y, _, _ = crop
     height, width = screen
-    if w < 1 or h < 1 or x >= width or y >= height:
+    if x >= width or y >= height:
         raise InvalidArgumentError(
             f"Expected the scenario's crop [x, y, width, height] to keep part of the {width}x{height} screen, "
-            f"got {list(crop)}; fix 'crop' in the scenario (x below {width}, y below {height}, sizes of 1 or more)."
+            f"got {list(crop)}; fix 'crop' in the scenario (x below {width}, y below {height})."
         )

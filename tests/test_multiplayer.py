@@ -126,15 +126,23 @@ def test_parallel_api_test_passes_with_a_player_eliminated(p2_last_life: Path, a
         warnings.simplefilter("always")
         parallel_api_test(env, num_cycles=60)
     assert not [str(w.message) for w in caught if "dead" in str(w.message) or "Live agent" in str(w.message)]
-    # The test's episodes really lost player 2 midway: replay one.
-    i, _ = play_until_p2_is_out(env)
-    assert 0 < i < 60
+    # The test's episodes really lost player 2 midway, with player 1 playing on: replay one.
+    i, (_, _, terminations, truncations, _) = play_until_p2_is_out(env)
+    assert 0 < i < 60 and env.agents == ["player_1"]
+    assert terminations["player_2"] and not truncations["player_2"]
     env.close()
 
 
 def test_aec_api_test_passes_with_a_player_eliminated(p2_last_life: Path) -> None:
     env = multiplayer.env(DASHER, **{**OPTIONS, "state": p2_last_life})
     api_test(env, num_cycles=60)
+    # Replay: player 2 is terminated and leaves while player 1 is still playing.
+    env.reset(seed=0)
+    for agent in env.agent_iter(max_iter=200):
+        if env.terminations.get("player_2"):
+            break
+        env.step(None if env.terminations[agent] or env.truncations[agent] else env.action_space(agent).sample())
+    assert env.terminations["player_2"] and not env.terminations["player_1"] and not env.truncations["player_1"]
     env.close()
 
 

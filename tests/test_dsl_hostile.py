@@ -12,6 +12,7 @@ import json
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from retrokit.dsl.codegen import MAX_NESTING
@@ -222,6 +223,24 @@ def test_json_variable_with_a_wrong_number_is_located(tmp_path, variable: dict, 
 def test_json_time_reward_that_is_no_number_is_refused() -> None:
     with pytest.raises(ScenarioError, match="reward to be a finite number"):
         load_scenario({"reward": {"time": {"reward": "z"}}}, FIELDS)
+
+
+@pytest.mark.parametrize(
+    "data,message",
+    [
+        pytest.param({"reward": object()}, "expected plain values", id="object"),
+        pytest.param({"reward": {1, 2}}, "tagged", id="set"),
+        pytest.param({"reward": b"x"}, "tagged", id="bytes"),
+    ],
+)
+def test_a_dict_scenario_with_values_yaml_cannot_hold_is_a_scenario_error(data: dict, message: str) -> None:
+    with pytest.raises(ScenarioError, match=message):
+        load_scenario(data, FIELDS)
+
+
+def test_a_dict_scenario_takes_numpy_values() -> None:
+    scenario = load_scenario({"reward": "x", "crop": np.array([0, 0, 32, 16]), "tables": {"t": {"values": {1: np.int64(2)}}}}, FIELDS)
+    assert scenario.crop == (0, 0, 32, 16)
 
 
 def test_json_scenario_written_as_dict_with_nan_multiplier_is_refused() -> None:

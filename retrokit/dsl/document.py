@@ -24,13 +24,14 @@ import math
 import os
 from pathlib import Path
 
+import numpy as np
 import yaml
 
 from retrokit.dsl.check import constant
 from retrokit.dsl.parser import MAX_INT, parse
 from retrokit.dsl.source import Snippet, SourceText, align, located, read_source
 from retrokit.dsl.spec import Scalar, ScenarioSpec, Table
-from retrokit.errors import ScenarioError, did_you_mean
+from retrokit.errors import ScenarioError, did_you_mean, shown
 
 TOP_KEYS = ("name", "description", "include", "tables", "define", "reward", "rewards", "done", "dones", "actions", "crop")
 INCLUDE_KEYS = ("description", "include", "tables", "define")
@@ -316,7 +317,14 @@ def document_from_dict(data: dict, *, name: str | None = None, game_dir: str | o
     ``<scenario NAME>``, so its errors point at lines of that text.
     """
     label = name or str(data.get("name", "scenario"))
-    text = yaml.safe_dump(_plain_keys(data), sort_keys=False, default_flow_style=False, width=10_000)
+    try:
+        text = yaml.safe_dump(_plain_keys(data), sort_keys=False, default_flow_style=False, width=10_000)
+    except yaml.YAMLError as exc:  # RepresenterError: an object YAML cannot write
+        found = exc.args[1] if len(exc.args) > 1 else exc
+        raise ScenarioError(
+            f"scenario {label!r}: expected plain values (text, numbers, lists, dicts), got {shown(found)} "
+            f"({type(found).__name__}); pass expressions as text"
+        ) from None
     loader = DocumentLoader(label)
     loader.load_text(text, f"<scenario {label!r}>", Path(game_dir) if game_dir is not None else None)
     if name:
@@ -325,9 +333,11 @@ def document_from_dict(data: dict, *, name: str | None = None, game_dir: str | o
 
 
 def _plain_keys(value: object) -> object:
-    """Make a dict dumpable: tuple keys ``(0, 1)`` become ``"0, 1"``."""
+    """Make a dict dumpable: tuple keys ``(0, 1)`` become ``"0, 1"``, numpy values Python ones."""
     if isinstance(value, dict):
         return {(", ".join(str(p) for p in k) if isinstance(k, tuple) else k): _plain_keys(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
         return [_plain_keys(v) for v in value]
+    if isinstance(value, (np.generic, np.ndarray)):  # np.int64(3), np.array([0, 0, 320, 224])
+        return _plain_keys(value.tolist())
     return value

@@ -18,7 +18,13 @@ import pytest
 from retrokit.dsl.codegen import MAX_NESTING
 from retrokit.dsl.parser import MAX_DEPTH
 from retrokit.dsl.scenario import load_scenario
-from retrokit.errors import ScenarioCompileError, ScenarioError, ScenarioRuntimeError, ScenarioSyntaxError
+from retrokit.errors import (
+    InvalidArgumentError,
+    ScenarioCompileError,
+    ScenarioError,
+    ScenarioRuntimeError,
+    ScenarioSyntaxError,
+)
 
 FIELDS = ["x", "lives"]
 
@@ -236,6 +242,12 @@ def test_json_time_reward_that_is_no_number_is_refused() -> None:
 def test_a_dict_scenario_with_values_yaml_cannot_hold_is_a_scenario_error(data: dict, message: str) -> None:
     with pytest.raises(ScenarioError, match=message):
         load_scenario(data, FIELDS)
+
+
+@pytest.mark.parametrize("source", [5, None, ["reward: x"]], ids=["int", "none", "list"])
+def test_a_scenario_source_that_is_no_path_or_dict_is_refused(source: object) -> None:
+    with pytest.raises(InvalidArgumentError, match="Expected a scenario file's path or a scenario dict"):
+        load_scenario(source, FIELDS)  # type: ignore[arg-type]
 
 
 def test_a_dict_scenario_takes_numpy_values() -> None:

@@ -23,7 +23,7 @@ from retrokit.dsl.compiler import Program
 from retrokit.dsl.document import document_from_dict, load_document
 from retrokit.dsl.gymretro import is_gym_retro, spec_from_json, spec_from_json_dict
 from retrokit.dsl.spec import ScenarioSpec
-from retrokit.errors import ScenarioError
+from retrokit.errors import InvalidArgumentError, ScenarioError, shown
 
 __all__ = ["Run", "Scenario", "load_scenario"]
 
@@ -135,6 +135,7 @@ def load_scenario(
         ScenarioCompileError: An unknown name, a wrong argument count, a type
             error or a division by a constant zero.
         ScenarioError: The file is malformed or cannot be read.
+        InvalidArgumentError: ``source`` is neither a path nor a dict.
     """
     if isinstance(source, Mapping):
         data = dict(source)
@@ -143,6 +144,10 @@ def load_scenario(
         else:
             spec = document_from_dict(data, name=name, game_dir=game_dir)
         return Scenario(spec, fields)
+    if not isinstance(source, (str, os.PathLike)):
+        raise InvalidArgumentError(
+            f"Expected a scenario file's path or a scenario dict, got {shown(source)} ({type(source).__name__})."
+        )
     path = Path(source)
     suffix = path.suffix.lower()
     if suffix == ".json":

@@ -66,6 +66,27 @@ def test_each_player_is_rewarded_for_its_own_progress() -> None:
     env.close()
 
 
+@pytest.mark.parametrize(
+    "action_type,bad,message",
+    [
+        pytest.param("discrete", lambda space: space.n, "from 0 to", id="discrete_past_the_end"),
+        pytest.param("discrete", lambda space: -1, "from 0 to", id="discrete_negative"),
+        pytest.param("multi_discrete", lambda space: space.nvec, "choice 0", id="multi_discrete_past_the_end"),
+        pytest.param("multi_discrete", lambda space: space.sample() + 0.5, "whole numbers", id="multi_discrete_floats"),
+        pytest.param("all", lambda space: np.zeros(space.n + 1, dtype=np.int8), "12 items", id="buttons_too_many"),
+        pytest.param("filtered", lambda space: np.zeros(space.n - 1, dtype=np.int8), "12 items", id="buttons_too_few"),
+    ],
+)
+def test_one_players_action_outside_its_space_is_refused(action_type: str, bad, message: str) -> None:
+    # Joined into one action, it would otherwise press buttons of the other player.
+    env = make_parallel(action_type=action_type)
+    env.reset(seed=0)
+    space = env.action_space("player_1")
+    with pytest.raises(InvalidArgumentError, match=message):
+        env.step({"player_1": bad(space), "player_2": env.action_space("player_2").sample()})
+    env.close()
+
+
 def test_one_player_games_are_refused() -> None:
     with pytest.raises(InvalidArgumentError, match="two or more players"):
         multiplayer.parallel_env("Airstriker-Genesis")

@@ -103,8 +103,20 @@ class ActionMap:
             raise InvalidArgumentError(f"Expected {self.players} actions, one per player, got {len(per_player)}.")
         if self.action_type == "discrete":
             size = math.prod(len(c) for c in self.combos)
-            return sum(int(a) * size**p for p, a in enumerate(per_player))  # type: ignore[call-overload]
-        return np.concatenate([np.asarray(a).ravel() for a in per_player]).astype(self.space.dtype)
+            # Each index is checked against one player's choices: past them it would pick another player's.
+            return sum(self._discrete_index(a, size) * size**p for p, a in enumerate(per_player))
+        parts = [np.asarray(a).ravel() for a in per_player]
+        width = len(self.combos) if self.action_type == "multi_discrete" else self.num_buttons
+        for p, part in enumerate(parts):
+            if part.size != width:
+                raise InvalidArgumentError(
+                    f"Expected player {p + 1}'s action to have {width} items, got {part.size}; "
+                    f"pass one like its action_space(agent).sample()."
+                )
+        joint = np.concatenate(parts)
+        if self.action_type == "multi_discrete":
+            self._check_choices(joint)  # before the cast, which would turn 1.5 into 1
+        return joint.astype(self.space.dtype)
 
     def _make_filter_table(self) -> np.ndarray:
         """What :meth:`filter` makes of every possible mask, for the native packer."""
@@ -139,19 +151,20 @@ class ActionMap:
             return
         out[: self.players] = self.to_masks(action)
 
-    def _discrete_index(self, action: object) -> int:
-        """A Discrete action as an int, refused unless it is a whole number in the space."""
+    def _discrete_index(self, action: object, n: int | None = None) -> int:
+        """A Discrete action as an int, refused unless it is a whole number below ``n`` (the space's size)."""
+        n = self.space.n if n is None else n  # type: ignore[attr-defined]
         if isinstance(action, np.ndarray) and action.size == 1:
             action = action.reshape(()).item()
         if isinstance(action, (bool, np.bool_)) or not isinstance(action, numbers.Integral):
             raise InvalidArgumentError(
-                f"Expected a discrete action, a whole number from 0 to {self.space.n - 1}, got {shown(action)} "  # type: ignore[attr-defined]
+                f"Expected a discrete action, a whole number from 0 to {n - 1}, got {shown(action)} "
                 f"({type(action).__name__}); pass e.g. env.action_space.sample()."
             )
         index = int(action)
-        if not 0 <= index < self.space.n:  # type: ignore[attr-defined]
+        if not 0 <= index < n:
             raise InvalidArgumentError(
-                f"Expected a discrete action from 0 to {self.space.n - 1}, got {index}; "  # type: ignore[attr-defined]
+                f"Expected a discrete action from 0 to {n - 1}, got {index}; "
                 f"other values would press other buttons."
             )
         return index

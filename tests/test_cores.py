@@ -27,12 +27,11 @@ def test_core_loads_declares_its_options_and_unloads(core, tmp_path) -> None:
 
 def test_two_copies_of_one_core_are_independent(tmp_path) -> None:
     core = next(p for p in CORES if p.name.startswith("gambatte"))
-    a = _host.Emulator(str(core), str(tmp_path), str(tmp_path))
-    b = _host.Emulator(str(core), str(tmp_path), str(tmp_path))
-    key = next(iter(a.options()))
-    allowed = a.options()[key][2]
-    a.set_option(key, allowed[-1])
-    b.set_option(key, allowed[0])
+    probe = _host.Emulator(str(core), str(tmp_path), str(tmp_path))
+    key, (_, _, allowed) = next(iter(probe.options().items()))
+    probe.close()
+    a = _host.Emulator(str(core), str(tmp_path), str(tmp_path), {key: allowed[-1]})
+    b = _host.Emulator(str(core), str(tmp_path), str(tmp_path), {key: allowed[0]})
     assert a.options()[key][1] == allowed[-1] and b.options()[key][1] == allowed[0]
     a.close()
     b.close()

@@ -31,17 +31,13 @@ PyMODINIT_FUNC PyInit__host(void) {
     InvalidArgumentError = PyObject_GetAttrString(errors, "InvalidArgumentError");
     Py_DECREF(errors);
     if (!CoreError || !StateError || !InvalidArgumentError) return NULL;
-    if (PyType_Ready(&EmulatorType) < 0 || PyType_Ready(&MemoryType) < 0 || PyType_Ready(&RunnerType) < 0) return NULL;
+    if (PyType_Ready(&MemoryType) < 0) return NULL;
     PyObject *m = PyModule_Create(&host_module);
-    if (!m) return NULL;
-    Py_INCREF(&EmulatorType);
-    PyModule_AddObject(m, "Emulator", (PyObject *)&EmulatorType);
-    Py_INCREF(&RunnerType);
-    PyModule_AddObject(m, "Runner", (PyObject *)&RunnerType);
-    PyModule_AddIntConstant(m, "MEMORY_SAVE_RAM", RK_RETRO_MEMORY_SAVE_RAM);
-    PyModule_AddIntConstant(m, "MEMORY_RTC", RK_RETRO_MEMORY_RTC);
+    if (!m || PyModule_AddType(m, &EmulatorType) < 0 || PyModule_AddType(m, &RunnerType) < 0) {
+        Py_XDECREF(m);
+        return NULL;
+    }
     PyModule_AddIntConstant(m, "MEMORY_SYSTEM_RAM", RK_RETRO_MEMORY_SYSTEM_RAM);
-    PyModule_AddIntConstant(m, "MEMORY_VIDEO_RAM", RK_RETRO_MEMORY_VIDEO_RAM);
     PyModule_AddIntConstant(m, "MAX_PORTS", RK_MAX_PORTS);
     PyModule_AddIntConstant(m, "PIXEL_FORMAT_0RGB1555", RK_RETRO_PIXEL_FORMAT_0RGB1555);
     PyModule_AddIntConstant(m, "PIXEL_FORMAT_XRGB8888", RK_RETRO_PIXEL_FORMAT_XRGB8888);

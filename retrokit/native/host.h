@@ -28,18 +28,18 @@ extern PyTypeObject EmulatorType, MemoryType, RunnerType;
 int rk_py_enter(EmulatorObject *self, int need_game);
 void rk_py_leave(EmulatorObject *self);
 
-void rk_py_really_close(EmulatorObject *self);
+/* Release `view` (a no-op if it holds nothing) and return `result`: the way
+ * out of a call that holds a buffer, whether it fails or not. */
+PyObject *rk_py_release(Py_buffer *view, PyObject *result);
+
+/* Get `obj` as a writable C-contiguous uint8 array of shape (height, width, 3),
+ * of this height and width unless they are 0; else raise and return -1. */
+int rk_py_get_screen(PyObject *obj, Py_buffer *view, unsigned height, unsigned width);
 
 /* Emulator methods defined in host_data.c. */
-PyObject *emulator_screen_shape(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_screen(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_memory(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_memory_maps(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_capture_audio(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_take_audio(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_serialize_size(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_serialize(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_unserialize(EmulatorObject *self, PyObject *arg);
+typedef PyObject *rk_emulator_method(EmulatorObject *self, PyObject *arg);
+rk_emulator_method emulator_screen_shape, emulator_screen, emulator_memory, emulator_memory_maps,
+    emulator_capture_audio, emulator_take_audio, emulator_serialize, emulator_unserialize;
 
 PyObject *rk_py_read_fields(PyObject *module, PyObject *const *args, Py_ssize_t nargs);
 PyObject *rk_py_pack_buttons(PyObject *module, PyObject *const *args, Py_ssize_t nargs);

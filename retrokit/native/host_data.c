@@ -15,8 +15,6 @@ typedef struct {
     Py_ssize_t size;
 } MemoryObject;
 
-/* ---- memory buffers ------------------------------------------------------------------------- */
-
 static int memory_getbuffer(MemoryObject *self, Py_buffer *view, int flags) {
     if (self->owner->closed && !self->owner->core.handle) {
         PyErr_SetString(CoreError, "the emulator behind this memory is closed");
@@ -57,8 +55,6 @@ static PyObject *memory_view(EmulatorObject *self, void *ptr, size_t size) {
     return view;
 }
 
-/* ---- Emulator: screen, memory, audio ---------------------------------------------------------------- */
-
 PyObject *emulator_screen_shape(EmulatorObject *self, PyObject *unused) {
     if (rk_py_enter(self, 1)) return NULL;
     unsigned w = self->core.frame_width, h = self->core.frame_height;
@@ -71,26 +67,13 @@ PyObject *emulator_screen_shape(EmulatorObject *self, PyObject *unused) {
 }
 
 PyObject *emulator_screen(EmulatorObject *self, PyObject *out) {
-    Py_buffer buf;
-    if (PyObject_GetBuffer(out, &buf, PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0) return NULL;
-    if (rk_py_enter(self, 1)) {
-        PyBuffer_Release(&buf);
-        return NULL;
-    }
+    if (rk_py_enter(self, 1)) return NULL;
     rk_core *c = &self->core;
     unsigned w = c->frame_data ? c->frame_width : c->av.geometry.base_width;
     unsigned h = c->frame_data ? c->frame_height : c->av.geometry.base_height;
-    int shape_ok = buf.ndim == 3 && buf.shape[0] == (Py_ssize_t)h && buf.shape[1] == (Py_ssize_t)w &&
-                   buf.shape[2] == 3 && buf.itemsize == 1 && buf.format && strchr("Bc", buf.format[0]) &&
-                   buf.format[1] == 0;
-    if (!shape_ok) {
+    Py_buffer buf;
+    if (rk_py_get_screen(out, &buf, h, w)) {
         rk_py_leave(self);
-        PyErr_Format(InvalidArgumentError,
-                     "the screen buffer must be a C-contiguous uint8 array of shape (%u, %u, 3), got %zd dimensions "
-                     "of %zd-byte items (format %s); make it with numpy.empty(emulator.screen_shape() + (3,), "
-                     "numpy.uint8)",
-                     h, w, (Py_ssize_t)buf.ndim, buf.itemsize, buf.format ? buf.format : "?");
-        PyBuffer_Release(&buf);
         return NULL;
     }
     int rc;
@@ -123,15 +106,11 @@ PyObject *emulator_memory_maps(EmulatorObject *self, PyObject *unused) {
     PyObject *list = PyList_New(0);
     for (int i = 0; list && i < self->core.n_maps; i++) {
         rk_memmap *m = &self->core.maps[i];
-        PyObject *view = Py_None;
-        Py_INCREF(view);
-        if (m->ptr && m->len) {
-            Py_DECREF(view);
-            view = memory_view(self, (uint8_t *)m->ptr + m->offset, m->len);
-            if (!view) {
-                Py_CLEAR(list);
-                break;
-            }
+        PyObject *view = m->ptr && m->len ? memory_view(self, (uint8_t *)m->ptr + m->offset, m->len)
+                                          : Py_NewRef(Py_None);
+        if (!view) {
+            Py_CLEAR(list);
+            break;
         }
         PyObject *d = Py_BuildValue("{s:K,s:n,s:n,s:n,s:n,s:s,s:N}", "flags", (unsigned long long)m->flags, "start",
                                     (Py_ssize_t)m->start, "select", (Py_ssize_t)m->select, "disconnect",
@@ -155,17 +134,6 @@ PyObject *emulator_take_audio(EmulatorObject *self, PyObject *unused) {
     PyObject *out = PyBytes_FromStringAndSize((const char *)self->core.audio, (Py_ssize_t)(self->core.audio_len * 2));
     self->core.audio_len = 0;
     return out;
-}
-
-/* ---- Emulator: states ---------------------------------------------------------------------------------------- */
-
-PyObject *emulator_serialize_size(EmulatorObject *self, PyObject *unused) {
-    if (rk_py_enter(self, 1)) return NULL;
-    rk_enter(&self->core);
-    size_t size = self->core.api.serialize_size();
-    rk_leave();
-    rk_py_leave(self);
-    return PyLong_FromSize_t(size);
 }
 
 PyObject *emulator_serialize(EmulatorObject *self, PyObject *unused) {
@@ -196,34 +164,26 @@ PyObject *emulator_serialize(EmulatorObject *self, PyObject *unused) {
 PyObject *emulator_unserialize(EmulatorObject *self, PyObject *arg) {
     Py_buffer buf;
     if (PyObject_GetBuffer(arg, &buf, PyBUF_SIMPLE) < 0) return NULL;
-    if (rk_py_enter(self, 1)) {
-        PyBuffer_Release(&buf);
-        return NULL;
-    }
+    if (rk_py_enter(self, 1)) return rk_py_release(&buf, NULL);
     rk_enter(&self->core);
     size_t size = self->core.api.serialize_size();
     rk_leave();
-    if ((size_t)buf.len != size) {
-        rk_py_leave(self);
-        PyErr_Format(StateError,
-                     "expected a state of %zu bytes for this core, got %zd bytes: the state is truncated, corrupt, "
-                     "or was made by another core or core version; make it again with this core",
-                     size, buf.len);
-        PyBuffer_Release(&buf);
-        return NULL;
+    bool fits = (size_t)buf.len == size, ok = false;
+    if (fits) {
+        Py_BEGIN_ALLOW_THREADS
+        rk_enter(&self->core);
+        ok = self->core.api.unserialize(buf.buf, size);
+        rk_leave();
+        Py_END_ALLOW_THREADS
+        self->core.have_held = 0;
     }
-    bool ok;
-    Py_BEGIN_ALLOW_THREADS
-    rk_enter(&self->core);
-    ok = self->core.api.unserialize(buf.buf, (size_t)buf.len);
-    rk_leave();
-    Py_END_ALLOW_THREADS
-    self->core.have_held = 0;
-    rk_py_leave(self);
-    PyBuffer_Release(&buf);
-    if (!ok)
-        return PyErr_Format(StateError, "the core refused the state (%zu bytes): it is corrupt or was made by "
-                                        "another core; make it again with this core", size);
-    Py_RETURN_NONE;
+    rk_py_leave(self); /* before raising: it may call the log callback */
+    if (!fits)
+        PyErr_Format(StateError, "expected a state of %zu bytes for this core, got %zd bytes: the state is truncated, "
+                     "corrupt, or was made by another core or core version; make it again with this core",
+                     size, buf.len);
+    else if (!ok)
+        PyErr_Format(StateError, "the core refused the state (%zu bytes): it is corrupt or was made by another core; "
+                     "make it again with this core", size);
+    return rk_py_release(&buf, ok ? Py_NewRef(Py_None) : NULL);
 }
-

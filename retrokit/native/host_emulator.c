@@ -9,8 +9,6 @@
 
 #include <string.h>
 
-/* ---- helpers ----------------------------------------------------------------------------- */
-
 static void flush_log(EmulatorObject *self) {
     rk_core *core = &self->core;
     for (int i = 0; i < core->n_log; i++) {
@@ -26,20 +24,14 @@ static void flush_log(EmulatorObject *self) {
 
 /* Claim the emulator for this call; a second thread gets an error, not a race. */
 int rk_py_enter(EmulatorObject *self, int need_game) {
-    if (self->closed) {
-        PyErr_SetString(CoreError, "this emulator is closed; make a new one");
-        return -1;
-    }
-    if (need_game && !self->core.game_loaded) {
-        PyErr_SetString(CoreError, "no game is loaded; call load_game first");
-        return -1;
-    }
     int expected = 0;
-    if (!atomic_compare_exchange_strong(&self->core.busy, &expected, 1)) {
-        PyErr_SetString(CoreError, "this emulator is running in another thread; use one emulator per thread");
-        return -1;
-    }
-    return 0;
+    const char *error = NULL;
+    if (self->closed) error = "this emulator is closed; make a new one";
+    else if (need_game && !self->core.game_loaded) error = "no game is loaded; call load_game first";
+    else if (!atomic_compare_exchange_strong(&self->core.busy, &expected, 1))
+        error = "this emulator is running in another thread; use one emulator per thread";
+    if (error) PyErr_SetString(CoreError, error);
+    return error ? -1 : 0;
 }
 
 void rk_py_leave(EmulatorObject *self) {
@@ -47,14 +39,33 @@ void rk_py_leave(EmulatorObject *self) {
     flush_log(self);
 }
 
-void rk_py_really_close(EmulatorObject *self) {
+PyObject *rk_py_release(Py_buffer *view, PyObject *result) {
+    PyBuffer_Release(view); /* a no-op on a zeroed view */
+    return result;
+}
+
+int rk_py_get_screen(PyObject *obj, Py_buffer *view, unsigned height, unsigned width) {
+    if (PyObject_GetBuffer(obj, view, PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0) return -1;
+    const char *f = view->format ? view->format : "B";
+    if (view->ndim == 3 && view->shape[2] == 3 && view->itemsize == 1 && (f[0] == 'B' || f[0] == 'c') && !f[1] &&
+        (!height || (view->shape[0] == (Py_ssize_t)height && view->shape[1] == (Py_ssize_t)width)))
+        return 0;
+    char shape[48] = "height, width";
+    if (height) snprintf(shape, sizeof shape, "%u, %u", height, width);
+    PyErr_Format(InvalidArgumentError,
+                 "the screen buffer must be a C-contiguous uint8 array of shape (%s, 3), got %d dimensions of "
+                 "%zd-byte items (format %s); make it with numpy.empty(emulator.screen_shape() + (3,), numpy.uint8)",
+                 shape, view->ndim, view->itemsize, f);
+    PyBuffer_Release(view);
+    return -1;
+}
+
+static void really_close(EmulatorObject *self) {
     if (self->core.handle || self->core.system_dir) {
         rk_core_close(&self->core);
         flush_log(self);
     }
 }
-
-/* ---- Emulator: life cycle ---------------------------------------------------------------------- */
 
 static int emulator_init(EmulatorObject *self, PyObject *args, PyObject *kwargs) {
     static char *kwlist[] = {"core_path", "system_dir", "save_dir", "options", "log", "ports", NULL};
@@ -101,7 +112,7 @@ static int emulator_init(EmulatorObject *self, PyObject *args, PyObject *kwargs)
     flush_log(self);
     if (rc) {
         PyErr_SetString(CoreError, self->core.error);
-        rk_py_really_close(self);
+        really_close(self);
         self->closed = 1;
         return -1;
     }
@@ -109,7 +120,7 @@ static int emulator_init(EmulatorObject *self, PyObject *args, PyObject *kwargs)
 }
 
 static void emulator_dealloc(EmulatorObject *self) {
-    rk_py_really_close(self);
+    really_close(self);
     Py_XDECREF(self->log);
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
@@ -121,37 +132,26 @@ static PyObject *emulator_close(EmulatorObject *self, PyObject *unused) {
     }
     self->closed = 1;
     /* Live memory views keep the core loaded until they are released. */
-    if (self->exports == 0) rk_py_really_close(self);
+    if (self->exports == 0) really_close(self);
     Py_RETURN_NONE;
 }
 
 static PyObject *emulator_load_game(EmulatorObject *self, PyObject *args) {
     const char *path;
     Py_buffer data = {0};
+    if (self->core.game_loaded)
+        return PyErr_Format(CoreError, "a game is already loaded; make a new Emulator for another game");
     if (!PyArg_ParseTuple(args, "s|z*", &path, &data)) return NULL;
-    if (self->core.game_loaded) {
-        PyBuffer_Release(&data);
-        PyErr_SetString(CoreError, "a game is already loaded; make a new Emulator for another game");
-        return NULL;
-    }
-    if (rk_py_enter(self, 0)) {
-        PyBuffer_Release(&data);
-        return NULL;
-    }
+    if (rk_py_enter(self, 0)) return rk_py_release(&data, NULL);
     int rc;
     Py_BEGIN_ALLOW_THREADS
     rc = rk_core_load_game(&self->core, path, data.buf, (size_t)data.len);
     Py_END_ALLOW_THREADS
     PyBuffer_Release(&data);
     rk_py_leave(self);
-    if (rc) {
-        PyErr_SetString(CoreError, self->core.error);
-        return NULL;
-    }
+    if (rc) return PyErr_Format(CoreError, "%s", self->core.error);
     Py_RETURN_NONE;
 }
-
-/* ---- Emulator: information ------------------------------------------------------------------------ */
 
 static PyObject *emulator_system_info(EmulatorObject *self, PyObject *unused) {
     if (rk_py_enter(self, 0)) return NULL;
@@ -192,32 +192,6 @@ static PyObject *emulator_options(EmulatorObject *self, PyObject *unused) {
     return result;
 }
 
-static PyObject *emulator_set_option(EmulatorObject *self, PyObject *args) {
-    const char *key, *value;
-    if (!PyArg_ParseTuple(args, "ss", &key, &value)) return NULL;
-    if (self->closed) return PyErr_Format(CoreError, "this emulator is closed; make a new one");
-    if (rk_core_set_option(&self->core, key, value)) {
-        PyErr_SetString(InvalidArgumentError, self->core.error);
-        return NULL;
-    }
-    Py_RETURN_NONE;
-}
-
-static PyObject *emulator_set_controller(EmulatorObject *self, PyObject *args) {
-    unsigned port, device;
-    if (!PyArg_ParseTuple(args, "II", &port, &device)) return NULL;
-    if (port >= (unsigned)self->core.n_ports)
-        return PyErr_Format(InvalidArgumentError, "port must be below %d, got %u", self->core.n_ports, port);
-    if (rk_py_enter(self, 1)) return NULL;
-    rk_enter(&self->core);
-    self->core.api.set_controller_port_device(port, device);
-    rk_leave();
-    rk_py_leave(self);
-    Py_RETURN_NONE;
-}
-
-/* ---- Emulator: running --------------------------------------------------------------------------------- */
-
 static PyObject *emulator_set_sticky(EmulatorObject *self, PyObject *args) {
     double prob;
     unsigned long long seed;
@@ -242,33 +216,18 @@ static PyObject *emulator_run(EmulatorObject *self, PyObject *const *args, Py_ss
     if (frames < 0) return PyErr_Format(InvalidArgumentError, "frames must be 0 or more, got %ld", frames);
     Py_buffer buf, screen = {0};
     if (PyObject_GetBuffer(args[0], &buf, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0) return NULL;
-    int ok = buf.itemsize == 2 && buf.format && (strcmp(buf.format, "H") == 0 || strcmp(buf.format, "=H") == 0 ||
-                                                 strcmp(buf.format, "<H") == 0);
-    Py_ssize_t n = ok ? buf.len / 2 : 0;
-    if (!ok || n > self->core.n_ports) {
-        PyErr_Format(InvalidArgumentError,
-                     "actions must be a uint16 array of at most %d button masks (one per port), got format %s "
-                     "with %zd bytes",
-                     self->core.n_ports, buf.format ? buf.format : "B", buf.len);
-        PyBuffer_Release(&buf);
-        return NULL;
-    }
+    const char *f = buf.format ? buf.format : "B";
+    Py_ssize_t n = buf.len / 2;
+    if (buf.itemsize != 2 || (strcmp(f, "H") && strcmp(f, "=H") && strcmp(f, "<H")) || n > self->core.n_ports)
+        return rk_py_release(&buf, PyErr_Format(InvalidArgumentError,
+                                                "actions must be a uint16 array of at most %d button masks (one per "
+                                                "port), got format %s with %zd bytes", self->core.n_ports, f, buf.len));
     uint16_t actions[RK_MAX_PORTS] = {0};
     memcpy(actions, buf.buf, (size_t)n * 2);
     PyBuffer_Release(&buf);
     int want_screen = nargs == 3 && args[2] != Py_None;
-    if (want_screen) {
-        if (PyObject_GetBuffer(args[2], &screen, PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0)
-            return NULL;
-        if (screen.ndim != 3 || screen.shape[2] != 3 || screen.itemsize != 1) {
-            PyBuffer_Release(&screen);
-            return PyErr_Format(InvalidArgumentError, "the screen buffer must be a uint8 array of shape (height, width, 3)");
-        }
-    }
-    if (rk_py_enter(self, 1)) {
-        if (want_screen) PyBuffer_Release(&screen);
-        return NULL;
-    }
+    if (want_screen && rk_py_get_screen(args[2], &screen, 0, 0)) return NULL;
+    if (rk_py_enter(self, 1)) return rk_py_release(&screen, NULL);
     int converted = 0;
     rk_core *c = &self->core;
     Py_BEGIN_ALLOW_THREADS
@@ -278,11 +237,7 @@ static PyObject *emulator_run(EmulatorObject *self, PyObject *const *args, Py_ss
         converted = rk_core_screen_into(c, screen.buf, (unsigned)screen.shape[1], (unsigned)screen.shape[0]);
     Py_END_ALLOW_THREADS
     rk_py_leave(self);
-    if (want_screen) {
-        PyBuffer_Release(&screen);
-        return PyBool_FromLong(converted);
-    }
-    Py_RETURN_NONE;
+    return rk_py_release(&screen, want_screen ? PyBool_FromLong(converted) : Py_NewRef(Py_None));
 }
 
 static PyObject *emulator_reset(EmulatorObject *self, PyObject *unused) {
@@ -298,11 +253,6 @@ static PyObject *emulator_reset(EmulatorObject *self, PyObject *unused) {
 static PyObject *emulator_get_frame(EmulatorObject *self, void *closure) {
     return PyLong_FromUnsignedLongLong(self->core.frame);
 }
-
-static PyObject *emulator_get_pixel_format(EmulatorObject *self, void *closure) {
-    return PyLong_FromLong(self->core.pixel_format);
-}
-
 static PyObject *emulator_get_stuck(EmulatorObject *self, void *closure) { return PyBool_FromLong(self->core.last_stuck); }
 
 static PyObject *emulator_held(EmulatorObject *self, PyObject *unused) {
@@ -312,15 +262,11 @@ static PyObject *emulator_held(EmulatorObject *self, PyObject *unused) {
     return out;
 }
 
-static PyObject *emulator_get_closed(EmulatorObject *self, void *closure) { return PyBool_FromLong(self->closed); }
-
 static PyMethodDef emulator_methods[] = {
     {"load_game", (PyCFunction)emulator_load_game, METH_VARARGS, "Load a game from a path, with its bytes unless the core needs the path."},
     {"system_info", (PyCFunction)emulator_system_info, METH_NOARGS, "The core's name, version and extensions."},
     {"av_info", (PyCFunction)emulator_av_info, METH_NOARGS, "Frame rate, sample rate and geometry."},
     {"options", (PyCFunction)emulator_options, METH_NOARGS, "Core options: key -> (description, value, allowed)."},
-    {"set_option", (PyCFunction)emulator_set_option, METH_VARARGS, "Set a core option."},
-    {"set_controller", (PyCFunction)emulator_set_controller, METH_VARARGS, "Plug a device into a port."},
     {"set_sticky", (PyCFunction)emulator_set_sticky, METH_VARARGS, "Set the sticky-action probability and seed the RNG."},
     {"forget_action", (PyCFunction)emulator_forget_action, METH_NOARGS, "Apply the next action from its first frame."},
     {"held", (PyCFunction)emulator_held, METH_NOARGS, "The buttons of the last frame run, one mask per port."},
@@ -334,7 +280,6 @@ static PyMethodDef emulator_methods[] = {
     {"memory_maps", (PyCFunction)emulator_memory_maps, METH_NOARGS, "The core's memory descriptors, with views."},
     {"capture_audio", (PyCFunction)emulator_capture_audio, METH_O, "Start or stop keeping audio samples."},
     {"take_audio", (PyCFunction)emulator_take_audio, METH_NOARGS, "Return and clear the captured int16 stereo samples."},
-    {"serialize_size", (PyCFunction)emulator_serialize_size, METH_NOARGS, "The size of a serialized state."},
     {"serialize", (PyCFunction)emulator_serialize, METH_NOARGS, "The core's state as bytes."},
     {"unserialize", (PyCFunction)emulator_unserialize, METH_O, "Restore a state made by serialize."},
     {"close", (PyCFunction)emulator_close, METH_NOARGS, "Unload the game and the core."},
@@ -343,8 +288,6 @@ static PyMethodDef emulator_methods[] = {
 
 static PyGetSetDef emulator_getset[] = {
     {"frame", (getter)emulator_get_frame, NULL, "Frames run since the core was loaded.", NULL},
-    {"pixel_format", (getter)emulator_get_pixel_format, NULL, "The core's libretro pixel format.", NULL},
-    {"closed", (getter)emulator_get_closed, NULL, "Whether close() was called.", NULL},
     {"stuck", (getter)emulator_get_stuck, NULL, "Whether the last run's first frame kept the previous buttons.", NULL},
     {NULL, NULL, NULL, NULL, NULL},
 };

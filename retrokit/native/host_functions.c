@@ -6,8 +6,6 @@
 
 #include "fields.h"
 
-/* ---- read_fields ------------------------------------------------------------------------------------------------------ */
-
 #define RK_MAX_BUFFERS 16
 
 /* The decoded values as a dict; 8-byte unsigned fields keep their true value. */
@@ -29,24 +27,21 @@ PyObject *rk_py_read_fields(PyObject *module, PyObject *const *args, Py_ssize_t 
     if (names && !PyTuple_Check(names)) return PyErr_Format(PyExc_TypeError, "names must be a tuple of str");
     PyObject *seq = PySequence_Fast(args[0], "buffers must be a sequence of buffers");
     if (!seq) return NULL;
-    Py_ssize_t nbuf = PySequence_Fast_GET_SIZE(seq);
-    if (nbuf > RK_MAX_BUFFERS) {
-        Py_DECREF(seq);
-        return PyErr_Format(InvalidArgumentError, "at most %d buffers, got %zd", RK_MAX_BUFFERS, nbuf);
-    }
-    Py_buffer bufs[RK_MAX_BUFFERS], plan, out;
+    Py_ssize_t nbuf = PySequence_Fast_GET_SIZE(seq), got = 0;
+    Py_buffer bufs[RK_MAX_BUFFERS], plan = {0}, out = {0}; /* releasing a zeroed one is a no-op */
     const uint8_t *ptrs[RK_MAX_BUFFERS];
-    Py_ssize_t got = 0;
     PyObject *result = NULL;
-    int have_plan = 0, have_out = 0;
+    if (nbuf > RK_MAX_BUFFERS) {
+        PyErr_Format(InvalidArgumentError, "at most %d buffers, got %zd", RK_MAX_BUFFERS, nbuf);
+        goto done;
+    }
     for (; got < nbuf; got++) {
         if (PyObject_GetBuffer(PySequence_Fast_GET_ITEM(seq, got), &bufs[got], PyBUF_SIMPLE) < 0) goto done;
         ptrs[got] = bufs[got].buf;
     }
-    if (PyObject_GetBuffer(args[1], &plan, PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0) goto done;
-    have_plan = 1;
-    if (PyObject_GetBuffer(args[2], &out, PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0) goto done;
-    have_out = 1;
+    if (PyObject_GetBuffer(args[1], &plan, PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0 ||
+        PyObject_GetBuffer(args[2], &out, PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0)
+        goto done;
     if (plan.itemsize != 8 || plan.ndim != 2 || plan.shape[1] != RK_PLAN_COLUMNS || out.itemsize != 8 ||
         out.len / 8 != plan.shape[0]) {
         PyErr_Format(InvalidArgumentError,
@@ -73,21 +68,14 @@ PyObject *rk_py_read_fields(PyObject *module, PyObject *const *args, Py_ssize_t 
     }
     int64_t *dst = out.buf;
     for (Py_ssize_t r = 0; r < rows; r++) dst[r] = rk_decode_field(ptrs, p + r * RK_PLAN_COLUMNS);
-    if (names) {
-        result = values_by_name(names, p, dst, rows);
-    } else {
-        result = Py_None;
-        Py_INCREF(result);
-    }
+    result = names ? values_by_name(names, p, dst, rows) : Py_NewRef(Py_None);
 done:
     for (Py_ssize_t i = 0; i < got; i++) PyBuffer_Release(&bufs[i]);
-    if (have_plan) PyBuffer_Release(&plan);
-    if (have_out) PyBuffer_Release(&out);
+    PyBuffer_Release(&plan);
+    PyBuffer_Release(&out);
     Py_DECREF(seq);
     return result;
 }
-
-/* ---- pack_buttons ----------------------------------------------------------------------------------------------------- */
 
 /* How items of a buffer format are tested for nonzero: 'i' byte by byte, 'f' or 'd' as floats; 0 if unknown. */
 static char item_kind(const Py_buffer *b) {
@@ -112,31 +100,21 @@ PyObject *rk_py_pack_buttons(PyObject *module, PyObject *const *args, Py_ssize_t
     Py_ssize_t buttons = PyLong_AsSsize_t(args[1]);
     if (buttons == -1 && PyErr_Occurred()) return NULL;
     if (buttons < 1 || buttons > 16) return PyErr_Format(InvalidArgumentError, "buttons must be 1 to 16, got %zd", buttons);
-    Py_buffer action, out, table = {0};
-    if (nargs == 4 && args[3] != Py_None) {
-        if (PyObject_GetBuffer(args[3], &table, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0) return NULL;
-        if (table.itemsize != 2 || table.len != ((Py_ssize_t)2 << buttons)) {
-            PyBuffer_Release(&table);
-            return PyErr_Format(InvalidArgumentError, "the table must hold 2**%zd uint16 masks, got %zd bytes", buttons,
-                                table.len);
-        }
-    }
-    if (PyObject_GetBuffer(args[0], &action, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0) {
-        if (table.obj) PyBuffer_Release(&table);
-        return NULL;
-    }
-    if (PyObject_GetBuffer(args[2], &out, PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0) {
-        PyBuffer_Release(&action);
-        if (table.obj) PyBuffer_Release(&table);
-        return NULL;
-    }
+    Py_buffer action = {0}, out = {0}, table = {0}; /* releasing a zeroed one is a no-op */
     PyObject *result = NULL;
-    const uint16_t *lookup = table.obj ? table.buf : NULL;
+    int with_table = nargs == 4 && args[3] != Py_None;
+    if ((with_table && PyObject_GetBuffer(args[3], &table, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0) ||
+        PyObject_GetBuffer(args[0], &action, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0 ||
+        PyObject_GetBuffer(args[2], &out, PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0)
+        goto done;
+    const uint16_t *lookup = with_table ? table.buf : NULL;
     char kind = item_kind(&action);
     Py_ssize_t items = action.len / action.itemsize, players = items / buttons;
-    if (!kind) { /* not a number format: the caller converts it itself */
-        result = Py_False;
-        Py_INCREF(result);
+    if (with_table && (table.itemsize != 2 || table.len != ((Py_ssize_t)2 << buttons))) {
+        PyErr_Format(InvalidArgumentError, "the table must hold 2**%zd uint16 masks, got %zd bytes", buttons,
+                     table.len);
+    } else if (!kind) { /* not a number format: the caller converts it itself */
+        result = Py_NewRef(Py_False);
     } else if (out.itemsize != 2 || players * buttons != items || players > out.len / 2 || players > RK_MAX_PORTS) {
         PyErr_Format(InvalidArgumentError, "expected %zd buttons for each of at most %zd players, got %zd items", buttons,
                      out.len / out.itemsize < RK_MAX_PORTS ? out.len / out.itemsize : RK_MAX_PORTS, items);
@@ -149,11 +127,11 @@ PyObject *rk_py_pack_buttons(PyObject *module, PyObject *const *args, Py_ssize_t
                 mask |= (unsigned)item_pressed(p, kind, action.itemsize) << b;
             masks[player] = lookup ? lookup[mask] : (uint16_t)mask;
         }
-        result = Py_True;
-        Py_INCREF(result);
+        result = Py_NewRef(Py_True);
     }
+done:
     PyBuffer_Release(&action);
     PyBuffer_Release(&out);
-    if (table.obj) PyBuffer_Release(&table);
+    PyBuffer_Release(&table);
     return result;
 }

@@ -10,8 +10,6 @@
 
 #include "runner.h"
 
-/* ---- Runner: several emulators' frames in one call ------------------------------------------------ */
-
 typedef struct {
     PyObject_HEAD
     rk_runner runner;
@@ -55,39 +53,16 @@ static PyObject *runner_run(RunnerObject *self, PyObject *args) {
     if (self->pid != getpid())
         return PyErr_Format(CoreError, "this runner was made in another process; make a new one after fork");
     if (frames < 0) return PyErr_Format(InvalidArgumentError, "frames must be 0 or more, got %d", frames);
-    PyObject *seq = PySequence_Fast(emus, "emulators must be a sequence of Emulator objects");
-    if (!seq) return NULL;
-    Py_ssize_t n = PySequence_Fast_GET_SIZE(seq);
+    int expected = 0, ports = 0;
+    if (!atomic_compare_exchange_strong(&self->busy, &expected, 1))
+        return PyErr_Format(CoreError, "this runner is running in another thread; use one runner per thread");
     PyObject *screen_seq = NULL, *result = NULL;
     rk_task *tasks = NULL;
-    Py_buffer actions = {0}, *views = NULL;
-    Py_ssize_t claimed = 0, viewed = 0;
-    int runner_claimed = 0, expected = 0;
-    if (!atomic_compare_exchange_strong(&self->busy, &expected, 1)) {
-        PyErr_SetString(CoreError, "this runner is running in another thread; use one runner per thread");
-        goto done;
-    }
-    runner_claimed = 1;
-    if (PyObject_GetBuffer(actions_obj, &actions, PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0) goto done;
-    tasks = calloc((size_t)(n > 0 ? n : 1), sizeof(rk_task));
-    views = calloc((size_t)(n > 0 ? n : 1), sizeof(Py_buffer));
-    if (!tasks || !views) {
-        PyErr_NoMemory();
-        goto done;
-    }
-    for (Py_ssize_t i = 0; i < n; i++) {
-        PyObject *item = PySequence_Fast_GET_ITEM(seq, i);
-        if (!Py_IS_TYPE(item, &EmulatorType)) {
-            PyErr_Format(InvalidArgumentError, "emulator %zd is a %s, not a native Emulator", i, Py_TYPE(item)->tp_name);
-            goto done;
-        }
-    }
-    int ports = n > 0 ? ((EmulatorObject *)PySequence_Fast_GET_ITEM(seq, 0))->core.n_ports : 0;
-    if (actions.itemsize != 2 || actions.ndim != 2 || actions.shape[0] != n || actions.shape[1] != ports) {
-        PyErr_Format(InvalidArgumentError, "actions must be a uint16 array of shape (%zd, %d): one mask per port "
-                     "per emulator", n, ports);
-        goto done;
-    }
+    Py_buffer actions = {0}, *views = NULL; /* zeroed: releasing one that holds nothing is a no-op */
+    Py_ssize_t n = 0, claimed = 0;
+    PyObject *seq = PySequence_Fast(emus, "emulators must be a sequence of Emulator objects");
+    if (!seq || PyObject_GetBuffer(actions_obj, &actions, PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0) goto done;
+    n = PySequence_Fast_GET_SIZE(seq);
     if (screens != Py_None) {
         screen_seq = PySequence_Fast(screens, "screens must be a sequence of buffers, or None");
         if (!screen_seq) goto done;
@@ -96,22 +71,26 @@ static PyObject *runner_run(RunnerObject *self, PyObject *args) {
             goto done;
         }
     }
+    tasks = calloc((size_t)(n > 0 ? n : 1), sizeof(rk_task));
+    views = calloc((size_t)(n > 0 ? n : 1), sizeof(Py_buffer));
+    if (!tasks || !views) {
+        PyErr_NoMemory();
+        goto done;
+    }
     for (Py_ssize_t i = 0; i < n; i++) {
         EmulatorObject *emu = (EmulatorObject *)PySequence_Fast_GET_ITEM(seq, i);
+        if (!Py_IS_TYPE(emu, &EmulatorType)) {
+            PyErr_Format(InvalidArgumentError, "emulator %zd is a %s, not a native Emulator", i, Py_TYPE(emu)->tp_name);
+            goto done;
+        }
+        if (i == 0) ports = emu->core.n_ports;
         if (emu->core.n_ports != ports) {
             PyErr_Format(InvalidArgumentError, "every emulator must have %d ports; emulator %zd has %d", ports, i,
                          emu->core.n_ports);
             goto done;
         }
         if (screen_seq) {
-            PyObject *buf = PySequence_Fast_GET_ITEM(screen_seq, i);
-            if (PyObject_GetBuffer(buf, &views[i], PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0)
-                goto done;
-            viewed++;
-            if (views[i].ndim != 3 || views[i].shape[2] != 3 || views[i].itemsize != 1) {
-                PyErr_Format(InvalidArgumentError, "screen buffer %zd must be a uint8 array of shape (height, width, 3)", i);
-                goto done;
-            }
+            if (rk_py_get_screen(PySequence_Fast_GET_ITEM(screen_seq, i), &views[i], 0, 0)) goto done;
             tasks[i].screen = views[i].buf;
             tasks[i].screen_height = (unsigned)views[i].shape[0];
             tasks[i].screen_width = (unsigned)views[i].shape[1];
@@ -119,9 +98,14 @@ static PyObject *runner_run(RunnerObject *self, PyObject *args) {
         if (rk_py_enter(emu, 1)) goto done;
         claimed++;
         tasks[i].core = &emu->core;
-        tasks[i].actions = (const uint16_t *)actions.buf + i * ports;
         tasks[i].frames = frames;
     }
+    if (actions.itemsize != 2 || actions.ndim != 2 || actions.shape[0] != n || actions.shape[1] != ports) {
+        PyErr_Format(InvalidArgumentError, "actions must be a uint16 array of shape (%zd, %d): one mask per port "
+                     "per emulator", n, ports);
+        goto done;
+    }
+    for (Py_ssize_t i = 0; i < n; i++) tasks[i].actions = (const uint16_t *)actions.buf + i * ports;
     Py_BEGIN_ALLOW_THREADS
     rk_runner_run(&self->runner, tasks, (int)n);
     Py_END_ALLOW_THREADS
@@ -129,13 +113,13 @@ static PyObject *runner_run(RunnerObject *self, PyObject *args) {
     for (Py_ssize_t i = 0; result && i < n; i++) PyTuple_SET_ITEM(result, i, PyBool_FromLong(tasks[i].converted));
 done:
     for (Py_ssize_t i = 0; i < claimed; i++) rk_py_leave((EmulatorObject *)PySequence_Fast_GET_ITEM(seq, i));
-    for (Py_ssize_t i = 0; i < viewed; i++) PyBuffer_Release(&views[i]);
-    if (actions.obj) PyBuffer_Release(&actions);
-    if (runner_claimed) atomic_store(&self->busy, 0);
+    for (Py_ssize_t i = 0; views && i < n; i++) PyBuffer_Release(&views[i]);
+    PyBuffer_Release(&actions);
+    atomic_store(&self->busy, 0);
     free(tasks);
     free(views);
     Py_XDECREF(screen_seq);
-    Py_DECREF(seq);
+    Py_XDECREF(seq);
     return result;
 }
 

@@ -37,6 +37,12 @@ def test_two_copies_of_one_core_are_independent(tmp_path) -> None:
     b.close()
 
 
+@pytest.mark.parametrize("options", [{"\udc80": "x"}, {"key": "\udc80"}], ids=["key", "value"])
+def test_an_option_utf8_cannot_hold_raises_instead_of_crashing(tmp_path, options: dict[str, str]) -> None:
+    with pytest.raises(UnicodeEncodeError):
+        _host.Emulator(str(CORES[0]), str(tmp_path), str(tmp_path), options)
+
+
 def reference(pixels: np.ndarray, fmt: int) -> np.ndarray:
     """The expected RGB of pixels, written with numpy, channels widened by shifting as stable-retro does."""
     p = pixels.astype(np.uint32)

@@ -28,6 +28,9 @@ extern PyTypeObject EmulatorType, MemoryType, RunnerType;
 int rk_py_enter(EmulatorObject *self, int need_game);
 void rk_py_leave(EmulatorObject *self);
 
+/* Raise `type` with a printf-style message and return -1 (for int-returning functions). */
+int rk_py_fail(PyObject *type, const char *format, ...);
+
 /* Release `view` (a no-op if it holds nothing) and return `result`: the way
  * out of a call that holds a buffer, whether it fails or not. */
 PyObject *rk_py_release(Py_buffer *view, PyObject *result);

@@ -39,6 +39,14 @@ void rk_py_leave(EmulatorObject *self) {
     flush_log(self);
 }
 
+int rk_py_fail(PyObject *type, const char *format, ...) {
+    va_list args;
+    va_start(args, format);
+    PyErr_FormatV(type, format, args);
+    va_end(args);
+    return -1;
+}
+
 PyObject *rk_py_release(Py_buffer *view, PyObject *result) {
     PyBuffer_Release(view); /* a no-op on a zeroed view */
     return result;
@@ -70,38 +78,28 @@ static void really_close(EmulatorObject *self) {
 static int emulator_init(EmulatorObject *self, PyObject *args, PyObject *kwargs) {
     static char *kwlist[] = {"core_path", "system_dir", "save_dir", "options", "log", "ports", NULL};
     const char *path, *system_dir, *save_dir;
-    PyObject *options = Py_None, *log = Py_None;
+    PyObject *options = Py_None, *log = Py_None, *key, *value;
+    Py_ssize_t pos = 0;
     int ports = 2;
     if (!PyArg_ParseTupleAndKeywords(args, kwargs, "sss|OOi", kwlist, &path, &system_dir, &save_dir, &options,
                                      &log, &ports))
         return -1;
-    if (self->core.handle) {
-        PyErr_SetString(InvalidArgumentError, "Emulator.__init__ was called twice; make a new Emulator instead");
-        return -1;
-    }
-    if (ports < 1 || ports > RK_MAX_PORTS) {
-        PyErr_Format(InvalidArgumentError, "ports must be between 1 and %d, got %d", RK_MAX_PORTS, ports);
-        return -1;
-    }
-    if (options != Py_None && !PyDict_Check(options)) {
-        PyErr_Format(InvalidArgumentError, "options must be a dict of str to str, got %s", Py_TYPE(options)->tp_name);
-        return -1;
-    }
-    if (log != Py_None && !PyCallable_Check(log)) {
-        PyErr_SetString(InvalidArgumentError, "log must be a callable taking (level, text), or None");
-        return -1;
-    }
+    if (self->core.handle)
+        return rk_py_fail(InvalidArgumentError, "Emulator.__init__ was called twice; make a new Emulator instead");
+    if (ports < 1 || ports > RK_MAX_PORTS)
+        return rk_py_fail(InvalidArgumentError, "ports must be between 1 and %d, got %d", RK_MAX_PORTS, ports);
+    if (options != Py_None && !PyDict_Check(options))
+        return rk_py_fail(InvalidArgumentError, "options must be a dict of str to str, got %s",
+                          Py_TYPE(options)->tp_name);
+    if (log != Py_None && !PyCallable_Check(log))
+        return rk_py_fail(InvalidArgumentError, "log must be a callable taking (level, text), or None");
     self->core.n_ports = ports;
-    if (options != Py_None) {
-        PyObject *key, *value;
-        Py_ssize_t pos = 0;
-        while (PyDict_Next(options, &pos, &key, &value)) {
-            if (!PyUnicode_Check(key) || !PyUnicode_Check(value)) {
-                PyErr_SetString(InvalidArgumentError, "options must map str keys to str values");
-                return -1;
-            }
-            rk_core_set_option(&self->core, PyUnicode_AsUTF8(key), PyUnicode_AsUTF8(value));
-        }
+    while (options != Py_None && PyDict_Next(options, &pos, &key, &value)) {
+        if (!PyUnicode_Check(key) || !PyUnicode_Check(value))
+            return rk_py_fail(InvalidArgumentError, "options must map str keys to str values");
+        const char *k = PyUnicode_AsUTF8(key), *v = k ? PyUnicode_AsUTF8(value) : NULL;
+        if (!v) return -1; /* a str UTF-8 cannot hold (a lone surrogate): UnicodeEncodeError */
+        rk_core_set_option(&self->core, k, v);
     }
     Py_XINCREF(log);
     self->log = log;
@@ -110,13 +108,10 @@ static int emulator_init(EmulatorObject *self, PyObject *args, PyObject *kwargs)
     rc = rk_core_open(&self->core, path, system_dir, save_dir);
     Py_END_ALLOW_THREADS
     flush_log(self);
-    if (rc) {
-        PyErr_SetString(CoreError, self->core.error);
-        really_close(self);
-        self->closed = 1;
-        return -1;
-    }
-    return 0;
+    if (!rc) return 0;
+    self->closed = 1;
+    really_close(self); /* before raising: it may call the log callback */
+    return rk_py_fail(CoreError, "%s", self->core.error);
 }
 
 static void emulator_dealloc(EmulatorObject *self) {

@@ -21,18 +21,11 @@ static int runner_init(RunnerObject *self, PyObject *args, PyObject *kwargs) {
     static char *kwlist[] = {"threads", NULL};
     int threads;
     if (!PyArg_ParseTupleAndKeywords(args, kwargs, "i", kwlist, &threads)) return -1;
-    if (self->runner.workers) {
-        PyErr_SetString(InvalidArgumentError, "Runner.__init__ was called twice; make a new Runner instead");
-        return -1;
-    }
-    if (threads < 0 || threads > 256) {
-        PyErr_Format(InvalidArgumentError, "threads must be 0 to 256, got %d", threads);
-        return -1;
-    }
-    if (rk_runner_init(&self->runner, threads)) {
-        PyErr_SetString(CoreError, "cannot start the runner's threads");
-        return -1;
-    }
+    if (self->runner.workers)
+        return rk_py_fail(InvalidArgumentError, "Runner.__init__ was called twice; make a new Runner instead");
+    if (threads < 0 || threads > 256)
+        return rk_py_fail(InvalidArgumentError, "threads must be 0 to 256, got %d", threads);
+    if (rk_runner_init(&self->runner, threads)) return rk_py_fail(CoreError, "cannot start the runner's threads");
     self->pid = getpid();
     return 0;
 }

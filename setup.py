@@ -37,7 +37,6 @@ host = Extension(
         "retrokit/native/host_emulator.c",
         "retrokit/native/host_data.c",
         "retrokit/native/host_runner.c",
-        "retrokit/native/host_functions.c",
         "retrokit/native/core.c",
         "retrokit/native/environment.c",
         "retrokit/native/isolate.c",

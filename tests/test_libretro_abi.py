@@ -33,7 +33,6 @@ STRUCTS = {
     "retro_core_option_value": ["value", "label"],
     "retro_core_option_definition": ["key", "desc", "info", "values", "default_value"],
     "retro_core_options_intl": ["us", "local"],
-    "retro_core_option_v2_category": ["key", "desc", "info"],
     "retro_core_option_v2_definition": [
         "key", "desc", "desc_categorized", "info", "info_categorized", "category_key", "values", "default_value",
     ],

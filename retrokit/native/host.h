@@ -44,7 +44,4 @@ typedef PyObject *rk_emulator_method(EmulatorObject *self, PyObject *arg);
 rk_emulator_method emulator_screen_shape, emulator_screen, emulator_memory, emulator_memory_maps,
     emulator_capture_audio, emulator_take_audio, emulator_serialize, emulator_unserialize;
 
-PyObject *rk_py_read_fields(PyObject *module, PyObject *const *args, Py_ssize_t nargs);
-PyObject *rk_py_pack_buttons(PyObject *module, PyObject *const *args, Py_ssize_t nargs);
-
 #endif

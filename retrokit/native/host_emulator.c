@@ -178,8 +178,11 @@ static PyObject *emulator_options(EmulatorObject *self, PyObject *unused) {
     for (int i = 0; result && i < self->core.n_options; i++) {
         rk_option *o = &self->core.options[i];
         PyObject *allowed = PyTuple_New(o->n_allowed);
-        for (int j = 0; allowed && j < o->n_allowed; j++)
-            PyTuple_SET_ITEM(allowed, j, PyUnicode_FromString(o->allowed[j]));
+        for (int j = 0; allowed && j < o->n_allowed; j++) {
+            PyObject *value = PyUnicode_FromString(o->allowed[j]); /* fails if the core's text is not UTF-8 */
+            if (value) PyTuple_SET_ITEM(allowed, j, value);
+            else Py_CLEAR(allowed);
+        }
         PyObject *entry = allowed ? Py_BuildValue("(ssN)", o->desc, o->value, allowed) : NULL;
         if (!entry || PyDict_SetItemString(result, o->key, entry) < 0) Py_CLEAR(result);
         Py_XDECREF(entry);

@@ -62,89 +62,42 @@
 #define RK_ENV_SET_CORE_OPTIONS_V2 67
 #define RK_ENV_SET_CORE_OPTIONS_V2_INTL 68
 
-struct rk_retro_variable {
-    const char *key, *value;
-};
-
-struct rk_retro_game_info {
-    const char *path;
-    const void *data;
-    size_t size;
-    const char *meta;
-};
-
+struct rk_retro_variable { const char *key, *value; };
+struct rk_retro_game_info { const char *path; const void *data; size_t size; const char *meta; };
 struct rk_retro_system_info {
     const char *library_name, *library_version, *valid_extensions;
     bool need_fullpath, block_extract;
 };
-
-struct rk_retro_game_geometry {
-    unsigned base_width, base_height, max_width, max_height;
-    float aspect_ratio;
-};
-
-struct rk_retro_system_timing {
-    double fps, sample_rate;
-};
-
-struct rk_retro_system_av_info {
-    struct rk_retro_game_geometry geometry;
-    struct rk_retro_system_timing timing;
-};
-
-struct rk_retro_log_callback {
-    void (*log)(int level, const char *fmt, ...);
-};
-
-struct rk_retro_message {
-    const char *msg;
-    unsigned frames;
-};
-
+struct rk_retro_game_geometry { unsigned base_width, base_height, max_width, max_height; float aspect_ratio; };
+struct rk_retro_system_timing { double fps, sample_rate; };
+struct rk_retro_system_av_info { struct rk_retro_game_geometry geometry; struct rk_retro_system_timing timing; };
+struct rk_retro_log_callback { void (*log)(int level, const char *fmt, ...); };
+struct rk_retro_message { const char *msg; unsigned frames; };
 struct rk_retro_memory_descriptor {
     uint64_t flags;
     void *ptr;
     size_t offset, start, select, disconnect, len;
     const char *addrspace;
 };
+struct rk_retro_memory_map { const struct rk_retro_memory_descriptor *descriptors; unsigned num_descriptors; };
 
-struct rk_retro_memory_map {
-    const struct rk_retro_memory_descriptor *descriptors;
-    unsigned num_descriptors;
-};
-
-struct rk_retro_core_option_value {
-    const char *value, *label;
-};
-
+struct rk_retro_core_option_value { const char *value, *label; };
 struct rk_retro_core_option_definition {
     const char *key, *desc, *info;
     struct rk_retro_core_option_value values[RK_RETRO_NUM_CORE_OPTION_VALUES_MAX];
     const char *default_value;
 };
-
-struct rk_retro_core_options_intl {
-    struct rk_retro_core_option_definition *us, *local;
-};
-
-struct rk_retro_core_option_v2_category {
-    const char *key, *desc, *info;
-};
-
+struct rk_retro_core_options_intl { struct rk_retro_core_option_definition *us, *local; };
 struct rk_retro_core_option_v2_definition {
     const char *key, *desc, *desc_categorized, *info, *info_categorized, *category_key;
     struct rk_retro_core_option_value values[RK_RETRO_NUM_CORE_OPTION_VALUES_MAX];
     const char *default_value;
 };
-
 struct rk_retro_core_options_v2 {
-    struct rk_retro_core_option_v2_category *categories;
+    const void *categories; /* retro_core_option_v2_category: the host shows no categories */
     struct rk_retro_core_option_v2_definition *definitions;
 };
-
-struct rk_retro_core_options_v2_intl {
-    struct rk_retro_core_options_v2 *us, *local;
-};
+struct rk_retro_core_options_v2_intl { struct rk_retro_core_options_v2 *us, *local; };
 
 /* Callbacks the frontend hands to the core. */
 typedef bool (*rk_retro_environment_t)(unsigned cmd, void *data);

@@ -5,6 +5,7 @@ from __future__ import annotations
 import ctypes
 
 import native_c as native_c_module
+from native_c import PIXEL_FORMATS
 import numpy as np
 import pytest
 
@@ -46,9 +47,9 @@ def test_an_option_utf8_cannot_hold_raises_instead_of_crashing(tmp_path, options
 def reference(pixels: np.ndarray, fmt: int) -> np.ndarray:
     """The expected RGB of pixels, written with numpy, channels widened by shifting as stable-retro does."""
     p = pixels.astype(np.uint32)
-    if fmt == _host.PIXEL_FORMAT_XRGB8888:
+    if fmt == PIXEL_FORMATS["XRGB8888"]:
         r, g, b = (p >> 16) & 0xFF, (p >> 8) & 0xFF, p & 0xFF
-    elif fmt == _host.PIXEL_FORMAT_RGB565:
+    elif fmt == PIXEL_FORMATS["RGB565"]:
         r, g, b = ((p >> 11) & 0x1F) << 3, ((p >> 5) & 0x3F) << 2, (p & 0x1F) << 3
     else:
         r, g, b = ((p >> 10) & 0x1F) << 3, ((p >> 5) & 0x1F) << 3, (p & 0x1F) << 3
@@ -56,9 +57,9 @@ def reference(pixels: np.ndarray, fmt: int) -> np.ndarray:
 
 
 FORMATS = [
-    (_host.PIXEL_FORMAT_0RGB1555, np.uint16),
-    (_host.PIXEL_FORMAT_XRGB8888, np.uint32),
-    (_host.PIXEL_FORMAT_RGB565, np.uint16),
+    (PIXEL_FORMATS["0RGB1555"], np.uint16),
+    (PIXEL_FORMATS["XRGB8888"], np.uint32),
+    (PIXEL_FORMATS["RGB565"], np.uint16),
 ]
 
 

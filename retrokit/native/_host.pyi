@@ -14,9 +14,6 @@ import numpy.typing as npt
 MEMORY_SYSTEM_RAM: int
 MAX_PORTS: int
 PLAN_COLUMNS: int
-PIXEL_FORMAT_0RGB1555: int
-PIXEL_FORMAT_XRGB8888: int
-PIXEL_FORMAT_RGB565: int
 
 class Emulator:
     """One libretro core, privately loaded, with at most one game."""

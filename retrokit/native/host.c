@@ -144,8 +144,7 @@ done:
 static PyMethodDef module_methods[] = {
     {"read_fields", (PyCFunction)(void (*)(void))read_fields, METH_FASTCALL, "Decode RAM fields by a plan."},
     {"pack_buttons", (PyCFunction)(void (*)(void))pack_buttons, METH_FASTCALL,
-     "pack_buttons(action, buttons, out[, table]): one bit per nonzero item, a mask per player, looked up in table if "
-     "given; False for an unknown format."},
+     "pack_buttons(action, buttons, out[, table]): a button mask per player; False for an unknown format."},
     {NULL, NULL, 0, NULL},
 };
 
@@ -170,9 +169,6 @@ PyMODINIT_FUNC PyInit__host(void) {
     }
     PyModule_AddIntConstant(m, "MEMORY_SYSTEM_RAM", RK_RETRO_MEMORY_SYSTEM_RAM);
     PyModule_AddIntConstant(m, "MAX_PORTS", RK_MAX_PORTS);
-    PyModule_AddIntConstant(m, "PIXEL_FORMAT_0RGB1555", RK_RETRO_PIXEL_FORMAT_0RGB1555);
-    PyModule_AddIntConstant(m, "PIXEL_FORMAT_XRGB8888", RK_RETRO_PIXEL_FORMAT_XRGB8888);
-    PyModule_AddIntConstant(m, "PIXEL_FORMAT_RGB565", RK_RETRO_PIXEL_FORMAT_RGB565);
     PyModule_AddIntConstant(m, "PLAN_COLUMNS", RK_PLAN_COLUMNS);
     return m;
 }

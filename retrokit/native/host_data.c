@@ -57,11 +57,9 @@ static PyObject *memory_view(EmulatorObject *self, void *ptr, size_t size) {
 
 PyObject *emulator_screen_shape(EmulatorObject *self, PyObject *unused) {
     if (rk_py_enter(self, 1)) return NULL;
-    unsigned w = self->core.frame_width, h = self->core.frame_height;
-    if (!self->core.frame_data) {
-        w = self->core.av.geometry.base_width;
-        h = self->core.av.geometry.base_height;
-    }
+    rk_core *c = &self->core; /* before the first frame, the size the core announced */
+    unsigned w = c->frame_data ? c->frame_width : c->av.geometry.base_width;
+    unsigned h = c->frame_data ? c->frame_height : c->av.geometry.base_height;
     rk_py_leave(self);
     return Py_BuildValue("(II)", h, w);
 }
@@ -142,22 +140,17 @@ PyObject *emulator_serialize(EmulatorObject *self, PyObject *unused) {
     size_t size = self->core.api.serialize_size();
     rk_leave();
     PyObject *out = PyBytes_FromStringAndSize(NULL, (Py_ssize_t)size);
-    if (!out) {
-        rk_py_leave(self);
-        return NULL;
+    char *dst = out ? PyBytes_AS_STRING(out) : NULL;
+    bool ok = false;
+    if (out) {
+        Py_BEGIN_ALLOW_THREADS
+        rk_enter(&self->core);
+        ok = self->core.api.serialize(dst, size);
+        rk_leave();
+        Py_END_ALLOW_THREADS
     }
-    bool ok;
-    char *dst = PyBytes_AS_STRING(out);
-    Py_BEGIN_ALLOW_THREADS
-    rk_enter(&self->core);
-    ok = self->core.api.serialize(dst, size);
-    rk_leave();
-    Py_END_ALLOW_THREADS
     rk_py_leave(self);
-    if (!ok) {
-        Py_DECREF(out);
-        return PyErr_Format(CoreError, "the core refused to serialize its state");
-    }
+    if (out && !ok) Py_SETREF(out, PyErr_Format(CoreError, "the core refused to serialize its state"));
     return out;
 }
 

@@ -269,8 +269,7 @@ static PyMethodDef emulator_methods[] = {
     {"forget_action", (PyCFunction)emulator_forget_action, METH_NOARGS, "Apply the next action from its first frame."},
     {"held", (PyCFunction)emulator_held, METH_NOARGS, "The buttons of the last frame run, one mask per port."},
     {"run", (PyCFunction)(void (*)(void))emulator_run, METH_FASTCALL,
-     "run(actions, frames[, screen]): run frames with one button mask per port; with a screen buffer, convert "
-     "the last frame into it and return whether it fitted."},
+     "run(actions, frames[, screen]): run frames; convert the last into screen and say if it fitted."},
     {"reset", (PyCFunction)emulator_reset, METH_NOARGS, "Hard-reset the console."},
     {"screen_shape", (PyCFunction)emulator_screen_shape, METH_NOARGS, "(height, width) of the last frame."},
     {"screen", (PyCFunction)emulator_screen, METH_O, "Write the last frame as RGB into a uint8 array."},

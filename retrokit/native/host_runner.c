@@ -118,8 +118,7 @@ done:
 
 static PyMethodDef runner_methods[] = {
     {"run", (PyCFunction)runner_run, METH_VARARGS,
-     "run(emulators, actions, frames, screens=None): run every emulator's frames, shared among the calling "
-     "thread and the workers, and convert each screen into its buffer; return whether each screen was converted."},
+     "run(emulators, actions, frames, screens=None): run them all; return whether each screen was converted."},
     {NULL, NULL, 0, NULL},
 };
 
@@ -128,8 +127,7 @@ PyTypeObject RunnerType = {
     .tp_basicsize = sizeof(RunnerObject),
     .tp_dealloc = (destructor)runner_dealloc,
     .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "Runner(threads): a pool of worker threads that, with the calling thread, run several emulators' "
-              "frames in one call.",
+    .tp_doc = "Runner(threads): worker threads that, with the caller, run several emulators' frames in one call.",
     .tp_methods = runner_methods,
     .tp_init = (initproc)runner_init,
     .tp_new = PyType_GenericNew,

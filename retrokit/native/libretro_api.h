@@ -13,19 +13,15 @@
 #include <stdint.h>
 
 #define RK_RETRO_API_VERSION 1
-
 #define RK_RETRO_DEVICE_JOYPAD 1
 #define RK_RETRO_DEVICE_ID_JOYPAD_MASK 256
-
 #define RK_RETRO_MEMORY_SYSTEM_RAM 2
+#define RK_RETRO_LOG_INFO 1
+#define RK_RETRO_NUM_CORE_OPTION_VALUES_MAX 128
 
 #define RK_RETRO_PIXEL_FORMAT_0RGB1555 0
 #define RK_RETRO_PIXEL_FORMAT_XRGB8888 1
 #define RK_RETRO_PIXEL_FORMAT_RGB565 2
-
-#define RK_RETRO_LOG_INFO 1
-
-#define RK_RETRO_NUM_CORE_OPTION_VALUES_MAX 128
 
 #define RK_ENV_EXPERIMENTAL 0x10000
 /* Environment commands, with the experimental bit where the API sets it. */

@@ -36,10 +36,7 @@ static PyObject *read_fields(PyObject *module, PyObject *const *args, Py_ssize_t
     Py_buffer bufs[RK_MAX_BUFFERS], plan = {0}, out = {0}; /* releasing a zeroed one is a no-op */
     const uint8_t *ptrs[RK_MAX_BUFFERS];
     PyObject *result = NULL;
-    if (nbuf > RK_MAX_BUFFERS) {
-        PyErr_Format(InvalidArgumentError, "at most %d buffers, got %zd", RK_MAX_BUFFERS, nbuf);
-        goto done;
-    }
+    RK_CHECK(nbuf <= RK_MAX_BUFFERS, InvalidArgumentError, "at most %d buffers, got %zd", RK_MAX_BUFFERS, nbuf);
     for (; got < nbuf; got++) {
         if (PyObject_GetBuffer(PySequence_Fast_GET_ITEM(seq, got), &bufs[got], PyBUF_SIMPLE) < 0) goto done;
         ptrs[got] = bufs[got].buf;
@@ -47,12 +44,9 @@ static PyObject *read_fields(PyObject *module, PyObject *const *args, Py_ssize_t
     if (PyObject_GetBuffer(args[1], &plan, PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0 ||
         PyObject_GetBuffer(args[2], &out, PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0)
         goto done;
-    if (plan.itemsize != 8 || plan.ndim != 2 || plan.shape[1] != RK_PLAN_COLUMNS || out.itemsize != 8 ||
-        out.len / 8 != plan.shape[0]) {
-        PyErr_Format(InvalidArgumentError,
-                     "read_fields needs an int64 plan of shape (n, %d) and an int64 output of n items", RK_PLAN_COLUMNS);
-        goto done;
-    }
+    RK_CHECK(plan.itemsize == 8 && plan.ndim == 2 && plan.shape[1] == RK_PLAN_COLUMNS && out.itemsize == 8 &&
+                 out.len / 8 == plan.shape[0], InvalidArgumentError,
+             "read_fields needs an int64 plan of shape (n, %d) and an int64 output of n items", RK_PLAN_COLUMNS);
     Py_ssize_t rows = plan.shape[0];
     const int64_t *p = plan.buf;
     for (Py_ssize_t r = 0; r < rows; r++) {
@@ -61,16 +55,10 @@ static PyObject *read_fields(PyObject *module, PyObject *const *args, Py_ssize_t
         int bad = b < 0 || b >= nbuf || w < 1 || w > 8 || k < 0 || k > 3;
         for (int i = 0; !bad && i < w; i++)
             bad = row[RK_PLAN_OFFSETS + i] < 0 || row[RK_PLAN_OFFSETS + i] >= bufs[b].len;
-        if (bad) {
-            PyErr_Format(InvalidArgumentError, "field plan row %zd points outside its buffer", r);
-            goto done;
-        }
+        RK_CHECK(!bad, InvalidArgumentError, "field plan row %zd points outside its buffer", r);
     }
-    if (names && PyTuple_GET_SIZE(names) != rows) {
-        PyErr_Format(InvalidArgumentError, "read_fields needs one name per plan row (%zd), got %zd", rows,
-                     PyTuple_GET_SIZE(names));
-        goto done;
-    }
+    RK_CHECK(!names || PyTuple_GET_SIZE(names) == rows, InvalidArgumentError,
+             "read_fields needs one name per plan row (%zd), got %zd", rows, PyTuple_GET_SIZE(names));
     int64_t *dst = out.buf;
     for (Py_ssize_t r = 0; r < rows; r++) dst[r] = rk_decode_field(ptrs, p + r * RK_PLAN_COLUMNS);
     result = names ? values_by_name(names, p, dst, rows) : Py_NewRef(Py_None);

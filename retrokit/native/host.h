@@ -31,6 +31,11 @@ void rk_py_leave(EmulatorObject *self);
 /* Raise `type` with a printf-style message and return -1 (for int-returning functions). */
 int rk_py_fail(PyObject *type, const char *format, ...);
 
+/* For a function that releases what it holds at its `done:` label: unless
+ * `ok`, raise `type` with a printf-style message and go there. */
+#define RK_CHECK(ok, type, ...) \
+    do { if (!(ok)) { PyErr_Format(type, __VA_ARGS__); goto done; } } while (0)
+
 /* Release `view` (a no-op if it holds nothing) and return `result`: the way
  * out of a call that holds a buffer, whether it fails or not. */
 PyObject *rk_py_release(Py_buffer *view, PyObject *result);

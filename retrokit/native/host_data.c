@@ -4,8 +4,6 @@
  */
 #include "host.h"
 
-#include <string.h>
-
 #include "video.h"
 
 typedef struct {

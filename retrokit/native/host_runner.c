@@ -59,29 +59,19 @@ static PyObject *runner_run(RunnerObject *self, PyObject *args) {
     if (screens != Py_None) {
         screen_seq = PySequence_Fast(screens, "screens must be a sequence of buffers, or None");
         if (!screen_seq) goto done;
-        if (PySequence_Fast_GET_SIZE(screen_seq) != n) {
-            PyErr_Format(InvalidArgumentError, "expected %zd screen buffers, got %zd", n, PySequence_Fast_GET_SIZE(screen_seq));
-            goto done;
-        }
+        RK_CHECK(PySequence_Fast_GET_SIZE(screen_seq) == n, InvalidArgumentError,
+                 "expected %zd screen buffers, got %zd", n, PySequence_Fast_GET_SIZE(screen_seq));
     }
     tasks = calloc((size_t)(n > 0 ? n : 1), sizeof(rk_task));
     views = calloc((size_t)(n > 0 ? n : 1), sizeof(Py_buffer));
-    if (!tasks || !views) {
-        PyErr_NoMemory();
-        goto done;
-    }
+    RK_CHECK(tasks && views, PyExc_MemoryError, "cannot allocate the tasks of %zd emulators", n);
     for (Py_ssize_t i = 0; i < n; i++) {
         EmulatorObject *emu = (EmulatorObject *)PySequence_Fast_GET_ITEM(seq, i);
-        if (!Py_IS_TYPE(emu, &EmulatorType)) {
-            PyErr_Format(InvalidArgumentError, "emulator %zd is a %s, not a native Emulator", i, Py_TYPE(emu)->tp_name);
-            goto done;
-        }
+        RK_CHECK(Py_IS_TYPE(emu, &EmulatorType), InvalidArgumentError, "emulator %zd is a %s, not a native Emulator",
+                 i, Py_TYPE(emu)->tp_name);
         if (i == 0) ports = emu->core.n_ports;
-        if (emu->core.n_ports != ports) {
-            PyErr_Format(InvalidArgumentError, "every emulator must have %d ports; emulator %zd has %d", ports, i,
-                         emu->core.n_ports);
-            goto done;
-        }
+        RK_CHECK(emu->core.n_ports == ports, InvalidArgumentError,
+                 "every emulator must have %d ports; emulator %zd has %d", ports, i, emu->core.n_ports);
         if (screen_seq) {
             if (rk_py_get_screen(PySequence_Fast_GET_ITEM(screen_seq, i), &views[i], 0, 0)) goto done;
             tasks[i].screen = views[i].buf;
@@ -93,11 +83,9 @@ static PyObject *runner_run(RunnerObject *self, PyObject *args) {
         tasks[i].core = &emu->core;
         tasks[i].frames = frames;
     }
-    if (actions.itemsize != 2 || actions.ndim != 2 || actions.shape[0] != n || actions.shape[1] != ports) {
-        PyErr_Format(InvalidArgumentError, "actions must be a uint16 array of shape (%zd, %d): one mask per port "
-                     "per emulator", n, ports);
-        goto done;
-    }
+    RK_CHECK(actions.itemsize == 2 && actions.ndim == 2 && actions.shape[0] == n && actions.shape[1] == ports,
+             InvalidArgumentError, "actions must be a uint16 array of shape (%zd, %d): one mask per port per emulator",
+             n, ports);
     for (Py_ssize_t i = 0; i < n; i++) tasks[i].actions = (const uint16_t *)actions.buf + i * ports;
     Py_BEGIN_ALLOW_THREADS
     rk_runner_run(&self->runner, tasks, (int)n);

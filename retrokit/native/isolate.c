@@ -89,10 +89,8 @@ static const struct {
     const char *name;
     void *replacement;
 } shims[] = {
-    {"rand", (void *)shim_rand},
-    {"random", (void *)shim_random_long},
-    {"srand", (void *)shim_srand},
-    {"srandom", (void *)shim_srand},
+    {"rand", (void *)shim_rand}, {"random", (void *)shim_random_long},
+    {"srand", (void *)shim_srand}, {"srandom", (void *)shim_srand},
 };
 
 /* ---- pointing a loaded library's relocations at the shims -------------------------------------- */

@@ -36,7 +36,6 @@ host = Extension(
         "retrokit/native/host.c",
         "retrokit/native/host_emulator.c",
         "retrokit/native/host_data.c",
-        "retrokit/native/host_runner.c",
         "retrokit/native/core.c",
         "retrokit/native/environment.c",
         "retrokit/native/isolate.c",

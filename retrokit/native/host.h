@@ -20,7 +20,7 @@ typedef struct {
     int closed;
 } EmulatorObject;
 
-extern PyTypeObject EmulatorType, MemoryType, RunnerType;
+extern PyTypeObject EmulatorType, MemoryType;
 
 /* Claim an emulator for one call (raises and returns -1 if closed, without a
  * game when one is needed, or busy in another thread); leave releases it

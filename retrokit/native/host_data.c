@@ -14,10 +14,8 @@ typedef struct {
 } MemoryObject;
 
 static int memory_getbuffer(MemoryObject *self, Py_buffer *view, int flags) {
-    if (self->owner->closed && !self->owner->core.handle) {
-        PyErr_SetString(CoreError, "the emulator behind this memory is closed");
-        return -1;
-    }
+    if (self->owner->closed && !self->owner->core.handle)
+        return rk_py_fail(CoreError, "the emulator behind this memory is closed");
     if (PyBuffer_FillInfo(view, (PyObject *)self, self->ptr, self->size, 0, flags) < 0) return -1;
     self->owner->exports++;
     return 0;

@@ -69,10 +69,9 @@ int rk_py_get_screen(PyObject *obj, Py_buffer *view, unsigned height, unsigned w
 }
 
 static void really_close(EmulatorObject *self) {
-    if (self->core.handle || self->core.system_dir) {
-        rk_core_close(&self->core);
-        flush_log(self);
-    }
+    if (!self->core.handle && !self->core.system_dir) return;
+    rk_core_close(&self->core);
+    flush_log(self);
 }
 
 static int emulator_init(EmulatorObject *self, PyObject *args, PyObject *kwargs) {
@@ -121,10 +120,8 @@ static void emulator_dealloc(EmulatorObject *self) {
 }
 
 static PyObject *emulator_close(EmulatorObject *self, PyObject *unused) {
-    if (atomic_load(&self->core.busy)) {
-        PyErr_SetString(CoreError, "cannot close an emulator that is running in another thread");
-        return NULL;
-    }
+    if (atomic_load(&self->core.busy))
+        return PyErr_Format(CoreError, "cannot close an emulator that is running in another thread");
     self->closed = 1;
     /* Live memory views keep the core loaded until they are released. */
     if (self->exports == 0) really_close(self);
@@ -248,10 +245,8 @@ static PyObject *emulator_reset(EmulatorObject *self, PyObject *unused) {
     Py_RETURN_NONE;
 }
 
-static PyObject *emulator_get_frame(EmulatorObject *self, void *closure) {
-    return PyLong_FromUnsignedLongLong(self->core.frame);
-}
-static PyObject *emulator_get_stuck(EmulatorObject *self, void *closure) { return PyBool_FromLong(self->core.last_stuck); }
+static PyObject *emulator_get_frame(EmulatorObject *self, void *c) { return PyLong_FromUnsignedLongLong(self->core.frame); }
+static PyObject *emulator_get_stuck(EmulatorObject *self, void *c) { return PyBool_FromLong(self->core.last_stuck); }
 
 static PyObject *emulator_held(EmulatorObject *self, PyObject *unused) {
     PyObject *out = PyTuple_New(self->core.n_ports);

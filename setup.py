@@ -40,7 +40,6 @@ host = Extension(
         "retrokit/native/environment.c",
         "retrokit/native/isolate.c",
         "retrokit/native/video.c",
-        "retrokit/native/fields.c",
         "retrokit/native/runner.c",
     ],
     include_dirs=["retrokit/native"],

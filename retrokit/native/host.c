@@ -181,12 +181,10 @@ static PyObject *runner_run(RunnerObject *self, PyObject *args) {
     PyObject *seq = PySequence_Fast(emus, "emulators must be a sequence of Emulator objects");
     if (!seq || PyObject_GetBuffer(actions_obj, &actions, PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0) goto done;
     n = PySequence_Fast_GET_SIZE(seq);
-    if (screens != Py_None) {
-        screen_seq = PySequence_Fast(screens, "screens must be a sequence of buffers, or None");
-        if (!screen_seq) goto done;
-        RK_CHECK(PySequence_Fast_GET_SIZE(screen_seq) == n, InvalidArgumentError,
-                 "expected %zd screen buffers, got %zd", n, PySequence_Fast_GET_SIZE(screen_seq));
-    }
+    if (screens != Py_None && !(screen_seq = PySequence_Fast(screens, "screens must be a sequence of buffers, or None")))
+        goto done;
+    RK_CHECK(!screen_seq || PySequence_Fast_GET_SIZE(screen_seq) == n, InvalidArgumentError,
+             "expected %zd screen buffers, got %zd", n, PySequence_Fast_GET_SIZE(screen_seq));
     tasks = calloc((size_t)(n > 0 ? n : 1), sizeof(rk_task));
     views = calloc((size_t)(n > 0 ? n : 1), sizeof(Py_buffer));
     RK_CHECK(tasks && views, PyExc_MemoryError, "cannot allocate the tasks of %zd emulators", n);

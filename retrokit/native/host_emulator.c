@@ -100,8 +100,7 @@ static int emulator_init(EmulatorObject *self, PyObject *args, PyObject *kwargs)
         if (!v) return -1; /* a str UTF-8 cannot hold (a lone surrogate): UnicodeEncodeError */
         rk_core_set_option(&self->core, k, v);
     }
-    Py_XINCREF(log);
-    self->log = log;
+    self->log = Py_NewRef(log);
     int rc;
     Py_BEGIN_ALLOW_THREADS
     rc = rk_core_open(&self->core, path, system_dir, save_dir);

@@ -75,9 +75,8 @@ PyObject *emulator_screen(EmulatorObject *self, PyObject *out) {
     rc = rk_frame_to_rgb(c->frame_data, c->frame_pitch, w, h, c->pixel_format, buf.buf);
     Py_END_ALLOW_THREADS
     rk_py_leave(self);
-    PyBuffer_Release(&buf);
-    if (rc) return PyErr_Format(CoreError, "the core uses pixel format %d, which retrokit cannot convert", c->pixel_format);
-    Py_RETURN_NONE;
+    if (rc) PyErr_Format(CoreError, "the core uses pixel format %d, which retrokit cannot convert", c->pixel_format);
+    return rk_py_release(&buf, rc ? NULL : Py_NewRef(Py_None));
 }
 
 PyObject *emulator_memory(EmulatorObject *self, PyObject *arg) {
@@ -100,12 +99,9 @@ PyObject *emulator_memory_maps(EmulatorObject *self, PyObject *unused) {
     PyObject *list = PyList_New(0);
     for (int i = 0; list && i < self->core.n_maps; i++) {
         rk_memmap *m = &self->core.maps[i];
+        /* If making the view fails, Py_BuildValue's N passes the error on. */
         PyObject *view = m->ptr && m->len ? memory_view(self, (uint8_t *)m->ptr + m->offset, m->len)
                                           : Py_NewRef(Py_None);
-        if (!view) {
-            Py_CLEAR(list);
-            break;
-        }
         PyObject *d = Py_BuildValue("{s:K,s:n,s:n,s:n,s:n,s:s,s:N}", "flags", (unsigned long long)m->flags, "start",
                                     (Py_ssize_t)m->start, "select", (Py_ssize_t)m->select, "disconnect",
                                     (Py_ssize_t)m->disconnect, "length", (Py_ssize_t)m->len, "addrspace",

@@ -179,7 +179,7 @@ static PyObject *emulator_options(EmulatorObject *self, PyObject *unused) {
             if (value) PyTuple_SET_ITEM(allowed, j, value);
             else Py_CLEAR(allowed);
         }
-        PyObject *entry = allowed ? Py_BuildValue("(ssN)", o->desc, o->value, allowed) : NULL;
+        PyObject *entry = Py_BuildValue("(ssN)", o->desc, o->value, allowed); /* N passes a NULL's error on */
         if (!entry || PyDict_SetItemString(result, o->key, entry) < 0) Py_CLEAR(result);
         Py_XDECREF(entry);
     }

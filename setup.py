@@ -35,7 +35,6 @@ host = Extension(
     sources=[
         "retrokit/native/host.c",
         "retrokit/native/host_emulator.c",
-        "retrokit/native/host_data.c",
         "retrokit/native/core.c",
         "retrokit/native/environment.c",
         "retrokit/native/isolate.c",

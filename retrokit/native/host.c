@@ -1,10 +1,11 @@
 /*
  * retrokit.native._host: the CPython face of the libretro host.
  *
- * The Emulator type (and the Memory it hands out) lives in host_emulator.c
- * and host_data.c; this file makes the module, with its functions (decoding
- * RAM fields by a plan, packing button arrays into RetroPad masks) and its
- * Runner type (several emulators' frames in one call, on runner.c's threads).
+ * The Emulator type (and the Memory it hands out) lives in host_emulator.c;
+ * this file makes the module, with the helpers both share, its functions
+ * (decoding RAM fields by a plan, packing button arrays into RetroPad masks)
+ * and its Runner type (several emulators' frames in one call, on runner.c's
+ * threads).
  */
 #include "host.h"
 
@@ -16,6 +17,35 @@
 #include "runner.h"
 
 PyObject *CoreError, *StateError, *InvalidArgumentError;
+
+int rk_py_fail(PyObject *type, const char *format, ...) {
+    va_list args;
+    va_start(args, format);
+    PyErr_FormatV(type, format, args);
+    va_end(args);
+    return -1;
+}
+
+PyObject *rk_py_release(Py_buffer *view, PyObject *result) {
+    PyBuffer_Release(view); /* a no-op on a zeroed view */
+    return result;
+}
+
+int rk_py_get_screen(PyObject *obj, Py_buffer *view, unsigned height, unsigned width) {
+    if (PyObject_GetBuffer(obj, view, PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0) return -1;
+    const char *f = view->format ? view->format : "B";
+    if (view->ndim == 3 && view->shape[2] == 3 && view->itemsize == 1 && (f[0] == 'B' || f[0] == 'c') && !f[1] &&
+        (!height || (view->shape[0] == (Py_ssize_t)height && view->shape[1] == (Py_ssize_t)width)))
+        return 0;
+    char shape[48] = "height, width";
+    if (height) snprintf(shape, sizeof shape, "%u, %u", height, width);
+    PyErr_Format(InvalidArgumentError,
+                 "the screen buffer must be a C-contiguous uint8 array of shape (%s, 3), got %d dimensions of "
+                 "%zd-byte items (format %s); make it with numpy.empty(emulator.screen_shape() + (3,), numpy.uint8)",
+                 shape, view->ndim, view->itemsize, f);
+    PyBuffer_Release(view);
+    return -1;
+}
 
 #define RK_MAX_BUFFERS 16
 

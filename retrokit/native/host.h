@@ -1,6 +1,7 @@
 /*
  * Shared by the files of retrokit.native._host: the exceptions, the Emulator
- * object, and claiming an emulator for a call. Not part of any interface.
+ * object, claiming an emulator for a call, and checking arguments. Not part
+ * of any interface.
  */
 #ifndef RETROKIT_HOST_H
 #define RETROKIT_HOST_H
@@ -43,10 +44,5 @@ PyObject *rk_py_release(Py_buffer *view, PyObject *result);
 /* Get `obj` as a writable C-contiguous uint8 array of shape (height, width, 3),
  * of this height and width unless they are 0; else raise and return -1. */
 int rk_py_get_screen(PyObject *obj, Py_buffer *view, unsigned height, unsigned width);
-
-/* Emulator methods defined in host_data.c. */
-typedef PyObject *rk_emulator_method(EmulatorObject *self, PyObject *arg);
-rk_emulator_method emulator_screen_shape, emulator_screen, emulator_memory, emulator_memory_maps,
-    emulator_capture_audio, emulator_take_audio, emulator_serialize, emulator_unserialize;
 
 #endif

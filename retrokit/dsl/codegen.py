@@ -1,9 +1,10 @@
 """Generate the Python source of a checked scenario.
 
-The output is one function, ``_bind(s, d)``, that closes over a Run's state list
-``s`` and its list of per-player dones ``d`` (written each step when the
-scenario has ``dones``), and returns two step functions, ``_first`` (reset) and ``_next`` (every
-later step), each ``(v, frame, step) -> ((reward, ...), done)``. Their bodies
+The output is one function, ``_bind(s, d)``, that closes over a Run's state
+list ``s`` and its list of per-player dones ``d`` (written each step when the
+scenario has ``dones``), and returns two step functions, ``_first`` (reset)
+and ``_next`` (every later step), each ``(v, frame, step) -> ((reward, ...),
+done)``. Their bodies
 are straight-line code: read the fields the scenario uses from ``v``, compute
 the definitions and memory arguments in dependency order, then the outputs,
 then store the slots. No user text reaches the code except numbers: fields are

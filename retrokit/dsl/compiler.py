@@ -48,7 +48,8 @@ class Program:
         namespace = {
             "__builtins__": {},
             "_abs": abs, "_min": min, "_max": max, "_float": float,
-            "_divzero": self._divzero, "_nonfinite": self._nonfinite, "_nokey": self._nokey, "_missing": self._missing, "_fail": self._fail,
+            "_divzero": self._divzero, "_nonfinite": self._nonfinite, "_nokey": self._nokey,
+            "_missing": self._missing, "_fail": self._fail,
             "_RuntimeError": ScenarioRuntimeError, "_KeyError": KeyError,
             "_Errors": (ArithmeticError, TypeError, ValueError),
         }

@@ -33,7 +33,9 @@ from retrokit.dsl.source import Snippet, SourceText, align, located, read_source
 from retrokit.dsl.spec import Scalar, ScenarioSpec, Table
 from retrokit.errors import ScenarioError, did_you_mean, shown
 
-TOP_KEYS = ("name", "description", "include", "tables", "define", "reward", "rewards", "done", "dones", "actions", "crop")
+TOP_KEYS = (
+    "name", "description", "include", "tables", "define", "reward", "rewards", "done", "dones", "actions", "crop",
+)
 INCLUDE_KEYS = ("description", "include", "tables", "define")
 TABLE_KEYS = ("by", "default", "values", "description")
 
@@ -149,7 +151,9 @@ class _Reader:
         if isinstance(value, float) and not math.isfinite(value):
             raise self.error(node, f"expected {role} to be a finite number, got {value}")
         if isinstance(value, int) and abs(value) > MAX_INT:
-            raise self.error(node, f"expected {role} to fit in 64 bits (at most {MAX_INT}), got a {value.bit_length()}-bit number")
+            raise self.error(
+                node, f"expected {role} to fit in 64 bits (at most {MAX_INT}), got a {value.bit_length()}-bit number"
+            )
         return value
 
     def table(self, key: yaml.Node, node: yaml.Node) -> Table:
@@ -190,7 +194,9 @@ class _Reader:
                 return self._checked(node, "a table key", float(text))
             except ValueError:
                 pass
-        raise self.error(node, f"a table key is one or more numbers separated by commas, e.g. '0, 1'; got {node.value[:40]!r}")
+        raise self.error(
+            node, f"a table key is one or more numbers separated by commas, e.g. '0, 1'; got {node.value[:40]!r}"
+        )
 
     def name_snippet(self, key: yaml.Node, role: str) -> Snippet:
         start = key.start_mark.index

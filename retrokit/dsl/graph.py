@@ -111,7 +111,9 @@ class Graph:
         items: list[Item] = [("def", name) for name in self.a.defines]
         return [key for kind, key in self._postorder(items, FIRST) if kind == "def"]  # type: ignore[misc]
 
-    def _postorder(self, items: list[Item], mode: str, on_cycle: Callable[[list[Item]], None] | None = None) -> list[Item]:
+    def _postorder(
+        self, items: list[Item], mode: str, on_cycle: Callable[[list[Item]], None] | None = None
+    ) -> list[Item]:
         """Depth-first post-order from ``items`` over what each reads in ``mode``.
 
         Iterative, so a chain of thousands of definitions needs no deep Python

@@ -166,7 +166,8 @@ class _Converter:
             if value is None:
                 continue
             whole = key == "reference"
-            if isinstance(value, bool) or not isinstance(value, int if whole else (int, float)) or not math.isfinite(value):
+            number = isinstance(value, int if whole else (int, float)) and not isinstance(value, bool)
+            if not number or not math.isfinite(value):
                 wanted = "an integer" if whole else "a finite number"
                 raise self.error([*path, key], f"expected {key} to be {wanted}, got {value!r}")
 

@@ -66,8 +66,9 @@ class Run:
 
     ``reset`` starts an episode. ``step`` returns ``(rewards, done)``: a tuple of
     ``players`` floats, and a bool; :attr:`dones` then holds each player's own
-    done condition (a scenario's ``dones:``), which ``done`` includes once all hold. Stepping without a reset treats the first
-    step as the reset point (``initial(x)`` is then the first step's value).
+    done condition (a scenario's ``dones:``), which ``done`` includes once all
+    hold. Stepping without a reset treats the first step as the reset point
+    (``initial(x)`` is then the first step's value).
     """
 
     def __init__(self, program: Program) -> None:

@@ -173,7 +173,8 @@ class ActionMap:
         """Refuse a multi-discrete action of the wrong length, or choosing past a group's combinations."""
         nvec = self.space.nvec  # type: ignore[attr-defined]
         values = flat.tolist()
-        if flat.size != nvec.size or not all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in values):
+        whole = all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in values)
+        if flat.size != nvec.size or not whole:
             raise InvalidArgumentError(
                 f"Expected a multi-discrete action of {nvec.size} whole numbers (one per button group and player), "
                 f"got {shown(values)}; pass an array like env.action_space.sample()."

@@ -36,7 +36,8 @@ def _integer(name: str, value: object, low: int, high: int) -> int:
     """A whole number (Python or numpy, never a bool) in [low, high]."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
         raise InvalidArgumentError(
-            f"Expected {name} to be a whole number, got {shown(value)} ({type(value).__name__}); pass e.g. {name}={low}."
+            f"Expected {name} to be a whole number, got {shown(value)} ({type(value).__name__}); "
+            f"pass e.g. {name}={low}."
         )
     number = int(value)
     if not low <= number <= high:

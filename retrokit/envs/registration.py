@@ -47,7 +47,9 @@ def register_envs() -> int:
             kwargs={"game": game.name},
         )
     for game, state in levels():
-        added += _register(level_id(game, state), entry_point="retrokit.envs.sonic:make", kwargs={"game": game, "state": state})
+        added += _register(
+            level_id(game, state), entry_point="retrokit.envs.sonic:make", kwargs={"game": game, "state": state}
+        )
     return added
 
 

@@ -20,6 +20,9 @@ PLAN_COLUMNS: int
 PIXEL_FORMAT_0RGB1555: int
 PIXEL_FORMAT_XRGB8888: int
 PIXEL_FORMAT_RGB565: int
+VIDEO_ALL: int
+VIDEO_LAST: int
+VIDEO_NONE: int
 
 class Emulator:
     """One libretro core, privately loaded, with at most one game."""
@@ -41,6 +44,14 @@ class Emulator:
     def set_option(self, key: str, value: str) -> None: ...
     def set_controller(self, port: int, device: int) -> None: ...
     def set_sticky(self, prob: float, seed: int) -> None: ...
+    def set_video_frames(self, mode: int) -> None:
+        """Which frames of each ``run`` the core is told to draw (``VIDEO_ALL``, ``VIDEO_LAST``, ``VIDEO_NONE``).
+
+        Also: audio is wanted with ``VIDEO_ALL`` or while captured, else not.
+        """
+    @property
+    def av_asked(self) -> int:
+        """How often the core asked whether video and audio are wanted (GET_AUDIO_VIDEO_ENABLE)."""
     def forget_action(self) -> None:
         """Make the next ``run`` apply its action from the first frame, as after a reset."""
     def run(

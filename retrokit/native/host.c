@@ -51,5 +51,8 @@ PyMODINIT_FUNC PyInit__host(void) {
     PyModule_AddIntConstant(m, "PIXEL_FORMAT_XRGB8888", RK_RETRO_PIXEL_FORMAT_XRGB8888);
     PyModule_AddIntConstant(m, "PIXEL_FORMAT_RGB565", RK_RETRO_PIXEL_FORMAT_RGB565);
     PyModule_AddIntConstant(m, "PLAN_COLUMNS", RK_PLAN_COLUMNS);
+    PyModule_AddIntConstant(m, "VIDEO_ALL", RK_VIDEO_ALL);
+    PyModule_AddIntConstant(m, "VIDEO_LAST", RK_VIDEO_LAST);
+    PyModule_AddIntConstant(m, "VIDEO_NONE", RK_VIDEO_NONE);
     return m;
 }

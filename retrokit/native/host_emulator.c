@@ -229,6 +229,15 @@ static PyObject *emulator_set_sticky(EmulatorObject *self, PyObject *args) {
     Py_RETURN_NONE;
 }
 
+static PyObject *emulator_set_video_frames(EmulatorObject *self, PyObject *arg) {
+    long mode = PyLong_AsLong(arg);
+    if (mode == -1 && PyErr_Occurred()) return NULL;
+    if (mode < RK_VIDEO_ALL || mode > RK_VIDEO_NONE)
+        return PyErr_Format(InvalidArgumentError, "video frames must be VIDEO_ALL, VIDEO_LAST or VIDEO_NONE, got %ld", mode);
+    self->core.video_frames = (int)mode;
+    Py_RETURN_NONE;
+}
+
 static PyObject *emulator_forget_action(EmulatorObject *self, PyObject *unused) {
     self->core.have_held = 0;
     Py_RETURN_NONE;
@@ -312,6 +321,10 @@ static PyObject *emulator_held(EmulatorObject *self, PyObject *unused) {
     return out;
 }
 
+static PyObject *emulator_get_av_asked(EmulatorObject *self, void *closure) {
+    return PyLong_FromUnsignedLongLong(self->core.av_asked);
+}
+
 static PyObject *emulator_get_closed(EmulatorObject *self, void *closure) { return PyBool_FromLong(self->closed); }
 
 static PyMethodDef emulator_methods[] = {
@@ -322,6 +335,8 @@ static PyMethodDef emulator_methods[] = {
     {"set_option", (PyCFunction)emulator_set_option, METH_VARARGS, "Set a core option."},
     {"set_controller", (PyCFunction)emulator_set_controller, METH_VARARGS, "Plug a device into a port."},
     {"set_sticky", (PyCFunction)emulator_set_sticky, METH_VARARGS, "Set the sticky-action probability and seed the RNG."},
+    {"set_video_frames", (PyCFunction)emulator_set_video_frames, METH_O,
+     "Which frames of each run the core is told to draw: VIDEO_ALL, VIDEO_LAST or VIDEO_NONE."},
     {"forget_action", (PyCFunction)emulator_forget_action, METH_NOARGS, "Apply the next action from its first frame."},
     {"held", (PyCFunction)emulator_held, METH_NOARGS, "The buttons of the last frame run, one mask per port."},
     {"run", (PyCFunction)(void (*)(void))emulator_run, METH_FASTCALL,
@@ -344,6 +359,8 @@ static PyMethodDef emulator_methods[] = {
 static PyGetSetDef emulator_getset[] = {
     {"frame", (getter)emulator_get_frame, NULL, "Frames run since the core was loaded.", NULL},
     {"pixel_format", (getter)emulator_get_pixel_format, NULL, "The core's libretro pixel format.", NULL},
+    {"av_asked", (getter)emulator_get_av_asked, NULL, "How often the core asked whether video and audio are wanted.",
+     NULL},
     {"closed", (getter)emulator_get_closed, NULL, "Whether close() was called.", NULL},
     {"stuck", (getter)emulator_get_stuck, NULL, "Whether the last run's first frame kept the previous buttons.", NULL},
     {NULL, NULL, NULL, NULL, NULL},

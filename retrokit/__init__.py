@@ -3,16 +3,81 @@
 ``retrokit.make(game, state, scenario, **options)`` makes a Gymnasium env;
 ``retrokit.make_vec`` steps several on threads; ``retrokit.multiplayer`` has
 the PettingZoo envs of two-player games; ``retrokit.sonic`` is the Sonic
-benchmark preset.
+benchmark preset; ``retrokit.movie`` reads, writes and plays ``.bk2`` movies.
+
+The package is layered (``docs/architecture.md``): ``host`` (the native
+emulator's Python face), ``data`` (games, states, ROMs), ``dsl`` (scenarios),
+``envs`` (Gymnasium and PettingZoo), ``movie``, and ``commands`` (the CLI).
+Names are imported on first use (PEP 562), so ``retrokit --help`` stays fast.
 """
 
 from __future__ import annotations
 
-from retrokit.env import RetroEnv, State, make
-from retrokit.registration import register_envs
-from retrokit.vector import ThreadedVectorEnv, make_vec
+import importlib
+from typing import TYPE_CHECKING, Any
 
 __version__ = "0.1.0"
-__all__ = ["RetroEnv", "State", "ThreadedVectorEnv", "make", "make_vec", "register_envs"]
 
-register_envs()
+# Public name -> the module that defines it (an attribute), or the module itself.
+_ATTRIBUTES = {
+    "RetroEnv": "retrokit.envs.env",
+    "State": "retrokit.envs.env",
+    "make": "retrokit.envs.env",
+    "ThreadedVectorEnv": "retrokit.envs.vector",
+    "make_vec": "retrokit.envs.vector",
+    "register_envs": "retrokit.envs.registration",
+    "Emulator": "retrokit.host.emulator",
+}
+_MODULES = {
+    "sonic": "retrokit.envs.sonic",
+    "multiplayer": "retrokit.envs.multiplayer",
+    "movie": "retrokit.movie",
+}
+
+__all__ = [
+    "Emulator",
+    "RetroEnv",
+    "State",
+    "ThreadedVectorEnv",
+    "make",
+    "make_vec",
+    "movie",
+    "multiplayer",
+    "register_envs",
+    "sonic",
+]
+
+if TYPE_CHECKING:
+    from retrokit import movie
+    from retrokit.envs import multiplayer, sonic
+    from retrokit.envs.env import RetroEnv, State, make
+    from retrokit.envs.registration import register_envs
+    from retrokit.envs.vector import ThreadedVectorEnv, make_vec
+    from retrokit.host.emulator import Emulator
+
+
+def __getattr__(name: str) -> Any:
+    if name in _MODULES:
+        value = importlib.import_module(_MODULES[name])
+    elif name in _ATTRIBUTES:
+        value = getattr(importlib.import_module(_ATTRIBUTES[name]), name)
+    else:
+        raise AttributeError(f"module 'retrokit' has no attribute {name!r}")
+    globals()[name] = value  # later lookups skip this function
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted({*globals(), *__all__})
+
+
+def _register() -> None:
+    # Gymnasium ids must exist as soon as retrokit is imported, since
+    # ``gymnasium.make("retrokit/<Game>")`` is how many users reach us; this
+    # costs Gymnasium's import and a scan of the game folders, not the envs'.
+    from retrokit.envs.registration import register_envs
+
+    register_envs()
+
+
+_register()

@@ -45,7 +45,7 @@ def airstriker_fields(airstriker_dir: Path) -> dict[str, dict]:
 @pytest.fixture
 def airstriker(airstriker_rom: Path, airstriker_state: bytes):
     """A Genesis emulator at the start of Airstriker's Level1."""
-    from retrokit.emulator import Emulator
+    from retrokit.host.emulator import Emulator
 
     emu = Emulator("Genesis", airstriker_rom)
     emu.set_state(airstriker_state)

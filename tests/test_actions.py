@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from retrokit.actions import ACTION_TYPES, ActionMap
+from retrokit.envs.actions import ACTION_TYPES, ActionMap
 from retrokit.errors import InvalidArgumentError
+from retrokit.host.systems import get_system
 from retrokit.native import _host
-from retrokit.systems import get_system
 
 GENESIS = get_system("Genesis")
 BUTTON_DTYPES = [np.int8, np.uint8, np.bool_, np.int16, np.int32, np.int64, np.uint64, np.float32, np.float64]

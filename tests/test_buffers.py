@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import retrokit
-from retrokit.buffers import BufferPool, Pool, StepArrays
+from retrokit.envs.buffers import BufferPool, Pool, StepArrays
 
 KEYS = ("score", "lives")
 

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 import yaml
 
-from retrokit.emulator import Emulator
+from retrokit.host.emulator import Emulator
 
 REPO = Path(__file__).resolve().parent.parent
 GAME_DIR = REPO / "games" / "Dasher-Genesis"

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 from retrokit.cli import main
-from retrokit.games import find_game
-from retrokit.scenario import load_scenario
+from retrokit.data.games import find_game
+from retrokit.dsl.scenario import load_scenario
 
 
 def test_convert_writes_yaml_that_scores_like_the_json(tmp_path, capsys) -> None:

@@ -12,6 +12,7 @@ import json
 
 import pytest
 
+from retrokit.dsl.scenario import load_scenario
 from retrokit.errors import (
     InvalidArgumentError,
     ScenarioCompileError,
@@ -19,7 +20,6 @@ from retrokit.errors import (
     ScenarioRuntimeError,
     ScenarioSyntaxError,
 )
-from retrokit.scenario import load_scenario
 
 FIELDS = ["x", "y", "xpos", "lives", "zone", "act", "score", "length"]
 

@@ -6,8 +6,8 @@ import math
 
 import pytest
 
+from retrokit.dsl.scenario import load_scenario
 from retrokit.errors import InvalidArgumentError
-from retrokit.scenario import load_scenario
 
 FIELDS = ["x", "y", "lives", "score", "zone", "act", "flags", "odd name", "frame"]
 RAM = {"x": 7, "y": -3, "lives": 3, "score": 1200, "zone": 1, "act": 0, "flags": 0b1010, "odd name": 5, "frame": 99}

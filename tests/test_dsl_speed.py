@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from retrokit.scenario import load_scenario
+from retrokit.dsl.scenario import load_scenario
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -8,7 +8,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import retrokit
-from retrokit.env import RetroEnv, State
+from retrokit.envs.env import RetroEnv, State
 from retrokit.errors import (
     GameNotFoundError,
     InvalidArgumentError,

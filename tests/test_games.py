@@ -9,7 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from retrokit import games, paths
+from retrokit import paths
+from retrokit.data import games
 from retrokit.errors import (
     DataFileError,
     FieldTypeError,
@@ -19,7 +20,7 @@ from retrokit.errors import (
     StateNotFoundError,
     UnknownNameError,
 )
-from retrokit.memory import FieldSpec
+from retrokit.host.fields import FieldSpec
 
 WHEEL = paths.wheel_dir()
 AIRSTRIKER_DIR = WHEEL / "data" / "stable" / "Airstriker-Genesis-v0"

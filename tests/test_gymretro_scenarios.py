@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 
 from retrokit.dsl import convert_scenario_json
-from retrokit.scenario import load_scenario
+from retrokit.dsl.scenario import load_scenario
 
 OPS = [None, "equal", "negative-equal", "not-equal", "less-than", "greater-than", "less-or-equal",
        "greater-or-equal", "nonzero", "zero", "positive", "negative", "sign"]

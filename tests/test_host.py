@@ -12,10 +12,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from retrokit.emulator import Emulator
 from retrokit.errors import CoreError, CoreNotFoundError, InvalidArgumentError, StateError, UnknownNameError
+from retrokit.host.emulator import Emulator
+from retrokit.host.systems import get_system
 from retrokit.native import _host
-from retrokit.systems import get_system
 
 GENESIS = get_system("Genesis")
 LEFT, RIGHT, FIRE = GENESIS.mask(["LEFT"]), GENESIS.mask(["RIGHT"]), GENESIS.mask(["B"])
@@ -108,7 +108,7 @@ def test_same_inputs_give_identical_ram_and_screen(airstriker_rom: Path, airstri
 CHILD = """
 import gzip, hashlib, sys
 import numpy as np
-from retrokit.emulator import Emulator
+from retrokit.host.emulator import Emulator
 from tests.test_host import play, script
 emu = Emulator("Genesis", sys.argv[1])
 emu.set_state(gzip.decompress(open(sys.argv[2], "rb").read()))
@@ -344,7 +344,7 @@ def test_a_library_that_is_not_a_core_is_refused(airstriker_rom: Path) -> None:
 
 
 def test_missing_core_says_where_it_looked(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:
-    from retrokit import cores
+    from retrokit.host import cores
 
     monkeypatch.setattr(cores, "wheel_cores_dir", lambda: None)
     monkeypatch.setattr(cores, "_DEBIAN_DIRS", ())
@@ -424,7 +424,7 @@ screen = lambda: em.get_screen().tobytes()
 """
 
 RETROKIT = """
-from retrokit.emulator import Emulator
+from retrokit.host.emulator import Emulator
 emu = Emulator("Genesis", sys.argv[1])
 emu.run([0, 0], 1)
 press = lambda mask: emu.run([mask, 0], 1)

@@ -9,9 +9,10 @@ from pathlib import Path
 
 import pytest
 
-from retrokit import games, paths, roms
+from retrokit import paths
+from retrokit.data import games, roms
+from retrokit.data.importer import import_roms
 from retrokit.errors import RomNotFoundError
-from retrokit.importer import import_roms
 
 AIRSTRIKER_ROM = paths.wheel_dir() / "data" / "stable" / "Airstriker-Genesis-v0" / "rom.md"
 NES_BODY = bytes(range(256)) * 128

@@ -8,12 +8,12 @@ from pathlib import Path
 import pytest
 
 from retrokit.cli import main
-from retrokit.emulator import Emulator
+from retrokit.data.games import find_game, load_game
+from retrokit.data.integrate import integrate, make_state, recipes
+from retrokit.data.states import read_state
 from retrokit.errors import DataFileError, StateError, StateNotFoundError
-from retrokit.games import find_game, load_game
-from retrokit.integrate import integrate, make_state, recipes
-from retrokit.memory import FieldReader
-from retrokit.states import read_state
+from retrokit.host.emulator import Emulator
+from retrokit.host.memory import FieldReader
 
 DASHER = Path(__file__).resolve().parent.parent / "games" / "Dasher-Genesis"
 

@@ -16,10 +16,10 @@ import numpy as np
 import pytest
 
 from retrokit.cli import main
-from retrokit.emulator import Emulator
 from retrokit.errors import FileConflictError, InvalidArgumentError, MovieError
+from retrokit.host.emulator import Emulator
+from retrokit.host.systems import get_system
 from retrokit.movie import Movie, MovieRecorder, encode_bk2, export, layout, play, read_bk2, write_bk2
-from retrokit.systems import get_system
 
 stable_retro = pytest.importorskip("stable_retro")
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from pettingzoo.test import api_test, parallel_api_test, parallel_seed_test, seed_test
 
-from retrokit import multiplayer
+from retrokit.envs import multiplayer
 from retrokit.errors import InvalidArgumentError
 
 DASHER = "Dasher-Genesis"

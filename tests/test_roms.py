@@ -6,7 +6,8 @@ import hashlib
 
 import pytest
 
-from retrokit import paths, roms
+from retrokit import paths
+from retrokit.data import roms
 from retrokit.errors import InvalidArgumentError, RomError, UnsupportedSystemError
 
 AIRSTRIKER_ROM = paths.wheel_dir() / "data" / "stable" / "Airstriker-Genesis-v0" / "rom.md"

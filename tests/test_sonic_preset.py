@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import retrokit
-from retrokit import sonic
+from retrokit.data.games import find_game
+from retrokit.envs import sonic
 from retrokit.errors import InvalidArgumentError, RomNotFoundError, StateNotFoundError
-from retrokit.games import find_game
 
 
 def test_58_levels_split_47_train_11_test() -> None:
@@ -89,8 +89,8 @@ def test_allow_backtracking_rewards_only_new_progress() -> None:
 
 @pytest.mark.parametrize("level", sonic.levels(), ids=lambda level: f"{level[0].split('-')[0]}/{level[1]}")
 def test_every_level_is_ready_but_for_the_rom(level: tuple[str, str], monkeypatch: pytest.MonkeyPatch, tmp_path) -> None:
-    from retrokit.scenario import load_scenario
-    from retrokit.states import read_state
+    from retrokit.data.states import read_state
+    from retrokit.dsl.scenario import load_scenario
 
     game_name, state = level
     game = find_game(game_name)

@@ -24,8 +24,8 @@ from pathlib import Path
 import pytest
 import yaml
 
+from retrokit.dsl.scenario import load_scenario
 from retrokit.errors import ScenarioRuntimeError
-from retrokit.scenario import load_scenario
 
 REPO = Path(__file__).resolve().parents[1]
 WHEEL = Path(__file__).resolve().parents[0]  # replaced below if stable-retro is installed

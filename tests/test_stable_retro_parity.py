@@ -12,8 +12,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from retrokit.emulator import Emulator
-from retrokit.memory import FieldReader, FieldSpec
+from retrokit.host.emulator import Emulator
+from retrokit.host.fields import FieldSpec
+from retrokit.host.memory import FieldReader
 from retrokit.paths import wheel_dir
 
 stable_retro = pytest.importorskip("stable_retro")

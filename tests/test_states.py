@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 
 from retrokit import paths
+from retrokit.data.states import compress_state, read_state, write_state
 from retrokit.errors import FileConflictError, StateError
-from retrokit.states import compress_state, read_state, write_state
 
 STABLE = paths.wheel_dir() / "data" / "stable"
 SONIC_FOLDERS = ("SonicTheHedgehog-Genesis-v0", "SonicTheHedgehog2-Genesis-v0", "SonicAndKnuckles3-Genesis-v0")

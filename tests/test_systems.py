@@ -6,10 +6,10 @@ import json
 
 import pytest
 
-from retrokit.cores import find_core
 from retrokit.errors import InvalidArgumentError, UnknownNameError, UnsupportedSystemError
+from retrokit.host.cores import find_core
+from retrokit.host.systems import all_systems, get_system, system_for_extension
 from retrokit.paths import wheel_cores_dir
-from retrokit.systems import all_systems, get_system, system_for_extension
 
 
 def wheel_systems() -> dict[str, dict]:
@@ -77,7 +77,7 @@ def test_unknown_button_suggests() -> None:
 
 
 def test_genesis_dump_aliases_are_known_to_both_lookups() -> None:
-    from retrokit.roms import detect_system
+    from retrokit.data.roms import detect_system
 
     for ext in ("gen", "smd"):
         assert system_for_extension(ext).name == "Genesis"

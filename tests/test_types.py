@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 from retrokit.errors import FieldTypeError, InvalidArgumentError
-from retrokit.memory import AddressSpace, FieldReader, FieldSpec, Region
-from retrokit.types import parse_type
+from retrokit.host.fields import FieldSpec
+from retrokit.host.memory import AddressSpace, FieldReader, Region
+from retrokit.host.typecodes import parse_type
 
 BASE = 0xFF0000
 
@@ -197,7 +198,7 @@ class MappedEmulator:
 
 
 def test_memory_maps_are_honoured() -> None:
-    from retrokit.systems import get_system
+    from retrokit.host.systems import get_system
 
     emu = MappedEmulator()
     space = AddressSpace.for_emulator(get_system("Snes"), emu)

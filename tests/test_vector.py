@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import retrokit
+from retrokit.envs.vector import ThreadedVectorEnv, available_cpus
 from retrokit.errors import InvalidArgumentError
-from retrokit.vector import ThreadedVectorEnv, available_cpus
 
 OPTIONS = {"frameskip": 4, "sticky_prob": 0.25, "max_episode_steps": 25, "action_type": "discrete"}
 

@@ -23,7 +23,7 @@ import yaml
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from retrokit.scenario import load_scenario
+from retrokit.dsl.scenario import load_scenario
 
 GAMES = ("SonicTheHedgehog-Genesis", "SonicTheHedgehog2-Genesis", "SonicAndKnuckles3-Genesis")
 LIMIT = 0.05
@@ -62,7 +62,7 @@ def time_emulator(runs: int, steps: int) -> float | None:
     try:
         import stable_retro
 
-        from retrokit.emulator import Emulator
+        from retrokit.host.emulator import Emulator
     except ImportError as exc:
         print(f"emulator: not available ({exc})")
         return None

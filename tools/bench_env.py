@@ -49,7 +49,7 @@ from collections.abc import Callable
 import numpy as np
 
 import retrokit
-from retrokit.emulator import Emulator
+from retrokit.host.emulator import Emulator
 from retrokit.native import _host
 from retrokit.paths import wheel_dir
 

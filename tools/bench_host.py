@@ -3,7 +3,7 @@
 
 The raw rate runs all frames in one native call, so per-call overhead
 vanishes; the API rate runs the same frames 4 at a time through
-``retrokit.emulator.Emulator.run``, as an env with frame skip 4 does. Both
+``retrokit.host.emulator.Emulator.run``, as an env with frame skip 4 does. Both
 start from Airstriker's Level1 state and are measured alternately in the same
 run, several times, and the medians are compared: these machines are noisy,
 so only the ratio means anything.
@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 
-from retrokit.emulator import Emulator
+from retrokit.host.emulator import Emulator
 from retrokit.paths import wheel_dir
 
 TARGET = 0.95

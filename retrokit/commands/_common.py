@@ -6,7 +6,7 @@ import os
 from pathlib import Path
 
 from retrokit import paths
-from retrokit.games import Game
+from retrokit.data.games import Game
 
 
 def rom_status(game: Game, data_dir: str | os.PathLike[str] | None = None) -> tuple[str, Path | None]:

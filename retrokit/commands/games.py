@@ -24,8 +24,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """List the games."""
+    from retrokit.data.games import list_games
     from retrokit.errors import GameNotFoundError, RetrokitError, did_you_mean
-    from retrokit.games import list_games
 
     games = list_games(args.pattern)
     if not games:

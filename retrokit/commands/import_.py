@@ -39,9 +39,9 @@ def _section(title: str, lines: list[str], verbose: bool) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Import ROMs, and/or show what a game expects."""
+    from retrokit.data.games import find_game
+    from retrokit.data.importer import import_roms
     from retrokit.errors import InvalidArgumentError
-    from retrokit.games import find_game
-    from retrokit.importer import import_roms
 
     if not args.paths and not args.game:
         raise InvalidArgumentError(

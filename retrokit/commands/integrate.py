@@ -22,8 +22,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Integrate the states; exit 1 if any differs from its recipe."""
-    from retrokit.games import find_game
-    from retrokit.integrate import integrate
+    from retrokit.data.games import find_game
+    from retrokit.data.integrate import integrate
 
     outcomes = integrate(find_game(args.game), args.state, force=args.force)
     width = max(len(o.name) for o in outcomes)

@@ -7,7 +7,7 @@ The language is documented in ``docs/scenarios.md``. The pipeline:
 :mod:`~retrokit.dsl.check`, :mod:`~retrokit.dsl.graph` and
 :mod:`~retrokit.dsl.typecheck` check them; :mod:`~retrokit.dsl.codegen` and
 :mod:`~retrokit.dsl.compiler` turn them into Python functions. Use
-:func:`retrokit.scenario.load_scenario` rather than these modules.
+:func:`retrokit.dsl.scenario.load_scenario` rather than these modules.
 """
 
 from __future__ import annotations

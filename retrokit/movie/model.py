@@ -9,9 +9,9 @@ import functools
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+from retrokit.data.games import normalize_name
 from retrokit.errors import MovieError
-from retrokit.games import normalize_name
-from retrokit.systems import get_system
+from retrokit.host.systems import get_system
 
 #: retrokit button name -> (the frame letter, the key-line name), as stable-retro writes them.
 LETTERS: dict[str, tuple[str, str]] = {

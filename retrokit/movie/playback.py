@@ -10,8 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
-from retrokit.emulator import Emulator
 from retrokit.errors import FileConflictError, GameNotFoundError, InvalidArgumentError, MovieError, RomError
+from retrokit.host.emulator import Emulator
 from retrokit.movie.bk2 import read_bk2
 from retrokit.movie.model import Movie
 from retrokit.paths import atomic_write
@@ -27,7 +27,7 @@ def open_emulator(movie: Movie) -> Emulator:
         GameNotFoundError: No game folder has the movie's game.
         RomNotFoundError: The game's ROM has not been imported.
     """
-    from retrokit.games import find_game
+    from retrokit.data.games import find_game
 
     rom = find_game(movie.game).require_rom()
     return Emulator(movie.system, rom, ports=max(2, movie.players))

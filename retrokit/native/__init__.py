@@ -1,1 +1,1 @@
-"""The C host for libretro cores. Its module ``_host`` is private: use :mod:`retrokit.emulator`."""
+"""The C host for libretro cores. Its module ``_host`` is private: use :mod:`retrokit.host.emulator`."""

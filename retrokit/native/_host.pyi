@@ -1,4 +1,4 @@
-"""Private native host for libretro cores. Use :class:`retrokit.emulator.Emulator`.
+"""Private native host for libretro cores. Use :class:`retrokit.host.emulator.Emulator`.
 
 Every function here is a data-only primitive: it loads, runs, copies or
 converts. Arguments are checked before the core is touched, and a failing core

@@ -22,8 +22,8 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from retrokit.emulator import Emulator
-from retrokit.games import load_game
+from retrokit.data.games import load_game
+from retrokit.host.emulator import Emulator
 
 REPO = Path(__file__).resolve().parents[2]
 GAME = REPO / "games" / "Dasher-Genesis"

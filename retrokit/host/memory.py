@@ -10,42 +10,18 @@ from __future__ import annotations
 
 import sys
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from retrokit.errors import FieldNotFoundError, InvalidArgumentError, did_you_mean
+from retrokit.host.fields import FieldSpec
+from retrokit.host.systems import System
+from retrokit.host.typecodes import UNSIGNED, parse_type
 from retrokit.native import _host
-from retrokit.systems import System
-from retrokit.types import UNSIGNED, FieldType, parse_type
 
 _LITTLE_HOST = sys.byteorder == "little"
 _CONST = 1  # RETRO_MEMDESC_CONST: read-only memory such as ROM
-
-
-@dataclass(frozen=True)
-class FieldSpec:
-    """A named RAM field of a game.
-
-    Attributes:
-        name: The field's name, e.g. ``"lives"``.
-        address: Its console address, e.g. ``0xFF0366``.
-        type: Its Gym Retro type code, e.g. ``">u2"``.
-        mask: Bits kept after decoding, or ``None`` for all.
-    """
-
-    name: str
-    address: int
-    type: str
-    mask: int | None = None
-    field_type: FieldType = field(init=False, repr=False, compare=False)
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "field_type", parse_type(self.type))
-        if not isinstance(self.address, int) or self.address < 0:
-            raise InvalidArgumentError(
-                f"Expected a non-negative integer address for field {self.name!r}, got {self.address!r}."
-            )
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,7 @@ Two folder formats are read:
   ``rom.sha``, ``*.state`` and scenario ``*.json`` files.
 
 This module reads only the data files, into a :class:`GameInfo`; finding game
-folders, states, scenarios and ROMs is :mod:`retrokit.games`'s job.
+folders, states, scenarios and ROMs is :mod:`retrokit.data.games`'s job.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING, Any
 from retrokit.errors import DataFileError, FieldTypeError, did_you_mean
 
 if TYPE_CHECKING:
-    from retrokit.memory import FieldSpec
+    from retrokit.host.fields import FieldSpec
 
 __all__ = [
     "GameInfo",
@@ -115,7 +115,7 @@ def _int(source: Path, where: str, value: Any) -> int:
 
 
 def _field(source: Path, name: str, entry: Any) -> FieldSpec:
-    from retrokit.memory import FieldSpec
+    from retrokit.host.fields import FieldSpec
 
     where = f"field {name!r}"
     entry = _expect(source, where, entry, Mapping, "a mapping with address, type and optionally mask")

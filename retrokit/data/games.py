@@ -4,7 +4,7 @@ A game is named ``<Name>-<System>`` and lives in a folder of that name in one
 of the search folders of :func:`retrokit.paths.game_search_dirs`. stable-retro's
 ``<Name>-<System>-v0`` folders are found as ``<Name>-<System>``. The folder's
 data file (``game.yaml``, or Gym Retro's ``data.json``, ``metadata.json`` and
-``rom.sha``) is read by :mod:`retrokit.gamefiles`.
+``rom.sha``) is read by :mod:`retrokit.data.gamefiles`.
 
 When several search folders hold a game of the same name, the first one's data
 file wins and the others add their states and scenarios: so a ``games/`` folder
@@ -27,7 +27,9 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
-from retrokit import paths, roms
+from retrokit import paths
+from retrokit.data import roms
+from retrokit.data.gamefiles import GameInfo, data_error, read_game_folder
 from retrokit.errors import (
     GameNotFoundError,
     RomMismatchError,
@@ -37,10 +39,9 @@ from retrokit.errors import (
     UnsupportedSystemError,
     did_you_mean,
 )
-from retrokit.gamefiles import GameInfo, data_error, read_game_folder
 
 if TYPE_CHECKING:
-    from retrokit.memory import FieldSpec
+    from retrokit.host.fields import FieldSpec
 
 __all__ = [
     "Game",

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import gymnasium
 
-from retrokit.games import list_games
+from retrokit.data.games import list_games
 
 NAMESPACE = "retrokit"
 
@@ -24,8 +24,8 @@ def register_envs() -> int:
             continue
         gymnasium.register(
             id=env_id,
-            entry_point="retrokit.env:RetroEnv",
-            vector_entry_point="retrokit.vector:make_vec",
+            entry_point="retrokit.envs.env:RetroEnv",
+            vector_entry_point="retrokit.envs.vector:make_vec",
             kwargs={"game": game.name},
         )
         added += 1

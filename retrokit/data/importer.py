@@ -3,7 +3,7 @@
 Every file under the given paths is a candidate, as are the members of zip
 files (read in memory, nested zips too) and the zip files themselves (FBNeo
 arcade sets are zips). Each candidate is hashed by stable-retro's rules (see
-:mod:`retrokit.roms`) and matched against the SHA-1s of every known game. A
+:mod:`retrokit.data.roms`) and matched against the SHA-1s of every known game. A
 match is written, through a temporary file, to ``<data>/roms/<Game>/rom.<ext>``
 (``.smd`` dumps de-interleaved, as ``.md``). A different file already there is
 never replaced unless asked. Folders whose names start with ``.`` (``.git``,
@@ -19,9 +19,10 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from retrokit import paths, roms
+from retrokit import paths
+from retrokit.data import roms
+from retrokit.data.games import Game, list_games
 from retrokit.errors import RetrokitError, RomError
-from retrokit.games import Game, list_games
 
 MAX_ZIP_DEPTH = 3
 _TOO_BIG = f"larger than {roms.MAX_ROM_SIZE // 2**20} MiB"

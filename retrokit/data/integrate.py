@@ -27,11 +27,11 @@ from typing import Any
 
 import numpy as np
 
-from retrokit.emulator import Emulator
+from retrokit.data.games import Game
+from retrokit.data.states import read_state, write_state
 from retrokit.errors import DataFileError, InvalidArgumentError, StateError, StateNotFoundError, did_you_mean
-from retrokit.games import Game
-from retrokit.memory import FieldReader
-from retrokit.states import read_state, write_state
+from retrokit.host.emulator import Emulator
+from retrokit.host.memory import FieldReader
 
 HOLD_FRAMES = 2  # a press is held this long, then released as long, until arrival
 CHECK_FRAMES = 60  # frames run from a state to compare two states

@@ -12,7 +12,7 @@ of the Gym Retro and stable-retro integrations matches:
   offsets 0x80 of the body, the interleaved ``"SEGA"``) is taken as it is.
 - Every other file is hashed whole, up to 32 MiB (the largest game supported).
 
-Systems and their extensions come from :mod:`retrokit.systems` (whose
+Systems and their extensions come from :mod:`retrokit.host.systems` (whose
 descriptors a test keeps equal to the stable-retro wheel's ``cores/*.json``),
 plus ``.smd`` for Genesis.
 """
@@ -24,7 +24,7 @@ import os
 from pathlib import Path
 
 from retrokit.errors import InvalidArgumentError, RomError, UnsupportedSystemError, did_you_mean
-from retrokit.systems import all_systems, systems_by_extension
+from retrokit.host.systems import all_systems, systems_by_extension
 
 MAX_ROM_SIZE = 32 * 1024 * 1024
 """The largest ROM hashed or imported, as in stable-retro."""
@@ -38,7 +38,7 @@ MAX_FILE_SIZE = MAX_ROM_SIZE + SMD_HEADER_SIZE
 
 
 def system_extensions() -> dict[str, tuple[str, ...]]:
-    """Return each system's ROM extensions (without dots), from :mod:`retrokit.systems`.
+    """Return each system's ROM extensions (without dots), from :mod:`retrokit.host.systems`.
 
     The first extension of a system is the one its ROMs are stored under.
 

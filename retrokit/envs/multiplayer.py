@@ -1,6 +1,6 @@
 """PettingZoo environments for games with several players.
 
-:class:`RetroParallelEnv` is written once, over a :class:`retrokit.env.RetroEnv`
+:class:`RetroParallelEnv` is written once, over a :class:`retrokit.envs.env.RetroEnv`
 with every player; the AEC form comes from PettingZoo's conversion wrapper.
 Every agent sees the whole screen (or RAM) and gets its own reward from the
 scenario's per-player rewards.
@@ -15,9 +15,9 @@ from gymnasium import spaces
 from pettingzoo import AECEnv, ParallelEnv
 from pettingzoo.utils.conversions import parallel_to_aec
 
-from retrokit.env import RetroEnv, State
+from retrokit.data.games import find_game
+from retrokit.envs.env import RetroEnv, State
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean
-from retrokit.games import find_game
 
 
 class RetroParallelEnv(ParallelEnv):
@@ -25,10 +25,10 @@ class RetroParallelEnv(ParallelEnv):
 
     Args:
         game: The game's name.
-        state: A state name, a ``.state`` path, or a :class:`retrokit.env.State`.
-        scenario: The scenario (see :class:`retrokit.env.RetroEnv`); it must
+        state: A state name, a ``.state`` path, or a :class:`retrokit.envs.env.State`.
+        scenario: The scenario (see :class:`retrokit.envs.env.RetroEnv`); it must
             give one reward per player.
-        **options: Other :class:`retrokit.env.RetroEnv` options, except ``players``.
+        **options: Other :class:`retrokit.envs.env.RetroEnv` options, except ``players``.
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "name": "retrokit_v0", "is_parallelizable": True}

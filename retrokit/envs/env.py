@@ -19,13 +19,13 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from retrokit.actions import ActionMap
-from retrokit.buffers import BufferPool
-from retrokit.emulator import Emulator
+from retrokit.data.games import Game, find_game
+from retrokit.data.states import read_state
+from retrokit.envs.actions import ActionMap
+from retrokit.envs.buffers import BufferPool
 from retrokit.errors import EnvError, FileConflictError, InvalidArgumentError, did_you_mean
-from retrokit.games import Game, find_game
-from retrokit.memory import FieldReader
-from retrokit.states import read_state
+from retrokit.host.emulator import Emulator
+from retrokit.host.memory import FieldReader
 
 OBS_TYPES = ("rgb", "ram")
 
@@ -132,7 +132,7 @@ class RetroEnv(gymnasium.Env):
         return str(state), read_state(self.game.state_path(str(state)))
 
     def _load_scenario(self, scenario: str | os.PathLike[str] | Mapping[str, Any] | None) -> Any:
-        from retrokit.scenario import load_scenario
+        from retrokit.dsl.scenario import load_scenario
 
         fields = list(self.game.fields)
         if isinstance(scenario, Mapping):
@@ -313,7 +313,7 @@ class RetroEnv(gymnasium.Env):
         if self.render_mode == "rgb_array":
             return frame
         if self._viewer is None:
-            from retrokit.viewer import Viewer
+            from retrokit.envs.viewer import Viewer
 
             self._viewer = Viewer(self.game.name, self.metadata["render_fps"])
         self._viewer.show(frame)

@@ -26,7 +26,7 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, concatenate, create_empty_array, iterate
 
-from retrokit.buffers import BufferPool, Pool, StepArrays
+from retrokit.envs.buffers import BufferPool, Pool, StepArrays
 from retrokit.errors import InvalidArgumentError
 from retrokit.native import _host
 
@@ -76,7 +76,7 @@ class ThreadedVectorEnv(VectorEnv):
 
     def _native_runner(self) -> _host.Runner | None:
         """A native runner when every env is a plain RetroEnv that can share one."""
-        from retrokit.env import RetroEnv
+        from retrokit.envs.env import RetroEnv
 
         envs = self.envs
         if not all(type(env) is RetroEnv for env in envs):
@@ -146,7 +146,7 @@ class ThreadedVectorEnv(VectorEnv):
     def _fields_step(self, results: list[tuple], observations: Any) -> tuple:
         """The step's arrays, when every env is a one-player RetroEnv whose info is exactly its fields.
 
-        They come from a pool (see :mod:`retrokit.buffers`) and are filled
+        They come from a pool (see :mod:`retrokit.envs.buffers`) and are filled
         through memoryviews, so a step touches none of numpy's code.
         """
         arrays = self._step_arrays.take()
@@ -247,7 +247,7 @@ def make_vec(
     game: str, num_envs: int, state: Any = None, scenario: Any = None, *, threads: int | None = None, **options: Any
 ) -> ThreadedVectorEnv:
     """Make ``num_envs`` copies of a game's env stepped on threads (one per CPU unless ``threads`` says)."""
-    from retrokit.env import State, make
+    from retrokit.envs.env import State, make
 
     if num_envs < 1:
         raise InvalidArgumentError(f"Expected num_envs of 1 or more, got {num_envs}.")

@@ -15,12 +15,12 @@ from typing import Self
 
 import numpy as np
 
-from retrokit.cores import find_core
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean
-from retrokit.memory import AddressSpace
+from retrokit.host.cores import find_core
+from retrokit.host.memory import AddressSpace
+from retrokit.host.systems import System, get_system, system_for_extension
 from retrokit.native import _host
 from retrokit.paths import data_dir
-from retrokit.systems import System, get_system, system_for_extension
 
 logger = logging.getLogger("retrokit.core")
 _LOG_LEVELS = (logging.DEBUG, logging.INFO, logging.WARNING, logging.ERROR)

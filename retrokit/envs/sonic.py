@@ -18,9 +18,9 @@ import gymnasium
 import numpy as np
 from gymnasium import spaces
 
-from retrokit.env import RetroEnv
+from retrokit.data.games import find_game
+from retrokit.envs.env import RetroEnv
 from retrokit.errors import InvalidArgumentError, StateNotFoundError, did_you_mean
-from retrokit.games import find_game
 
 GAMES = ("SonicTheHedgehog-Genesis", "SonicTheHedgehog2-Genesis", "SonicAndKnuckles3-Genesis")
 

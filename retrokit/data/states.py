@@ -36,7 +36,7 @@ def decompress_state(blob: bytes, *, source: str = "the state") -> bytes:
         raise StateError(
             f"{source}: expected a gzip-compressed save state (starting with bytes 1f 8b); "
             f"found {len(blob)} bytes starting with {blob[:8].hex(' ')}. If this is a raw "
-            "core state, compress it with retrokit.states.write_state. " + fix
+            "core state, compress it with retrokit.data.states.write_state. " + fix
         )
     try:
         data = gzip.decompress(blob)

@@ -23,8 +23,8 @@ import numpy as np
 from gymnasium import spaces
 
 from retrokit.errors import InvalidArgumentError, did_you_mean
+from retrokit.host.systems import System
 from retrokit.native import _host
-from retrokit.systems import System
 
 ACTION_TYPES = ("all", "filtered", "discrete", "multi_discrete")
 

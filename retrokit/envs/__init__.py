@@ -1,0 +1,10 @@
+"""The env layer: games as Gymnasium and PettingZoo environments.
+
+- ``env``: :class:`RetroEnv` and ``make``, one game as a Gymnasium env.
+- ``stepper``: one episode's steps, shared by the env and the vector env.
+- ``vector``: many envs stepped in one native call.
+- ``multiplayer``: PettingZoo envs for two-player games.
+- ``sonic``: the Sonic benchmark preset.
+- ``actions``, ``buffers``, ``viewer``, ``registration``: action spaces, reusable
+  arrays, the ``human`` window, Gymnasium ids.
+"""

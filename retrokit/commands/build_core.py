@@ -46,6 +46,7 @@ def run(args: argparse.Namespace) -> int:
             bar.pop().close()
         print(message, file=sys.stderr, flush=True)
 
+
     def progress(what: str, done: int, total: int) -> None:
         if not bar:
             scale = what == "download"
@@ -53,16 +54,19 @@ def run(args: argparse.Namespace) -> int:
                             leave=False, desc=what, file=sys.stderr))
         bar[0].update(done - bar[0].n)
 
-    path = build_core(
-        args.core,
-        version=args.version,
-        index_url=args.index_url,
-        data=Path(args.data_dir) if args.data_dir else None,
-        sdist=Path(args.sdist) if args.sdist else None,
-        force=args.force,
-        progress=progress,
-        step=step,
-    )
-    step("")
+    try:
+        path = build_core(
+            args.core,
+            version=args.version,
+            index_url=args.index_url,
+            data=Path(args.data_dir) if args.data_dir else None,
+            sdist=Path(args.sdist) if args.sdist else None,
+            force=args.force,
+            progress=progress,
+            step=step,
+        )
+    finally:
+        while bar:  # an error message starts on a line of its own
+            bar.pop().close()
     print(path)
     return 0

@@ -187,7 +187,7 @@ def unpack_core_source(sdist: Path, folder: str, dest: Path, *, progress: Progre
         with tarfile.open(sdist, "r:gz") as tar:
             members = []
             for member in tar:
-                top, _, rest = member.name.partition("/")
+                rest = member.name.partition("/")[2]
                 if rest == folder or rest.startswith(folder + "/"):
                     members.append(member)
             if not members:
@@ -243,11 +243,8 @@ def make_core(
     return library
 
 
-def install_core(library: Path, recipe: Recipe, version: str, data: Path | None, *, force: bool) -> Path:
-    """Put a built library into ``<data>/cores`` with its record; return its path.
-
-    A library there that ``build-core`` did not make (no record) is replaced
-    only with ``force``.
+def check_target(recipe: Recipe, data: Path | None, *, force: bool) -> Path:
+    """Return where the build goes; a library there that ``build-core`` did not make is replaced only with ``force``.
 
     Raises:
         FileConflictError: Such a library is in the way.
@@ -258,6 +255,12 @@ def install_core(library: Path, recipe: Recipe, version: str, data: Path | None,
             f"Expected no core at {target} that retrokit did not build; found one. Move it away, "
             f"or pass --force to replace it."
         )
+    return target
+
+
+def install_core(library: Path, recipe: Recipe, version: str, data: Path | None, *, force: bool) -> Path:
+    """Put a built library into ``<data>/cores`` with its record; return its path."""
+    target = check_target(recipe, data, force=force)
     record = {
         "core": recipe.core,
         "stable_retro": version,
@@ -326,6 +329,7 @@ def build_core(
     if current is not None and not force:
         step(f"Already built from stable-retro {version} with {recipe.patch}: {current} (--force builds it again)")
         return current
+    check_target(recipe, data, force=force)
     cc, _ = check_tools()
     with tempfile.TemporaryDirectory(prefix="retrokit-build-") as tmp:
         work = Path(tmp)

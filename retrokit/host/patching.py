@@ -50,7 +50,7 @@ def parse_patch(text: str, name: str = "the patch") -> list[FilePatch]:
         line = lines[i]
         if line.startswith("--- ") and i + 1 < len(lines) and lines[i + 1].startswith("+++ "):
             path = lines[i + 1][4:].split("\t")[0].strip()
-            files.append(FilePatch(path[2:] if path.startswith("b/") else path))
+            files.append(FilePatch(path.removeprefix("b/")))
             i += 2
             continue
         match = _HUNK.match(line)

@@ -103,6 +103,12 @@ def test_a_compiler_named_by_cc_must_exist(monkeypatch, tmp_path, capsys) -> Non
     assert_one_line_error(*run_cli(capsys)[::2], "(clang-99)")
 
 
+def test_cc_may_carry_a_wrapper_or_flags(tmp_path) -> None:
+    folder = tools(tmp_path)
+    cc, make = build.check_tools({"PATH": str(folder), "CC": "cc -O2"})
+    assert (cc, make) == (f"{folder}/cc -O2", f"{folder}/make")
+
+
 @pytest.fixture
 def pip_without_config(monkeypatch: pytest.MonkeyPatch) -> None:
     """pip with no configuration file or PIP_ variable: only the index a test names."""

@@ -51,7 +51,7 @@ def run(args: argparse.Namespace) -> int:
         if not bar:
             scale = what == "download"
             bar.append(tqdm(total=total or None, unit="B" if scale else " files", unit_scale=scale,
-                            leave=False, desc=what, file=sys.stderr))
+                            leave=False, desc=what, file=sys.stderr, disable=None))  # no bar unless a terminal
         bar[0].update(done - bar[0].n)
 
     try:

@@ -20,6 +20,7 @@ import hashlib
 import json
 import os
 import re
+import shlex
 import shutil
 import subprocess
 import sys
@@ -104,7 +105,7 @@ def recipe_for(core: str) -> Recipe:
 
 
 def check_tools(env: dict[str, str] | None = None) -> tuple[str, str]:
-    """Return the C compiler and make the build will run, as found on ``PATH``.
+    """Return the C compiler command and make the build will run, as found on ``PATH``.
 
     The compiler is ``$CC`` if set, else ``cc``.
 
@@ -114,14 +115,15 @@ def check_tools(env: dict[str, str] | None = None) -> tuple[str, str]:
     env = dict(os.environ if env is None else env)
     path = env.get("PATH", "")
     cc = env.get("CC") or "cc"
-    found_cc, found_make = shutil.which(cc, path=path), shutil.which("make", path=path)
-    for name, found, what in ((cc, found_cc, "a C compiler"), ("make", found_make, "make")):
+    words = shlex.split(cc) or ["cc"]  # CC may carry a wrapper or flags: "ccache gcc"
+    found_cc, found_make = shutil.which(words[0], path=path), shutil.which("make", path=path)
+    for name, found, what in ((words[0], found_cc, "a C compiler"), ("make", found_make, "make")):
         if found is None:
             raise BuildToolError(
                 f"Expected {what} ({name}) on PATH to build the core; found none. Install one "
                 f"(Debian/Ubuntu: apt install build-essential), or keep using the wheel's core, which needs no build."
             )
-    return found_cc, found_make  # type: ignore[return-value]
+    return shlex.join([found_cc, *words[1:]]), found_make  # type: ignore[list-item,return-value]
 
 
 def fetch_sdist(

@@ -162,7 +162,7 @@ class Bare:
         for emu in self.emus:
             emu.set_state(state)
             emu.set_video_frames(video)  # as the env tells its core: only a step's last frame is seen
-        self.natives = [emu._emu for emu in self.emus]
+        self.natives = [emu.handle for emu in self.emus]
         self.actions = np.zeros((count, 2), dtype=np.uint16)
         self.runner = _host.Runner(count - 1)
 

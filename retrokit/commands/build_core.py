@@ -5,8 +5,6 @@ from __future__ import annotations
 import argparse
 import sys
 
-from retrokit.commands._common import add_data_dir_option
-
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``build-core`` command."""
@@ -16,7 +14,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Fetch the source package (sdist) of the installed stable-retro version from the package "
         "index with pip, unpack only the core's source, apply retrokit's patch, build it with the flags "
         "stable-retro's wheel uses, and install it into the data folder, where retrokit uses it instead of the "
-        "wheel's. Needs a C compiler (cc, or $CC), make, and network access to the package index. "
+        "wheel's (the data folder is $RETROKIT_DATA, else $XDG_DATA_HOME/retrokit, else ~/.local/share/retrokit). "
+        "Needs a C compiler (cc, or $CC), make, and network access to the package index. "
         "The patched genesis_plus_gx skips drawing the frames an env does not show.",
     )
     parser.add_argument("core", metavar="CORE", help="the core to build: genesis_plus_gx")
@@ -27,7 +26,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--sdist", metavar="FILE", help="a stable-retro sdist already downloaded, instead of fetching")
     parser.add_argument("--force", action="store_true",
                         help="build again even if built, and replace a core in the data folder that retrokit did not build")
-    add_data_dir_option(parser)
     parser.set_defaults(run=run)
 
 
@@ -40,18 +38,24 @@ def run(args: argparse.Namespace) -> int:
     from retrokit.host.build import build_core
 
     bar: list[tqdm] = []
+    logged: dict[str, int] = {}  # when stderr is a log, not a terminal: the last quarter of each step printed
 
     def step(message: str) -> None:
         while bar:
             bar.pop().close()
         print(message, file=sys.stderr, flush=True)
 
-
     def progress(what: str, done: int, total: int) -> None:
+        if not sys.stderr.isatty():
+            quarter = 4 * done // total if total else 0
+            if quarter > logged.get(what, 0):
+                logged[what] = quarter
+                print(f"  {what}: {25 * quarter}%", file=sys.stderr, flush=True)
+            return
         if not bar:
             scale = what == "download"
             bar.append(tqdm(total=total or None, unit="B" if scale else " files", unit_scale=scale,
-                            leave=False, desc=what, file=sys.stderr, disable=None))  # no bar unless a terminal
+                            leave=False, desc=what, file=sys.stderr))
         bar[0].update(done - bar[0].n)
 
     try:
@@ -59,7 +63,6 @@ def run(args: argparse.Namespace) -> int:
             args.core,
             version=args.version,
             index_url=args.index_url,
-            data=Path(args.data_dir) if args.data_dir else None,
             sdist=Path(args.sdist) if args.sdist else None,
             force=args.force,
             progress=progress,

@@ -202,6 +202,7 @@ def test_a_build_is_installed_recorded_and_found_first(monkeypatch, tmp_path, ca
     assert status == 0 and out.strip() == str(installed), err
     for step in ("Unpacking cores/genesis/", "Applying genesis_plus_gx-av-enable.patch", "Compiling", "Installed"):
         assert step in err
+    assert "  unpack: 100%" in err and "  compile: 50%" in err  # progress, as lines: stderr is not a terminal
     record = json.loads((built_cores_dir(isolated) / "genesis_plus_gx.build.json").read_text())
     assert record["stable_retro"] == "1.0.1" and record["patch"] == RECIPE.patch
     found = locate_core("genesis_plus_gx")

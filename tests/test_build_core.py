@@ -264,3 +264,21 @@ def test_hunks_apply_where_their_lines_moved_to(tmp_path) -> None:
 def test_malformed_patches_are_refused(tmp_path, text: str, message: str) -> None:
     with pytest.raises(PatchError, match=re.escape(message)):
         apply_patch(text, tmp_path)
+
+
+# --- what find_core and retrokit cores make of the data folder ------------------------------------
+
+
+def test_without_a_build_the_wheel_core_is_listed(capsys) -> None:
+    assert main(["cores"]) == 0
+    out = capsys.readouterr().out
+    assert "Genesis     genesis_plus_gx    wheel " in out and "retrokit build-core CORE" in out
+
+
+@pytest.mark.parametrize("record", [b"{not json", b"[1, 2]", b""], ids=["corrupt", "not-a-dict", "empty"])
+def test_a_build_with_an_unreadable_record_is_not_used(isolated, record: bytes) -> None:
+    folder = built_cores_dir(isolated)
+    folder.mkdir(parents=True)
+    (folder / "genesis_plus_gx_libretro.so").write_bytes(b"whatever")
+    (folder / "genesis_plus_gx.build.json").write_bytes(record)
+    assert locate_core("genesis_plus_gx").origin == "wheel"

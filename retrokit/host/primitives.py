@@ -24,9 +24,6 @@ read_fields = _host.read_fields
 MAX_PORTS: int = _host.MAX_PORTS
 PLAN_COLUMNS: int = _host.PLAN_COLUMNS
 MEMORY_SYSTEM_RAM: int = _host.MEMORY_SYSTEM_RAM
-PIXEL_FORMAT_0RGB1555: int = _host.PIXEL_FORMAT_0RGB1555
-PIXEL_FORMAT_XRGB8888: int = _host.PIXEL_FORMAT_XRGB8888
-PIXEL_FORMAT_RGB565: int = _host.PIXEL_FORMAT_RGB565
 # Which frames of a run the core is told are seen (GET_AUDIO_VIDEO_ENABLE; docs/cores.md).
 VIDEO_ALL: int = _host.VIDEO_ALL
 VIDEO_LAST: int = _host.VIDEO_LAST

@@ -136,6 +136,7 @@ WRONG = [
     pytest.param((AIRSTRIKER,), {"options": 5}, "options to map", id="options_int"),
     pytest.param((AIRSTRIKER,), {"options": {"region": 1}}, "options to map", id="options_int_value"),
     pytest.param((AIRSTRIKER,), {"scenario_every_frame": "no"}, "True or False", id="scenario_every_frame_str"),
+    pytest.param((AIRSTRIKER,), {"skip_video": 1}, "True or False", id="skip_video_int"),
     pytest.param((AIRSTRIKER,), {"obs_type": ["rgb"]}, "obs_type to be one of", id="obs_type_list"),
     pytest.param((AIRSTRIKER,), {"obs_type": "rbg"}, "Did you mean 'rgb'", id="obs_type_typo"),
     pytest.param((AIRSTRIKER,), {"action_type": "discreet"}, "Did you mean 'discrete'", id="action_type_typo"),

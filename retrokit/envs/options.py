@@ -122,6 +122,7 @@ OPTIONS: dict[str, Callable[[Any], Any]] = {
     "render_mode": _choice("render_mode", RENDER_MODES, optional=True),
     "record": _record,
     "scenario_every_frame": _flag("scenario_every_frame"),
+    "skip_video": _flag("skip_video"),
     "options": _core_options,
 }
 

@@ -98,7 +98,8 @@ class GameReport:
 def render(report: GameReport, *, width: int | None = None) -> str:
     """Return the report as a text table: check, state (and scenario), result, message."""
     width = width or shutil.get_terminal_size((120, 24)).columns
-    rows = [(r.check, r.state + (f" [{r.scenario}]" if r.scenario else ""), r.status.upper(), r.message)
+    rows = [(r.check, " ".join(filter(None, (r.state, f"[{r.scenario}]" if r.scenario else ""))), r.status.upper(),
+             r.message)
             for r in report.results]
     heads = ("check", "state", "result", "message")
     widths = [max([len(h), *(len(row[i]) for row in rows)]) for i, h in enumerate(heads[:3])]

@@ -39,7 +39,7 @@ def run(args: argparse.Namespace) -> int:
 
     if args.frames is not None and args.frames < 1:
         raise InvalidArgumentError(f"Expected --frames of 1 or more, got {args.frames}.")
-    targets = list(args.games) + (_every_own_game() if args.all else [])
+    targets = list(args.games) + (own_games() if args.all else [])
     if not targets:
         if not Path("game.yaml").is_file():
             raise InvalidArgumentError(
@@ -69,7 +69,7 @@ def run(args: argparse.Namespace) -> int:
     return 0 if all(r.passed for r in reports) else 1
 
 
-def _every_own_game() -> list[str]:
+def own_games() -> list[str]:
     """The games whose first folder is not the stable-retro wheel's: the ones this project and its users made."""
     from retrokit import paths
     from retrokit.data.games import list_games

@@ -77,8 +77,20 @@ class Game:
 
     @cached_property
     def info(self) -> GameInfo:
-        """The game's data file, parsed (read on first use)."""
-        return read_game_folder(self.folders[0])
+        """The game's data file, parsed (read on first use): the first of its folders that has one.
+
+        Raises:
+            DataFileError: None of its folders has a data file (only a user's folder of states can lack one).
+        """
+        for folder in self.folders:
+            if _is_game_folder(folder):
+                return read_game_folder(folder)
+        raise data_error(
+            self.folders[0], f"a data file (game.yaml) for {self.name}, here or in a shipped game folder of that name",
+            "none: this folder of the user's data holds states or scenarios of a game that is not known",
+            "rename the folder to a known game's name (retrokit games lists them), or add a game.yaml",
+            did_you_mean(self.name, [name for name, folders in _index().items() if any(map(_is_game_folder, folders))]),
+        )
 
     @property
     def system(self) -> str:
@@ -303,13 +315,16 @@ def _index() -> dict[str, tuple[Path, ...]]:
     if key in _index_cache:
         return _index_cache[key]
     index: dict[str, list[Path]] = {}
+    user = paths.user_games_dir()
     for directory in dirs:
         with os.scandir(directory) as entries:
             for entry in sorted(entries, key=lambda e: e.name):
                 if entry.name[:1] in "._" or not entry.is_dir():
                     continue
                 path = Path(entry.path)
-                if _is_game_folder(path):
+                # A user's folder may hold only states and scenarios for a shipped game; one that
+                # matches no game is kept too, so that it fails loudly instead of being ignored.
+                if _is_game_folder(path) or directory == user:
                     index.setdefault(normalize_name(entry.name), []).append(path)
     result = {name: tuple(folders) for name, folders in sorted(index.items())}
     _index_cache.clear()

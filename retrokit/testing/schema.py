@@ -18,16 +18,13 @@ __all__ = ["check_schemas"]
 
 
 def check_schemas(game: Game, report: GameReport) -> bool:
-    """Check the game's YAML files against their schemas; add the results; return whether game.yaml conforms."""
-    game_yaml = game.folders[0] / "game.yaml"
+    """Check the game's YAML files against their schemas; add the results; return whether its game.yaml files conform."""
     ok = True
-    if game_yaml.is_file():
-        ok = _check(report, game_yaml, "game", "")
-    else:
+    data_files = [folder / "game.yaml" for folder in game.folders if (folder / "game.yaml").is_file()]
+    for path in data_files:
+        ok = _check(report, path, "game", "") and ok
+    if not data_files:
         report.add("schema", SKIP, f"{game.folders[0].name} is a Gym Retro folder (data.json): no game.yaml to check")
-    for folder in game.folders[1:]:
-        if (folder / "game.yaml").is_file():
-            _check(report, folder / "game.yaml", "game", "")
     seen: set[Path] = set()
     for name, path in _scenario_files(game):
         _check(report, path, "scenario", name)

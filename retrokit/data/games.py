@@ -163,7 +163,7 @@ class Game:
         if key in self.state_recipes:
             raise StateNotFoundError(
                 f"Expected the state file {key}{STATE_SUFFIX} in {where}; it has a recipe but has not been made. "
-                f"Make it with: retrokit integrate {self.name}"
+                f"Make it with: retrokit integrate {self.name} {key}"
             )
         raise StateNotFoundError(
             f"Expected a state of {self.name}: one of {', '.join(self.states) or '(none)'}; "

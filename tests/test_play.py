@@ -10,11 +10,11 @@ import pytest
 
 pygame = pytest.importorskip("pygame")
 
-from retrokit.data.games import find_game  # noqa: E402
-from retrokit.data.states import read_state  # noqa: E402
-from retrokit.envs.play import PlaySession  # noqa: E402
-from retrokit.host.emulator import Emulator  # noqa: E402
-from retrokit.movie import play, read_bk2  # noqa: E402
+from retrokit.data.games import find_game
+from retrokit.data.states import read_state
+from retrokit.envs.play import PlaySession
+from retrokit.host.emulator import Emulator
+from retrokit.movie import play, read_bk2
 
 
 @pytest.fixture(autouse=True)

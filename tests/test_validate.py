@@ -127,6 +127,14 @@ def test_a_corrupt_state_fails_without_stopping_the_run(dasher: Path, kind: str)
     assert report.find("smoke run", state="Zone3.Act2", status=PASS)
 
 
+def test_a_gzip_bomb_state_fails_in_its_child_within_the_memory_limit(dasher: Path) -> None:
+    member = gzip.compress(bytes(16 << 20), compresslevel=9, mtime=0)
+    (dasher / "Zone1.Act2.state").write_bytes(member * 48)  # 768 MiB once inflated (gzip members concatenate)
+    report = check_game(dasher, frames=FRAMES)
+    assert failed(report) == {("state loads", "Zone1.Act2")}, render(report)
+    assert "too much memory" in report.failures[0].message
+
+
 def test_another_games_state_is_flagged(dasher: Path, airstriker_dir: Path) -> None:
     shutil.copy(airstriker_dir / "Level1.state", dasher / "Zone2.Act2.state")
     report = check_game(dasher, frames=FRAMES)

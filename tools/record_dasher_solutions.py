@@ -23,12 +23,12 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
-from retrokit.data.games import find_game  # noqa: E402
-from retrokit.data.states import read_state  # noqa: E402
-from retrokit.host.emulator import Emulator  # noqa: E402
-from retrokit.host.memory import FieldReader  # noqa: E402
-from retrokit.movie import Movie, write_bk2  # noqa: E402
-from retrokit.testing.movies import MOVIES_FOLDER, replay  # noqa: E402
+from retrokit.data.games import find_game
+from retrokit.data.states import read_state
+from retrokit.host.emulator import Emulator
+from retrokit.host.memory import FieldReader
+from retrokit.movie import Movie, write_bk2
+from retrokit.testing.movies import MOVIES_FOLDER, replay
 
 ACTS = ("Zone1.Act1", "Zone1.Act2", "Zone2.Act1", "Zone2.Act2", "Zone3.Act1", "Zone3.Act2")
 CHUNK = 8

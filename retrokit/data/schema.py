@@ -26,7 +26,7 @@ import yaml
 
 from retrokit.errors import DataFileError, did_you_mean
 
-__all__ = ["SCHEMA_DIR", "SCHEMAS", "SchemaIssue", "check_file", "check_text", "schema_path"]
+__all__ = ["SCHEMAS", "SCHEMA_DIR", "SchemaIssue", "check_file", "check_text", "schema_path"]
 
 SCHEMA_DIR = Path(__file__).with_name("schemas")
 #: The kinds of data file, and their schema's file name.

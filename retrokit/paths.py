@@ -6,7 +6,8 @@ Game folders are searched, in order, in:
 2. the per-user data folder's ``games/`` (what ``retrokit integrate`` and
    ``retrokit play`` make: a game folder there extends or overrides the
    shipped one, and may hold only states and scenarios),
-3. the repository's ``games/`` folder (next to the ``retrokit`` package),
+3. the bundled integrations: the checkout's ``games/`` folder (next to the
+   ``retrokit`` package), or its copy inside an installed package,
 4. the stable-retro wheel's ``data/stable``, ``data/experimental`` and
    ``data/contrib`` folders.
 
@@ -67,10 +68,17 @@ def wheel_data_dirs() -> list[Path]:
     return [root / "data" / kind for kind in WHEEL_DATA_KINDS if (root / "data" / kind).is_dir()]
 
 
+BUNDLED_GAMES = "_games"
+"""The package folder an installed retrokit keeps the bundled ``games/`` in (``setup.py`` copies it there)."""
+
+
 def repo_games_dir() -> Path | None:
-    """Return the repository's ``games/`` folder next to the package, if it exists."""
-    path = Path(__file__).resolve().parent.parent / "games"
-    return path if path.is_dir() else None
+    """Return the bundled integrations: ``games/`` of a checkout, or the copy inside an installed package."""
+    package = Path(__file__).resolve().parent
+    for path in (package / BUNDLED_GAMES, package.parent / "games"):
+        if path.is_dir():
+            return path
+    return None
 
 
 def env_games_dirs() -> list[Path]:

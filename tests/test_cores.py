@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import ctypes
+
+import native_c as native_c_module
+from native_c import PIXEL_FORMATS
 import numpy as np
 import pytest
 
-from retrokit.errors import InvalidArgumentError
 from retrokit.native import _host
 from retrokit.paths import wheel_cores_dir
 
@@ -25,23 +28,28 @@ def test_core_loads_declares_its_options_and_unloads(core, tmp_path) -> None:
 
 def test_two_copies_of_one_core_are_independent(tmp_path) -> None:
     core = next(p for p in CORES if p.name.startswith("gambatte"))
-    a = _host.Emulator(str(core), str(tmp_path), str(tmp_path))
-    b = _host.Emulator(str(core), str(tmp_path), str(tmp_path))
-    key = next(iter(a.options()))
-    allowed = a.options()[key][2]
-    a.set_option(key, allowed[-1])
-    b.set_option(key, allowed[0])
+    probe = _host.Emulator(str(core), str(tmp_path), str(tmp_path))
+    key, (_, _, allowed) = next(iter(probe.options().items()))
+    probe.close()
+    a = _host.Emulator(str(core), str(tmp_path), str(tmp_path), {key: allowed[-1]})
+    b = _host.Emulator(str(core), str(tmp_path), str(tmp_path), {key: allowed[0]})
     assert a.options()[key][1] == allowed[-1] and b.options()[key][1] == allowed[0]
     a.close()
     b.close()
 
 
+@pytest.mark.parametrize("options", [{"\udc80": "x"}, {"key": "\udc80"}], ids=["key", "value"])
+def test_an_option_utf8_cannot_hold_raises_instead_of_crashing(tmp_path, options: dict[str, str]) -> None:
+    with pytest.raises(UnicodeEncodeError):
+        _host.Emulator(str(CORES[0]), str(tmp_path), str(tmp_path), options)
+
+
 def reference(pixels: np.ndarray, fmt: int) -> np.ndarray:
     """The expected RGB of pixels, written with numpy, channels widened by shifting as stable-retro does."""
     p = pixels.astype(np.uint32)
-    if fmt == _host.PIXEL_FORMAT_XRGB8888:
+    if fmt == PIXEL_FORMATS["XRGB8888"]:
         r, g, b = (p >> 16) & 0xFF, (p >> 8) & 0xFF, p & 0xFF
-    elif fmt == _host.PIXEL_FORMAT_RGB565:
+    elif fmt == PIXEL_FORMATS["RGB565"]:
         r, g, b = ((p >> 11) & 0x1F) << 3, ((p >> 5) & 0x3F) << 2, (p & 0x1F) << 3
     else:
         r, g, b = ((p >> 10) & 0x1F) << 3, ((p >> 5) & 0x1F) << 3, (p & 0x1F) << 3
@@ -49,38 +57,42 @@ def reference(pixels: np.ndarray, fmt: int) -> np.ndarray:
 
 
 FORMATS = [
-    (_host.PIXEL_FORMAT_0RGB1555, np.uint16),
-    (_host.PIXEL_FORMAT_XRGB8888, np.uint32),
-    (_host.PIXEL_FORMAT_RGB565, np.uint16),
+    (PIXEL_FORMATS["0RGB1555"], np.uint16),
+    (PIXEL_FORMATS["XRGB8888"], np.uint32),
+    (PIXEL_FORMATS["RGB565"], np.uint16),
 ]
+
+
+@pytest.fixture(scope="module")
+def native_c(tmp_path_factory):
+    lib = native_c_module.build(tmp_path_factory.mktemp("native"))
+    if lib is None:
+        pytest.skip("no C compiler to build the native host's plain C on its own")
+    return lib
 
 
 @pytest.mark.parametrize("fmt,dtype", FORMATS, ids=["0rgb1555", "xrgb8888", "rgb565"])
 @pytest.mark.parametrize("width", [320, 37], ids=["wide", "odd-width"])
-def test_pixel_format_converts_with_row_padding(fmt: int, dtype: type, width: int) -> None:
+def test_pixel_format_converts_with_row_padding(native_c, fmt: int, dtype: type, width: int) -> None:
     rng = np.random.default_rng(fmt)
     height, pad = 11, 5  # rows padded, as cores' frames are
     frame = rng.integers(0, np.iinfo(dtype).max, (height, width + pad), dtype=dtype, endpoint=True)
     out = np.zeros((height, width, 3), dtype=np.uint8)
-    _host.convert_frame(frame.tobytes(), width, height, frame.strides[0], fmt, out)
+    assert native_c.rk_frame_to_rgb(frame.ctypes.data, frame.strides[0], width, height, fmt, out.ctypes.data) == 0
     assert (out == reference(frame[:, :width], fmt)).all()
 
 
-def test_convert_frame_checks_sizes() -> None:
-    with pytest.raises(InvalidArgumentError, match="needs more than"):
-        _host.convert_frame(b"\0" * 10, 4, 4, 8, _host.PIXEL_FORMAT_RGB565, np.zeros((4, 4, 3), np.uint8))
-    with pytest.raises(InvalidArgumentError, match="format must be"):
-        _host.convert_frame(b"\0" * 32, 4, 4, 8, 7, np.zeros((4, 4, 3), np.uint8))
-    with pytest.raises(InvalidArgumentError, match="must hold"):
-        _host.convert_frame(b"\0" * 32, 4, 4, 8, _host.PIXEL_FORMAT_RGB565, np.zeros((4, 3, 3), np.uint8))
+def test_unknown_pixel_format_is_refused(native_c) -> None:
+    frame, out = np.zeros((4, 4), np.uint16), np.zeros((4, 4, 3), np.uint8)
+    assert native_c.rk_frame_to_rgb(frame.ctypes.data, 8, 4, 4, 7, out.ctypes.data) == -1
 
 
 @pytest.mark.parametrize("seed", [0, 1, 42, 2**31 + 5], ids=["zero", "default", "42", "large"])
-def test_the_cores_rand_is_glibcs(seed: int) -> None:
-    import ctypes
-
+def test_the_cores_rand_is_glibcs(native_c, seed: int) -> None:
     libc = ctypes.CDLL(None)
     libc.random.restype = ctypes.c_long
     libc.srandom(ctypes.c_uint(seed))
     expected = [libc.random() for _ in range(1000)]
-    assert _host.rand_sequence(seed, 1000) == expected
+    state = native_c_module.Rand()
+    native_c.rk_rand_seed(ctypes.byref(state), seed)
+    assert [native_c.rk_rand_next(ctypes.byref(state)) for _ in range(1000)] == expected

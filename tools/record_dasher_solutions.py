@@ -109,7 +109,7 @@ def solve(game, state: str) -> Movie:
         emu.set_sticky(0.0, 0)
         emu.set_state(start)
         frames = BacktrackingAgent(emu, FieldReader(game.fields, emu.space)).solve()
-    return Movie(game=game.name, system=game.system, players=1, state=start, frames=frames)
+    return Movie(game=game.name, system=game.system.name, players=1, state=start, frames=frames)
 
 
 def main() -> int:

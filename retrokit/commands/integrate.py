@@ -32,8 +32,9 @@ def run(args: argparse.Namespace) -> int:
     """Integrate the states; exit 1 if any differs from what was made."""
     from pathlib import Path
 
-    from retrokit.data.integrate import integrate, place_state, resolve, state_from_movie, target_folder
+    from retrokit.data.integrate import integrate, place_state, resolve, target_folder
     from retrokit.errors import InvalidArgumentError
+    from retrokit.movie.playback import state_from_movie
 
     if len(args.names) > 2:
         raise InvalidArgumentError(

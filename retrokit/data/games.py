@@ -8,7 +8,10 @@ data file (``game.yaml``, or Gym Retro's ``data.json``, ``metadata.json`` and
 
 When several search folders hold a game of the same name, the first one's data
 file wins and the others add their states and scenarios: so a ``games/`` folder
-can use the states of the wheel's folder of the same game.
+can use the states of the wheel's folder of the same game. A folder holding
+only scenario files (no data file) adds its scenarios to a game found in a
+later folder: ``games/1942-Nes/scenario.yaml`` replaces the wheel's Lua
+``scenario.json`` while the wheel's data, ROM hashes and states stay in use.
 
 :func:`list_games` only lists folders; a :class:`Game` reads its files the
 first time one of its properties is used. :func:`find_game` reads and checks
@@ -39,6 +42,7 @@ from retrokit.errors import (
     UnsupportedSystemError,
     did_you_mean,
 )
+from retrokit.host.systems import System, get_system
 
 if TYPE_CHECKING:
     from retrokit.host.fields import FieldSpec
@@ -93,9 +97,13 @@ class Game:
         )
 
     @property
-    def system(self) -> str:
-        """The system's name, e.g. ``"Genesis"``."""
-        return self.info.system or self.name.rsplit("-", 1)[-1]
+    def system(self) -> System:
+        """The game's system, from its data file or else its name's suffix (``-Genesis``).
+
+        Raises:
+            UnsupportedSystemError: No known system has that name.
+        """
+        return get_system(self.info.system or self.name.rsplit("-", 1)[-1])
 
     @property
     def sha1s(self) -> tuple[str, ...]:
@@ -215,8 +223,7 @@ class Game:
     @property
     def rom_extensions(self) -> tuple[str, ...]:
         """The ROM extensions of the game's system; the first is the one imported ROMs get."""
-        ext = roms.system_extension(self.system)
-        return (ext, *(e for e in roms.system_extensions()[self.system] if e != ext))
+        return self.system.extensions
 
     def imported_rom_path(self, data_dir: str | os.PathLike[str] | None = None) -> Path:
         """Return where an imported ROM of this game is (or would be) stored."""
@@ -293,7 +300,7 @@ class Game:
                 "fix the default state's name", did_you_mean(info.default_state, self._state_files),
             )
         try:
-            roms.system_extension(self.system)
+            self.system  # noqa: B018 -- an unknown system fails here, when the game loads
         except UnsupportedSystemError as exc:
             raise UnsupportedSystemError(f"{info.source}: {exc}") from exc
         return self
@@ -308,6 +315,11 @@ def _is_game_folder(path: Path) -> bool:
     return any((path / marker).is_file() for marker in ("game.yaml", "rom.sha", "data.json"))
 
 
+def _is_scenario_folder(path: Path) -> bool:
+    """Whether a folder without a data file holds scenario files (to add to a game found elsewhere)."""
+    return any(p.name not in _NOT_SCENARIOS for pattern in ("*.yaml", "*.json") for p in path.glob(pattern))
+
+
 def _index() -> dict[str, tuple[Path, ...]]:
     """Map each game name to its folders, in search order (cached until a search folder changes)."""
     dirs = paths.game_search_dirs()
@@ -315,18 +327,25 @@ def _index() -> dict[str, tuple[Path, ...]]:
     if key in _index_cache:
         return _index_cache[key]
     index: dict[str, list[Path]] = {}
+    has_data: set[str] = set()
     user = paths.user_games_dir()
     for directory in dirs:
         with os.scandir(directory) as entries:
             for entry in sorted(entries, key=lambda e: e.name):
                 if entry.name[:1] in "._" or not entry.is_dir():
                     continue
-                path = Path(entry.path)
-                # A user's folder may hold only states and scenarios for a shipped game; one that
-                # matches no game is kept too, so that it fails loudly instead of being ignored.
-                if _is_game_folder(path) or directory == user:
-                    index.setdefault(normalize_name(entry.name), []).append(path)
-    result = {name: tuple(folders) for name, folders in sorted(index.items())}
+                path, name = Path(entry.path), normalize_name(entry.name)
+                if _is_game_folder(path):
+                    has_data.add(name)
+                elif directory == user:
+                    # A user's folder may hold only states and scenarios for a shipped game; one that
+                    # matches no game is kept too, so that it fails loudly instead of being ignored.
+                    has_data.add(name)
+                elif not _is_scenario_folder(path):
+                    continue
+                index.setdefault(name, []).append(path)
+    # A name with scenario folders only is no game: nothing says its system, ROM or fields.
+    result = {name: tuple(folders) for name, folders in sorted(index.items()) if name in has_data}
     _index_cache.clear()
     _index_cache[key] = result
     return result
@@ -391,9 +410,9 @@ def find_game(name: str) -> Game:
 _sha1_cache: dict[tuple[str, int, int, str], str] = {}
 
 
-def _cached_sha1(path: Path, system: str) -> str:
+def _cached_sha1(path: Path, system: System) -> str:
     stat = path.stat()
-    key = (str(path), stat.st_size, stat.st_mtime_ns, system)
+    key = (str(path), stat.st_size, stat.st_mtime_ns, system.name)
     if key not in _sha1_cache:
         _sha1_cache[key] = roms.rom_sha1(path, system)
     return _sha1_cache[key]

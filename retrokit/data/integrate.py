@@ -13,8 +13,9 @@ has a recipe for, and checks the ones already there::
         settle: 0                      # frames to run after arrival
 
 States can also be made from a movie: the state a ``.bk2`` reaches at a
-frame (:func:`state_from_movie`). The format and the commands are documented
-in ``docs/integrate.md``.
+frame (:func:`retrokit.movie.playback.state_from_movie`), placed with
+:func:`place_state`. The format and the commands are documented in
+``docs/integrate.md``.
 
 Made states go to the user's data folder (``<data>/games/<Game>/``, which
 extends the shipped game), never into the installed package. A made state is
@@ -40,7 +41,6 @@ from retrokit.errors import (
     DataFileError,
     GameNotFoundError,
     InvalidArgumentError,
-    MovieError,
     RetrokitError,
     StateError,
     StateNotFoundError,
@@ -224,36 +224,6 @@ def target_folder(game: Game, data_dir: Path | None = None) -> Path:
     if len(game.folders) == 1 and own.parent not in searched:
         return game.folders[0]
     return paths.user_games_dir(data_dir) / game.name
-
-
-def state_from_movie(game: Game, movie_path: str | Path, frame: int | None = None) -> bytes:
-    """Replay a movie of ``game`` for ``frame`` frames (all by default) and return the state it reaches.
-
-    Raises:
-        MovieError: The movie is malformed, of another game, or shorter than ``frame``.
-    """
-    from retrokit.movie import play, read_bk2
-
-    movie = read_bk2(movie_path)
-    if movie.game != game.name:
-        raise MovieError(
-            f"Expected a movie of {game.name}; found one of {movie.game} in {movie_path}. "
-            f"Give its game instead: retrokit integrate {movie.game} NAME --movie {movie_path}"
-        )
-    length = len(movie.frames)
-    frame = length if frame is None else frame
-    if not 0 <= frame <= length:
-        raise MovieError(f"Expected a frame from 0 to {length} (the movie's length) for --frame; found {frame}.")
-    movie.frames = movie.frames[:frame]
-    with Emulator(game.system, game.require_rom(), ports=max(2, movie.players)) as emu:
-        for _ in play(movie, emulator=emu):
-            pass
-        if frame == 0:  # play() ran nothing: put the console at the movie's start
-            if movie.state is not None:
-                emu.set_state(movie.state)
-            else:
-                emu.reset()
-        return emu.get_state()
 
 
 def resolve(first: str, second: str | None = None, *, cwd: Path | None = None) -> tuple[Game, list[str] | None]:

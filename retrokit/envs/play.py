@@ -115,7 +115,7 @@ class PlaySession:
         """Start recording a movie from now, or stop and write the one being recorded (returning its path)."""
         if self.recorder is None:
             path = claim_movie_path(self.folder / "movies", self.name)
-            self.recorder = MovieRecorder(path, self.game.name, self.game.system, 1, self.emulator.get_state())
+            self.recorder = MovieRecorder(path, self.game.name, self.game.system.name, 1, self.emulator.get_state())
             print(f"recording {path}")
             return None
         path = self.recorder.close()

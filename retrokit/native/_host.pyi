@@ -11,15 +11,9 @@ from typing import Any, overload
 import numpy as np
 import numpy.typing as npt
 
-MEMORY_SAVE_RAM: int
-MEMORY_RTC: int
 MEMORY_SYSTEM_RAM: int
-MEMORY_VIDEO_RAM: int
 MAX_PORTS: int
 PLAN_COLUMNS: int
-PIXEL_FORMAT_0RGB1555: int
-PIXEL_FORMAT_XRGB8888: int
-PIXEL_FORMAT_RGB565: int
 
 class Emulator:
     """One libretro core, privately loaded, with at most one game."""
@@ -38,8 +32,6 @@ class Emulator:
     def av_info(self) -> dict[str, float | int]: ...
     def options(self) -> dict[str, tuple[str, str, tuple[str, ...]]]:
         """Map each core option key to (description, current value, allowed values)."""
-    def set_option(self, key: str, value: str) -> None: ...
-    def set_controller(self, port: int, device: int) -> None: ...
     def set_sticky(self, prob: float, seed: int) -> None: ...
     def forget_action(self) -> None:
         """Make the next ``run`` apply its action from the first frame, as after a reset."""
@@ -51,7 +43,6 @@ class Emulator:
     def screen(self, out: npt.NDArray[np.uint8]) -> None: ...
     def memory(self, kind: int) -> memoryview | None: ...
     def memory_maps(self) -> list[dict[str, object]]: ...
-    def serialize_size(self) -> int: ...
     def serialize(self) -> bytes: ...
     def unserialize(self, data: bytes) -> None: ...
     def reset(self) -> None: ...
@@ -61,14 +52,10 @@ class Emulator:
     @property
     def frame(self) -> int: ...
     @property
-    def pixel_format(self) -> int: ...
-    @property
     def stuck(self) -> bool:
         """Whether the last ``run``'s first frame kept the previous buttons."""
     def held(self) -> tuple[int, ...]:
         """The buttons of the last frame run, one mask per port (zeros after a reset)."""
-    @property
-    def closed(self) -> bool: ...
     def close(self) -> None: ...
 
 class Runner:
@@ -90,12 +77,6 @@ class Runner:
         screen is converted into its buffer when its shape fits the frame; the
         result says, per emulator, whether it was.
         """
-
-def convert_frame(data: bytes, width: int, height: int, pitch: int, format: int, out: npt.NDArray[np.uint8]) -> None:
-    """Convert a frame in a libretro pixel format to RGB, as screens are (for tests and tools)."""
-
-def rand_sequence(seed: int, n: int) -> list[int]:
-    """The first ``n`` numbers a core's ``rand()`` gives after ``srand(seed)`` (glibc's generator)."""
 
 def pack_buttons(
     action: npt.NDArray[Any], buttons: int, out: npt.NDArray[np.uint16], table: npt.NDArray[np.uint16] | None = None

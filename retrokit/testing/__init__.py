@@ -135,7 +135,7 @@ def _check_fields(game, report: GameReport, rom: Path | None) -> None:
         return
     for name in game.states:  # the RAM a state holds tells its extent
         try:
-            ram = state_ram(read_state(game.state_path(name)), game.system)
+            ram = state_ram(read_state(game.state_path(name)), game.system.name)
         except RetrokitError:
             continue
         if ram is not None:

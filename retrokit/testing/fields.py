@@ -47,7 +47,7 @@ def check_fields(game: Game, report: GameReport, space: object | None, where: st
     unusual = sorted({f.type for f in fields.values()} - set(usual)) if usual else []
     if unusual:
         names = [f.name for f in fields.values() if f.type in unusual]
-        report.add("type codes", WARN, f"valid, but not among {game.system}'s usual codes: {', '.join(unusual)} "
+        report.add("type codes", WARN, f"valid, but not among {game.system.name}'s usual codes: {', '.join(unusual)} "
                    f"(fields {', '.join(names)}); check the byte order and width")
     else:
         report.add("type codes", PASS, f"{len(fields)} fields with valid type codes")

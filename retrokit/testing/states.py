@@ -77,7 +77,7 @@ def probe_states(game: Game, names: Sequence[str], rom: Path, *, frames: int = I
     probes: dict[str, StateProbe] = {}
     todo = list(names)
     while todo:
-        request = {"system": game.system, "rom": str(rom), "fields": fields, "frames": frames,
+        request = {"system": game.system.name, "rom": str(rom), "fields": fields, "frames": frames,
                    "states": [[n, paths[n]] for n in todo]}
         done, current, failure = _run_child(request, timeout=CHILD_TIMEOUT * len(todo) + 10)
         probes.update(done)
@@ -143,7 +143,7 @@ def parse_states(game: Game, names: Sequence[str]) -> dict[str, StateProbe]:
             probe.error = str(exc)
             continue
         probe.detail = f"{state_format(data) or 'no core signature'}, {len(data)} bytes"
-        ram = state_ram(data, game.system)
+        ram = state_ram(data, game.system.name)
         if ram is None:
             continue
         space = AddressSpace([Region(system.ram_base, len(ram), memoryview(bytearray(ram)), system.ram_swap)])

@@ -160,6 +160,18 @@ def test_a_movie_with_the_wrong_expected_reward_fails(dasher_with_movies: Path) 
     assert "a total reward of 3900" in report.failures[0].message and "found 3952" in report.failures[0].message
 
 
+def test_movies_without_an_outcome_warn_and_missing_or_broken_ones_fail(dasher: Path) -> None:
+    (dasher / "movies").mkdir()
+    shutil.copy(DASHER / "movies" / "Zone1.Act1.bk2", dasher / "movies" / "Loose.bk2")
+    (dasher / "movies" / "Broken.bk2").write_bytes(b"PK\x03\x04 not really a zip")
+    with (dasher / "game.yaml").open("a") as f:
+        f.write("movies:\n  Gone: {reward: 1}\n  Broken: {reward: 1}\n")
+    report = check_game(dasher, frames=FRAMES)
+    assert failed(report) == {("movie", "Gone"), ("movie", "Broken")}, render(report)
+    assert report.find("movie", state="Loose")[0].status == "warn"
+    assert "could not be replayed" in report.find("movie", state="Broken")[0].message
+
+
 def test_a_misspelled_key_in_game_yaml_fails_with_its_line(dasher: Path) -> None:
     text = (dasher / "game.yaml").read_text()
     (dasher / "game.yaml").write_text(text.replace("\nintegrate:", "\nintgrate:"))
@@ -168,6 +180,7 @@ def test_a_misspelled_key_in_game_yaml_fails_with_its_line(dasher: Path) -> None
     assert {check for check, _ in failed(report)} == {"schema", "data file"}, render(report)
     schema = report.find("schema", status=FAIL)[0].message
     assert f"game.yaml:{line}:1:" in schema and "Did you mean 'integrate'?" in schema
+    assert "Did you mean 'integrate'?" in report.find("data file")[0].message  # loading the game refuses it too
 
 
 def test_a_field_outside_ram_fails_and_overlaps_warn(dasher: Path) -> None:

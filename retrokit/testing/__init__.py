@@ -21,8 +21,12 @@ from __future__ import annotations
 import os
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from retrokit.testing.report import FAIL, PASS, SKIP, GameReport, Result
+
+if TYPE_CHECKING:
+    from retrokit.data.games import Game
 
 __all__ = ["STAGES", "GameReport", "Result", "check_game"]
 
@@ -31,7 +35,7 @@ STAGES = ("schema", "data file", "ROM", "fields", "states", "scenarios", "movies
 
 
 def check_game(
-    game: object,
+    game: Game | str | os.PathLike[str],
     *,
     frames: int | None = None,
     progress: Callable[[str], None] | None = None,
@@ -97,14 +101,14 @@ def check_game(
     return report
 
 
-def _resolve(game: object):  # -> Game
+def _resolve(game: Game | str | os.PathLike[str]) -> Game:
     """A Game from a Game, a name or a folder, without checking its files (that is a check of its own)."""
     from retrokit.data.games import Game, list_games, normalize_name
     from retrokit.errors import GameNotFoundError
 
     if isinstance(game, Game):
         return game
-    text = os.fspath(game)  # type: ignore[arg-type]
+    text = os.fspath(game)
     known = {g.name: g for g in list_games()}
     if normalize_name(text) in known:
         return known[normalize_name(text)]
@@ -117,7 +121,7 @@ def _resolve(game: object):  # -> Game
     raise GameNotFoundError(f"Expected a game name or a game folder; found {text!r}.")  # pragma: no cover
 
 
-def _check_fields(game, report: GameReport, rom: Path | None) -> None:
+def _check_fields(game: Game, report: GameReport, rom: Path | None) -> None:
     from retrokit.data.states import read_state, state_ram
     from retrokit.errors import RetrokitError
     from retrokit.host.memory import AddressSpace, Region

@@ -11,16 +11,20 @@ inside a word, but often a typo in an address).
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 from retrokit.data.games import Game
 from retrokit.host.fields import FieldSpec
 from retrokit.host.systems import get_system
 from retrokit.testing.report import FAIL, PASS, SKIP, WARN, GameReport
 
+if TYPE_CHECKING:
+    from retrokit.host.memory import AddressSpace
+
 __all__ = ["check_fields", "overlaps"]
 
 
-def check_fields(game: Game, report: GameReport, space: object | None, where: str = "") -> None:
+def check_fields(game: Game, report: GameReport, space: AddressSpace | None, where: str = "") -> None:
     """Check the game's fields; add the results to ``report``.
 
     Args:
@@ -77,13 +81,13 @@ def _span(spec: FieldSpec) -> str:
     return f"{spec.name} ({spec.address:#x}" + (f"-{last:#x})" if width > 1 else ")")
 
 
-def _outside(spec: FieldSpec, space: object) -> str:
+def _outside(spec: FieldSpec, space: AddressSpace) -> str:
     from retrokit.errors import RetrokitError
 
     try:
-        space.locate(spec.address, spec.field_type.width)  # type: ignore[attr-defined]
+        space.locate(spec.address, spec.field_type.width)
     except RetrokitError:
-        mapped = ", ".join(f"{r.start:#x}-{r.start + r.length - 1:#x}" for r in space.regions)  # type: ignore[attr-defined]
+        mapped = ", ".join(f"{r.start:#x}-{r.start + r.length - 1:#x}" for r in space.regions)
         return (f"expected field {spec.name!r} ({spec.type} at {spec.address:#x}) inside the system's memory "
                 f"({mapped}); found it outside. Fix its address in the data file: it is a console address.")
     return ""

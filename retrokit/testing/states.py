@@ -24,12 +24,16 @@ import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from retrokit.data.games import Game, list_games
 from retrokit.data.states import read_state, state_format, state_ram
 from retrokit.errors import RetrokitError
 from retrokit.testing.report import FAIL, PASS, SKIP, WARN, GameReport
+
+if TYPE_CHECKING:
+    from retrokit.host.fields import FieldSpec
+    from retrokit.host.memory import AddressSpace
 
 __all__ = ["IDLE_FRAMES", "StateProbe", "check_states", "parse_states", "probe_states"]
 
@@ -152,7 +156,7 @@ def parse_states(game: Game, names: Sequence[str]) -> dict[str, StateProbe]:
     return probes
 
 
-def _inside(space: Any, spec: Any) -> bool:  # an AddressSpace and a FieldSpec
+def _inside(space: AddressSpace, spec: FieldSpec) -> bool:
     try:
         space.locate(spec.address, spec.field_type.width)
     except RetrokitError:

@@ -231,7 +231,9 @@ def _expected_values(recipe: Any) -> dict[str, int]:
     if not isinstance(recipe, Mapping):
         return {}
     expected: dict[str, int] = {}
-    for part in ("set", "until"):
+    # After arrival a recipe may run more frames ('settle'): then only what it set must still hold.
+    parts = ("set", "until") if not recipe.get("settle") else ("set",)
+    for part in parts:
         values = recipe.get(part)
         if isinstance(values, Mapping):
             expected.update({str(k): v for k, v in values.items() if isinstance(v, int)})

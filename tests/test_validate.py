@@ -219,6 +219,15 @@ def test_validate_command_exits_1_on_a_failure(capsys, dasher: Path) -> None:
     assert "state loads" in out and "Zone1.Act1" in out and "FAIL" in out and "0 of 1 game passed" in out
 
 
+def test_validate_without_names_checks_the_game_yaml_here(capsys, dasher: Path, monkeypatch) -> None:
+    monkeypatch.chdir(dasher)
+    assert main(["validate", "--frames", str(FRAMES), "-q"]) == 0
+    assert "Dasher-Genesis: all" in capsys.readouterr().out
+    monkeypatch.chdir(dasher.parent)
+    assert main(["validate"]) == 2
+    assert "Expected game names, --all, or a game.yaml" in capsys.readouterr().err
+
+
 def test_validate_an_unknown_game_is_a_one_line_error(capsys) -> None:
     assert main(["validate", "Dashr-Genesis"]) == 2
     err = capsys.readouterr().err

@@ -109,7 +109,9 @@ def render(report: GameReport, *, width: int | None = None) -> str:
     lines = [f"{report.game}", "  ".join(h.ljust(w) for h, w in zip(heads[:3], widths)) + "  message",
              "  ".join("-" * w for w in widths) + "  " + "-" * min(room, 40)]
     for row in rows:
-        message = textwrap.wrap(row[3], room) or [""]
+        # A message's first line is wrapped; later ones (a scenario's source line and its caret) keep their shape.
+        first, *rest = row[3].split("\n") or [""]
+        message = (textwrap.wrap(first, room) or [""]) + [line.rstrip() for line in rest]
         lines.append("  ".join(c.ljust(w) for c, w in zip(row[:3], widths)) + "  " + message[0])
         lines.extend(" " * indent + more for more in message[1:])
     return "\n".join(lines)

@@ -138,6 +138,16 @@ def test_a_gzip_bomb_state_fails_in_its_child_within_the_memory_limit(dasher: Pa
     assert "too much memory" in report.failures[0].message
 
 
+def test_a_state_that_hangs_the_core_fails_and_the_next_child_goes_on(monkeypatch: pytest.MonkeyPatch) -> None:
+    from retrokit.data.games import find_game
+    from retrokit.testing import states
+
+    monkeypatch.setattr(states, "CHILD_TIMEOUT", 0.001)  # 60 frames take longer: each state looks hung
+    game = find_game("Dasher-Genesis")
+    probes = states.probe_states(game, ["Zone1.Act1", "Zone1.Act2"], game.require_rom())
+    assert [p.error.startswith("the core hung") for p in probes.values()] == [True, True]
+
+
 def test_another_games_state_is_flagged(dasher: Path, airstriker_dir: Path) -> None:
     shutil.copy(airstriker_dir / "Level1.state", dasher / "Zone2.Act2.state")
     report = check_game(dasher, frames=FRAMES)

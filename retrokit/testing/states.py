@@ -39,6 +39,7 @@ __all__ = ["IDLE_FRAMES", "StateProbe", "check_states", "parse_states", "probe_s
 
 IDLE_FRAMES = 60  # frames run after loading, so a state that breaks the core does so here
 CHILD_TIMEOUT = 30.0  # seconds a child may spend on one state
+CHILD_STARTUP = 120.0  # seconds a child may take to start (importing retrokit, loading the core) on a busy machine
 CHILD_MEMORY = 512 << 20  # bytes of address space a child may map: a gzip bomb fails there, the machine lives
 
 
@@ -83,7 +84,7 @@ def probe_states(game: Game, names: Sequence[str], rom: Path, *, frames: int = I
     while todo:
         request = {"system": game.system.name, "rom": str(rom), "fields": fields, "frames": frames,
                    "states": [[n, paths[n]] for n in todo]}
-        done, current, failure = _run_child(request, timeout=CHILD_TIMEOUT * len(todo) + 10)
+        done, current, failure = _run_child(request)
         probes.update(done)
         todo = [n for n in todo if n not in probes]
         if current is not None and current in todo:  # the child died or hung on this one
@@ -96,37 +97,64 @@ def probe_states(game: Game, names: Sequence[str], rom: Path, *, frames: int = I
     return {name: probes[name] for name in names}
 
 
-def _run_child(request: Mapping[str, Any], timeout: float) -> tuple[dict[str, StateProbe], str | None, str]:
-    """Run one child; return the probes it finished, the state it was on when it stopped, and why it stopped."""
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "retrokit.testing.states"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE, text=True,
-    )
-    try:
-        out, err = proc.communicate(json.dumps(request), timeout=timeout)
-        failure = ""
-    except subprocess.TimeoutExpired:
-        proc.kill()
-        out, err = proc.communicate()
-        failure = f"the core hung: loading the state and running {request['frames']} frames took over {timeout:.0f} s"
+def _run_child(request: Mapping[str, Any]) -> tuple[dict[str, StateProbe], str | None, str]:
+    """Run one child; return the probes it finished, the state it was on when it stopped, and why it stopped.
+
+    The child prints a line before and after each state; a state that prints
+    nothing for :data:`CHILD_TIMEOUT` seconds has hung the core, and the child
+    is killed. Its log goes to a file, so a chatty core cannot fill a pipe.
+    """
+    import selectors
+    import tempfile
+
     probes: dict[str, StateProbe] = {}
-    current = None
-    for line in out.splitlines():
+    current, failure = None, ""
+    with tempfile.TemporaryFile("w+") as log:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "retrokit.testing.states"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+            stderr=log, bufsize=0,
+        )
         try:
-            message = json.loads(line)
-        except json.JSONDecodeError:
-            continue
-        if "begin" in message:
-            current = message["begin"]
-        else:
-            probes[message["name"]] = StateProbe(**message)
-            current = None
-    if not failure and proc.returncode != 0:
-        if proc.returncode < 0:
-            failure = f"the core crashed (signal {-proc.returncode}) while loading or running the state"
-        else:
-            last = err.strip().splitlines()[-1:] or ["no message"]
-            failure = f"the state loader exited with status {proc.returncode}: {last[0]}"
+            proc.stdin.write(json.dumps(request).encode())  # type: ignore[union-attr]
+            proc.stdin.close()  # type: ignore[union-attr]
+        except BrokenPipeError:  # it died at once; its status says why
+            pass
+        # Raw reads, split here: a buffered reader could hold a line that select() then waits for.
+        fd = proc.stdout.fileno()  # type: ignore[union-attr]
+        pending = b""
+        with selectors.DefaultSelector() as selector:
+            selector.register(fd, selectors.EVENT_READ)
+            wait = CHILD_STARTUP
+            while True:
+                if not selector.select(timeout=wait):
+                    proc.kill()
+                    failure = (f"the core hung: loading the state and running {request['frames']} frames "
+                               f"took over {CHILD_TIMEOUT:g} s")
+                    break
+                chunk = os.read(fd, 1 << 16)
+                if not chunk:
+                    break
+                wait = CHILD_TIMEOUT
+                *lines, pending = (pending + chunk).split(b"\n")
+                for line in lines:
+                    try:
+                        message = json.loads(line)
+                    except json.JSONDecodeError:
+                        continue
+                    if "begin" in message:
+                        current = message["begin"]
+                    else:
+                        probes[message["name"]] = StateProbe(**message)
+                        current = None
+        proc.stdout.close()  # type: ignore[union-attr]
+        status = proc.wait()
+        if not failure and status != 0:
+            if status < 0:
+                failure = f"the core crashed (signal {-status}) while loading or running the state"
+            else:
+                log.seek(0)
+                last = log.read().strip().splitlines()[-1:] or ["no message"]
+                failure = f"the state loader exited with status {status}: {last[0]}"
     return probes, current, failure
 
 

@@ -50,11 +50,16 @@ def run(args: argparse.Namespace) -> int:
     reports: list[GameReport] = []
     with tqdm(total=len(targets) * len(STAGES), unit="stage", leave=False) as bar:
         for target in targets:
-            def step(stage: str, name: str = str(target)) -> None:
-                bar.set_description(f"{name}: {stage}")
-                bar.update(1)
+            started = [0]  # stages of this game begun; the bar counts those finished
+
+            def step(stage: str, detail: str, name: str = str(target), started: list[int] = started) -> None:
+                bar.set_description(f"{name}: {detail or stage}")
+                if not detail:  # a stage starts (so the one before it is done); details only say where it is
+                    bar.update(1 if started[0] else 0)
+                    started[0] += 1
 
             reports.append(check_game(target, frames=args.frames, progress=step))
+            bar.update(len(STAGES) - max(started[0] - 1, 0))  # the last stage, and any a broken game skipped
     for report in reports:
         if args.quiet:
             shown = GameReport(report.game, [r for r in report.results if r.status != PASS])

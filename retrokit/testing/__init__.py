@@ -38,14 +38,15 @@ def check_game(
     game: Game | str | os.PathLike[str],
     *,
     frames: int | None = None,
-    progress: Callable[[str], None] | None = None,
+    progress: Callable[[str, str], None] | None = None,
 ) -> GameReport:
     """Check a game's integration; return every result.
 
     Args:
         game: A :class:`~retrokit.data.games.Game`, a game's name, or a path to a game folder.
         frames: Frames per smoke run (default :data:`retrokit.testing.scenarios.SMOKE_FRAMES`).
-        progress: Called with each stage's name as it starts.
+        progress: Called as ``progress(stage, "")`` when each of :data:`STAGES` starts, and as
+            ``progress(stage, detail)`` along the long ones (e.g. the state a smoke run is on).
 
     Returns:
         The report; ``report.passed`` is false if any check failed.
@@ -59,7 +60,10 @@ def check_game(
     from retrokit.testing.schema import check_schemas
     from retrokit.testing.states import check_states
 
-    step = progress or (lambda _stage: None)
+    def step(stage: str, detail: str = "") -> None:
+        if progress is not None:
+            progress(stage, detail)
+
     game = _resolve(game)
     report = GameReport(game.name)
 
@@ -95,7 +99,8 @@ def check_game(
     probes = check_states(game, report, rom)
     step("scenarios")
     starts = {name: probe.start for name, probe in probes.items() if probe.start}
-    check_scenarios(game, report, starts, rom=rom is not None, frames=frames or SMOKE_FRAMES)
+    check_scenarios(game, report, starts, rom=rom is not None, frames=frames or SMOKE_FRAMES,
+                    progress=lambda detail: step("scenarios", detail))
     step("movies")
     check_movies(game, report, rom)
     return report

@@ -16,7 +16,7 @@ For each scenario file:
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -56,6 +56,7 @@ class SmokeRun:
 
 def check_scenarios(
     game: Game, report: GameReport, starts: Mapping[str, Mapping[str, int]], *, rom: bool, frames: int = SMOKE_FRAMES,
+    progress: Callable[[str], None] | None = None,
 ) -> None:
     """Check every scenario of the game; add the results to ``report``.
 
@@ -65,6 +66,7 @@ def check_scenarios(
         starts: Each usable state's field values at its start (from loading or parsing it).
         rom: Whether the ROM is available (smoke runs need it).
         frames: Frames per smoke run.
+        progress: Told which scenario and state each smoke run is on.
     """
     from retrokit.dsl.scenario import load_scenario
 
@@ -84,6 +86,8 @@ def check_scenarios(
         _check_tables(report, name, path, starts)
         if rom:
             for state in starts:
+                if progress is not None:
+                    progress(f"{name} on {state}")
                 _check_runs(game, report, name, path, state, frames)
 
 

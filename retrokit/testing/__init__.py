@@ -127,11 +127,10 @@ def _resolve(game: Game | str | os.PathLike[str]) -> Game:
 
 
 def _check_fields(game: Game, report: GameReport, rom: Path | None) -> None:
-    from retrokit.data.states import read_state, state_ram
+    from retrokit.data.states import read_state
     from retrokit.errors import RetrokitError
-    from retrokit.host.memory import AddressSpace, Region
-    from retrokit.host.systems import get_system
     from retrokit.testing.fields import check_fields
+    from retrokit.testing.states import state_space
 
     if rom is not None:
         from retrokit.host.emulator import Emulator
@@ -144,13 +143,12 @@ def _check_fields(game: Game, report: GameReport, rom: Path | None) -> None:
         return
     for name in game.states:  # the RAM a state holds tells its extent
         try:
-            ram = state_ram(read_state(game.state_path(name)), game.system.name)
+            space = state_space(game, read_state(game.state_path(name)))
         except RetrokitError:
             continue
-        if ram is not None:
-            system = get_system(game.system)
-            space = AddressSpace([Region(system.ram_base, len(ram), memoryview(bytearray(ram)), system.ram_swap)])
-            check_fields(game, report, space, f"the {len(ram) // 1024} KiB of RAM its states hold")
+        if space is not None:
+            size = space.regions[0].length
+            check_fields(game, report, space, f"the {size // 1024} KiB of RAM its states hold")
             return
     check_fields(game, report, None)
 

@@ -35,7 +35,7 @@ if TYPE_CHECKING:
     from retrokit.host.fields import FieldSpec
     from retrokit.host.memory import AddressSpace
 
-__all__ = ["IDLE_FRAMES", "StateProbe", "check_states", "parse_states", "probe_states"]
+__all__ = ["IDLE_FRAMES", "StateProbe", "check_states", "parse_states", "probe_states", "state_space"]
 
 IDLE_FRAMES = 60  # frames run after loading, so a state that breaks the core does so here
 CHILD_TIMEOUT = 30.0  # seconds a child may spend on one state
@@ -158,13 +158,21 @@ def _run_child(request: Mapping[str, Any]) -> tuple[dict[str, StateProbe], str |
     return probes, current, failure
 
 
+def state_space(game: Game, data: bytes) -> AddressSpace | None:
+    """The console addresses of the RAM inside a serialized state, where its layout is known (else ``None``)."""
+    from retrokit.host.memory import AddressSpace, Region
+
+    ram = state_ram(data, game.system.name)
+    if ram is None:
+        return None
+    return AddressSpace([Region(game.system.ram_base, len(ram), memoryview(bytearray(ram)), game.system.ram_swap)])
+
+
 def parse_states(game: Game, names: Sequence[str]) -> dict[str, StateProbe]:
     """Parse each state file without a core: gzip, signature, and the fields where the RAM layout is known."""
-    from retrokit.host.memory import AddressSpace, FieldReader, Region
-    from retrokit.host.systems import get_system
+    from retrokit.host.memory import FieldReader
 
     probes = {}
-    system = get_system(game.system)
     for name in names:
         path = game.state_path(name)
         probe = StateProbe(name, str(path), parsed_only=True)
@@ -175,10 +183,9 @@ def parse_states(game: Game, names: Sequence[str]) -> dict[str, StateProbe]:
             probe.error = str(exc)
             continue
         probe.detail = f"{state_format(data) or 'no core signature'}, {len(data)} bytes"
-        ram = state_ram(data, game.system.name)
-        if ram is None:
+        space = state_space(game, data)
+        if space is None:
             continue
-        space = AddressSpace([Region(system.ram_base, len(ram), memoryview(bytearray(ram)), system.ram_swap)])
         mapped = [f for f in game.fields.values() if _inside(space, f)]
         probe.start = FieldReader(mapped, space).read()
     return probes
@@ -237,7 +244,7 @@ def check_states(game: Game, report: GameReport, rom: Path | None) -> dict[str, 
                            f"Remake it: retrokit integrate {game.name} {name} (add --force to replace it).",
                            state=name)
                 continue
-            report.add("state is the game's", PASS, f"reaches its recipe's {mismatch_text(recipes[name])}", state=name)
+            report.add("state is the game's", PASS, f"reaches its recipe's {_recipe_text(recipes[name])}", state=name)
         else:
             report.add("state is the game's", PASS, "not a copy of another game's state (no recipe to compare with)",
                        state=name)
@@ -268,7 +275,7 @@ def _expected_values(recipe: Any) -> dict[str, int]:
     return expected
 
 
-def mismatch_text(recipe: Any) -> str:
+def _recipe_text(recipe: Any) -> str:
     """The values a recipe reaches, as ``zone=0, act=1, game_mode=1``."""
     return ", ".join(f"{k}={v}" for k, v in _expected_values(recipe).items())
 

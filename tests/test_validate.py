@@ -86,6 +86,23 @@ def test_dasher_movies_prove_the_completion_reward_and_done() -> None:
         assert 0 <= progress - (ends[zone][act] - 48) <= 3, f"{name}: paid {outcome.reward}"
 
 
+@pytest.mark.parametrize("game,state", [("Dasher-Genesis", "Zone2.Act1"), ("Airstriker-Genesis", "Level1")])
+def test_the_ram_read_from_a_state_file_is_the_ram_the_core_loads(game: str, state: str) -> None:
+    """The layout that lets validate read the fields of states whose ROM is missing (the Sonic games)."""
+    import numpy as np
+
+    from retrokit.data.games import find_game
+    from retrokit.data.states import read_state, state_ram
+    from retrokit.host.emulator import Emulator
+
+    found = find_game(game)
+    data = read_state(found.state_path(state))
+    with Emulator(found.system, found.require_rom()) as emu:
+        emu.set_state(data)
+        assert state_ram(data, "Genesis") == bytes(np.asarray(emu.ram))
+    assert state_ram(data, "Snes") is None and state_ram(b"GENPLUS-GX 1.7.5" + bytes(100), "Genesis") is None
+
+
 # --- Planted faults ----------------------------------------------------------------------------------------
 
 

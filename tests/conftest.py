@@ -17,22 +17,6 @@ from retrokit.paths import wheel_dir
 REPO = Path(__file__).resolve().parent.parent
 
 
-@pytest.fixture(autouse=True, scope="session")
-def _private_data_dir(tmp_path_factory: pytest.TempPathFactory):
-    """Point the per-user data folder at a temporary one, so no test writes into the real one."""
-    import os
-
-    from retrokit.paths import DATA_ENV
-
-    old = os.environ.get(DATA_ENV)
-    os.environ[DATA_ENV] = str(tmp_path_factory.mktemp("retrokit-data"))
-    yield
-    if old is None:
-        os.environ.pop(DATA_ENV, None)
-    else:
-        os.environ[DATA_ENV] = old
-
-
 @pytest.fixture(scope="session")
 def airstriker_dir() -> Path:
     """The wheel's Airstriker integration folder."""

@@ -1,0 +1,90 @@
+"""Hostile inputs to ``retrokit import``: devices, FIFOs and zip bombs neither hang it nor blow up its memory.
+
+Each case runs in a child process with a timeout and an address-space limit
+(tests/childproc.py), so a regression fails here instead of hanging the suite.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import zipfile
+from pathlib import Path
+
+import pytest
+from childproc import MAX_RSS_MB, run_cli
+
+from retrokit import paths
+
+AIRSTRIKER_ROM = paths.wheel_dir() / "data" / "stable" / "Airstriker-Genesis-v0" / "rom.md"
+
+
+def _fifo(folder: Path) -> None:
+    os.mkfifo(folder / "pipe.md")  # nobody ever writes: reading it blocks forever
+
+
+def _dev_zero(folder: Path) -> None:
+    (folder / "zero.md").symlink_to("/dev/zero")  # reading it never ends
+
+
+def _zip_with_big_inner_zip(folder: Path) -> None:
+    # inner.zip is 1 GiB (one stored member of zeros); the outer zip deflates it to about 1 MiB.
+    # The inner zip is written straight into the outer member, never to disk.
+    with zipfile.ZipFile(folder / "outer.zip", "w", zipfile.ZIP_DEFLATED, compresslevel=1) as outer:
+        with outer.open("inner.zip", "w", force_zip64=True) as stream:
+            with zipfile.ZipFile(stream, "w", zipfile.ZIP_STORED) as inner:
+                with inner.open("big.bin", "w", force_zip64=True) as member:
+                    block = bytes(2**20)
+                    for _ in range(1024):
+                        member.write(block)
+
+
+def _zip_bomb_member(folder: Path) -> None:
+    # 1 GiB of zeros deflated to about 1 MiB: a ROM-named member whose real size is far past the cap.
+    with zipfile.ZipFile(folder / "bomb.zip", "w", zipfile.ZIP_DEFLATED) as archive:
+        with archive.open("bomb.md", "w", force_zip64=True) as member:
+            block = bytes(2**20)
+            for _ in range(1024):
+                member.write(block)
+
+
+def _lying_zip_header(folder: Path) -> None:
+    # The member's header claims 10 bytes; its data inflates to 64 MiB.
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("liar.md", bytes(64 * 2**20))
+    data = bytearray(buffer.getvalue())
+    for offset in (data.find(b"PK\x03\x04") + 22, data.find(b"PK\x01\x02") + 24):  # uncompressed size fields
+        data[offset : offset + 4] = (10).to_bytes(4, "little")
+    (folder / "liar.zip").write_bytes(bytes(data))
+
+
+CASES = {
+    "fifo": (_fifo, "not a regular file"),
+    "symlink-to-dev-zero": (_dev_zero, "not a regular file"),
+    "zip-holding-a-1GiB-inner-zip": (_zip_with_big_inner_zip, "larger than 256 MiB inside a zip"),
+    "zip-bomb-member": (_zip_bomb_member, "larger than 32 MiB"),
+    "zip-member-lying-about-its-size": (_lying_zip_header, "liar.md"),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES), ids=list(CASES))
+def test_import_skips_hostile_files_quickly_and_in_little_memory(tmp_path: Path, case: str) -> None:
+    make, expected = CASES[case]
+    folder = tmp_path / "roms"
+    folder.mkdir()
+    make(folder)
+    (folder / "Airstriker.bin").write_bytes(AIRSTRIKER_ROM.read_bytes())  # the good ROM beside it still imports
+    child = run_cli(["import", "-v", str(folder), "--data-dir", str(tmp_path / "data")], timeout=60)
+    assert child.returncode == 0, child.describe()
+    assert "Airstriker-Genesis <- " in child.stdout, child.describe()
+    assert expected in child.stdout, child.describe()
+    assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
+    assert (tmp_path / "data" / "roms" / "Airstriker-Genesis" / "rom.md").is_file()
+
+
+def test_a_fifo_named_on_the_command_line_is_skipped(tmp_path: Path) -> None:
+    os.mkfifo(tmp_path / "pipe.zip")
+    child = run_cli(["import", str(tmp_path / "pipe.zip"), "--data-dir", str(tmp_path / "data")], timeout=30)
+    assert child.returncode == 0, child.describe()
+    assert "not a regular file" in child.stdout, child.describe()

@@ -133,7 +133,7 @@ def _read_capped(stream: BinaryIO, limit: int) -> bytes | None:
 
 def _spool_member(archive: zipfile.ZipFile, info: zipfile.ZipInfo) -> IO[bytes] | None:
     """A nested zip member, copied to memory (small) or a temporary file, or ``None`` past the cap."""
-    spool = tempfile.SpooledTemporaryFile(max_size=roms.MAX_FILE_SIZE)
+    spool = tempfile.SpooledTemporaryFile(max_size=roms.MAX_FILE_SIZE)  # noqa: SIM115 - handed to the caller
     with archive.open(info) as member:
         copied = 0
         while chunk := member.read(_CHUNK):

@@ -4,19 +4,29 @@ from __future__ import annotations
 
 import io
 import os
+import re
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 
-from retrokit.errors import FileConflictError, GameNotFoundError, InvalidArgumentError, MovieError, RomError
+from retrokit.data.states import StateRecord
+from retrokit.errors import (
+    DataFileError,
+    FileConflictError,
+    GameNotFoundError,
+    InvalidArgumentError,
+    MovieError,
+    RomError,
+)
 from retrokit.host.emulator import Emulator
 from retrokit.movie.bk2 import read_bk2
-from retrokit.movie.model import Movie
+from retrokit.movie.model import STATE_DIGEST, Movie
 from retrokit.paths import atomic_write
 
 FRAME_PATTERN = "frame_{:06d}.png"
+_SHA1 = re.compile(r"[0-9a-f]{40}")
 VIDEO_SUFFIXES = (".gif", ".mp4")
 
 
@@ -31,6 +41,30 @@ def open_emulator(movie: Movie) -> Emulator:
 
     rom = find_game(movie.game).require_rom()
     return Emulator(movie.system, rom, ports=max(2, movie.players))
+
+
+def check_movie_state(movie: Movie, emu: Emulator, source: str) -> None:
+    """Refuse a movie's start state that is for another ROM, or that crashes or hangs the core.
+
+    A movie retrokit recorded names its ROM's SHA-1 and its state's SHA-256 in
+    its header; one that does not (stable-retro's), or whose state changed
+    since, is probed in a child process first (see :mod:`retrokit.data.statecheck`).
+
+    Raises:
+        StateError: The state is for another ROM, or the core cannot run it.
+    """
+    from retrokit.data.games import cached_rom_sha1, find_game
+    from retrokit.data.probe import vet_state
+    from retrokit.data.statecheck import check_state
+
+    sha1 = movie.header.get("SHA1", "?").strip().lower()
+    record = StateRecord(movie.game, sha1, movie.header.get(STATE_DIGEST, "")) if _SHA1.fullmatch(sha1) else None
+    try:
+        game = find_game(movie.game)
+    except (GameNotFoundError, DataFileError):  # a movie of a game retrokit does not know: probe it all the same
+        vet_state(movie.state, emu.system.name, emu.rom, cached_rom_sha1(emu.rom, emu.system.name), source=source)
+        return
+    check_state(game, movie.state, record, source=source, rom=emu.rom)
 
 
 def play(movie: Movie | str | os.PathLike[str], *, emulator: Emulator | None = None) -> Iterator[np.ndarray]:
@@ -50,6 +84,7 @@ def play(movie: Movie | str | os.PathLike[str], *, emulator: Emulator | None = N
     Raises:
         MovieError: The movie is malformed, or ``emulator`` runs another system or has too few ports.
     """
+    source = f"the start state (Core.bin) of the {movie.game} movie" if isinstance(movie, Movie) else f"{movie}: Core.bin"
     if not isinstance(movie, Movie):
         movie = read_bk2(movie)
     own = emulator is None
@@ -63,6 +98,7 @@ def play(movie: Movie | str | os.PathLike[str], *, emulator: Emulator | None = N
         emu.set_sticky(0.0, 0)
         emu.forget_action()
         if movie.state is not None:
+            check_movie_state(movie, emu, source)
             emu.set_state(movie.state)
         else:
             emu.reset()

@@ -2,7 +2,8 @@
 
 The commands live in :mod:`retrokit.commands`, one module each. Errors that
 retrokit raises on purpose (:class:`~retrokit.errors.RetrokitError`) are printed
-as one message, without a traceback, and exit with status 2.
+as one message, without a traceback, and exit with status 2; so, as a last
+resort, is a file-system error that escaped them.
 """
 
 from __future__ import annotations
@@ -45,6 +46,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         return int(args.run(args) or 0)
     except RetrokitError as exc:
         print(f"retrokit: error: {exc}", file=sys.stderr)
+        return ERROR_STATUS
+    except OSError as exc:  # the last resort: the places that read and write files raise RetrokitError
+        where = f" ({exc.filename})" if exc.filename else ""
+        print(f"retrokit: error: a file operation failed{where}: {exc.strerror or exc}.", file=sys.stderr)
         return ERROR_STATUS
     except KeyboardInterrupt:
         print("retrokit: interrupted", file=sys.stderr)

@@ -23,6 +23,8 @@ import os
 import tempfile
 from pathlib import Path
 
+from retrokit.errors import FileSystemError
+
 GAMES_ENV = "RETROKIT_GAMES"
 DATA_ENV = "RETROKIT_DATA"
 WHEEL_DATA_KINDS = ("stable", "experimental", "contrib")
@@ -140,10 +142,15 @@ def atomic_write(path: Path | str, data: bytes, *, overwrite: bool = False) -> N
 
     Raises:
         FileExistsError: ``path`` exists and ``overwrite`` is false.
+        FileSystemError: The folder cannot be made or written (a file in its
+            way, no permission, a read-only or full disk).
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    ensure_folder(path.parent, f"to write {path.name} into")
+    try:
+        fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as exc:
+        raise _cannot(path.parent, f"to write {path.name} into", exc) from None
     tmp = Path(tmp_name)
     try:
         # mkstemp makes the file private (0600); give it the mode any new file gets.
@@ -163,5 +170,50 @@ def atomic_write(path: Path | str, data: bytes, *, overwrite: bool = False) -> N
             if path.exists():
                 raise FileExistsError(path) from None
             os.replace(tmp, path)
+    except FileExistsError:
+        raise
+    except OSError as exc:  # a full disk, a file system gone read-only meanwhile
+        raise _cannot(path, "written", exc) from None
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def _cannot(path: Path, purpose: str, exc: OSError) -> FileSystemError:
+    """The error for a folder that exists but cannot be written, or a file that cannot be."""
+    reason = exc.strerror or str(exc)
+    if purpose == "written":
+        return FileSystemError(
+            f"Expected to write {str(path)!r}; found it cannot be written: {reason}. "
+            "Free some space, or choose another place."
+        )
+    return FileSystemError(
+        f"Expected a writable folder at {str(path)!r} {purpose}; found it cannot be written: {reason}. "
+        "Choose another place, or make the folder writable."
+    )
+
+
+def ensure_folder(folder: Path | str, purpose: str = "written") -> Path:
+    """Create ``folder`` (and its parents) if needed; return it.
+
+    Args:
+        folder: The folder.
+        purpose: What it is for, in the error message (``"to write x.gif into"``).
+
+    Raises:
+        FileSystemError: A file stands where the folder or one of its parents
+            should be, or the folder cannot be created.
+    """
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # mkdir says FileExistsError for a file in the way: not a conflict, a wrong path
+        if folder.exists():
+            reason = "a file, not a folder"
+        elif isinstance(exc, (FileExistsError, NotADirectoryError)):
+            reason = "a file where one of its parent folders should be"
+        else:
+            reason = exc.strerror or str(exc)
+        raise FileSystemError(
+            f"Expected a folder at {str(folder)!r} {purpose}; found {reason}. Choose another place, or move the file."
+        ) from None
+    return folder

@@ -15,6 +15,7 @@ from retrokit.data.states import StateRecord
 from retrokit.errors import (
     DataFileError,
     FileConflictError,
+    FileSystemError,
     GameNotFoundError,
     InvalidArgumentError,
     MovieError,
@@ -23,7 +24,7 @@ from retrokit.errors import (
 from retrokit.host.emulator import Emulator
 from retrokit.movie.bk2 import read_bk2
 from retrokit.movie.model import STATE_DIGEST, Movie
-from retrokit.paths import atomic_write
+from retrokit.paths import atomic_write, ensure_folder
 
 FRAME_PATTERN = "frame_{:06d}.png"
 _SHA1 = re.compile(r"[0-9a-f]{40}")
@@ -152,6 +153,7 @@ def export(
     except (GameNotFoundError, RomError) as exc:
         raise type(exc)(f"{movie_path} plays {movie.game}. {exc}") from None
     try:
+        ensure_folder(out if kind is None else out.parent, "for the frames" if kind is None else f"to write {out.name} into")
         fps = float(emu.av_info()["fps"]) / every
         frames = ((i, f) for i, f in enumerate(play(movie, emulator=emu)) if i % every == 0)
         if kind is None:
@@ -174,6 +176,11 @@ def _output_kind(out: Path) -> str | None:
         raise InvalidArgumentError(
             f"Expected the output to be a folder (for PNG frames), a .gif or an .mp4 file; found {str(out)!r}."
         )
+    if out.exists():
+        raise InvalidArgumentError(
+            f"Expected the output to be a folder (for PNG frames), a .gif or an .mp4 file; found {str(out)!r}, "
+            "a file without a suffix. Name a folder, or a file ending in .gif or .mp4."
+        )
     return None
 
 
@@ -192,10 +199,14 @@ def _require_imageio(out: Path):  # the imageio.v2 module
 def _write_pngs(frames: Iterator[tuple[int, np.ndarray]], folder: Path) -> int:
     from PIL import Image
 
-    folder.mkdir(parents=True, exist_ok=True)
+    ensure_folder(folder, "for PNG frames")
     count = 0
     for index, frame in frames:
-        Image.fromarray(frame).save(folder / FRAME_PATTERN.format(index))
+        path = folder / FRAME_PATTERN.format(index)
+        try:
+            Image.fromarray(frame).save(path)
+        except OSError as exc:
+            raise FileSystemError(f"Expected to write {path}; found it cannot be written: {exc}.") from None
         count += 1
     return count
 
@@ -213,7 +224,7 @@ def _write_gif(frames: Iterator[tuple[int, np.ndarray]], out: Path, fps: float, 
 
 
 def _write_mp4(imageio, frames: Iterator[tuple[int, np.ndarray]], out: Path, fps: float, overwrite: bool) -> int:
-    out.parent.mkdir(parents=True, exist_ok=True)
+    ensure_folder(out.parent, f"to write {out.name} into")
     fd, tmp_name = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=".mp4", dir=out.parent)
     os.close(fd)
     count = 0

@@ -16,12 +16,15 @@ The stable-retro wheel is located without importing its Python code.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import importlib.metadata
 import importlib.util
 import os
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
+from typing import BinaryIO
 
 from retrokit.errors import FileSystemError
 
@@ -145,6 +148,22 @@ def atomic_write(path: Path | str, data: bytes, *, overwrite: bool = False) -> N
         FileSystemError: The folder cannot be made or written (a file in its
             way, no permission, a read-only or full disk).
     """
+    with atomic_output(path, overwrite=overwrite) as f:
+        f.write(data)
+
+
+@contextlib.contextmanager
+def atomic_output(path: Path | str, *, overwrite: bool = False) -> Iterator[BinaryIO]:
+    """Open a temporary file beside ``path`` to write into; put it in place when the block ends.
+
+    Like :func:`atomic_write`, for output written piece by piece (a long GIF)
+    that should never be held in memory whole. If the block raises, the
+    temporary file is deleted and ``path`` is left as it was.
+
+    Raises:
+        FileExistsError: ``path`` exists and ``overwrite`` is false.
+        FileSystemError: The folder cannot be made or written.
+    """
     path = Path(path)
     ensure_folder(path.parent, f"to write {path.name} into")
     try:
@@ -156,7 +175,7 @@ def atomic_write(path: Path | str, data: bytes, *, overwrite: bool = False) -> N
         # mkstemp makes the file private (0600); give it the mode any new file gets.
         os.chmod(fd, 0o666 & ~_umask())
         with os.fdopen(fd, "wb") as f:
-            f.write(data)
+            yield f
             f.flush()
             os.fsync(f.fileno())
         if overwrite:
@@ -171,6 +190,8 @@ def atomic_write(path: Path | str, data: bytes, *, overwrite: bool = False) -> N
                 raise FileExistsError(path) from None
             os.replace(tmp, path)
     except FileExistsError:
+        raise
+    except FileSystemError:
         raise
     except OSError as exc:  # a full disk, a file system gone read-only meanwhile
         raise _cannot(path, "written", exc) from None

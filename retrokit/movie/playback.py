@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import io
 import os
 import re
 import tempfile
@@ -10,6 +9,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
 from retrokit.data.states import StateRecord
 from retrokit.errors import (
@@ -23,8 +23,9 @@ from retrokit.errors import (
 )
 from retrokit.host.emulator import Emulator
 from retrokit.movie.bk2 import read_bk2
+from retrokit.movie.gif import GifWriter, gif_step
 from retrokit.movie.model import STATE_DIGEST, Movie
-from retrokit.paths import atomic_write, ensure_folder
+from retrokit.paths import atomic_output, atomic_write, ensure_folder
 
 FRAME_PATTERN = "frame_{:06d}.png"
 _SHA1 = re.compile(r"[0-9a-f]{40}")
@@ -117,6 +118,7 @@ def export(
     *,
     every: int = 1,
     overwrite: bool = False,
+    progress: bool = False,
 ) -> int:
     """Replay a movie into PNG frames, an animated GIF or an MP4 video.
 
@@ -126,6 +128,7 @@ def export(
             file ending in ``.gif`` (Pillow) or ``.mp4`` (needs ``imageio`` with ffmpeg).
         every: Keep one frame in ``every`` (the video's frame rate shrinks to match).
         overwrite: Replace the output file, or frames already in the folder.
+        progress: Show a progress bar (on standard error) while the movie plays.
 
     Returns:
         How many images were written.
@@ -155,7 +158,9 @@ def export(
     try:
         ensure_folder(out if kind is None else out.parent, "for the frames" if kind is None else f"to write {out.name} into")
         fps = float(emu.av_info()["fps"]) / every
-        frames = ((i, f) for i, f in enumerate(play(movie, emulator=emu)) if i % every == 0)
+        screens = tqdm(play(movie, emulator=emu), total=len(movie.frames), unit="frame", disable=not progress,
+                       desc=Path(movie_path).name)
+        frames = ((i, f) for i, f in enumerate(screens) if i % every == 0)
         if kind is None:
             return _write_pngs(frames, out)
         if kind == ".gif":
@@ -212,15 +217,22 @@ def _write_pngs(frames: Iterator[tuple[int, np.ndarray]], folder: Path) -> int:
 
 
 def _write_gif(frames: Iterator[tuple[int, np.ndarray]], out: Path, fps: float, overwrite: bool) -> int:
-    from PIL import Image
-
-    images = [Image.fromarray(frame) for _, frame in frames]
-    if not images:
-        raise MovieError(f"Expected a movie with frames to write {out}; found none.")
-    buffer = io.BytesIO()
-    images[0].save(buffer, "GIF", save_all=True, append_images=images[1:], duration=round(1000 / fps), loop=0)
-    _place(out, buffer.getvalue(), overwrite)
-    return len(images)
+    """Stream the frames into a GIF at 30 fps at most, one frame encoded at a time (see :mod:`retrokit.movie.gif`)."""
+    step = gif_step(fps)
+    try:
+        with atomic_output(out, overwrite=overwrite) as stream:
+            writer = GifWriter(stream, fps / step)
+            for k, (_, frame) in enumerate(frames):
+                if k % step == 0:
+                    writer.add(frame)
+            if writer.count == 0:
+                raise MovieError(f"Expected a movie with frames to write {out}; found none.")
+            writer.close()
+    except FileExistsError:
+        raise FileConflictError(
+            f"Expected no file at {out}; found one. Choose another path, or pass overwrite (--overwrite)."
+        ) from None
+    return writer.count
 
 
 def _write_mp4(imageio, frames: Iterator[tuple[int, np.ndarray]], out: Path, fps: float, overwrite: bool) -> int:

@@ -92,3 +92,15 @@ def test_a_fifo_named_on_the_command_line_is_skipped(tmp_path: Path) -> None:
     child = run_cli(["import", str(tmp_path / "pipe.zip"), "--data-dir", str(tmp_path / "data")], timeout=30)
     assert child.returncode == 0, child.describe()
     assert "not a regular file" in child.stdout, child.describe()
+
+
+def test_import_shows_a_progress_bar(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from retrokit.cli import main
+
+    folder = tmp_path / "roms"
+    folder.mkdir()
+    for i in range(3):
+        (folder / f"junk{i}.bin").write_bytes(bytes([i]) * 100)
+    assert main(["import", str(folder), "--data-dir", str(tmp_path / "data")]) == 0
+    err = capsys.readouterr().err
+    assert "Searching: " in err and "3 files" in err, err

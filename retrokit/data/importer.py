@@ -23,6 +23,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO, BinaryIO
 
+from tqdm import tqdm
+
 from retrokit import paths
 from retrokit.data import roms
 from retrokit.data.games import Game, list_games
@@ -267,6 +269,7 @@ def import_roms(
     data_dir: str | os.PathLike[str] | None = None,
     overwrite: bool = False,
     games: Iterable[Game] | None = None,
+    progress: bool = False,
 ) -> ImportReport:
     """Find the ROMs of known games under ``sources`` and copy them into the data folder.
 
@@ -275,13 +278,15 @@ def import_roms(
         data_dir: The data folder; by default :func:`retrokit.paths.data_dir`.
         overwrite: Replace a different ROM already imported for the same game.
         games: The games to match against; by default every known game.
+        progress: Show a progress bar (on standard error) of the files searched.
 
     Returns:
         What was imported, already present, in conflict, unmatched and skipped.
     """
     report = ImportReport(Path(data_dir) if data_dir is not None else paths.data_dir())
     table, report.broken_games = known_hashes(games)
-    for label, ext, read in (c for source in sources for c in _walk(Path(source), report)):
+    candidates = (c for source in sources for c in _walk(Path(source), report))
+    for label, ext, read in tqdm(candidates, desc="Searching", unit=" files", disable=not progress):
         try:
             data, sha1 = roms.groom_rom(read(), ext)
         except (OSError, RomError) as exc:

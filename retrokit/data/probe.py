@@ -55,6 +55,13 @@ def probe_key(state: bytes, system: str, rom_sha1: str) -> str:
     return digest.hexdigest()
 
 
+def _child_env() -> dict[str, str]:
+    """This process's environment, with the folder retrokit was imported from first on the path."""
+    root = str(Path(__file__).resolve().parents[2])
+    path = os.environ.get("PYTHONPATH")
+    return {**os.environ, "PYTHONPATH": root + (os.pathsep + path if path else "")}
+
+
 def _child_limits() -> None:
     resource.setrlimit(resource.RLIMIT_CORE, (0, 0))  # a crashing probe leaves no core file
 
@@ -73,7 +80,7 @@ def probe_state(
         try:
             done = subprocess.run(
                 command, capture_output=True, text=True, timeout=timeout, check=False, stdin=subprocess.DEVNULL,
-                preexec_fn=_child_limits,
+                preexec_fn=_child_limits, env=_child_env(),
             )
         except subprocess.TimeoutExpired:
             return ProbeVerdict(False, f"the emulator still ran {timeout:.0f} s after loading it (it hangs the core)")

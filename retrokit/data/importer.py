@@ -286,16 +286,18 @@ def import_roms(
     report = ImportReport(Path(data_dir) if data_dir is not None else paths.data_dir())
     table, report.broken_games = known_hashes(games)
     candidates = (c for source in sources for c in _walk(Path(source), report))
-    for label, ext, read in tqdm(candidates, desc="Searching", unit=" files", disable=not progress):
-        try:
-            data, sha1 = roms.groom_rom(read(), ext)
-        except (OSError, RomError) as exc:
-            report.skipped.append((label, str(exc)))
-            continue
-        matches = table.get(sha1)
-        if not matches:
-            report.unmatched.append(label)
-            continue
-        for game in matches:
-            _store(game, label, data, sha1, report, overwrite)
+    # closed on any error too, so an error prints on a line of its own
+    with tqdm(candidates, desc="Searching", unit=" files", disable=not progress) as bar:
+        for label, ext, read in bar:
+            try:
+                data, sha1 = roms.groom_rom(read(), ext)
+            except (OSError, RomError) as exc:
+                report.skipped.append((label, str(exc)))
+                continue
+            matches = table.get(sha1)
+            if not matches:
+                report.unmatched.append(label)
+                continue
+            for game in matches:
+                _store(game, label, data, sha1, report, overwrite)
     return report

@@ -155,19 +155,25 @@ def export(
         emu = open_emulator(movie)
     except (GameNotFoundError, RomError) as exc:
         raise type(exc)(f"{movie_path} plays {movie.game}. {exc}") from None
-    try:
+    bar = tqdm(total=len(movie.frames), unit="frame", disable=not progress, desc=Path(movie_path).name)
+    try:  # the bar is closed on any error, so the error prints on a line of its own
         ensure_folder(out if kind is None else out.parent, "for the frames" if kind is None else f"to write {out.name} into")
         fps = float(emu.av_info()["fps"]) / every
-        screens = tqdm(play(movie, emulator=emu), total=len(movie.frames), unit="frame", disable=not progress,
-                       desc=Path(movie_path).name)
-        frames = ((i, f) for i, f in enumerate(screens) if i % every == 0)
+        frames = ((i, f) for i, f in enumerate(_counted(play(movie, emulator=emu), bar)) if i % every == 0)
         if kind is None:
             return _write_pngs(frames, out)
         if kind == ".gif":
             return _write_gif(frames, out, fps, overwrite)
         return _write_mp4(imageio, frames, out, fps, overwrite)
     finally:
+        bar.close()
         emu.close()
+
+
+def _counted(screens: Iterator[np.ndarray], bar: tqdm) -> Iterator[np.ndarray]:
+    for screen in screens:
+        bar.update(1)
+        yield screen
 
 
 def _output_kind(out: Path) -> str | None:

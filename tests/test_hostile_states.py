@@ -132,8 +132,9 @@ def test_playback_refuses_a_hostile_core_bin(tmp_path: Path, kind: str, corrupt_
     movie = _movie(tmp_path, corrupt_state) if kind == "corrupt" else _bomb_movie(tmp_path, bytes(2**30))
     child = run_cli(["playback", str(movie), str(tmp_path / "out.gif")], env={"RETROKIT_DATA": str(tmp_path / "data")})
     assert child.returncode == 2, child.describe()
-    assert child.stderr.startswith("retrokit: error:") and "Traceback" not in child.stderr, child.describe()
-    assert ("SIGSEGV" if kind == "corrupt" else "at most") in child.stderr, child.describe()
+    last = child.stderr.strip().splitlines()[-1]
+    assert last.startswith(f"retrokit: error: {movie}") and "Traceback" not in child.stderr, child.describe()
+    assert ("SIGSEGV" if kind == "corrupt" else "at most") in last, child.describe()
     assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
     assert not (tmp_path / "out.gif").exists()
 

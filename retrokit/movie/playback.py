@@ -69,7 +69,9 @@ def check_movie_state(movie: Movie, emu: Emulator, source: str) -> None:
     check_state(game, movie.state, record, source=source, rom=emu.rom)
 
 
-def play(movie: Movie | str | os.PathLike[str], *, emulator: Emulator | None = None) -> Iterator[np.ndarray]:
+def play(
+    movie: Movie | str | os.PathLike[str], *, emulator: Emulator | None = None, source: str | None = None
+) -> Iterator[np.ndarray]:
     """Replay a movie, yielding the screen after each of its frames.
 
     The emulator is set to the movie's start state (or reset to power-on if it
@@ -79,6 +81,7 @@ def play(movie: Movie | str | os.PathLike[str], *, emulator: Emulator | None = N
         movie: A movie, or the path of a ``.bk2`` file.
         emulator: An emulator of the movie's game to replay on; its sticky-action
             probability is set to 0. By default one is opened (and closed after).
+        source: What to call the movie's start state in errors (by default its path, or its game).
 
     Yields:
         RGB ``uint8`` arrays of shape (H, W, 3), one per movie frame.
@@ -86,7 +89,8 @@ def play(movie: Movie | str | os.PathLike[str], *, emulator: Emulator | None = N
     Raises:
         MovieError: The movie is malformed, or ``emulator`` runs another system or has too few ports.
     """
-    source = f"the start state (Core.bin) of the {movie.game} movie" if isinstance(movie, Movie) else f"{movie}: Core.bin"
+    if source is None:
+        source = f"the start state (Core.bin) of the {movie.game} movie" if isinstance(movie, Movie) else f"{movie}: Core.bin"
     if not isinstance(movie, Movie):
         movie = read_bk2(movie)
     own = emulator is None
@@ -159,7 +163,7 @@ def export(
     try:  # the bar is closed on any error, so the error prints on a line of its own
         ensure_folder(out if kind is None else out.parent, "for the frames" if kind is None else f"to write {out.name} into")
         fps = float(emu.av_info()["fps"]) / every
-        frames = ((i, f) for i, f in enumerate(_counted(play(movie, emulator=emu), bar)) if i % every == 0)
+        frames = ((i, f) for i, f in enumerate(_counted(play(movie, emulator=emu, source=f"{movie_path}: Core.bin"), bar)) if i % every == 0)
         if kind is None:
             return _write_pngs(frames, out)
         if kind == ".gif":

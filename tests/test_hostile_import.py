@@ -12,6 +12,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
+from bombs import zip_bytes, zip_parts
 from childproc import MAX_RSS_MB, run_cli
 
 from retrokit import paths
@@ -29,27 +30,13 @@ def _dev_zero(folder: Path) -> None:
 
 def _zip_with_big_inner_zip(folder: Path) -> None:
     # inner.zip is 1 GiB (one stored member of zeros); the outer zip deflates it to about 1 MiB.
-    # The inner zip is written straight into the outer member, never to disk.
-    with (
-        zipfile.ZipFile(folder / "outer.zip", "w", zipfile.ZIP_DEFLATED, compresslevel=1) as outer,
-        outer.open("inner.zip", "w", force_zip64=True) as stream,
-        zipfile.ZipFile(stream, "w", zipfile.ZIP_STORED) as inner,
-        inner.open("big.bin", "w", force_zip64=True) as member,
-    ):
-        block = bytes(2**20)
-        for _ in range(1024):
-            member.write(block)
+    inner = zip_parts([("big.bin", [1024], False)])
+    (folder / "outer.zip").write_bytes(zip_bytes([("inner.zip", inner, True)]))
 
 
 def _zip_bomb_member(folder: Path) -> None:
     # 1 GiB of zeros deflated to about 1 MiB: a ROM-named member whose real size is far past the cap.
-    with (
-        zipfile.ZipFile(folder / "bomb.zip", "w", zipfile.ZIP_DEFLATED) as archive,
-        archive.open("bomb.md", "w", force_zip64=True) as member,
-    ):
-        block = bytes(2**20)
-        for _ in range(1024):
-            member.write(block)
+    (folder / "bomb.zip").write_bytes(zip_bytes([("bomb.md", [1024], True)]))
 
 
 def _lying_zip_header(folder: Path) -> None:

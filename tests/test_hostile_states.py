@@ -14,6 +14,7 @@ import zipfile
 from pathlib import Path
 
 import pytest
+from bombs import gzip_of_zeros, zip_bytes
 from childproc import MAX_RSS_MB, REPO, run_child, run_cli
 
 from retrokit.data.games import cached_rom_sha1, find_game
@@ -37,14 +38,10 @@ def corrupt_state(good_state: bytes) -> bytes:
     return good_state[:16] + rng.randbytes(len(good_state) - 16)
 
 
-def gzip_bomb() -> bytes:
-    """About 1 MiB of gzip that inflates to 1 GiB."""
-    return gzip.compress(bytes(2**30), compresslevel=9, mtime=0)
-
-
 @pytest.fixture(scope="module")
 def bomb() -> bytes:
-    return gzip_bomb()
+    """About 1 MiB of gzip that inflates to 1 GiB."""
+    return gzip_of_zeros(1024)
 
 
 def test_the_corrupt_state_really_crashes_the_core(corrupt_state: bytes) -> None:
@@ -60,14 +57,12 @@ def _movie(tmp_path: Path, state: bytes, game: str = "Dasher-Genesis", header: d
     return path
 
 
-def _bomb_movie(tmp_path: Path, data: bytes) -> Path:
-    path = _movie(tmp_path, b"\0")  # a placeholder Core.bin, replaced by the bomb's inflated bytes, deflated
-    with zipfile.ZipFile(path) as archive:
-        members = {name: archive.read(name) for name in archive.namelist()}
-    members["Core.bin"] = data
-    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as archive:
-        for name, body in members.items():
-            archive.writestr(name, body)
+def _bomb_movie(tmp_path: Path) -> Path:
+    """A movie whose Core.bin inflates to 1 GiB (its zip is about 1 MiB)."""
+    with zipfile.ZipFile(_movie(tmp_path, b"\0")) as archive:
+        text = [(name, [archive.read(name)], True) for name in ("Input Log.txt", "Header.txt")]
+    path = tmp_path / "bomb.bk2"
+    path.write_bytes(zip_bytes([*text, ("Core.bin", [1024], True)]))
     return path
 
 
@@ -129,7 +124,7 @@ def test_a_state_changed_since_retrokit_wrote_it_is_probed(tmp_path: Path, corru
 
 @pytest.mark.parametrize("kind", ["corrupt", "gzip-bomb"], ids=["corrupt-core-bin", "gzip-bomb-core-bin"])
 def test_playback_refuses_a_hostile_core_bin(tmp_path: Path, kind: str, corrupt_state: bytes) -> None:
-    movie = _movie(tmp_path, corrupt_state) if kind == "corrupt" else _bomb_movie(tmp_path, bytes(2**30))
+    movie = _movie(tmp_path, corrupt_state) if kind == "corrupt" else _bomb_movie(tmp_path)
     child = run_cli(["playback", str(movie), str(tmp_path / "out.gif")], env={"RETROKIT_DATA": str(tmp_path / "data")})
     assert child.returncode == 2, child.describe()
     last = child.stderr.strip().splitlines()[-1]

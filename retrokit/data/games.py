@@ -8,7 +8,10 @@ data file (``game.yaml``, or Gym Retro's ``data.json``, ``metadata.json`` and
 
 When several search folders hold a game of the same name, the first one's data
 file wins and the others add their states and scenarios: so a ``games/`` folder
-can use the states of the wheel's folder of the same game.
+can use the states of the wheel's folder of the same game. A folder holding
+only scenario files (no data file) adds its scenarios to a game found in a
+later folder: ``games/1942-Nes/scenario.yaml`` replaces the wheel's Lua
+``scenario.json`` while the wheel's data, ROM hashes and states stay in use.
 
 :func:`list_games` only lists folders; a :class:`Game` reads its files the
 first time one of its properties is used. :func:`find_game` reads and checks
@@ -39,6 +42,7 @@ from retrokit.errors import (
     UnsupportedSystemError,
     did_you_mean,
 )
+from retrokit.host.systems import System, get_system
 
 if TYPE_CHECKING:
     from retrokit.host.fields import FieldSpec
@@ -77,13 +81,17 @@ class Game:
 
     @cached_property
     def info(self) -> GameInfo:
-        """The game's data file, parsed (read on first use)."""
-        return read_game_folder(self.folders[0])
+        """The game's data file, parsed (read on first use): the first folder's that has one."""
+        return read_game_folder(next((f for f in self.folders if _is_game_folder(f)), self.folders[0]))
 
     @property
-    def system(self) -> str:
-        """The system's name, e.g. ``"Genesis"``."""
-        return self.info.system or self.name.rsplit("-", 1)[-1]
+    def system(self) -> System:
+        """The game's system, from its data file or else its name's suffix (``-Genesis``).
+
+        Raises:
+            UnsupportedSystemError: No known system has that name.
+        """
+        return get_system(self.info.system or self.name.rsplit("-", 1)[-1])
 
     @property
     def sha1s(self) -> tuple[str, ...]:
@@ -203,8 +211,7 @@ class Game:
     @property
     def rom_extensions(self) -> tuple[str, ...]:
         """The ROM extensions of the game's system; the first is the one imported ROMs get."""
-        ext = roms.system_extension(self.system)
-        return (ext, *(e for e in roms.system_extensions()[self.system] if e != ext))
+        return self.system.extensions
 
     def imported_rom_path(self, data_dir: str | os.PathLike[str] | None = None) -> Path:
         """Return where an imported ROM of this game is (or would be) stored."""
@@ -281,7 +288,7 @@ class Game:
                 "fix the default state's name", did_you_mean(info.default_state, self._state_files),
             )
         try:
-            roms.system_extension(self.system)
+            self.system  # noqa: B018 -- an unknown system fails here, when the game loads
         except UnsupportedSystemError as exc:
             raise UnsupportedSystemError(f"{info.source}: {exc}") from exc
         return self
@@ -296,6 +303,11 @@ def _is_game_folder(path: Path) -> bool:
     return any((path / marker).is_file() for marker in ("game.yaml", "rom.sha", "data.json"))
 
 
+def _is_scenario_folder(path: Path) -> bool:
+    """Whether a folder without a data file holds scenario files (to add to a game found elsewhere)."""
+    return any(p.name not in _NOT_SCENARIOS for pattern in ("*.yaml", "*.json") for p in path.glob(pattern))
+
+
 def _index() -> dict[str, tuple[Path, ...]]:
     """Map each game name to its folders, in search order (cached until a search folder changes)."""
     dirs = paths.game_search_dirs()
@@ -303,15 +315,20 @@ def _index() -> dict[str, tuple[Path, ...]]:
     if key in _index_cache:
         return _index_cache[key]
     index: dict[str, list[Path]] = {}
+    has_data: set[str] = set()
     for directory in dirs:
         with os.scandir(directory) as entries:
             for entry in sorted(entries, key=lambda e: e.name):
                 if entry.name[:1] in "._" or not entry.is_dir():
                     continue
-                path = Path(entry.path)
+                path, name = Path(entry.path), normalize_name(entry.name)
                 if _is_game_folder(path):
-                    index.setdefault(normalize_name(entry.name), []).append(path)
-    result = {name: tuple(folders) for name, folders in sorted(index.items())}
+                    has_data.add(name)
+                elif not _is_scenario_folder(path):
+                    continue
+                index.setdefault(name, []).append(path)
+    # A name with scenario folders only is no game: nothing says its system, ROM or fields.
+    result = {name: tuple(folders) for name, folders in sorted(index.items()) if name in has_data}
     _index_cache.clear()
     _index_cache[key] = result
     return result
@@ -376,10 +393,11 @@ def find_game(name: str) -> Game:
 _sha1_cache: dict[tuple[str, int, int, str], str] = {}
 
 
-def cached_rom_sha1(path: Path, system: str) -> str:
+def cached_rom_sha1(path: Path, system: System | str) -> str:
     """Return a ROM file's SHA-1 (stable-retro's rules), hashed once per file version."""
+    system = get_system(system)
     stat = path.stat()
-    key = (str(path), stat.st_size, stat.st_mtime_ns, system)
+    key = (str(path), stat.st_size, stat.st_mtime_ns, system.name)
     if key not in _sha1_cache:
         _sha1_cache[key] = roms.rom_sha1(path, system)
     return _sha1_cache[key]

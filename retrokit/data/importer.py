@@ -29,6 +29,7 @@ from retrokit import paths
 from retrokit.data import roms
 from retrokit.data.games import Game, list_games
 from retrokit.errors import RetrokitError, RomError
+from retrokit.host.systems import extension_of
 
 MAX_ZIP_DEPTH = 3
 MAX_NESTED_ZIP_SIZE = 256 * 2**20
@@ -155,7 +156,10 @@ def _zip_candidates(label: str, opener: Callable[[], zipfile.ZipFile], report: I
                 if info.is_dir():
                     continue
                 member = f"{label}!{info.filename}"
-                ext = roms.file_extension(info.filename)
+                ext = extension_of(info.filename)
+                if _too_big(info.file_size) and ext != "zip":  # declared too big: no need to read it
+                    report.skipped.append((member, _TOO_BIG))
+                    continue
                 try:
                     if ext == "zip" and depth < MAX_ZIP_DEPTH:
                         yield from _nested_zip_candidates(member, archive, info, report, depth)
@@ -213,7 +217,7 @@ def _read_file(path: Path) -> bytes:
 
 
 def _file_candidates(path: Path, report: ImportReport) -> Iterator[_Candidate]:
-    label, ext = str(path), roms.file_extension(path)
+    label, ext = str(path), extension_of(path)
     size = _regular_file_size(path, report)
     if size is None:
         return

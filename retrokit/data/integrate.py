@@ -33,7 +33,6 @@ from retrokit.data.states import StateRecord, write_state
 from retrokit.errors import DataFileError, InvalidArgumentError, StateError, StateNotFoundError, did_you_mean
 from retrokit.host.emulator import Emulator
 from retrokit.host.memory import FieldReader
-from retrokit.host.systems import get_system
 
 HOLD_FRAMES = 2  # a press is held this long, then released as long, until arrival
 CHECK_FRAMES = 60  # frames run from a state to compare two states
@@ -137,7 +136,7 @@ def _press(game: Game, where: str, raw: Any) -> dict[int, tuple[str, ...]]:
     if raw is None:
         return {}
     by_port = raw if isinstance(raw, Mapping) else {1: raw}
-    system = get_system(game.system)
+    system = game.system
     press = {}
     for port, buttons in by_port.items():
         number = _integer(port)
@@ -234,7 +233,7 @@ def integrate(game: Game, names: list[str] | None = None, *, force: bool = False
     if not known:
         raise StateNotFoundError(
             f"Expected state recipes under 'integrate' in {game.info.source}; found none. "
-            f"Add one per state (see retrokit/integrate.py)."
+            f"Add one per state (see retrokit/data/integrate.py)."
         )
     wanted = list(known) if names is None else names
     outcomes = []

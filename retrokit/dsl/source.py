@@ -13,10 +13,27 @@ and prints the source line with carets under the offending text::
 from __future__ import annotations
 
 import bisect
-from collections.abc import Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 
-from retrokit.errors import RetrokitError
+from retrokit.errors import RetrokitError, ScenarioError
+
+
+def read_source(path: Path) -> str:
+    """Return a scenario file's text.
+
+    Raises:
+        ScenarioError: The file cannot be read, or is not UTF-8 text.
+    """
+    try:
+        return path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ScenarioError(f"cannot read scenario file {str(path)!r}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(
+            f"{path}: expected a UTF-8 text file; found a byte that is not UTF-8 at offset {exc.start}. "
+            "Save the scenario as UTF-8 text."
+        ) from None
 
 
 @dataclass(frozen=True)
@@ -136,9 +153,3 @@ def located(cls: type[RetrokitError], source: SourceText, start: int, end: int, 
     err.file, err.line, err.column = source.name, line, col  # type: ignore[attr-defined]
     return err
 
-
-def choices_text(names: Sequence[str], limit: int = 12) -> str:
-    """Return ``'a', 'b', ... (and N more)`` for a message."""
-    shown = ", ".join(repr(n) for n in list(names)[:limit])
-    more = len(names) - limit
-    return shown + (f" (and {more} more)" if more > 0 else "")

@@ -64,7 +64,7 @@ def check_movie_state(movie: Movie, emu: Emulator, source: str) -> None:
     try:
         game = find_game(movie.game)
     except (GameNotFoundError, DataFileError):  # a movie of a game retrokit does not know: probe it all the same
-        vet_state(movie.state, emu.system.name, emu.rom, cached_rom_sha1(emu.rom, emu.system.name), source=source)
+        vet_state(movie.state, emu.system.name, emu.rom, cached_rom_sha1(emu.rom, emu.system), source=source)
         return
     check_state(game, movie.state, record, source=source, rom=emu.rom)
 

@@ -26,6 +26,7 @@ from pathlib import Path
 
 from retrokit import paths
 from retrokit.errors import RetrokitError, StateError
+from retrokit.host.systems import System, get_system
 
 PROBE_FRAMES = 300
 """Frames run from a probed state: five seconds of play, long enough for a corrupt body to show."""
@@ -67,12 +68,21 @@ def _child_limits() -> None:
 
 
 def probe_state(
-    state: bytes, system: str, rom: str | os.PathLike[str], *, frames: int = PROBE_FRAMES, timeout: float = PROBE_TIMEOUT
+    state: bytes, system: str | System, rom: str | os.PathLike[str], *, frames: int = PROBE_FRAMES,
+    timeout: float = PROBE_TIMEOUT,
 ) -> ProbeVerdict:
     """Load ``state`` on ``rom`` in a child process and run ``frames`` frames; report how the child ended.
 
     This is not cached: see :func:`vet_state`.
+
+    Args:
+        state: The serialized state (uncompressed).
+        system: The system (a name or descriptor).
+        rom: The ROM to load it on.
+        frames: How many frames to run after loading it.
+        timeout: Seconds before the child counts as hung, and is killed.
     """
+    system = get_system(system).name
     with tempfile.NamedTemporaryFile(prefix="retrokit-probe-", suffix=".bin") as tmp:
         tmp.write(state)
         tmp.flush()
@@ -115,7 +125,7 @@ def _remember(key: str, verdict: ProbeVerdict, data_dir: Path | None) -> None:
 
 
 def vet_state(
-    state: bytes, system: str, rom: str | os.PathLike[str], rom_sha1: str, *, source: str,
+    state: bytes, system: str | System, rom: str | os.PathLike[str], rom_sha1: str, *, source: str,
     data_dir: str | os.PathLike[str] | None = None,
 ) -> None:
     """Refuse a state that crashes or hangs the core, probing it in a child once per machine.
@@ -131,6 +141,7 @@ def vet_state(
     Raises:
         StateError: The state crashed, hung or was refused in the child.
     """
+    system = get_system(system).name
     folder = Path(data_dir) if data_dir is not None else None
     key = probe_key(state, system, rom_sha1)
     verdict = _cached(key, folder)

@@ -63,7 +63,7 @@ def check_state(
         if record.rom_sha1 == rom_sha1 and record.describes(data):
             return  # exactly what retrokit wrote for this ROM
     if not trusted:
-        vet_state(data, game.system.name, rom, rom_sha1, source=source)
+        vet_state(data, game.system, rom, rom_sha1, source=source)
 
 
 def load_state(game: Game, path: str | Path) -> bytes:

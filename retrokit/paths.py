@@ -22,6 +22,7 @@ import functools
 import importlib.metadata
 import importlib.util
 import os
+import stat
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
@@ -246,3 +247,27 @@ def ensure_folder(folder: Path | str, purpose: str = "written") -> Path:
             f"Expected a folder at {str(folder)!r} {purpose}; found {reason}. Choose another place, or move the file."
         ) from None
     return folder
+
+
+def require_regular_file(path: Path | str, what: str) -> Path:
+    """Return ``path`` if it is a regular file (symlinks followed).
+
+    A FIFO would block a reader forever and a device (``/dev/zero``) never
+    end, so neither is ever read as a data file.
+
+    Args:
+        path: The file.
+        what: What it should be, for the error (``"a .bk2 movie"``).
+
+    Raises:
+        FileSystemError: ``path`` is missing, a folder, a device, a FIFO or a socket.
+    """
+    path = Path(path)
+    try:
+        mode = path.stat().st_mode
+    except OSError as exc:
+        raise FileSystemError(f"Expected {what} at {str(path)!r}; found {exc.strerror or exc}.") from None
+    if not stat.S_ISREG(mode):
+        kind = "a folder" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode) else "a device or socket"
+        raise FileSystemError(f"Expected {what} at {str(path)!r}; found {kind}, which is not a file retrokit reads.")
+    return path

@@ -8,10 +8,12 @@ folder is one in /proc, where nothing can be created.
 
 from __future__ import annotations
 
+import os
 import shutil
 from pathlib import Path
 
 import pytest
+from childproc import run_cli
 
 from retrokit import paths
 from retrokit.cli import ERROR_STATUS, main
@@ -105,3 +107,18 @@ def test_the_cli_turns_a_stray_os_error_into_one_line(capsys, monkeypatch: pytes
     monkeypatch.setattr(games, "run", broken)
     assert main(["games"]) == ERROR_STATUS
     assert capsys.readouterr().err == "retrokit: error: a file operation failed (/somewhere): Permission denied.\n"
+
+
+SPECIAL = {"fifo": lambda path: os.mkfifo(path), "symlink-to-dev-zero": lambda path: path.symlink_to("/dev/zero")}
+READERS = {"playback-movie": (["playback", "{path}", "out.gif"], ".bk2"), "convert-scenario": (["convert", "{path}"], ".json")}
+
+
+@pytest.mark.parametrize("special", list(SPECIAL), ids=list(SPECIAL))
+@pytest.mark.parametrize("reader", list(READERS), ids=list(READERS))
+def test_a_fifo_or_device_given_as_input_is_refused_not_read(tmp_path: Path, special: str, reader: str) -> None:
+    args, suffix = READERS[reader]
+    path = tmp_path / f"input{suffix}"
+    SPECIAL[special](path)
+    child = run_cli([a.format(path=path) for a in args], timeout=30, cwd=tmp_path)
+    assert child.returncode == ERROR_STATUS, child.describe()
+    assert "which is not a file retrokit reads" in child.stderr.strip().splitlines()[-1], child.describe()

@@ -38,7 +38,7 @@ from pathlib import Path
 from retrokit.data.states import MAX_STATE_SIZE
 from retrokit.errors import FileConflictError, MovieError, UnsupportedSystemError
 from retrokit.movie.model import Layout, Movie, layout, platform_of, system_of_platform
-from retrokit.paths import atomic_write
+from retrokit.paths import atomic_write, require_regular_file
 
 MAX_TEXT_SIZE = 32 * 2**20
 """The largest header or input log read: about a million frames (over four hours at 60 fps)."""
@@ -62,6 +62,10 @@ def read_bk2(path: str | os.PathLike[str]) -> Movie:
             the file, what was expected and what was found.
     """
     path = Path(path)
+    if path.is_dir():
+        raise MovieError(f"Expected a .bk2 movie at {path}; found a folder.")
+    if path.exists():
+        require_regular_file(path, "a .bk2 movie")  # a FIFO would block, a device never end
     try:
         with zipfile.ZipFile(path) as archive:
             names = archive.namelist()

@@ -214,3 +214,23 @@ def test_a_recorded_movie_names_its_rom_and_state(tmp_path: Path) -> None:
     game = find_game("Dasher-Genesis")
     assert movie.header["SHA1"] == game.sha1s[0]
     assert StateRecord.of(game.name, game.sha1s[0], movie.state).sha256 == movie.header["StateSHA256"]
+
+
+def test_make_refuses_a_state_from_another_games_folder(airstriker_dir: Path) -> None:
+    import retrokit
+    from retrokit.paths import wheel_data_dirs
+
+    sonic = next(d / "SonicTheHedgehog-Genesis-v0" for d in wheel_data_dirs() if (d / "SonicTheHedgehog-Genesis-v0").is_dir())
+    with pytest.raises(StateError, match="in the folder of SonicTheHedgehog-Genesis, a game on another ROM"):
+        retrokit.make("Airstriker-Genesis", str(sonic / "GreenHillZone.Act1.state"))
+
+
+def test_games_sharing_a_rom_may_share_states(tmp_path: Path, good_state: bytes, monkeypatch) -> None:
+    from retrokit.data.statecheck import load_state
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    twin = tmp_path / "DasherTwin-Genesis"  # another integration of Dasher's ROM, with a state of its own
+    twin.mkdir()
+    shutil.copy(DASHER / "game.yaml", twin / "game.yaml")
+    (twin / "Start.state").write_bytes(compress_state(good_state))  # as stable-retro writes it: no record
+    assert load_state(find_game("Dasher-Genesis"), twin / "Start.state") == good_state

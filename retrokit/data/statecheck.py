@@ -4,7 +4,9 @@ A state is loaded only if it is for the game's ROM and cannot crash the core:
 
 - a state retrokit wrote records the game and the SHA-1 of its ROM
   (:class:`~retrokit.data.states.StateRecord`); one recorded for a ROM the game
-  does not accept is refused, naming the game it is for;
+  does not accept is refused, naming the game it is for; one without a record
+  that sits in another game's folder (where stable-retro keeps each game's
+  states) is refused too, unless the two games share a ROM;
 - a state that is exactly what retrokit recorded, or that ships with retrokit
   or the stable-retro wheel, is trusted as it is;
 - any other state (a user's, stable-retro's, one changed since retrokit wrote
@@ -17,10 +19,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from retrokit import paths
-from retrokit.data.games import Game, cached_rom_sha1
+from retrokit.data.games import Game, cached_rom_sha1, load_game
 from retrokit.data.probe import vet_state
 from retrokit.data.states import StateRecord, read_state_file
-from retrokit.errors import StateError
+from retrokit.errors import RetrokitError, StateError
 
 
 def is_shipped(path: Path) -> bool:
@@ -74,6 +76,27 @@ def load_state(game: Game, path: str | Path) -> bytes:
     """
     path = Path(path)
     state = read_state_file(path)
+    if state.record is None:
+        _check_folder(game, path)
     check_state(game, state.data, state.record, source=str(path), trusted=is_shipped(path))
     return state.data
+
+
+def folder_game(path: Path) -> Game | None:
+    """The game whose integration folder holds the file ``path``, or ``None`` if its folder is no game's."""
+    try:
+        return load_game(path.resolve().parent)
+    except (RetrokitError, OSError):
+        return None
+
+
+def _check_folder(game: Game, path: Path) -> None:
+    """Refuse a state kept in another game's folder, as stable-retro keeps each game's states, unless the two share a ROM."""
+    owner = folder_game(path)
+    if owner is None or owner.name == game.name or set(owner.sha1s) & set(game.sha1s):
+        return
+    raise StateError(
+        f"{path}: expected a state of {game.name}; found one in the folder of {owner.name}, a game on another "
+        f"ROM, where it plays garbage. Load it with {owner.name}, or pick a state of {game.name}."
+    )
 

@@ -108,3 +108,18 @@ def test_gif_frame_delays_add_up_to_the_true_time(fps: float, step: int, delays:
     writer = GifWriter(io.BytesIO(), fps / step)
     assert [writer.delay_ms(i) for i in range(3)] == delays
     assert sum(writer.delay_ms(i) for i in range(300)) == round(300 * 1000 * step / fps, -1)
+
+
+@pytest.mark.parametrize("member", ["Input Log.txt", "Header.txt"], ids=["input-log-bomb", "header-bomb"])
+def test_a_movie_member_that_inflates_to_a_gigabyte_is_refused(tmp_path: Path, member: str) -> None:
+    from bombs import zip_bytes
+    from childproc import MAX_RSS_MB, run_cli
+
+    small = {"Input Log.txt": b"[Input]\nP1 B|\n|..|.|\n[/Input]", "Header.txt": b"Platform GEN\nGameName Dasher-Genesis-v0\n"}
+    members = [(name, [1024] if name == member else [data], True) for name, data in small.items()]
+    path = tmp_path / "bomb.bk2"
+    path.write_bytes(zip_bytes(members))
+    child = run_cli(["playback", str(path), str(tmp_path / "out")], timeout=60)
+    assert child.returncode == 2, child.describe()
+    assert f"expected {member!r} to hold at most" in child.stderr, child.describe()
+    assert child.peak_rss_mb < MAX_RSS_MB, child.describe()

@@ -66,6 +66,26 @@ class CoreNotFoundError(CoreError):
     """No libretro core for a system was found in any search location."""
 
 
+class CoreBuildError(RetrokitError):
+    """Building a core from source failed (retrokit build-core)."""
+
+
+class BuildToolError(CoreBuildError):
+    """A tool the build needs (a C compiler, make, pip) is not installed."""
+
+
+class SourceFetchError(CoreBuildError):
+    """The package index could not be reached to fetch a core's source."""
+
+
+class SourceNotFoundError(CoreBuildError):
+    """The package index has no source package (sdist) of that stable-retro version."""
+
+
+class PatchError(CoreBuildError):
+    """A patch does not apply to the source it was given."""
+
+
 class UnsupportedSystemError(UnknownNameError):
     """A ROM, file extension or system name maps to no known system."""
 

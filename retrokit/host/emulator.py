@@ -134,6 +134,29 @@ class Emulator:
             raise InvalidArgumentError(f"Expected a sticky-action probability in [0, 1], got {prob}.")
         self._emu.set_sticky(float(prob), int(seed) & 0xFFFFFFFFFFFFFFFF)
 
+    def set_video_frames(self, which: str) -> None:
+        """Tell the core which frames of each ``run`` anyone will look at.
+
+        The host answers libretro's ``GET_AUDIO_VIDEO_ENABLE`` with it: a core
+        that asks (the Genesis Plus GX ``retrokit build-core`` makes) skips
+        drawing the others; emulation, and so RAM, is unchanged. With
+        ``"last"`` or ``"none"`` audio is reported unwanted unless captured.
+
+        Args:
+            which: ``"all"`` (the default), ``"last"`` or ``"none"``.
+        """
+        modes = {"all": primitives.VIDEO_ALL, "last": primitives.VIDEO_LAST, "none": primitives.VIDEO_NONE}
+        if which not in modes:
+            raise InvalidArgumentError(
+                f"Expected video frames 'all', 'last' or 'none', got {which!r}." + did_you_mean(str(which), modes)
+            )
+        self._emu.set_video_frames(modes[which])
+
+    @property
+    def av_asked(self) -> int:
+        """How often the core asked whether video and audio are wanted (0: it never asks, so never skips)."""
+        return self._emu.av_asked
+
     def forget_action(self) -> None:
         """Make the next ``run`` apply its buttons from its first frame."""
         self._emu.forget_action()

@@ -188,6 +188,7 @@ int rk_core_open(rk_core *core, const char *path, const char *system_dir, const 
     core->system_dir = strdup(system_dir);
     core->save_dir = strdup(save_dir);
     core->pixel_format = RK_RETRO_PIXEL_FORMAT_0RGB1555;
+    core->av_enable = 1 | 2; /* video and audio, until a run says otherwise */
     rk_enter(core);
     core->api.set_environment(rk_cb_environment);
     core->api.set_video_refresh(rk_cb_video);
@@ -286,6 +287,9 @@ void rk_core_run(rk_core *core, const uint16_t *actions, int n_ports, int frames
     for (int f = 0; f < frames; f++) {
         /* The first frame of a new action keeps the last applied one when it sticks. */
         memcpy(core->buttons, (f == 0 && stick) ? core->held : action, sizeof core->buttons);
+        int all = core->video_frames == RK_VIDEO_ALL;
+        core->av_enable = (all || (core->video_frames == RK_VIDEO_LAST && f == frames - 1)) |
+                          (all || core->capture_audio) << 1;
         core->api.run();
         core->frame++;
     }

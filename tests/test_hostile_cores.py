@@ -92,3 +92,10 @@ def test_side_by_side_emulators_still_get_private_copies(dasher_rom: Path) -> No
         one.ram[0] = 0x55
         two.ram[0] = 0xAA
         assert one.ram[0] == 0x55
+
+
+@pytest.mark.parametrize("core", sorted(CORE.parent.glob("*_libretro.so")), ids=lambda p: p.name)
+def test_every_wheel_core_passes_the_elf_check(core: Path) -> None:
+    from retrokit.host.elf import check_core_file
+
+    check_core_file(core)

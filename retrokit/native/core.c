@@ -7,14 +7,12 @@
 #include "video.h"
 
 #include <dlfcn.h>
-#include <elf.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 _Thread_local rk_core *rk_current;
@@ -30,63 +28,6 @@ void rk_set_error(rk_core *core, const char *fmt, ...) {
 }
 
 /* ---- loading a private copy ---------------------------------------------------------------- */
-
-/* A truncated or damaged shared library makes the loader fault (SIGBUS on pages past the end
- * of the file): check that the ELF header is this machine's and that every segment and section
- * table it names lies inside the file, before dlopen maps it. */
-#if UINTPTR_MAX == 0xffffffffffffffffULL
-typedef Elf64_Ehdr rk_ehdr;
-typedef Elf64_Phdr rk_phdr;
-#define RK_ELFCLASS ELFCLASS64
-#else
-typedef Elf32_Ehdr rk_ehdr;
-typedef Elf32_Phdr rk_phdr;
-#define RK_ELFCLASS ELFCLASS32
-#endif
-#if defined(__x86_64__)
-#define RK_MACHINE EM_X86_64
-#elif defined(__aarch64__)
-#define RK_MACHINE EM_AARCH64
-#elif defined(__i386__)
-#define RK_MACHINE EM_386
-#elif defined(__arm__)
-#define RK_MACHINE EM_ARM
-#endif
-
-static int check_elf(rk_core *core, const char *path, int fd) {
-    struct stat st;
-    rk_ehdr eh;
-    if (fstat(fd, &st) || pread(fd, &eh, sizeof eh, 0) != (ssize_t)sizeof eh || memcmp(eh.e_ident, ELFMAG, SELFMAG)) {
-        rk_set_error(core, "%s is not a shared library: expected an ELF file; found %s", path,
-                     "another kind of file, or one too short for an ELF header");
-        return -1;
-    }
-    uint64_t size = (uint64_t)st.st_size;
-    int ours = eh.e_ident[EI_CLASS] == RK_ELFCLASS && eh.e_type == ET_DYN && eh.e_phentsize == sizeof(rk_phdr);
-#ifdef RK_MACHINE
-    ours = ours && eh.e_machine == RK_MACHINE;
-#endif
-    if (!ours) {
-        rk_set_error(core, "%s is not a shared library for this machine (ELF class %d, type %d, machine %d)", path,
-                     eh.e_ident[EI_CLASS], eh.e_type, eh.e_machine);
-        return -1;
-    }
-    uint64_t need = (uint64_t)eh.e_phoff + (uint64_t)eh.e_phnum * eh.e_phentsize;
-    if (eh.e_shnum && (uint64_t)eh.e_shoff + (uint64_t)eh.e_shnum * eh.e_shentsize > need)
-        need = (uint64_t)eh.e_shoff + (uint64_t)eh.e_shnum * eh.e_shentsize;
-    for (unsigned i = 0; i < eh.e_phnum && need <= size; i++) {
-        rk_phdr ph;
-        if (pread(fd, &ph, sizeof ph, (off_t)(eh.e_phoff + (uint64_t)i * sizeof ph)) != (ssize_t)sizeof ph) break;
-        if ((uint64_t)ph.p_offset + ph.p_filesz > need) need = (uint64_t)ph.p_offset + ph.p_filesz;
-    }
-    if (need > size) {
-        rk_set_error(core, "%s is truncated or damaged: its ELF headers describe %llu bytes; the file has %llu. "
-                     "Reinstall the core (pip install --force-reinstall stable-retro)", path,
-                     (unsigned long long)need, (unsigned long long)size);
-        return -1;
-    }
-    return 0;
-}
 
 /* Copies the core to a temporary file, unlinks it at once (a crash can leave no file behind)
  * and returns its open descriptor, which names the copy for dlopen. */
@@ -118,7 +59,6 @@ static int copy_to_private_file(rk_core *core, const char *path) {
     if (n < 0) rc = -1;
     if (rc) rk_set_error(core, "cannot copy the core %s to %s: %s", path, name, strerror(errno));
     close(src);
-    if (!rc) rc = check_elf(core, path, dst);
     if (rc) {
         close(dst);
         return -1;

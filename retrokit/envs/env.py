@@ -20,7 +20,7 @@ import numpy as np
 from gymnasium import spaces
 
 from retrokit.data.games import Game, find_game
-from retrokit.data.states import read_state
+from retrokit.data.statecheck import load_state
 from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
 from retrokit.envs.stepper import Stepper, drive
@@ -146,13 +146,13 @@ class RetroEnv(gymnasium.Env):
         if state is None or state is State.DEFAULT:
             by_players = self.game.default_player_states
             name = by_players[self.players - 1] if len(by_players) >= self.players else self.game.default_state
-            return (name, read_state(self.game.state_path(name))) if name else (None, None)
+            return (name, load_state(self.game, self.game.state_path(name))) if name else (None, None)
         if state is State.NONE:
             return None, None
         path = Path(state)
         if path.suffix == ".state" and path.is_file():
-            return path.stem, read_state(path)
-        return str(state), read_state(self.game.state_path(str(state)))
+            return path.stem, load_state(self.game, path)
+        return str(state), load_state(self.game, self.game.state_path(str(state)))
 
     def _load_scenario(self, scenario: str | os.PathLike[str] | Mapping[str, Any] | None) -> Any:
         from retrokit.dsl.scenario import load_scenario

@@ -114,6 +114,7 @@ class PlaySession:
     def toggle_movie(self) -> Path | None:
         """Start recording a movie from now, or stop and write the one being recorded (returning its path)."""
         if self.recorder is None:
+            (self.folder / "movies").mkdir(parents=True, exist_ok=True)
             path = claim_movie_path(self.folder / "movies", self.name)
             self.recorder = MovieRecorder(path, self.game.name, self.game.system.name, 1, self.emulator.get_state())
             print(f"recording {path}")

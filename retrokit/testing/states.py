@@ -9,8 +9,9 @@ Without the ROM no core can load a state; the files are then parsed: the
 gzip stream, the core's signature and, where the layout is known
 (:func:`retrokit.data.states.state_ram`), the fields read from the RAM inside.
 
-A state is flagged as not the game's own when it is a copy of another game's
-state file, or when it does not reach what its recipe in ``game.yaml``
+A state is flagged as not the game's own when retrokit recorded it on another
+ROM (:class:`~retrokit.data.states.StateRecord`), when it is a copy of another
+game's state file, or when it does not reach what its recipe in ``game.yaml``
 (``integrate``) says it should: the recipe's ``set`` and ``until`` values.
 """
 
@@ -229,6 +230,10 @@ def check_states(game: Game, report: GameReport, rom: Path | None) -> dict[str, 
             report.add("state parses", PASS, probe.detail, state=name)
         else:
             report.add("state loads", PASS, f"loaded and ran {IDLE_FRAMES} frames in a child process", state=name)
+        foreign = _recorded_elsewhere(game, Path(probe.path))
+        if foreign:
+            report.add("state is the game's", FAIL, foreign, state=name)
+            continue
         if name in copies:
             report.add("state is the game's", FAIL,
                        f"expected a state made with {game.name}'s ROM; found a copy of {copies[name]}. "
@@ -255,6 +260,21 @@ def check_states(game: Game, report: GameReport, rom: Path | None) -> dict[str, 
                        state=name)
         good[name] = probe
     return good
+
+
+def _recorded_elsewhere(game: Game, path: Path) -> str:
+    """Why a state retrokit wrote is another ROM's (from the record in its file), or ``""``."""
+    from retrokit.data.states import read_state_file
+
+    try:
+        record = read_state_file(path).record
+    except RetrokitError:
+        return ""  # an unreadable file already failed to load
+    if record is None or not game.sha1s or record.rom_sha1 in game.sha1s:
+        return ""
+    of = f" (a state of {record.game})" if record.game != game.name else ""
+    return (f"expected a state made with {game.name}'s ROM ({', '.join(game.sha1s)}); found one retrokit recorded "
+            f"on the ROM with SHA-1 {record.rom_sha1}{of}. Remake it with this game's ROM.")
 
 
 def _sample(values: Mapping[str, int], limit: int = 6) -> str:

@@ -42,12 +42,19 @@ class SchemaIssue:
         line: 1-based line.
         column: 1-based column.
         message: What is wrong there and how to fix it.
+        keyword: The JSON Schema keyword it breaks, e.g. ``"additionalProperties"`` for an unknown key.
     """
 
     file: str
     line: int
     column: int
     message: str
+    keyword: str = ""
+
+    @property
+    def unknown_key(self) -> bool:
+        """Whether the issue is a key the schema does not know (often a typo)."""
+        return self.keyword == "additionalProperties"
 
     def __str__(self) -> str:
         return f"{self.file}:{self.line}:{self.column}: {self.message}"
@@ -100,7 +107,7 @@ def check_text(text: str, kind: str, name: str = "<text>") -> list[SchemaIssue]:
     errors = sorted(_validator(kind).iter_errors(document), key=lambda e: list(map(str, e.absolute_path)))
     for error in errors:
         node, message = _locate(root, error)
-        issues.append(SchemaIssue(name, node.start_mark.line + 1, node.start_mark.column + 1, message))
+        issues.append(SchemaIssue(name, node.start_mark.line + 1, node.start_mark.column + 1, message, error.validator))
     return sorted(issues, key=lambda i: (i.line, i.column))
 
 
@@ -108,7 +115,7 @@ def raise_first(issues: list[SchemaIssue]) -> None:
     """Raise the first issue as a :class:`DataFileError` (nothing if there are none)."""
     if issues:
         # An unknown key is often the cause of a missing one ('untill:'), so it goes first.
-        issues = sorted(issues, key=lambda i: not i.message.startswith("unknown key"))
+        issues = sorted(issues, key=lambda i: not i.unknown_key)
         more = f" ({len(issues) - 1} more problem{'s' * (len(issues) > 2)} in the file)" if len(issues) > 1 else ""
         raise DataFileError(f"{issues[0]}{more}")
 

@@ -127,6 +127,10 @@ class FileConflictError(RetrokitError, FileExistsError):
     """Writing would replace a different file the user already has."""
 
 
+class FileSystemError(RetrokitError, OSError):
+    """A file or folder cannot be read or written: a file where a folder should be, no permission, a full disk."""
+
+
 class MovieError(RetrokitError, ValueError):
     """A .bk2 movie is malformed or does not fit the game it is played on."""
 

@@ -20,7 +20,7 @@ import numpy as np
 from gymnasium import spaces
 
 from retrokit.data.games import Game, find_game
-from retrokit.data.states import read_state
+from retrokit.data.statecheck import load_state
 from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
 from retrokit.envs.compat import StableRetroCompat
@@ -45,7 +45,7 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
     """A game as a Gymnasium environment.
 
     Args:
-        game: The game's name, e.g. ``"Airstriker-Genesis"``.
+        game: The game's name, e.g. ``"Airstriker-Genesis"``, or a loaded :class:`Game`.
         state: A state name, a ``.state`` path, or a :class:`State`.
         scenario: A scenario name of the game, a path to a ``.yaml`` or
             Gym Retro ``.json`` scenario, or ``None`` for the game's default.
@@ -70,7 +70,7 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
 
     def __init__(
         self,
-        game: str,
+        game: str | Game,
         state: str | os.PathLike[str] | State | None = State.DEFAULT,
         scenario: str | os.PathLike[str] | Mapping[str, Any] | None = None,
         *,
@@ -86,7 +86,7 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
         options: Mapping[str, str] | None = None,
         skip_video: bool = True,
     ) -> None:
-        self.game: Game = find_game(game)
+        self.game: Game = game if isinstance(game, Game) else find_game(game)
         _check_choice("obs_type", obs_type, OBS_TYPES)
         _check_choice("render_mode", render_mode, (None, *self.metadata["render_modes"]))
         if not isinstance(frameskip, int) or frameskip < 1:
@@ -149,13 +149,13 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
         if state is None or state is State.DEFAULT:
             by_players = self.game.default_player_states
             name = by_players[self.players - 1] if len(by_players) >= self.players else self.game.default_state
-            return (name, read_state(self.game.state_path(name))) if name else (None, None)
+            return (name, load_state(self.game, self.game.state_path(name))) if name else (None, None)
         if state is State.NONE:
             return None, None
         path = Path(state)
         if path.suffix == ".state" and path.is_file():
-            return path.stem, read_state(path)
-        return str(state), read_state(self.game.state_path(str(state)))
+            return path.stem, load_state(self.game, path)
+        return str(state), load_state(self.game, self.game.state_path(str(state)))
 
     def _load_scenario(self, scenario: str | os.PathLike[str] | Mapping[str, Any] | None) -> Any:
         from retrokit.dsl.scenario import load_scenario
@@ -312,7 +312,7 @@ def _check_choice(name: str, value: object, choices: tuple[object, ...]) -> None
 
 
 def make(
-    game: str,
+    game: str | Game,
     state: str | os.PathLike[str] | State | None = State.DEFAULT,
     scenario: str | os.PathLike[str] | Mapping[str, Any] | None = None,
     **options: Any,

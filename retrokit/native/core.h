@@ -77,6 +77,7 @@ typedef struct {
 
 typedef struct rk_core {
     void *handle;
+    int copy_fd; /* the unlinked private copy's descriptor + 1 (0: none), open while loaded */
     rk_core_api api;
     int initialized;
     int game_loaded;

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 import retrokit
+from retrokit.data.games import find_game
 from retrokit.envs import sonic
 from retrokit.envs.env import RetroEnv
 from retrokit.envs.options import OPTIONS
@@ -148,6 +149,12 @@ WRONG = [
 def test_wrongly_typed_argument_is_an_invalid_argument_error(args: tuple, kwargs: dict, message: str) -> None:
     with pytest.raises(InvalidArgumentError, match=message):
         retrokit.make(*args, **kwargs)
+
+
+def test_a_game_object_is_taken_as_well_as_a_name() -> None:
+    env = retrokit.make(find_game(DASHER), frameskip=2)
+    assert env.game.name == DASHER
+    env.close()
 
 
 @pytest.mark.parametrize(

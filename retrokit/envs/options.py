@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from retrokit.data.games import Game
 from retrokit.envs.actions import ACTION_TYPES
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean, shown
 
@@ -150,7 +151,7 @@ def make_arguments(game: object, state: object, scenario: object, options: Mappi
     """Check everything ``retrokit.make`` was given; return RetroEnv's keyword arguments.
 
     Args:
-        game: The game's name.
+        game: The game's name, or a :class:`~retrokit.data.games.Game`.
         state: A state name or ``.state`` path, a :class:`~retrokit.envs.env.State`, or ``None``.
         scenario: A scenario name or path, a scenario dict, or ``None``.
         options: The keyword options.
@@ -159,9 +160,9 @@ def make_arguments(game: object, state: object, scenario: object, options: Mappi
         UnknownNameError: A keyword is not an option.
         InvalidArgumentError: An argument has the wrong type or range.
     """
-    if not isinstance(game, str) or not game:
+    if not (isinstance(game, Game) or (isinstance(game, str) and game)):
         raise InvalidArgumentError(
-            f"Expected game to be a game's name (str), got {shown(game)}; pass e.g. 'Airstriker-Genesis' "
+            f"Expected game to be a game's name (str) or a Game, got {shown(game)}; pass e.g. 'Airstriker-Genesis' "
             f"(`retrokit games` lists them)."
         )
     if not (state is None or isinstance(state, (str, os.PathLike, enum.Enum))):

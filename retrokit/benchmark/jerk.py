@@ -100,13 +100,11 @@ class Jerk:
         while True:
             if new_episode:
                 if self.sequences and self.rng.random() < self.beta + self.timesteps / self.budget:
-                    self.sequences.sort(key=lambda s: s.mean)  # stable: among equal means, the later one
-                    best = self.sequences[-1]
-                    self.events.append(("replay", self.timesteps))
+                    best = self.best()
                     best.rewards.append(self.replay(best.actions))
                     continue
-                self.events.append(("explore", self.timesteps))
                 self._reset()
+                self.events.append(("explore", self.timesteps))
                 new_episode = False
             gained, new_episode = self.move(self.right_steps, left=False)
             if not new_episode and gained <= 0:
@@ -114,6 +112,11 @@ class Jerk:
                 _, new_episode = self.move(self.left_steps, left=True)
             if new_episode:
                 self.sequences.append(Solution(self.best_prefix(), [max(self._cumulative)]))
+
+    def best(self) -> Solution:
+        """The sequence of highest mean reward (of equal means, the one ranked last before)."""
+        self.sequences.sort(key=lambda s: s.mean)  # stable, as the baselines' sorted() was
+        return self.sequences[-1]
 
     def move(self, steps: int, *, left: bool) -> tuple[float, bool]:
         """Run one way for ``steps`` steps, jumping now and then; return the reward and whether the episode ended."""
@@ -133,6 +136,7 @@ class Jerk:
     def replay(self, actions: list[Any]) -> float:
         """Play ``actions`` from a reset, then no-ops until the episode ends; return its total reward."""
         self._reset()
+        self.events.append(("replay", self.timesteps))
         index, done = 0, False
         while not done:
             _, done = self._step(actions[index] if index < len(actions) else self.noop)

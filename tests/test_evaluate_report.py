@@ -75,3 +75,10 @@ def test_a_damaged_paper_file_is_treated_as_absent(tmp_path, monkeypatch) -> Non
     (tmp_path / "test-scores.csv").write_bytes(b"agent,game\n\xff\xfe\x00garbage")
     monkeypatch.setenv(PAPER_ENV, str(tmp_path))
     assert load_paper() is None
+
+
+@needs_paper
+@pytest.mark.parametrize(("ours", "theirs"), [("jerk", "JERK"), ("my_agents.py:ppo", "PPO"), ("pkg.mod:Rainbow", "Rainbow"),
+                                              ("random", None), ("pkg.mod:random", None)])
+def test_our_agents_are_matched_to_the_papers_by_name(ours, theirs) -> None:
+    assert paper.agent(ours) == theirs

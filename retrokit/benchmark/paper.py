@@ -34,8 +34,12 @@ class PaperScores:
     aggregates: dict[str, tuple[float, float]] = field(default_factory=dict)
 
     def agent(self, name: str) -> str | None:
-        """The paper's name of our agent ``name``, if the paper ran it (case does not matter)."""
-        wanted = AGENT_NAMES.get(name, name).lower()
+        """The paper's name of our agent ``name``, if the paper ran it.
+
+        Case does not matter, and a user agent ``MODULE:CALLABLE`` goes by its
+        callable's name, so ``my_agents.py:ppo`` is compared with the paper's PPO.
+        """
+        wanted = AGENT_NAMES.get(name, name.rpartition(":")[2]).lower()
         return next((a for a in self.levels if a.lower() == wanted), None)
 
 

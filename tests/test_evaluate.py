@@ -276,3 +276,13 @@ def test_a_missing_state_is_named(tmp_path, capsys) -> None:
     path.write_text("budget: 10\nlevels: {test: [Dasher-Genesis/Zone4.Act1]}\n")
     assert main(["evaluate", "--benchmark", str(path), "--out", str(tmp_path / "run")]) == 2
     assert "Dasher-Genesis/Zone4.Act1" in capsys.readouterr().err
+
+
+def test_without_matplotlib_the_report_says_how_to_get_plots(tmp_path, monkeypatch) -> None:
+    from retrokit.benchmark import plots
+
+    monkeypatch.setattr(plots, "have_matplotlib", lambda: False)
+    out = tmp_path / "run"
+    assert evaluate(out, "--agent", "random", "--levels", "Zone3.Act2", "--timesteps", "200") == 0
+    assert "pip install 'retrokit[plot]'" in (out / "report.md").read_text()
+    assert not (out / "scores.png").exists() and (out / "summary.json").is_file()

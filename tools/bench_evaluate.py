@@ -3,8 +3,8 @@
 
 The evaluation plays two Dasher levels (JERK, the Dasher benchmark's rules)
 for ``--timesteps`` each, once with one worker (both levels in this
-process, one after the other) and once with two (one worker process per
-level). Its throughput is env steps per second over the whole run, from the
+process, one after the other) and once with two (this process plays one
+level, a worker process the other). Its throughput is env steps per second over the whole run, from the
 call to the written report: process start-up, env creation and the output
 files included.
 
@@ -18,7 +18,7 @@ ceiling is lower, within 5% of it (speed-up / ceiling >= 0.95).
 The kinds alternate within each round, so that each ratio compares runs
 that saw the same machine; the medians over the rounds are reported.
 
-Usage: python tools/bench_evaluate.py [--timesteps 3000] [--rounds 3] [--agent jerk]
+Usage: python tools/bench_evaluate.py [--timesteps 10000] [--rounds 3] [--agent jerk]
 """
 
 from __future__ import annotations
@@ -86,7 +86,7 @@ def evaluation_rate(workers: int, timesteps: int, agent: str) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--timesteps", type=int, default=3000, help="timesteps per level (default: 3000)")
+    parser.add_argument("--timesteps", type=int, default=10_000, help="timesteps per level (default: 10000, the benchmark's)")
     parser.add_argument("--rounds", type=int, default=3, help="rounds (default: 3)")
     parser.add_argument("--agent", default="jerk", help="the agent (default: jerk)")
     args = parser.parse_args()

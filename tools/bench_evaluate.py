@@ -15,8 +15,10 @@ CPU is busy elsewhere cannot give the evaluation more than it gives the bare
 emulators, so the target is a 2-worker speed-up of 1.8 or more, or, where the
 ceiling is lower, within 5% of it (speed-up / ceiling >= 0.95).
 
-The kinds alternate within each round, so that each ratio compares runs
-that saw the same machine; the medians over the rounds are reported.
+Within a round each evaluation runs right after (or before) the bare run of
+its own parallelism, and the order flips from one round to the next, so that
+each comparison is between runs that saw the same machine; the medians over
+the rounds are reported.
 
 Usage: python tools/bench_evaluate.py [--timesteps 10000] [--rounds 3] [--agent jerk]
 """
@@ -96,7 +98,9 @@ def main() -> None:
     print(f"{'round':>5}  {'eval 1':>8}  {'eval 2':>8}  {'bare 1':>8}  {'bare 2':>8}  {'eval 2/1':>8}  {'bare 2/1':>8}")
     for round_ in range(args.rounds):
         rates = {}
-        order = ["eval1", "eval2", "bare1", "bare2"] if round_ % 2 == 0 else ["bare2", "bare1", "eval2", "eval1"]
+        # Each evaluation runs next to the bare run of its own parallelism, so that the two parts of
+        # speed-up / ceiling = (eval2 / bare2) / (eval1 / bare1) each compare runs close in time.
+        order = ["bare1", "eval1", "bare2", "eval2"] if round_ % 2 == 0 else ["eval2", "bare2", "eval1", "bare1"]
         for kind in order:
             n = int(kind[-1])
             if kind.startswith("eval"):

@@ -30,7 +30,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
                         help="processes (or Ray CPUs) sharing the levels (default: up to 2)")
     parser.add_argument("--backend", choices=("local", "ray"), default="local", help="local processes, or Ray")
     parser.add_argument("--ray-address", default=None, help="an existing Ray cluster (default: start a local Ray)")
-    parser.add_argument("--out", type=Path, required=False, default=None, help="the run folder (required)")
+    parser.add_argument("--out", type=Path, default=None, metavar="DIR", help="the run folder (required, except with --list)")
     parser.add_argument("--resume", action="store_true", help="continue the interrupted evaluation in --out")
     parser.add_argument("--gif", action="store_true", help="save a GIF of each level's best episode in --out/gifs")
     parser.add_argument("--list", action="store_true", help="list the benchmark's levels and stop")

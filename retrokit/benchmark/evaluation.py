@@ -104,7 +104,7 @@ def evaluate(evaluation: Evaluation) -> dict[str, Any]:
                 bars[message.level].update(message.data["timesteps"] - bars[message.level].n)
         elif message.kind == "done":
             if "gif" in message.data:
-                atomic_write(ev.out / "gifs" / f"{_file_name(message.level)}.gif", message.data["gif"], overwrite=True)
+                atomic_write(ev.out / "gifs" / f"{level_file_name(message.level)}.gif", message.data["gif"], overwrite=True)
             run.finish(message.level, message.data["timesteps"])
             if message.level in bars:
                 bars[message.level].update(budget - bars[message.level].n)
@@ -152,7 +152,8 @@ def _progress_bars(ev: Evaluation, run: RunDir, budget: int) -> dict[str, Any]:
     return bars
 
 
-def _file_name(level: str) -> str:
+def level_file_name(level: str) -> str:
+    """A level's name as a file name (``gifs/<this>.gif``)."""
     return level.replace("/", "_").replace(os.sep, "_")
 
 

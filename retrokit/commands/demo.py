@@ -50,7 +50,7 @@ def run(args: argparse.Namespace) -> int:
     """Evaluate both agents, print the table, write the comparison plot and the GIF."""
     from retrokit.benchmark import plots
     from retrokit.benchmark.definition import load_benchmark
-    from retrokit.benchmark.evaluation import Evaluation, evaluate
+    from retrokit.benchmark.evaluation import Evaluation, evaluate, level_file_name
     from retrokit.commands.evaluate import print_table
     from retrokit.paths import atomic_write
 
@@ -70,13 +70,16 @@ def run(args: argparse.Namespace) -> int:
         print(f"JERK's aggregate is {jerk / rand:.2f}x random's.")
 
     names = [level.name for level in levels]
-    written = [f"{out / agent}/ (report.md, summary.json, plots)" for agent in AGENTS]
-    if plots.have_matplotlib():
+    made = "report.md, summary.json, plots" if plots.have_matplotlib() else "report.md, summary.json"
+    written = [f"{out / agent}/ ({made})" for agent in AGENTS]
+    if not plots.have_matplotlib():
+        written.append(f"(no plots: matplotlib is not installed; pip install '{plots.PLOT_EXTRA}')")
+    else:
         series = {agent: {lv: e["mean_score"] for lv, e in s["levels"].items()} for agent, s in summaries.items()}
         atomic_write(out / "scores.png", plots.score_bars(series, names, "JERK against random on Dasher: level scores"))
         written.append(str(out / "scores.png"))
     best = max(summaries["jerk"]["levels"].items(), key=lambda item: item[1]["best"] or float("-inf"))[0]
-    gif = out / "jerk" / "gifs" / f"{best.replace('/', '_')}.gif"
+    gif = out / "jerk" / "gifs" / f"{level_file_name(best)}.gif"
     if gif.is_file():
         shutil.copyfile(gif, out / "jerk-best.gif")
         written.append(f"{out / 'jerk-best.gif'} (JERK's best episode, on {best})")

@@ -57,8 +57,9 @@ def run_level(task: LevelTask, emit: Callable[[Message], None]) -> None:
     try:
         agent = resolve_agent(task.agent)
         env = RetroEnv(task.level.game, task.level.state, options.pop("scenario", None), **options)
-    except RetrokitError as exc:
-        emit(Message("failed", name, {"error": f"level {name}, step 0: {exc}", "timesteps": 0}))
+    except Exception as exc:  # noqa: BLE001 - any failure to start a level fails that level only
+        what = str(exc) if isinstance(exc, RetrokitError) else f"{type(exc).__name__}: {exc}"
+        emit(Message("failed", name, {"error": f"Expected to start level {name} (step 0), but: {what}", "timesteps": 0}))
         return
 
     def on_episode(episode: Episode) -> None:

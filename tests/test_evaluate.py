@@ -187,6 +187,22 @@ def out_of_range(env, budget, seed):
         env.step(np.zeros(12, dtype=np.int8))
     env.step(np.full(12, 3, dtype=np.int8))
 
+def dies_in_a_worker(env, budget, seed):
+    """Kills its own process by a signal in a worker process; plays randomly in the command's own."""
+    import multiprocessing, os, pathlib, signal, time
+    flag = pathlib.Path(os.environ["RETROKIT_TEST_FLAG"])
+    if multiprocessing.parent_process() is not None:
+        flag.touch()
+        os.kill(os.getpid(), signal.SIGKILL)
+    deadline = time.monotonic() + 120
+    while not flag.exists() and time.monotonic() < deadline:  # let the worker take the other level
+        time.sleep(0.05)
+    env.reset()
+    while True:
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        if terminated or truncated:
+            env.reset()
+
 def no_reset(env, budget, seed):
     env.step(np.zeros(12, dtype=np.int8))
 '''
@@ -286,3 +302,22 @@ def test_without_matplotlib_the_report_says_how_to_get_plots(tmp_path, monkeypat
     assert evaluate(out, "--agent", "random", "--levels", "Zone3.Act2", "--timesteps", "200") == 0
     assert "pip install 'retrokit[plot]'" in (out / "report.md").read_text()
     assert not (out / "scores.png").exists() and (out / "summary.json").is_file()
+
+
+def test_a_level_whose_env_cannot_start_fails_alone(tmp_path, capsys) -> None:
+    path = tmp_path / "mine.yaml"
+    path.write_text("budget: 100\nenv: {obs_type: pixels}\nlevels: {test: [Dasher-Genesis/Zone1.Act1]}\n")
+    out = tmp_path / "run"
+    assert main(["evaluate", "--benchmark", str(path), "--agent", "random", "--no-progress", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "Expected to start level Dasher-Genesis/Zone1.Act1 (step 0)" in err and "obs_type" in err
+    assert json.loads(summary(out))["levels"] == {}
+
+
+def test_a_worker_killed_by_a_signal_fails_its_level_only(agents_file, tmp_path, monkeypatch, capsys) -> None:
+    monkeypatch.setenv("RETROKIT_TEST_FLAG", str(tmp_path / "worker-started"))
+    out = tmp_path / "run"
+    assert evaluate(out, "--agent", f"{agents_file}:dies_in_a_worker", "--workers", "2") == 2
+    err = capsys.readouterr().err
+    assert "Dasher-Genesis/Zone3.Act2" in err and ("died (signal 9)" in err or "No worker is left" in err)
+    assert list(json.loads(summary(out))["levels"]) == ["Dasher-Genesis/Zone2.Act2"]

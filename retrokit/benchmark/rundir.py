@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any
 
 from retrokit.errors import FileConflictError, RunFolderError
-from retrokit.paths import atomic_write
+from retrokit.paths import atomic_write, ensure_folder
 
 RUN_FILE = "run.json"
 EPISODES_FILE = "episodes.jsonl"
@@ -52,7 +52,7 @@ class RunDir:
                     f"Expected a new or empty --out folder, but {self.path} already holds an evaluation "
                     f"({', '.join(there)}); continue it with --resume, or choose another --out."
                 )
-            self.path.mkdir(parents=True, exist_ok=True)
+            ensure_folder(self.path, "for the evaluation's results")
             self._save()
             atomic_write(self.path / EPISODES_FILE, b"", overwrite=True)
         self._log = open(self.path / EPISODES_FILE, "a", encoding="utf-8")  # noqa: SIM115 - open for the run

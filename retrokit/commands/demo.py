@@ -41,10 +41,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def free_folder(path: Path) -> Path:
-    """``path``, or ``path-1``, ``path-2``...: the first that does not exist or is empty, created.
+    """``path``, or ``path-1``, ``path-2``...: the first that does not exist or is an empty folder.
 
     Raises:
-        FileSystemError: ``path`` is a file, or cannot be created (checked before anything is played).
+        FileSystemError: ``path`` is a file (checked before anything is played).
         FileConflictError: Every name is taken.
     """
     if path.exists() and not path.is_dir():
@@ -52,7 +52,7 @@ def free_folder(path: Path) -> Path:
     for n in range(10_000):
         candidate = path if n == 0 else path.with_name(f"{path.name}-{n}")
         if not candidate.exists() or (candidate.is_dir() and not any(candidate.iterdir())):
-            return ensure_folder(candidate, "for the demo's results")
+            return candidate
     raise FileConflictError(
         f"Expected a free folder name for {path}; found all 10000 taken. Delete some, or pass --out."
     )
@@ -96,76 +96,4 @@ def run(args: argparse.Namespace) -> int:
         shutil.copyfile(gif, out / "jerk-best.gif")
         written.append(f"{out / 'jerk-best.gif'} (JERK's best episode, on {best})")
     print("wrote " + "\n      ".join(written))
-
-        base = stem if n == 0 else f"{stem}-{n}"
-        gif, png = folder / f"{base}.gif", folder / f"{base}.png"
-        if not gif.exists() and not png.exists():
-            return gif, png
-    raise FileConflictError(
-        f"Expected a free file name for {stem} in {folder}; found all 10000 taken. Delete some, or pass --out."
-    )
-
-
-def run(args: argparse.Namespace) -> int:
-    """Play, print the scores, save the pictures."""
-    import io
-
-    import numpy as np
-    from PIL import Image
-    from tqdm import tqdm
-
-    import retrokit
-    from retrokit.errors import InvalidArgumentError
-    from retrokit.paths import atomic_write, ensure_folder
-
-    if args.episodes < 1 or args.max_steps < 1:
-        raise InvalidArgumentError(
-            f"Expected --episodes and --max-steps of 1 or more, got {args.episodes} and {args.max_steps}."
-        )
-    ensure_folder(args.out, "for the GIF and PNG")  # before playing, so a bad --out costs nothing
-    state = retrokit.State.DEFAULT if args.state is None else args.state
-    env = retrokit.make(
-        args.game, state, frameskip=4, sticky_prob=0.25, max_episode_steps=args.max_steps,
-        action_type="all", render_mode="rgb_array",
-    )
-    rng = np.random.default_rng(args.seed)
-    agent = RunAndJump(env, rng)
-    results, best_frames, best_score = [], [], float("-inf")
-    with tqdm(total=args.episodes * args.max_steps, unit="step", desc=f"{args.game}") as bar:
-        for episode in range(args.episodes):
-            env.reset(seed=args.seed + episode)
-            frames, score, steps = [env.render()], 0.0, 0
-            while True:
-                _, reward, terminated, truncated, _info = env.step(agent.act())
-                score += reward
-                steps += 1
-                bar.update(1)
-                if steps % 2 == 0:
-                    frames.append(env.render())
-                if terminated or truncated:
-                    break
-            bar.update(args.max_steps - steps)  # an episode that ended early
-            frames.append(env.render())
-            results.append((episode + 1, score, steps, "done" if terminated else "time limit"))
-            if score > best_score:
-                best_score, best_frames = score, frames
-    env.close()
-
-    print(f"\n{'episode':>7}  {'score':>8}  {'steps':>5}  ended by")
-    for episode, score, steps, ended in results:
-        print(f"{episode:>7}  {score:>8.0f}  {steps:>5}  {ended}")
-    scores = [r[1] for r in results]
-    print(f"mean score {np.mean(scores):.1f}, best {max(scores):.0f}")
-
-    gif, png = free_names(args.out, args.game)
-    pictures = [Image.fromarray(f) for f in best_frames]
-    gif_bytes, png_bytes = io.BytesIO(), io.BytesIO()
-    pictures[0].save(gif_bytes, "GIF", save_all=True, append_images=pictures[1:], duration=2 * 4 * 1000 // 60, loop=0)
-    pictures[-1].save(png_bytes, "PNG")
-    try:
-        atomic_write(gif, gif_bytes.getvalue())
-        atomic_write(png, png_bytes.getvalue())
-    except FileExistsError:  # another demo took the name meanwhile
-        raise FileConflictError(f"Expected {gif} and {png} to be free; found one written meanwhile. Run again.") from None
-    print(f"saved {gif} ({len(pictures)} frames) and {png}")
     return 0

@@ -83,31 +83,32 @@ def test_the_same_seed_gives_the_same_summary_twice_and_on_two_workers(reference
     assert summary(tmp_path / "other") != summary(reference)
 
 
-def test_an_interrupted_run_resumes_to_the_uninterrupted_result(reference, tmp_path) -> None:
+def test_an_interrupted_run_resumes_to_the_uninterrupted_result(reference, agents_file, tmp_path, monkeypatch) -> None:
+    # The agent is JERK, which on the second level holds still at its 200th step until a flag file
+    # appears: the test interrupts it there, with the first level finished and the second half-played.
+    flag = tmp_path / "go-on"
+    monkeypatch.setenv("RETROKIT_TEST_FLAG", str(flag))
     out = tmp_path / "run"
-    command = [sys.executable, "-m", "retrokit", "evaluate", *SMALL, "--agent", "jerk", "--workers", "1",
-               "--out", str(out)]
+    command = [sys.executable, "-m", "retrokit", "evaluate", *SMALL, "--agent", f"{agents_file}:jerk_pausing",
+               "--workers", "1", "--out", str(out)]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 120
-    while time.monotonic() < deadline and process.poll() is None:  # wait for the first level to finish
-        try:
-            if json.loads((out / "run.json").read_text())["finished"]:
-                break
-        except (OSError, ValueError):
-            pass
+    while not (tmp_path / "waiting").exists() and process.poll() is None and time.monotonic() < deadline:
         time.sleep(0.05)
     process.send_signal(signal.SIGINT)
     _, err = process.communicate(timeout=60)
     assert process.returncode == 130, err
     assert "--resume" in err
-    state = json.loads((out / "run.json").read_text())
-    assert list(state["finished"]) == ["Dasher-Genesis/Zone2.Act2"]
+    assert list(json.loads((out / "run.json").read_text())["finished"]) == ["Dasher-Genesis/Zone2.Act2"]
+    played = (out / "episodes.jsonl").read_text()
+    assert "Dasher-Genesis/Zone3.Act2" in played  # some of its episodes, to be dropped on resume
     interrupted = json.loads(summary(out))
     assert not interrupted["complete"] and list(interrupted["levels"]) == ["Dasher-Genesis/Zone2.Act2"]
-    assert evaluate(out, "--agent", "jerk", "--workers", "2", "--resume") == 0
-    assert summary(out) == summary(reference)
-    assert (out / "episodes.jsonl").read_text().count("\n") == sum(
-        e["episodes"] for e in json.loads(summary(out))["levels"].values())
+    flag.touch()
+    assert evaluate(out, "--agent", f"{agents_file}:jerk_pausing", "--workers", "2", "--resume") == 0
+    resumed, uninterrupted = json.loads(summary(out)), json.loads(summary(reference))
+    assert (resumed["levels"], resumed["aggregate"]) == (uninterrupted["levels"], uninterrupted["aggregate"])
+    assert (out / "episodes.jsonl").read_text().count("\n") == sum(e["episodes"] for e in resumed["levels"].values())
 
 
 def test_a_half_written_episode_line_is_dropped_on_resume(reference, tmp_path) -> None:
@@ -202,6 +203,27 @@ def dies_in_a_worker(env, budget, seed):
         _, _, terminated, truncated, _ = env.step(env.action_space.sample())
         if terminated or truncated:
             env.reset()
+
+def jerk_pausing(env, budget, seed):
+    """JERK; on Zone3.Act2 its 200th step waits for a flag file (so a test can interrupt it there)."""
+    import os, pathlib, time
+    import gymnasium
+    from retrokit.benchmark.jerk import jerk
+
+    flag = pathlib.Path(os.environ["RETROKIT_TEST_FLAG"])
+
+    class Pause(gymnasium.Wrapper):
+        steps = 0
+
+        def step(self, action):
+            self.steps += 1
+            if self.steps == 200 and env.unwrapped.state_name == "Zone3.Act2":
+                (flag.parent / "waiting").touch()
+                while not flag.exists():
+                    time.sleep(0.05)
+            return self.env.step(action)
+
+    jerk(Pause(env), budget, seed)
 
 def no_reset(env, budget, seed):
     env.step(np.zeros(12, dtype=np.int8))

@@ -28,20 +28,21 @@ DASHER = "Dasher-Genesis"
 # --- fault 13: actions outside the action space ----------------------------------------------
 
 
-@pytest.fixture(scope="module")
-def discrete_env():
-    env = retrokit.make(AIRSTRIKER, action_type="discrete")
+def _airstriker(action_type: str):
+    env = retrokit.make(AIRSTRIKER, action_type=action_type)
     env.reset(seed=0)
     yield env
     env.close()
+
+
+@pytest.fixture(scope="module")
+def discrete_env():
+    yield from _airstriker("discrete")
 
 
 @pytest.fixture(scope="module")
 def multi_discrete_env():
-    env = retrokit.make(AIRSTRIKER, action_type="multi_discrete")
-    env.reset(seed=0)
-    yield env
-    env.close()
+    yield from _airstriker("multi_discrete")
 
 
 @pytest.mark.parametrize(

@@ -25,3 +25,11 @@ def add_data_dir_option(parser) -> None:  # an argparse parser
         help=f"the data folder that holds imported ROMs (default: ${paths.DATA_ENV}, "
         "else $XDG_DATA_HOME/retrokit, else ~/.local/share/retrokit)",
     )
+
+
+def add_evaluation_options(parser, workers_help: str) -> None:  # an argparse parser
+    """Add the options of a benchmark run that ``evaluate`` and ``demo`` share."""
+    parser.add_argument("--levels", default="test", help="test, train, all, or LEVEL,... (default: test)")
+    parser.add_argument("--timesteps", type=int, default=None, help="timesteps per level (default: the benchmark's)")
+    parser.add_argument("--seed", type=int, default=0, help="the run's seed (default: 0)")
+    parser.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1), help=workers_help)

@@ -12,10 +12,10 @@ name if the given one is taken: nothing is replaced.
 from __future__ import annotations
 
 import argparse
-import os
 import shutil
 from pathlib import Path
 
+from retrokit.commands._common import add_evaluation_options
 from retrokit.errors import FileConflictError
 from retrokit.paths import ensure_folder
 
@@ -31,10 +31,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "actions, with a progress bar per level; print the per-level scores and aggregates, and write the reports, "
         "the plots and a GIF of JERK's best episode.",
     )
-    parser.add_argument("--levels", default="test", help="test, train, all, or LEVEL,... (default: test)")
-    parser.add_argument("--timesteps", type=int, default=None, help="timesteps per level (default: the benchmark's)")
-    parser.add_argument("--seed", type=int, default=0, help="the run's seed (default: 0)")
-    parser.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1), help="processes (default: up to 2)")
+    add_evaluation_options(parser, "processes (default: up to 2)")
     parser.add_argument("--out", type=Path, default=Path("retrokit-demo"), help="the output folder (default: retrokit-demo)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     parser.set_defaults(run=run)

@@ -8,8 +8,9 @@ scores. See docs/evaluate.md.
 from __future__ import annotations
 
 import argparse
-import os
 from pathlib import Path
+
+from retrokit.commands._common import add_evaluation_options
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -22,12 +23,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "PNG plots into --out.",
     )
     parser.add_argument("--benchmark", default="dasher", help="sonic, dasher, or a benchmark YAML file (default: dasher)")
-    parser.add_argument("--levels", default="test", help="test, train, all, or LEVEL,... (default: test)")
     parser.add_argument("--agent", default="jerk", help="random, jerk, or MODULE:CALLABLE (default: jerk)")
-    parser.add_argument("--timesteps", type=int, default=None, help="timesteps per level (default: the benchmark's)")
-    parser.add_argument("--seed", type=int, default=0, help="the run's seed (default: 0)")
-    parser.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1),
-                        help="processes (or Ray CPUs) sharing the levels (default: up to 2)")
+    add_evaluation_options(parser, "processes (or Ray CPUs) sharing the levels (default: up to 2)")
     parser.add_argument("--backend", choices=("local", "ray"), default="local", help="local processes, or Ray")
     parser.add_argument("--ray-address", default=None, help="an existing Ray cluster (default: start a local Ray)")
     parser.add_argument("--out", type=Path, default=None, metavar="DIR", help="the run folder (required, except with --list)")

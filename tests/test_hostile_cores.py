@@ -14,10 +14,10 @@ from pathlib import Path
 import pytest
 from childproc import run_child
 
-from retrokit.host.cores import core_filename, find_core
+from retrokit.host.cores import core_filename
 from retrokit.paths import wheel_cores_dir
 
-CORE = find_core("genesis_plus_gx")
+CORE = wheel_cores_dir() / core_filename("genesis_plus_gx")  # the wheel's, whose layout the cases know
 OPEN = """
 from retrokit.errors import CoreError
 from retrokit.host.emulator import Emulator

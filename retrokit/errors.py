@@ -129,3 +129,14 @@ class ScenarioRuntimeError(RetrokitError, ArithmeticError):
 
 class EnvError(RetrokitError, RuntimeError):
     """An environment was used out of order, e.g. stepped before reset."""
+
+
+# --- RAM search ----------------------------------------------------------------------------------
+
+
+class RamSearchError(RetrokitError, ValueError):
+    """A RAM search was asked for something its snapshots or history cannot give."""
+
+
+class SessionError(RamSearchError):
+    """A RAM search session file is missing, corrupt, not a session, or from another game."""

@@ -1,0 +1,21 @@
+"""RAM search: find a game's variables in RAM and write them into its game.yaml.
+
+- :class:`RamSearch` (:mod:`.search`): the search on a running game, its moves and its session file.
+- :mod:`.engine`: candidates over snapshots, filters, undo and redo.
+- :mod:`.types`: every type interpretation of a snapshot, decoded at once.
+- :mod:`.scales`: the scaled matches of a value search.
+- :mod:`.ram`: the RAM regions as console-order bytes, and console addresses.
+- :mod:`.session`: the session file.
+- :mod:`.gamefile`: writing a field into a game.yaml, keeping its layout.
+
+See ``docs/ramsearch.md``.
+"""
+
+from __future__ import annotations
+
+from retrokit.ramsearch.engine import OPS
+from retrokit.ramsearch.search import Candidate, RamSearch, group_candidates
+from retrokit.ramsearch.session import DEFAULT_SESSION
+from retrokit.ramsearch.types import SEARCH_TYPES
+
+__all__ = ["DEFAULT_SESSION", "OPS", "SEARCH_TYPES", "Candidate", "RamSearch", "group_candidates"]

@@ -1,0 +1,330 @@
+"""The search engine: candidates over snapshots, narrowed by filters, with undo and redo.
+
+A candidate is a type and a snapshot position (the value of that type that
+starts there), with the scale a value search matched it with
+(:mod:`retrokit.ramsearch.scales`). Candidates are kept as one boolean array
+per type over every position, so a filter is a few numpy comparisons over the
+type's decoded values (:mod:`retrokit.ramsearch.types`); once few candidates
+are left, only their positions are compared.
+
+Filters follow BizHawk's RAM Search: compare each candidate's value in the
+newest snapshot with a number, with its value in the previous or the first
+snapshot, or with the value at another address, by ``equal``,
+``not-equal``, ``less``, ``greater``, ``less-equal``, ``greater-equal``,
+``changed-by N``, ``increased``, ``decreased``, ``changed`` or
+``unchanged``; or compare its change count (snapshots at which its value
+differed from the one before) with a number.
+"""
+
+from __future__ import annotations
+
+import operator
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from retrokit.errors import InvalidArgumentError, RamSearchError, did_you_mean
+from retrokit.host.typecodes import FieldType
+from retrokit.ramsearch.ram import RamLayout
+from retrokit.ramsearch.scales import SCALES, UNPINNED
+from retrokit.ramsearch.types import decode_all
+
+COMPARISONS: dict[str, Callable[[np.ndarray, object], np.ndarray]] = {
+    "equal": operator.eq,
+    "not-equal": operator.ne,
+    "less": operator.lt,
+    "greater": operator.gt,
+    "less-equal": operator.le,
+    "greater-equal": operator.ge,
+}
+#: The operations that compare with a snapshot, and the comparison each is.
+CHANGES = {"increased": "greater", "decreased": "less", "changed": "not-equal", "unchanged": "equal"}
+OPS = (*COMPARISONS, "changed-by", *CHANGES)
+REFERENCES = ("previous", "first", "changes")
+_SPARSE = 8  # compare only the candidates' positions once fewer than 1 in 8 positions are left
+_DECODED_KEPT = 4  # decoded snapshots kept for the next filter
+
+
+@dataclass(frozen=True)
+class Filter:
+    """One filter: an operation, an optional number, and what to compare with.
+
+    Attributes:
+        op: One of :data:`OPS`.
+        value: The number compared with (for ``changed-by``, the difference).
+        than: ``"previous"``, ``"first"``, ``"changes"`` or a console address;
+            ``None`` with a number means the number itself.
+    """
+
+    op: str
+    value: int | None = None
+    than: str | int | None = None
+
+    def describe(self, layout: RamLayout | None = None) -> str:
+        """The filter as the command line writes it."""
+        words = [self.op] + ([] if self.value is None else [str(self.value)])
+        if self.than is not None:
+            than = layout.format(self.than) if layout is not None and isinstance(self.than, int) else str(self.than)
+            words.append(f"--than {than}")
+        return " ".join(words)
+
+
+def check_filter(op: str, value: int | None = None, than: str | int | None = None) -> Filter:
+    """Check a filter's parts fit together and fill in the default reference.
+
+    Raises:
+        InvalidArgumentError: Unknown operation or reference, or a missing or extra number.
+    """
+    if op not in OPS:
+        raise InvalidArgumentError(
+            f"Expected a filter operation ({', '.join(OPS)}), got {op!r}." + did_you_mean(op, OPS)
+        )
+    if isinstance(than, str) and than not in REFERENCES:
+        raise InvalidArgumentError(
+            f"Expected --than previous, first, changes or a console address, got {than!r}."
+            + did_you_mean(than, REFERENCES)
+        )
+    if op in CHANGES:
+        if value is not None:
+            raise InvalidArgumentError(
+                f"Expected no number after {op!r}, got {value}. For a difference, use: changed-by N."
+            )
+        if than == "changes":
+            raise InvalidArgumentError(f"Expected --than previous, first or an address for {op!r}, got 'changes'.")
+        return Filter(op, None, "previous" if than is None else than)
+    if op == "changed-by":
+        if value is None:
+            raise InvalidArgumentError("Expected a number after 'changed-by' (the difference, e.g. -1), got none.")
+        if than == "changes":
+            raise InvalidArgumentError("Expected --than previous, first or an address for 'changed-by', got 'changes'.")
+        return Filter(op, value, "previous" if than is None else than)
+    if value is None:
+        if than == "changes":
+            raise InvalidArgumentError(f"Expected a number to compare change counts with: {op} N --than changes.")
+        return Filter(op, None, "previous" if than is None else than)
+    if than is not None and than != "changes":
+        raise InvalidArgumentError(
+            f"Expected a number or --than {than}, not both: '{op} {value}' compares with the number, "
+            f"'{op} --than {than}' with the snapshot. For a difference, use: changed-by {value} --than {than}."
+        )
+    return Filter(op, value, than)
+
+
+class Candidates:
+    """Which (type, position) pairs are still candidates, and the scale each was matched with.
+
+    Args:
+        alive: Per type, a boolean array over positions.
+        scale: Per type, an ``int8`` array of scale indices (:data:`~retrokit.ramsearch.scales.UNPINNED` if none).
+    """
+
+    def __init__(self, alive: list[np.ndarray], scale: list[np.ndarray]) -> None:
+        self.alive = alive
+        self.scale = scale
+
+    @classmethod
+    def everything(cls, layout: RamLayout, types: Sequence[FieldType]) -> Candidates:
+        """Every position of every type whose bytes fit in a region."""
+        alive = [layout.valid(t.width) for t in types]
+        return cls(alive, [np.full(layout.size, UNPINNED, dtype=np.int8) for _ in types])
+
+    def copy(self) -> Candidates:
+        return Candidates([a.copy() for a in self.alive], [s.copy() for s in self.scale])
+
+    def count(self) -> int:
+        """How many candidates are left."""
+        return int(sum(np.count_nonzero(a) for a in self.alive))
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, Candidates) or len(other.alive) != len(self.alive):
+            return NotImplemented
+        return all(
+            np.array_equal(a, b) and np.array_equal(s[a], t[b])
+            for a, b, s, t in zip(self.alive, other.alive, self.scale, other.scale)
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+
+class Engine:
+    """Snapshots and candidates of one RAM search.
+
+    Args:
+        layout: The RAM regions.
+        types: The types searched.
+    """
+
+    def __init__(self, layout: RamLayout, types: Sequence[FieldType]) -> None:
+        self.layout = layout
+        self.types = tuple(types)
+        self.snapshots: list[np.ndarray] = []
+        self.candidates = Candidates.everything(layout, self.types)
+        self.history: list[tuple[str, Candidates]] = []  # (filter, the candidates before it)
+        self.redo_stack: list[tuple[str, Candidates]] = []  # (filter, the candidates after it)
+        self._decoded: dict[int, list[np.ndarray]] = {}
+
+    # --- snapshots --------------------------------------------------------------------------
+
+    def add_snapshot(self, data: np.ndarray) -> int:
+        """Add a snapshot (console-order bytes); return its index."""
+        data = np.ascontiguousarray(data, dtype=np.uint8)
+        if data.shape != (self.layout.size,):
+            raise InvalidArgumentError(f"Expected a snapshot of {self.layout.size} bytes, got shape {data.shape}.")
+        self.snapshots.append(data)
+        return len(self.snapshots) - 1
+
+    def decoded(self, index: int) -> list[np.ndarray]:
+        """Snapshot ``index`` decoded as every type (a few are cached)."""
+        index %= len(self.snapshots)
+        if index not in self._decoded:
+            while len(self._decoded) >= _DECODED_KEPT:
+                del self._decoded[next(iter(self._decoded))]
+            self._decoded[index] = decode_all(self.snapshots[index], self.types)
+        return self._decoded[index]
+
+    # --- filtering ----------------------------------------------------------------------------
+
+    def filter(self, op: str, value: int | None = None, than: str | int | None = None) -> int:
+        """Keep the candidates that pass a filter; return how many are left.
+
+        Raises:
+            InvalidArgumentError: The filter is malformed, or its address is outside RAM.
+            RamSearchError: The filter compares snapshots and there are not two yet.
+        """
+        spec = check_filter(op, value, than)
+        if not self.snapshots:
+            raise RamSearchError("Expected a snapshot to filter; found none. Take one first (RamSearch.snapshot).")
+        if spec.than in ("previous", "first", "changes") and len(self.snapshots) < 2:
+            raise RamSearchError(
+                f"Expected two snapshots to compare for '{spec.describe()}'; found 1. Move the game on first, "
+                "e.g. retrokit ramsearch run --frames 60, or compare with a number: filter equal N."
+            )
+        if isinstance(spec.than, int):
+            self.layout.position(spec.than)  # outside RAM: a clear error now
+        before = self.candidates.copy()
+        for t in range(len(self.types)):
+            self._filter_type(t, spec)
+        self.history.append((spec.describe(self.layout), before))
+        self.redo_stack.clear()
+        return self.candidates.count()
+
+    def _filter_type(self, t: int, spec: Filter) -> None:
+        alive, scales = self.candidates.alive[t], self.candidates.scale[t]
+        left = np.count_nonzero(alive)
+        if not left:
+            return
+        if left * _SPARSE < len(alive):  # few left: compare only their positions
+            positions = np.flatnonzero(alive)
+
+            def pick(a: np.ndarray) -> np.ndarray:
+                return a[positions]
+
+            scale = scales[positions]
+            alive[positions] = self._compare(t, spec, pick(self.decoded(-1)[t]), scale, pick)
+            scales[positions] = scale
+        else:  # scale is changed in place
+            alive &= self._compare(t, spec, self.decoded(-1)[t], scales, lambda a: a)
+
+    def _compare(self, t: int, spec: Filter, cur: np.ndarray, scale: np.ndarray, pick) -> np.ndarray:
+        ftype = self.types[t]
+        if spec.than is None and spec.op == "equal":
+            return _value_search(ftype, cur, scale, spec.value)
+        if spec.than is None:
+            shown, ok = _shown(cur, scale)
+            return ok & COMPARISONS[spec.op](shown, spec.value)
+        if spec.than == "changes":
+            counts = sum(
+                (pick(self.decoded(k)[t]) != pick(self.decoded(k - 1)[t])).astype(np.int32)
+                for k in range(1, len(self.snapshots))
+            )
+            return COMPARISONS[spec.op](counts, spec.value)
+        shown, ok = _shown(cur, scale)
+        if isinstance(spec.than, int):  # another address: its stored value in the newest snapshot
+            try:
+                position = self.layout.position(spec.than, ftype.width)
+            except InvalidArgumentError:
+                return np.zeros(len(cur), dtype=bool)
+            ref, ref_ok = self.decoded(-1)[t][position], True
+        else:
+            ref, ref_ok = _shown(pick(self.decoded(0 if spec.than == "first" else -2)[t]), scale)
+        if spec.op == "changed-by":
+            return ok & ref_ok & (shown.astype(np.int64) - ref == spec.value)
+        op = CHANGES.get(spec.op, spec.op)
+        return ok & ref_ok & COMPARISONS[op](shown, ref)
+
+    # --- undo and redo ---------------------------------------------------------------------
+
+    def undo(self) -> str:
+        """Undo the last filter; return its description.
+
+        Raises:
+            RamSearchError: No filter to undo.
+        """
+        if not self.history:
+            raise RamSearchError("Expected a filter to undo; found none. Filters are undone newest first.")
+        label, before = self.history.pop()
+        self.redo_stack.append((label, self.candidates))
+        self.candidates = before
+        return label
+
+    def redo(self) -> str:
+        """Apply the last undone filter again; return its description.
+
+        Raises:
+            RamSearchError: Nothing was undone since the last filter.
+        """
+        if not self.redo_stack:
+            raise RamSearchError("Expected an undone filter to redo; found none (a new filter clears what undo kept).")
+        label, after = self.redo_stack.pop()
+        self.history.append((label, self.candidates))
+        self.candidates = after
+        return label
+
+
+def _shown(stored: np.ndarray, scale: np.ndarray) -> tuple[np.ndarray, np.ndarray | bool]:
+    """The shown values of candidates, and where they are defined (exact division)."""
+    scaled = scale > 0
+    if not scaled.any():
+        return stored, True
+    shown, ok = stored.astype(np.int64), np.ones(len(stored), dtype=bool)
+    for index in np.unique(scale[scaled]):
+        where = scale == index
+        shown[where], ok[where] = SCALES[index].shown(stored[where])
+    return shown, ok
+
+
+def _value_search(ftype: FieldType, cur: np.ndarray, scale: np.ndarray, value: int) -> np.ndarray:
+    """``equal N``: pinned candidates by their scale; the others by the first scale that matches, which pins it."""
+    pinned = scale != UNPINNED
+    any_pinned = bool(pinned.any())
+    if any_pinned:
+        shown, ok = _shown(cur, np.where(pinned, scale, 0).astype(np.int8))
+        keep = pinned & ok & (shown == value)
+    else:
+        keep = np.zeros(len(cur), dtype=bool)
+    low, high = ftype.value_range()
+    targets = []  # (scale index, stored value), first preferred
+    for index, candidate in enumerate(SCALES):
+        stored = candidate.stored(value)
+        if ftype.kind not in candidate.kinds or stored is None or not low <= stored <= high:
+            continue
+        if all(stored != s for _, s in targets):
+            targets.append((index, stored))
+    if not targets:
+        return keep
+    # Few positions hold any of the stored values: find them with one pass per
+    # value, then tell which scale each matched only there.
+    hit = cur == targets[0][1]
+    for _, stored in targets[1:]:
+        hit |= cur == stored
+    if any_pinned:
+        hit &= ~pinned
+    where = np.flatnonzero(hit)
+    found = cur[where]
+    chosen = np.empty(len(where), dtype=np.int8)
+    for index, stored in reversed(targets):
+        chosen[found == stored] = index
+    scale[where] = chosen
+    keep[where] = True
+    return keep

@@ -1,0 +1,189 @@
+"""The session file: a RAM search saved between commands.
+
+Each ``retrokit ramsearch`` command runs in its own process, reading the
+session file, doing one thing and writing it back, so a search can be
+scripted and resumed. The file is a numpy ``.npz`` archive (a zip) holding:
+
+- ``meta``: JSON: the format's name and version, the game, its ROM's SHA-1,
+  the start state, the searched types, the RAM regions, each snapshot's label
+  and the history's filters;
+- ``emulator_state``: the core's serialized state now;
+- ``snapshots``: one row of console-order RAM bytes per snapshot;
+- the candidates now, before each filter that can be undone, and after each
+  one that can be redone: the alive bits of every (type, position), packed,
+  and the scale index of each alive candidate.
+
+It is written to a temporary file and renamed into place, so it is never
+half-written. Reading checks everything and says what is wrong in one line.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import zipfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from retrokit.errors import SessionError
+from retrokit.paths import atomic_write
+from retrokit.ramsearch.engine import Candidates
+from retrokit.ramsearch.scales import SCALES
+
+DEFAULT_SESSION = "ramsearch.session"
+FORMAT = "retrokit-ramsearch-session"
+VERSION = 1
+MAX_UNPACKED = 1 << 28  # 256 MiB: a bigger archive is not one this tool wrote for a console's RAM
+_START = "Start a new search with: retrokit ramsearch new GAME"
+
+
+@dataclass
+class SessionData:
+    """Everything a session file holds."""
+
+    game: str
+    rom_sha1: str
+    state: str | None
+    types: tuple[str, ...]
+    regions: tuple[tuple[int, int], ...]
+    emulator_state: bytes
+    snapshots: np.ndarray
+    labels: list[str]
+    candidates: Candidates
+    history: list[tuple[str, Candidates]] = field(default_factory=list)
+    redo: list[tuple[str, Candidates]] = field(default_factory=list)
+
+
+def _pack(prefix: str, candidates: Candidates, arrays: dict[str, np.ndarray]) -> None:
+    alive = np.concatenate(candidates.alive)
+    arrays[f"{prefix}_alive"] = np.packbits(alive)
+    arrays[f"{prefix}_scale"] = np.concatenate(candidates.scale)[alive]
+
+
+def _unpack(prefix: str, archive, types: int, size: int, scales: np.ndarray) -> Candidates:
+    alive = np.unpackbits(archive[f"{prefix}_alive"], count=types * size).astype(bool)
+    scale = np.full(types * size, -1, dtype=np.int8)
+    scale[alive] = scales[archive[f"{prefix}_scale"].astype(np.int64) + 1]  # the file's indices, from -1
+    return Candidates(list(alive.reshape(types, size).copy()), list(scale.reshape(types, size).copy()))
+
+
+def encode_session(data: SessionData) -> bytes:
+    """The bytes of a session file."""
+    meta = {
+        "format": FORMAT,
+        "version": VERSION,
+        "game": data.game,
+        "rom_sha1": data.rom_sha1,
+        "state": data.state,
+        "types": list(data.types),
+        "regions": [list(r) for r in data.regions],
+        "labels": data.labels,
+        "scales": [scale.label for scale in SCALES],
+        "history": [label for label, _ in data.history],
+        "redo": [label for label, _ in data.redo],
+    }
+    arrays = {
+        "meta": np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8),
+        "emulator_state": np.frombuffer(data.emulator_state, dtype=np.uint8),
+        "snapshots": data.snapshots,
+    }
+    _pack("now", data.candidates, arrays)
+    for i, (_, candidates) in enumerate(data.history):
+        _pack(f"history{i}", candidates, arrays)
+    for i, (_, candidates) in enumerate(data.redo):
+        _pack(f"redo{i}", candidates, arrays)
+    buffer = io.BytesIO()
+    np.savez_compressed(buffer, **arrays)
+    return buffer.getvalue()
+
+
+def write_session(path: str | os.PathLike[str], data: SessionData) -> None:
+    """Write a session file atomically (replacing the one there)."""
+    atomic_write(path, encode_session(data), overwrite=True)
+
+
+def read_session(path: str | os.PathLike[str]) -> SessionData:
+    """Read a session file.
+
+    Raises:
+        SessionError: The file is missing, unreadable, not a session file, or corrupt.
+    """
+    path = Path(path)
+    try:
+        blob = path.read_bytes()
+    except FileNotFoundError:
+        raise SessionError(
+            f"Expected a RAM search session at {str(path)!r}; found no file. {_START} "
+            f"(or pass --session with the file you started)."
+        ) from None
+    except OSError as exc:
+        raise SessionError(
+            f"Expected a readable session file at {str(path)!r}; found an error: {exc.strerror or exc}."
+        ) from None
+    try:
+        return _decode(blob)
+    except SessionError as exc:
+        raise SessionError(f"{path}: {exc}") from None
+    except (zipfile.BadZipFile, ValueError, KeyError, EOFError, OSError, TypeError, IndexError) as exc:
+        raise SessionError(
+            f"{path}: expected a RAM search session file; found a corrupt one ({type(exc).__name__}: {exc}). {_START}"
+        ) from None
+
+
+def _decode(blob: bytes) -> SessionData:
+    if not zipfile.is_zipfile(io.BytesIO(blob)):
+        raise SessionError(
+            f"expected a RAM search session file (a zip archive); found {len(blob)} bytes of something else. {_START}"
+        )
+    with zipfile.ZipFile(io.BytesIO(blob)) as archive:
+        unpacked = sum(info.file_size for info in archive.infolist())
+    if unpacked > MAX_UNPACKED:
+        raise SessionError(
+            f"expected a session of at most {MAX_UNPACKED >> 20} MiB unpacked; found {unpacked >> 20} MiB. {_START}"
+        )
+    with np.load(io.BytesIO(blob), allow_pickle=False) as archive:
+        if "meta" not in archive.files:
+            raise SessionError(f"expected a RAM search session file; found a zip without its 'meta' member. {_START}")
+        meta = json.loads(bytes(archive["meta"]).decode())
+        if not isinstance(meta, dict) or meta.get("format") != FORMAT:
+            raise SessionError(f"expected a RAM search session file; found another kind of archive. {_START}")
+        if meta.get("version") != VERSION:
+            raise SessionError(f"expected session format version {VERSION}; found {meta.get('version')!r}. {_START}")
+        types, regions = tuple(meta["types"]), tuple((int(s), int(n)) for s, n in meta["regions"])
+        known = {scale.label: index for index, scale in enumerate(SCALES)}
+        missing = [label for label in meta["scales"] if label not in known]
+        if missing:
+            raise SessionError(f"expected scales this version knows; found {missing}. {_START}")
+        scales = np.array([-1] + [known[label] for label in meta["scales"]], dtype=np.int8)
+        size = sum(n for _, n in regions)
+        snapshots = archive["snapshots"]
+        if snapshots.dtype != np.uint8 or snapshots.ndim != 2 or snapshots.shape[1] != size:
+            raise SessionError(
+                f"expected snapshots of {size} bytes; found an array of shape {snapshots.shape}. {_START}"
+            )
+        if len(meta["labels"]) != len(snapshots):
+            raise SessionError(
+                f"expected a label per snapshot; found {len(meta['labels'])} for {len(snapshots)}. {_START}"
+            )
+        return SessionData(
+            game=str(meta["game"]),
+            rom_sha1=str(meta["rom_sha1"]),
+            state=meta["state"],
+            types=types,
+            regions=regions,
+            emulator_state=archive["emulator_state"].tobytes(),
+            snapshots=snapshots,
+            labels=[str(label) for label in meta["labels"]],
+            candidates=_unpack("now", archive, len(types), size, scales),
+            history=[
+                (str(label), _unpack(f"history{i}", archive, len(types), size, scales))
+                for i, label in enumerate(meta["history"])
+            ],
+            redo=[
+                (str(label), _unpack(f"redo{i}", archive, len(types), size, scales))
+                for i, label in enumerate(meta["redo"])
+            ],
+        )

@@ -102,7 +102,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("type", metavar="TYPE", help="its type code, e.g. '|u1'")
     p.add_argument("--game-file", metavar="PATH", help="the game.yaml to write (default: the game's own)")
     p.add_argument("--force", action="store_true", help="replace a field of the same name")
-    parser.set_defaults(run=lambda args: parser.print_help() or 2)
+    parser.set_defaults(run=run)
+
+
+SUBCOMMANDS = ("new", "run", "filter", "show", "undo", "redo", "poke", "screenshot", "save")
+
+
+def run(args: argparse.Namespace) -> int:
+    """``retrokit ramsearch`` without a subcommand: say which there are."""
+    raise InvalidArgumentError(
+        f"Expected a subcommand of ramsearch: {', '.join(SUBCOMMANDS)}; got none. See: retrokit ramsearch --help"
+    )
 
 
 # --- helpers --------------------------------------------------------------------------------------
@@ -188,7 +198,10 @@ def _run(args: argparse.Namespace) -> int:
 def _filter(args: argparse.Namespace) -> int:
     than = args.than
     if than is not None and than not in ("previous", "first", "changes"):
-        than = _number(than, "--than (previous, first, changes or an address)")
+        try:
+            than = int(than, 0)
+        except ValueError:
+            pass  # the engine names what --than takes, and the closest one
     with _open(args) as search:
         before = search.count
         after = search.filter(args.op, _number(args.value, "VALUE"), than)

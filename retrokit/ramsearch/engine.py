@@ -230,28 +230,34 @@ class Engine:
         ftype = self.types[t]
         if spec.than is None and spec.op == "equal":
             return _value_search(ftype, cur, scale, spec.value)
-        if spec.than is None:
-            shown, ok = _shown(cur, scale)
-            return ok & COMPARISONS[spec.op](shown, spec.value)
         if spec.than == "changes":
             counts = sum(
                 (pick(self.decoded(k)[t]) != pick(self.decoded(k - 1)[t])).astype(np.int32)
                 for k in range(1, len(self.snapshots))
             )
             return COMPARISONS[spec.op](counts, spec.value)
-        shown, ok = _shown(cur, scale)
-        if isinstance(spec.than, int):  # another address: its stored value in the newest snapshot
+        scaled = bool((scale > 0).any())  # else every value is shown as stored: compare the compact arrays
+        shown, ok = _shown(cur, scale) if scaled else (cur, None)
+        if spec.than is None:
+            ref, ref_ok = spec.value, None
+        elif isinstance(spec.than, int):  # another address: its stored value in the newest snapshot
             try:
                 position = self.layout.position(spec.than, ftype.width)
             except InvalidArgumentError:
                 return np.zeros(len(cur), dtype=bool)
-            ref, ref_ok = self.decoded(-1)[t][position], True
+            ref, ref_ok = self.decoded(-1)[t][position], None
         else:
-            ref, ref_ok = _shown(pick(self.decoded(0 if spec.than == "first" else -2)[t]), scale)
+            ref = pick(self.decoded(0 if spec.than == "first" else -2)[t])
+            ref, ref_ok = _shown(ref, scale) if scaled else (ref, None)
         if spec.op == "changed-by":
-            return ok & ref_ok & (shown.astype(np.int64) - ref == spec.value)
-        op = CHANGES.get(spec.op, spec.op)
-        return ok & ref_ok & COMPARISONS[op](shown, ref)
+            wide = np.int64 if shown.itemsize > 2 or not scaled and shown.dtype == np.uint32 else np.int32
+            result = np.subtract(shown, ref, dtype=wide) == spec.value
+        else:
+            result = COMPARISONS[CHANGES.get(spec.op, spec.op)](shown, ref)
+        for defined in (ok, ref_ok):
+            if defined is not None:
+                result &= defined
+        return result
 
     # --- undo and redo ---------------------------------------------------------------------
 
@@ -282,13 +288,10 @@ class Engine:
         return label
 
 
-def _shown(stored: np.ndarray, scale: np.ndarray) -> tuple[np.ndarray, np.ndarray | bool]:
-    """The shown values of candidates, and where they are defined (exact division)."""
-    scaled = scale > 0
-    if not scaled.any():
-        return stored, True
+def _shown(stored: np.ndarray, scale: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The shown values of candidates (as int64), and where they are defined (exact division)."""
     shown, ok = stored.astype(np.int64), np.ones(len(stored), dtype=bool)
-    for index in np.unique(scale[scaled]):
+    for index in np.unique(scale[scale > 0]):
         where = scale == index
         shown[where], ok[where] = SCALES[index].shown(stored[where])
     return shown, ok

@@ -107,9 +107,9 @@ def add_field(path: str | os.PathLike[str], name: str, address: str, type_code: 
         )
     replaced = bool(fields) and name in fields
     if replaced and not force:
-        old = fields[name]
+        line = text.splitlines()[fields.lc.key(name)[0]].strip()
         raise FileConflictError(
-            f"Expected no field {name!r} in {path}; found one ({dict(old) if isinstance(old, dict) else old}). "
+            f"Expected no field {name!r} in {path}; found one ({line}). "
             "Choose another name, or pass --force (force=True) to replace it."
         )
     new_text = _insert(text, doc, fields, name, address, type_code)

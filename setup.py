@@ -1,12 +1,34 @@
-"""Build the private native host, ``retrokit.native._host``.
+"""Build the private native host, ``retrokit.native._host``, and bundle ``games/`` into the package.
 
 Everything else about the package is declared in ``pyproject.toml``; this file
-exists only because a C extension needs a setuptools ``Extension``.
+exists because a C extension needs a setuptools ``Extension``, and because the
+bundled integrations live at the top of the repository (where integrators
+look for them) but must ship inside the installed package.
 """
 
 from __future__ import annotations
 
+import shutil
+from pathlib import Path
+
 from setuptools import Extension, setup
+from setuptools.command.build_py import build_py
+
+HERE = Path(__file__).resolve().parent
+
+
+class BuildWithGames(build_py):
+    """Copies ``games/`` (data, scenarios, states, the test cartridge) to ``retrokit/_games`` in the build."""
+
+    def run(self) -> None:
+        super().run()
+        if self.editable_mode:  # an editable install finds games/ in the checkout itself
+            return
+        target = Path(self.build_lib) / "retrokit" / "_games"
+        if target.exists():
+            shutil.rmtree(target)
+        shutil.copytree(HERE / "games", target, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+
 
 host = Extension(
     "retrokit.native._host",
@@ -28,4 +50,4 @@ host = Extension(
     libraries=["dl", "pthread"],
 )
 
-setup(ext_modules=[host])
+setup(ext_modules=[host], cmdclass={"build_py": BuildWithGames})

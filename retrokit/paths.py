@@ -3,7 +3,8 @@
 Game folders are searched, in order, in:
 
 1. every folder in ``RETROKIT_GAMES`` (separated by :data:`os.pathsep`),
-2. the repository's ``games/`` folder (next to the ``retrokit`` package),
+2. the bundled integrations: the checkout's ``games/`` folder (next to the
+   ``retrokit`` package), or its copy inside an installed package,
 3. the stable-retro wheel's ``data/stable``, ``data/experimental`` and
    ``data/contrib`` folders.
 
@@ -63,10 +64,17 @@ def wheel_data_dirs() -> list[Path]:
     return [root / "data" / kind for kind in WHEEL_DATA_KINDS if (root / "data" / kind).is_dir()]
 
 
+BUNDLED_GAMES = "_games"
+"""The package folder an installed retrokit keeps the bundled ``games/`` in (``setup.py`` copies it there)."""
+
+
 def repo_games_dir() -> Path | None:
-    """Return the repository's ``games/`` folder next to the package, if it exists."""
-    path = Path(__file__).resolve().parent.parent / "games"
-    return path if path.is_dir() else None
+    """Return the bundled integrations: ``games/`` of a checkout, or the copy inside an installed package."""
+    package = Path(__file__).resolve().parent
+    for path in (package / BUNDLED_GAMES, package.parent / "games"):
+        if path.is_dir():
+            return path
+    return None
 
 
 def env_games_dirs() -> list[Path]:

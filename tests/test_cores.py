@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+import ctypes
+
+import native_c as native_c_module
 import numpy as np
 import pytest
 
-from retrokit.errors import InvalidArgumentError
 from retrokit.native import _host
 from retrokit.paths import wheel_cores_dir
 
@@ -55,32 +57,36 @@ FORMATS = [
 ]
 
 
+@pytest.fixture(scope="module")
+def native_c(tmp_path_factory):
+    lib = native_c_module.build(tmp_path_factory.mktemp("native"))
+    if lib is None:
+        pytest.skip("no C compiler to build the native host's plain C on its own")
+    return lib
+
+
 @pytest.mark.parametrize("fmt,dtype", FORMATS, ids=["0rgb1555", "xrgb8888", "rgb565"])
 @pytest.mark.parametrize("width", [320, 37], ids=["wide", "odd-width"])
-def test_pixel_format_converts_with_row_padding(fmt: int, dtype: type, width: int) -> None:
+def test_pixel_format_converts_with_row_padding(native_c, fmt: int, dtype: type, width: int) -> None:
     rng = np.random.default_rng(fmt)
     height, pad = 11, 5  # rows padded, as cores' frames are
     frame = rng.integers(0, np.iinfo(dtype).max, (height, width + pad), dtype=dtype, endpoint=True)
     out = np.zeros((height, width, 3), dtype=np.uint8)
-    _host.convert_frame(frame.tobytes(), width, height, frame.strides[0], fmt, out)
+    assert native_c.rk_frame_to_rgb(frame.ctypes.data, frame.strides[0], width, height, fmt, out.ctypes.data) == 0
     assert (out == reference(frame[:, :width], fmt)).all()
 
 
-def test_convert_frame_checks_sizes() -> None:
-    with pytest.raises(InvalidArgumentError, match="needs more than"):
-        _host.convert_frame(b"\0" * 10, 4, 4, 8, _host.PIXEL_FORMAT_RGB565, np.zeros((4, 4, 3), np.uint8))
-    with pytest.raises(InvalidArgumentError, match="format must be"):
-        _host.convert_frame(b"\0" * 32, 4, 4, 8, 7, np.zeros((4, 4, 3), np.uint8))
-    with pytest.raises(InvalidArgumentError, match="must hold"):
-        _host.convert_frame(b"\0" * 32, 4, 4, 8, _host.PIXEL_FORMAT_RGB565, np.zeros((4, 3, 3), np.uint8))
+def test_unknown_pixel_format_is_refused(native_c) -> None:
+    frame, out = np.zeros((4, 4), np.uint16), np.zeros((4, 4, 3), np.uint8)
+    assert native_c.rk_frame_to_rgb(frame.ctypes.data, 8, 4, 4, 7, out.ctypes.data) == -1
 
 
 @pytest.mark.parametrize("seed", [0, 1, 42, 2**31 + 5], ids=["zero", "default", "42", "large"])
-def test_the_cores_rand_is_glibcs(seed: int) -> None:
-    import ctypes
-
+def test_the_cores_rand_is_glibcs(native_c, seed: int) -> None:
     libc = ctypes.CDLL(None)
     libc.random.restype = ctypes.c_long
     libc.srandom(ctypes.c_uint(seed))
     expected = [libc.random() for _ in range(1000)]
-    assert _host.rand_sequence(seed, 1000) == expected
+    state = native_c_module.Rand()
+    native_c.rk_rand_seed(ctypes.byref(state), seed)
+    assert [native_c.rk_rand_next(ctypes.byref(state)) for _ in range(1000)] == expected

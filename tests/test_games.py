@@ -76,7 +76,7 @@ def make_yaml_game(root: Path, name: str = "Testbed-Genesis", text: str = TESTBE
 def test_airstriker_is_reachable_with_fields_state_and_bundled_rom(name):
     game = games.find_game(name)
     assert game.name == "Airstriker-Genesis"
-    assert game.system == "Genesis"
+    assert game.system.name == "Genesis"
     assert game.folders == (AIRSTRIKER_DIR,)
     assert game.sha1s == (AIRSTRIKER_SHA1,)
     assert dict(game.fields) == {
@@ -212,7 +212,7 @@ def test_yaml_game(user_games):
     (folder / "scenario.yaml").write_text("reward: x\n")
     game = games.find_game("Testbed-Genesis")
     assert game.folders == (folder,)
-    assert game.system == "Genesis"
+    assert game.system.name == "Genesis"
     assert game.sha1s == (SHA_NOBODY_HAS,)
     assert game.fields["jumped"] == FieldSpec("jumped", 0xFF0013, "|u1", 0x80)
     assert game.fields["x"] == FieldSpec("x", 0xFF0010, ">i2")
@@ -290,7 +290,7 @@ def test_gym_retro_folder(user_games):
     make_gym_game(user_games, "Runner-Nes-v0", data, metadata_json='{"default_state": "Start"}')
     (user_games / "Runner-Nes-v0" / "Start.state").write_bytes(b"")
     game = games.find_game("Runner-Nes")
-    assert game.system == "Nes"
+    assert game.system.name == "Nes"
     assert game.fields == {"lives": FieldSpec("lives", 0x75A, "|u1", 15)}
     assert game.states == ["Start"] and game.default_state == "Start"
 

@@ -320,7 +320,7 @@ def test_bad_sticky_probability_is_refused(airstriker: Emulator) -> None:
 
 
 def test_native_run_checks_its_arguments_before_the_core(airstriker: Emulator) -> None:
-    raw = airstriker._emu
+    raw = airstriker.handle
     with pytest.raises(InvalidArgumentError, match="uint16"):
         raw.run(np.zeros(2, dtype=np.int32), 1)
     with pytest.raises(InvalidArgumentError, match="frames must be 0 or more"):
@@ -375,7 +375,7 @@ def test_runner_steps_match_single_runs_and_screens_land_in_the_batch(
     batch = np.zeros((count, 224, 320, 3), dtype=np.uint8)
     for step in range(60):
         actions = np.array([[s[step], 0] for s in scripts], dtype=np.uint16)
-        converted = runner.run([e._emu for e in emus], actions, 4, list(batch))
+        converted = runner.run([e.handle for e in emus], actions, 4, list(batch))
         for emu, row in zip(solo, actions):
             emu.run(row, 4)
         assert converted == (True,) * count
@@ -393,11 +393,11 @@ def test_runner_checks_its_arguments_first(airstriker: Emulator) -> None:
     with pytest.raises(InvalidArgumentError, match="not a native Emulator"):
         runner.run([airstriker], actions, 4)
     with pytest.raises(InvalidArgumentError, match=r"shape \(1, 2\)"):
-        runner.run([airstriker._emu], np.zeros((1, 3), dtype=np.uint16), 4)
+        runner.run([airstriker.handle], np.zeros((1, 3), dtype=np.uint16), 4)
     with pytest.raises(CoreError, match="another thread"):  # the same emulator twice
-        runner.run([airstriker._emu] * 2, np.zeros((2, 2), dtype=np.uint16), 4)
+        runner.run([airstriker.handle] * 2, np.zeros((2, 2), dtype=np.uint16), 4)
     with pytest.raises(InvalidArgumentError, match=r"shape \(height, width, 3\)"):
-        runner.run([airstriker._emu], actions, 4, [np.zeros((224, 320), dtype=np.uint8)])
+        runner.run([airstriker.handle], actions, 4, [np.zeros((224, 320), dtype=np.uint8)])
     airstriker.run(0, 1)  # every emulator was released again
 
 

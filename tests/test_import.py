@@ -8,9 +8,10 @@ import zipfile
 from pathlib import Path
 
 import pytest
+from smd import interleave_smd
 
 from retrokit import paths
-from retrokit.data import games, roms
+from retrokit.data import games
 from retrokit.data.importer import import_roms
 from retrokit.errors import RomNotFoundError
 
@@ -79,7 +80,7 @@ def test_import_from_a_zip(src, data_dir, nested):
 
 
 def test_import_of_an_smd_stores_the_md_form(src, data_dir):
-    (src / "Airstriker.smd").write_bytes(roms.interleave_smd(AIRSTRIKER_ROM.read_bytes()))
+    (src / "Airstriker.smd").write_bytes(interleave_smd(AIRSTRIKER_ROM.read_bytes()))
     report = import_roms([src])
     assert [r.game for r in report.imported] == ["Airstriker-Genesis"]
     assert imported(data_dir, "Airstriker-Genesis", "md").read_bytes() == AIRSTRIKER_ROM.read_bytes()

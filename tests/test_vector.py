@@ -150,7 +150,7 @@ def test_vector_movies_replay_what_each_env_saw(tmp_path, every_frame: bool) -> 
     seen = []  # (movie, index of the step's last frame in it, what the env saw)
     frames_in: dict = {}
     for _ in range(30):
-        movies = [env._recorder.path if env._recorder is not None else None for env in vec.envs]
+        movies = [env.movies.recorder.path if env.movies.recorder is not None else None for env in vec.envs]
         before = [env.emulator.frame for env in vec.envs]
         obs = vec.step((rng.random((2, 12)) < 0.3).astype(np.int8))[0]
         for i, env in enumerate(vec.envs):

@@ -146,7 +146,7 @@ class Bare:
         self.emus = [Emulator("Genesis", rom) for _ in range(count)]
         for emu in self.emus:
             emu.set_state(state)
-        self.natives = [emu._emu for emu in self.emus]
+        self.natives = [emu.handle for emu in self.emus]
         self.actions = np.zeros((count, 2), dtype=np.uint16)
         self.runner = _host.Runner(count - 1)
 

@@ -43,7 +43,7 @@ def main() -> int:
     def raw() -> float:
         emu.set_state(state)
         start = time.perf_counter()
-        emu._emu.run(actions, calls * 4)  # one native call: the host's own rate
+        emu.handle.run(actions, calls * 4)  # one native call: the host's own rate
         return calls * 4 / (time.perf_counter() - start)
 
     def api() -> float:

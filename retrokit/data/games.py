@@ -39,6 +39,7 @@ from retrokit.errors import (
     UnsupportedSystemError,
     did_you_mean,
 )
+from retrokit.host.systems import System, get_system
 
 if TYPE_CHECKING:
     from retrokit.host.fields import FieldSpec
@@ -81,9 +82,13 @@ class Game:
         return read_game_folder(self.folders[0])
 
     @property
-    def system(self) -> str:
-        """The system's name, e.g. ``"Genesis"``."""
-        return self.info.system or self.name.rsplit("-", 1)[-1]
+    def system(self) -> System:
+        """The game's system, from its data file or else its name's suffix (``-Genesis``).
+
+        Raises:
+            UnsupportedSystemError: No known system has that name.
+        """
+        return get_system(self.info.system or self.name.rsplit("-", 1)[-1])
 
     @property
     def sha1s(self) -> tuple[str, ...]:
@@ -203,8 +208,7 @@ class Game:
     @property
     def rom_extensions(self) -> tuple[str, ...]:
         """The ROM extensions of the game's system; the first is the one imported ROMs get."""
-        ext = roms.system_extension(self.system)
-        return (ext, *(e for e in roms.system_extensions()[self.system] if e != ext))
+        return self.system.extensions
 
     def imported_rom_path(self, data_dir: str | os.PathLike[str] | None = None) -> Path:
         """Return where an imported ROM of this game is (or would be) stored."""
@@ -281,7 +285,7 @@ class Game:
                 "fix the default state's name", did_you_mean(info.default_state, self._state_files),
             )
         try:
-            roms.system_extension(self.system)
+            self.system  # noqa: B018 -- an unknown system fails here, when the game loads
         except UnsupportedSystemError as exc:
             raise UnsupportedSystemError(f"{info.source}: {exc}") from exc
         return self
@@ -376,9 +380,9 @@ def find_game(name: str) -> Game:
 _sha1_cache: dict[tuple[str, int, int, str], str] = {}
 
 
-def _cached_sha1(path: Path, system: str) -> str:
+def _cached_sha1(path: Path, system: System) -> str:
     stat = path.stat()
-    key = (str(path), stat.st_size, stat.st_mtime_ns, system)
+    key = (str(path), stat.st_size, stat.st_mtime_ns, system.name)
     if key not in _sha1_cache:
         _sha1_cache[key] = roms.rom_sha1(path, system)
     return _sha1_cache[key]

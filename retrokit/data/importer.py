@@ -23,6 +23,7 @@ from retrokit import paths
 from retrokit.data import roms
 from retrokit.data.games import Game, list_games
 from retrokit.errors import RetrokitError, RomError
+from retrokit.host.systems import extension_of
 
 MAX_ZIP_DEPTH = 3
 _TOO_BIG = f"larger than {roms.MAX_ROM_SIZE // 2**20} MiB"
@@ -121,7 +122,7 @@ def _zip_candidates(label: str, opener: Callable[[], zipfile.ZipFile], report: I
                 if info.is_dir():
                     continue
                 member = f"{label}!{info.filename}"
-                ext = roms.file_extension(info.filename)
+                ext = extension_of(info.filename)
                 if _too_big(info.file_size) and ext != "zip":
                     report.skipped.append((member, _TOO_BIG))
                     continue
@@ -145,7 +146,7 @@ def _blob_candidates(label: str, ext: str, data: bytes, report: ImportReport, de
 
 
 def _file_candidates(path: Path, report: ImportReport) -> Iterator[_Candidate]:
-    label, ext = str(path), roms.file_extension(path)
+    label, ext = str(path), extension_of(path)
     try:
         size = path.stat().st_size
     except OSError as exc:

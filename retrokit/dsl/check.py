@@ -1,11 +1,10 @@
 """Check scenario expressions before anything runs.
 
-:func:`analyse` parses every expression of a :class:`ScenarioSpec` and checks
+:class:`Checker` parses every expression of a :class:`ScenarioSpec` and checks
 it: every name is a field, a definition or a time counter; every function and
-table exists and gets the right number of arguments; no division is by a
-constant zero; and the types fit. The language has three types: integers and
-decimals (both *numbers*), and booleans (*conditions*). A condition is never
-used as a number or the reverse; bit operations take integers only.
+table exists and gets the right number of arguments; and no division is by a
+constant zero. Types are checked afterwards, by :mod:`retrokit.dsl.typecheck`,
+over the analysis this module makes; the type names it uses live here.
 
 It also gives every memory call (``prev``, ``delta``, ``initial``, ``peak``)
 a :class:`Slot`; equal calls share one.

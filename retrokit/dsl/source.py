@@ -13,7 +13,6 @@ and prints the source line with carets under the offending text::
 from __future__ import annotations
 
 import bisect
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from retrokit.errors import RetrokitError
@@ -136,9 +135,3 @@ def located(cls: type[RetrokitError], source: SourceText, start: int, end: int, 
     err.file, err.line, err.column = source.name, line, col  # type: ignore[attr-defined]
     return err
 
-
-def choices_text(names: Sequence[str], limit: int = 12) -> str:
-    """Return ``'a', 'b', ... (and N more)`` for a message."""
-    shown = ", ".join(repr(n) for n in list(names)[:limit])
-    more = len(names) - limit
-    return shown + (f" (and {more} more)" if more > 0 else "")

@@ -23,8 +23,8 @@ import numpy as np
 from gymnasium import spaces
 
 from retrokit.errors import InvalidArgumentError, did_you_mean
+from retrokit.host.primitives import pack_buttons
 from retrokit.host.systems import System
-from retrokit.native import _host
 
 ACTION_TYPES = ("all", "filtered", "discrete", "multi_discrete")
 
@@ -133,7 +133,7 @@ class ActionMap:
             self._packs
             and type(action) is np.ndarray
             and action.size == self._size
-            and _host.pack_buttons(action, self.num_buttons, out, self._filter_table)
+            and pack_buttons(action, self.num_buttons, out, self._filter_table)
         ):
             return
         out[: self.players] = self.to_masks(action)

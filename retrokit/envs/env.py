@@ -23,9 +23,11 @@ from retrokit.data.games import Game, find_game
 from retrokit.data.states import read_state
 from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
-from retrokit.errors import EnvError, FileConflictError, InvalidArgumentError, did_you_mean
+from retrokit.envs.stepper import Stepper, drive
+from retrokit.errors import InvalidArgumentError, did_you_mean
 from retrokit.host.emulator import Emulator
 from retrokit.host.memory import FieldReader
+from retrokit.movie.recorder import EpisodeMovies
 
 OBS_TYPES = ("rgb", "ram")
 
@@ -98,24 +100,39 @@ class RetroEnv(gymnasium.Env):
         self.state_name, self._state = self._resolve_state(state)
         self.scenario = self._load_scenario(scenario)
         self.emulator = Emulator(self.game.system, self.game.require_rom(), options=options, ports=max(players, 2))
-        self._emu = self.emulator._emu  # the native object, for the hot path
         self.reader = FieldReader(self.game.fields, self.emulator.space)
         self.actions = ActionMap(self.emulator.system, action_type, getattr(self.scenario, "actions", None), players)
         self.action_space = self.actions.space
-        self._masks = np.zeros(self.emulator.ports, dtype=np.uint16)
+        self.stepper = Stepper(
+            self.emulator,
+            self.reader,
+            self.actions,
+            self.scenario,
+            frameskip=frameskip,
+            players=players,
+            every_frame=scenario_every_frame,
+        )
         self._crop = getattr(self.scenario, "crop", None)
         self._screen_shape = self.emulator.system.screen or self._first_frame_shape()
         self.observation_space = self._make_observation_space()
         self._buffers = BufferPool(self.observation_space.shape)
-        self._direct = obs_type == "rgb" and self._crop is None
         self.record_dir = Path(record) if record is not None else None
-        self._recorder = None
-        self._run = None
+        self.movies: EpisodeMovies | None = None
+        if self.record_dir is not None:
+            stem = f"{self.game.name}-{self.state_name or 'power-on'}"
+            self.movies = EpisodeMovies(
+                self.record_dir, stem, self.game.name, self.emulator.system.name, players, self._state
+            )
+            self.stepper.observers.append(self.movies)
         self._viewer = None
-        self._frame = self._steps = 0
         self._first_obs: np.ndarray | None = None
         self._first_frame: np.ndarray | None = None
         self._at_start = False
+
+    @property
+    def direct_screen(self) -> bool:
+        """Whether an observation is the whole screen, so frames can be converted straight into a buffer of its shape."""
+        return self.obs_type == "rgb" and self._crop is None
 
     # --- set-up -----------------------------------------------------------------------------------
 
@@ -148,7 +165,7 @@ class RetroEnv(gymnasium.Env):
 
     def _first_frame_shape(self) -> tuple[int, int]:
         self._start()
-        self.emulator.run(self._masks, 1)  # one frame shows the core's screen size
+        self.emulator.run(0, 1)  # one frame shows the core's screen size
         return self.emulator.screen_shape()
 
     def _initial_observation(self) -> np.ndarray:
@@ -159,13 +176,13 @@ class RetroEnv(gymnasium.Env):
         restored: episodes still start exactly at the state.
         """
         if self._first_frame is None:
-            self._emu.run(np.zeros_like(self._masks), 1)
+            self.emulator.run(0, 1)
             self._first_frame = self.emulator.screen()
-            self._first_obs = self._observe()
+            self._first_obs = self.observe()
             self._start()
             self.emulator.forget_action()
         if self.obs_type == "ram":
-            return self._observe()
+            return self.observe()
         return self._first_obs.copy()  # type: ignore[union-attr]
 
     def _make_observation_space(self) -> spaces.Box:
@@ -191,110 +208,56 @@ class RetroEnv(gymnasium.Env):
         self._start()
         self.emulator.forget_action()
         self.emulator.set_sticky(self.sticky_prob, int(self.np_random.integers(0, 2**63)))
-        self._frame = self._steps = 0
-        values = self.reader.read()
+        values = self.stepper.start()
         obs = self._initial_observation()
         self._at_start = True
-        if self.scenario is not None:
-            self._run = self.scenario.start()
-            self._run.reset(values)
-        self._begin_movie()
+        if self.movies is not None:
+            self.movies.start()
         if self.render_mode == "human":
             self.render()
         return obs, values
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        before = self.prepare_step(action)
-        if self.scenario_every_frame:
-            for i in range(self.frameskip):
-                before = self.start_frame(i)
-                self._emu.run(self._masks, 1)
-                if self.end_frame(before):
-                    break
-            return self.finish_frames()
-        if self._direct:  # the host converts the screen right after the frames
-            obs = self._buffers.take()
-            return self.finish_step(before, obs if self._emu.run(self._masks, self.frameskip, obs) else None)
-        self._emu.run(self._masks, self.frameskip)
-        return self.finish_step(before)
+        stepper = self.stepper
+        stepper.begin(action)
+        out = self._buffers.take() if self.direct_screen else None
+        run = self.emulator.run
 
-    # The vector env runs many envs' frames in one native call between these two
-    # (or, with the scenario evaluated every frame, one frame at a time between
-    # start_frame and end_frame, then finish_frames).
+        def frames(live: list[int], count: int, last: bool) -> tuple[bool | None]:
+            return (run(stepper.masks, count, out if last else None),)
 
-    def prepare_step(self, action: Any) -> tuple[int, ...] | None:
-        """Set the buttons for a step's frames; return what a movie needs to know of the last frame."""
-        if self._run is None and self.scenario is not None:
-            raise EnvError("Expected reset() before the first step(); call env.reset() first.")
-        self.actions.write_masks(action, self._masks)
-        self._steps += 1
+        converted = drive((stepper,), frames)[0]
+        return self.finish_step(out if converted else None)
+
+    def finish_step(self, obs: np.ndarray | None = None) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        """End a step once its frames ran (see :func:`~retrokit.envs.stepper.drive`): the step's 5-tuple.
+
+        Args:
+            obs: The observation, if the frames were converted straight into
+                it (see :attr:`direct_screen`); else it is made here.
+        """
         self._at_start = False
-        return self._emu.held() if self._recorder is not None else None
-
-    def finish_step(
-        self, before: tuple[int, ...] | None, obs: np.ndarray | None = None
-    ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        """Account for a step's frames once they ran: fields, scenario, observation."""
-        self._frame += self.frameskip
-        if before is not None:
-            self._record_step(before, self.frameskip)
-        values = self.reader.read()
-        rewards, done = self._evaluate(values)
-        return self._end_step(rewards, done, values, self._observe() if obs is None else obs)
-
-    def _end_step(
-        self, rewards: tuple[float, ...], done: bool, values: dict[str, Any], obs: np.ndarray
-    ) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        truncated = self.max_episode_steps is not None and self._steps >= self.max_episode_steps and not done
+        stepper = self.stepper
+        rewards, done, values = stepper.rewards, stepper.done, stepper.values
+        if obs is None:
+            obs = self.observe()
+        truncated = self.max_episode_steps is not None and stepper.steps >= self.max_episode_steps and not done
         if self.players > 1:
             values["rewards"] = rewards
-        if (done or truncated) and self._recorder is not None:
-            self._end_movie()
+        if (done or truncated) and self.movies is not None:
+            self.movies.end()
         if self.render_mode == "human":
             self.render()
         return obs, float(sum(rewards)), done, truncated, values
 
-    def _evaluate(self, values: dict[str, int]) -> tuple[tuple[float, ...], bool]:
-        if self._run is None:
-            return (0.0,) * self.players, False
-        rewards, done = self._run.step(values, self._frame, self._steps)
-        return tuple(rewards[: self.players]), bool(done)
-
-    def start_frame(self, i: int) -> tuple[int, ...] | None:
-        """Before frame ``i`` of a step whose scenario runs every frame; return what a movie needs."""
-        if i == 0:
-            self._frame_rewards, self._frame_done, self._frame_values = [0.0] * self.players, False, {}
-        before = self._emu.held() if self._recorder is not None else None
-        if i > 0:
-            self._emu.forget_action()  # only a step's first frame may stick
-        return before
-
-    def end_frame(self, before: tuple[int, ...] | None) -> bool:
-        """After one frame of such a step: read the fields and add the frame's rewards; return done."""
-        self._frame += 1
-        if before is not None:
-            self._record_step(before, 1)
-        values = self._frame_values = self.reader.read()
-        rewards, done = self._evaluate(values)
-        self._frame_rewards = [t + r for t, r in zip(self._frame_rewards, rewards)]
-        self._frame_done = done
-        return done
-
-    def finish_frames(self, obs: np.ndarray | None = None) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        """End such a step once its frames ran (all of them, or up to the one that ended the episode)."""
-        rewards = tuple(self._frame_rewards)
-        return self._end_step(rewards, self._frame_done, self._frame_values, self._observe() if obs is None else obs)
-
-    def _observe(self) -> np.ndarray:
+    def observe(self) -> np.ndarray:
+        """The observation now: the screen (cropped as the scenario says, in the fixed shape) or the RAM."""
         if self.obs_type == "ram":
             out = self._buffers.take()
             out[:] = self.emulator.ram
             return out
-        shape = self._emu.screen_shape()
-        if shape == self._screen_shape and self._crop is None:
-            out = self._buffers.take()
-            self._emu.screen(out)
-            return out
+        if self.emulator.screen_shape() == self._screen_shape and self._crop is None:
+            return self.emulator.screen(self._buffers.take())
         frame = self.emulator.screen()
         out = np.zeros(self.observation_space.shape, dtype=np.uint8)
         if self._crop is not None:
@@ -320,53 +283,13 @@ class RetroEnv(gymnasium.Env):
         return None
 
     def close(self) -> None:
-        if self._recorder is not None:
-            self._end_movie()
+        if self.movies is not None:
+            self.movies.end()
         if self._viewer is not None:
             self._viewer.close()
             self._viewer = None
         if hasattr(self, "emulator"):
             self.emulator.close()
-
-    # --- movies ----------------------------------------------------------------------------------
-
-    def _begin_movie(self) -> None:
-        if self.record_dir is None:
-            return
-        from retrokit.movie.recorder import MovieRecorder, claim_movie_path
-
-        if self._recorder is not None:
-            self._end_movie()
-        self.record_dir.mkdir(parents=True, exist_ok=True)
-        self._recorder = MovieRecorder(
-            claim_movie_path(self.record_dir, self._movie_stem),
-            self.game.name,
-            self.emulator.system.name,
-            self.players,
-            self._state,
-        )
-
-    def _record_step(self, before: tuple[int, ...], frames: int) -> None:
-        """Record the buttons each frame of the last run really saw."""
-        applied = tuple(int(m) for m in self._masks[: self.players])
-        first = before[: self.players] if self._emu.stuck else applied
-        self._recorder.record(first)
-        for _ in range(frames - 1):
-            self._recorder.record(applied)
-
-    @property
-    def _movie_stem(self) -> str:
-        return f"{self.game.name}-{self.state_name or 'power-on'}"
-
-    def _end_movie(self) -> None:
-        from retrokit.movie.recorder import claim_movie_path
-
-        recorder, self._recorder = self._recorder, None
-        try:
-            recorder.close()
-        except FileConflictError:  # another process wrote a movie of that name meanwhile
-            recorder.path = claim_movie_path(self.record_dir, self._movie_stem)
-            recorder.close()
 
 
 def _check_choice(name: str, value: object, choices: tuple[object, ...]) -> None:

@@ -101,7 +101,7 @@ class RetroParallelEnv(ParallelEnv):
 
     def state(self) -> Any:
         """The global state: the same screen (or RAM) every agent sees."""
-        return self._env._observe()
+        return self._env.observe()
 
     def close(self) -> None:
         self._env.close()

@@ -27,8 +27,9 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, concatenate, create_empty_array, iterate
 
 from retrokit.envs.buffers import BufferPool, Pool, StepArrays
+from retrokit.envs.stepper import drive
 from retrokit.errors import InvalidArgumentError
-from retrokit.native import _host
+from retrokit.host.runner import Runner
 
 
 class ThreadedVectorEnv(VectorEnv):
@@ -74,7 +75,7 @@ class ThreadedVectorEnv(VectorEnv):
         self._pool = ThreadPoolExecutor(max_workers=max(self.threads - 1, 1), thread_name_prefix="retrokit-env")
         self._runner = self._native_runner()
 
-    def _native_runner(self) -> _host.Runner | None:
+    def _native_runner(self) -> Runner | None:
         """A native runner when every env is a plain RetroEnv that can share one."""
         from retrokit.envs.env import RetroEnv
 
@@ -83,17 +84,18 @@ class ThreadedVectorEnv(VectorEnv):
             return None
         if len({(env.frameskip, env.emulator.ports, env.scenario_every_frame) for env in envs}) != 1:
             return None
+        self._steppers = [env.stepper for env in envs]
         # Each env's buttons become a row of one array the runner reads.
         self._actions = np.zeros((self.num_envs, envs[0].emulator.ports), dtype=np.uint16)
-        for i, env in enumerate(envs):
-            env._masks = self._actions[i]
-        self._direct_screens = all(env.obs_type == "rgb" and env._crop is None for env in envs) and self._batches is not None
+        for i, stepper in enumerate(self._steppers):
+            stepper.use_masks(self._actions[i])
+        self._direct_screens = all(env.direct_screen for env in envs) and self._batches is not None
         names = {tuple(env.reader.names) for env in envs}
         if len(names) == 1 and all(env.players == 1 and env.reader.fits_int64 for env in envs):
             keys = names.pop()
             self._step_arrays = Pool(lambda: StepArrays(self.num_envs, keys))
             self._field_values = [memoryview(env.reader.values) for env in envs]
-        return _host.Runner(self.threads - 1)
+        return Runner([env.emulator for env in envs], self.threads - 1)
 
     def _each(self, job: Callable[[int], Any]) -> list[Any]:
         """Run ``job(i)`` for every env: the pool takes all but every ``threads``-th, which this thread runs."""
@@ -162,16 +164,19 @@ class ThreadedVectorEnv(VectorEnv):
         envs = self.envs
         batch, views = self._batches.take_rows() if self._batches is not None else (None, [])
         stepping = [i for i in range(self.num_envs) if not self._autoreset[i]]
-        befores = [envs[i].prepare_step(actions[i]) for i in stepping]
-        if envs[0].scenario_every_frame:
-            results = self._run_frames(stepping, views)
-        else:
-            screens = [views[i] for i in stepping] if self._direct_screens else None
-            converted = self._run(stepping, envs[0].frameskip, screens)
-            results = {
-                i: envs[i].finish_step(befores[k], views[i] if screens is not None and converted[k] else None)
-                for k, i in enumerate(stepping)
-            }
+        for i in stepping:
+            self._steppers[i].begin(actions[i])
+        steppers = [self._steppers[i] for i in stepping]
+        screens = [views[i] for i in stepping] if self._direct_screens else None
+
+        def frames(live: list[int], count: int, last: bool) -> tuple[bool, ...]:
+            envs_live = [stepping[k] for k in live]
+            rows = self._actions if len(envs_live) == self.num_envs else self._actions[envs_live]
+            converted = screens is not None and last
+            return self._runner.run(envs_live, rows, count, [screens[k] for k in live] if converted else None)
+
+        converted = drive(steppers, frames)
+        results = {i: envs[i].finish_step(views[i] if converted[k] else None) for k, i in enumerate(stepping)}
         for i in range(self.num_envs):
             if self._autoreset[i]:
                 obs, info = envs[i].reset()
@@ -183,39 +188,6 @@ class ThreadedVectorEnv(VectorEnv):
             if result[0] is not views[i]:  # not converted straight into the batch
                 batch[i] = result[0]
         return ordered, batch
-
-    def _run(self, envs: list[int], frames: int, screens: list[np.ndarray] | None) -> tuple[bool, ...]:
-        """Run these envs' emulators for some frames in one native call."""
-        if not envs:
-            return ()
-        rows = self._actions if len(envs) == self.num_envs else self._actions[envs]
-        return self._runner.run([self.envs[i]._emu for i in envs], rows, frames, screens)
-
-    def _run_frames(self, stepping: list[int], views: list[np.ndarray]) -> dict[int, tuple]:
-        """A step of envs whose scenario runs every frame: one native call per frame, for the envs still going.
-
-        An env whose episode ends on a frame runs no more frames this step, as
-        a single env's step does; the others' screens are converted on the
-        last frame.
-        """
-        envs, frameskip = self.envs, self.envs[0].frameskip
-        results: dict[int, tuple] = {}
-        live = stepping
-        for f in range(frameskip):
-            befores = [envs[i].start_frame(f) for i in live]
-            last = f == frameskip - 1
-            screens = [views[i] for i in live] if self._direct_screens and last else None
-            converted = self._run(live, 1, screens)
-            going = []
-            for k, i in enumerate(live):
-                if envs[i].end_frame(befores[k]):
-                    results[i] = envs[i].finish_frames()
-                elif last:
-                    results[i] = envs[i].finish_frames(views[i] if screens is not None and converted[k] else None)
-                else:
-                    going.append(i)
-            live = going
-        return results
 
     def _step_threads(self, actions: list[Any]) -> list[tuple]:
         def one(i: int) -> tuple[Any, float, bool, bool, dict[str, Any]]:

@@ -16,10 +16,10 @@ from typing import Self
 import numpy as np
 
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean
+from retrokit.host import primitives
 from retrokit.host.cores import find_core
 from retrokit.host.memory import AddressSpace
 from retrokit.host.systems import System, get_system, system_for_extension
-from retrokit.native import _host
 from retrokit.paths import data_dir
 
 logger = logging.getLogger("retrokit.core")
@@ -59,14 +59,14 @@ class Emulator:
         rom = Path(rom)
         if not rom.is_file():
             raise InvalidArgumentError(f"Expected a ROM file, found nothing at {rom}.")
-        if not 1 <= ports <= _host.MAX_PORTS:
-            raise InvalidArgumentError(f"Expected 1 to {_host.MAX_PORTS} ports, got {ports}.")
+        if not 1 <= ports <= primitives.MAX_PORTS:
+            raise InvalidArgumentError(f"Expected 1 to {primitives.MAX_PORTS} ports, got {ports}.")
         self.ports = ports
         core = Path(core_path) if core_path is not None else find_core(self.system.core)
         merged = {**self.system.options, **(options or {})}
         folder = data_dir()
         system_dir, save_dir = folder / "system", folder / "saves"
-        self._emu = _host.Emulator(str(core), str(system_dir), str(save_dir), merged, _log_core, ports)
+        self._emu = primitives.NativeEmulator(str(core), str(system_dir), str(save_dir), merged, _log_core, ports)
         declared = self._emu.options()
         for key in options or {}:
             if key not in declared:
@@ -93,17 +93,25 @@ class Emulator:
 
     # --- running ---------------------------------------------------------------------
 
-    def run(self, actions: Sequence[int] | np.ndarray | int = 0, frames: int = 1) -> None:
+    def run(
+        self, actions: Sequence[int] | np.ndarray | int = 0, frames: int = 1, screen: np.ndarray | None = None
+    ) -> bool | None:
         """Emulate frames holding one RetroPad button mask per port.
 
         Args:
             actions: One mask per port (fewer ports than opened press nothing
                 on the rest), or a single mask for port 1.
             frames: How many frames to run.
+            screen: A ``(H, W, 3)`` uint8 buffer to convert the last frame
+                into while it is still in cache, if the shapes match.
+
+        Returns:
+            With ``screen``, whether the frame was converted into it (its
+            shape fitted); else ``None``.
         """
         if type(actions) is not np.ndarray or actions.dtype != np.uint16:  # the exact type is the fast path
             actions = self._as_actions(actions)
-        self._emu.run(actions, frames)
+        return self._emu.run(actions, frames, screen)
 
     def _as_actions(self, actions: Sequence[int] | np.ndarray | int) -> np.ndarray:
         values = [actions] if isinstance(actions, (int, np.integer)) else list(np.asarray(actions).ravel())
@@ -144,6 +152,11 @@ class Emulator:
         self._emu.reset()
 
     @property
+    def handle(self) -> primitives.NativeEmulator:
+        """The native emulator, for :class:`retrokit.host.runner.Runner`, which runs many in one call."""
+        return self._emu
+
+    @property
     def frame(self) -> int:
         """Frames emulated since the emulator was made."""
         return self._emu.frame
@@ -176,7 +189,7 @@ class Emulator:
     @property
     def ram(self) -> np.ndarray:
         """The system RAM as a writable zero-copy ``uint8`` array, in the core's byte order."""
-        view = self._emu.memory(_host.MEMORY_SYSTEM_RAM)
+        view = self._emu.memory(primitives.MEMORY_SYSTEM_RAM)
         if view is None:
             raise InvalidArgumentError(f"The {self.system.name} core exposes no system RAM.")
         return np.frombuffer(view, dtype=np.uint8)

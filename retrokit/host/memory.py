@@ -15,10 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from retrokit.errors import FieldNotFoundError, InvalidArgumentError, did_you_mean
+from retrokit.host import primitives
 from retrokit.host.fields import FieldSpec
 from retrokit.host.systems import System
 from retrokit.host.typecodes import UNSIGNED, parse_type
-from retrokit.native import _host
 
 _LITTLE_HOST = sys.byteorder == "little"
 _CONST = 1  # RETRO_MEMDESC_CONST: read-only memory such as ROM
@@ -51,7 +51,7 @@ class AddressSpace:
         self.buffers = [r.buffer for r in self.regions]
 
     @classmethod
-    def for_emulator(cls, system: System, emulator: _host.Emulator) -> AddressSpace:
+    def for_emulator(cls, system: System, emulator: primitives.NativeEmulator) -> AddressSpace:
         """Build the address space of a loaded emulator.
 
         The core's memory map is used where it gives one (skipping read-only
@@ -68,7 +68,7 @@ class AddressSpace:
                 length = min(length, by_select) if length else by_select
             regions.append(Region(desc["start"], length, desc["memory"], system.ram_swap))
         if not regions:
-            ram = emulator.memory(_host.MEMORY_SYSTEM_RAM)
+            ram = emulator.memory(primitives.MEMORY_SYSTEM_RAM)
             if ram is not None:
                 regions.append(Region(system.ram_base, len(ram), ram, system.ram_swap))
         return cls(regions)
@@ -131,7 +131,7 @@ class FieldReader:
         self.space = space
         self.specs = {s.name: s for s in specs}
         self.names = list(self.specs)
-        self.plan = np.zeros((len(specs), _host.PLAN_COLUMNS), dtype=np.int64)
+        self.plan = np.zeros((len(specs), primitives.PLAN_COLUMNS), dtype=np.int64)
         for row, spec in zip(self.plan, specs):
             ftype = spec.field_type
             index, offs = space.offsets(spec.address, ftype.width)
@@ -149,12 +149,12 @@ class FieldReader:
         The array is int64: an 8-byte unsigned field of 2**63 or more reads
         as its two's-complement negative here; :meth:`read` corrects it.
         """
-        _host.read_fields(self.space.buffers, self.plan, self.values)
+        primitives.read_fields(self.space.buffers, self.plan, self.values)
         return self.values
 
     def read(self) -> dict[str, int]:
         """Return every field's value by name."""
-        return _host.read_fields(self.space.buffers, self.plan, self.values, self._names)
+        return primitives.read_fields(self.space.buffers, self.plan, self.values, self._names)
 
     def spec(self, name: str) -> FieldSpec:
         """Return a field's spec by name.

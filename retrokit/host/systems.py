@@ -6,6 +6,7 @@ The descriptors live in ``systems.yaml`` beside this module.
 from __future__ import annotations
 
 import functools
+import os
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -46,6 +47,9 @@ class System:
     actions: tuple[tuple[tuple[str, ...], ...], ...] = ()
     screen: tuple[int, int] | None = None
     aliases: tuple[str, ...] = ()
+
+    def __str__(self) -> str:
+        return self.name
 
     @property
     def button_names(self) -> tuple[str, ...]:
@@ -145,6 +149,11 @@ def systems_by_extension() -> dict[str, System]:
     return known
 
 
+def extension_of(filename: str | os.PathLike[str]) -> str:
+    """Return a file name's extension, lowercase and without the dot (``""`` if none)."""
+    return Path(filename).suffix.lower().lstrip(".")
+
+
 def system_for_extension(ext: str) -> System:
     """Return the system whose ROMs have a file extension (``"md"`` or ``".md"``).
 
@@ -157,5 +166,6 @@ def system_for_extension(ext: str) -> System:
         return known[ext]
     raise UnsupportedSystemError(
         f"Expected a ROM file extension retrokit knows ({', '.join('.' + e for e in sorted(known))}), got "
-        f"{'.' + ext!r}. Rename the file, or pass the system explicitly." + did_you_mean(ext, known)
+        f"{'.' + ext!r}. Rename the file, or pass the system explicitly."
+        + did_you_mean(f".{ext}", [f".{k}" for k in known])
     )

@@ -122,3 +122,58 @@ class MovieRecorder:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+class EpisodeMovies:
+    """Records each episode of an env into a movie of its own: an observer of the env's stepper.
+
+    Every episode gets the first free ``<stem>-NNNNNN.bk2`` in ``folder``
+    (:func:`claim_movie_path`), so a file already there is never replaced.
+
+    Args:
+        folder: Where the movies go (made if missing).
+        stem: The movies' name before the number, e.g. ``Dasher-Genesis-Zone1.Act1``.
+        game: The game's name.
+        system: The system's name.
+        players: Players whose buttons each frame holds.
+        start_state: The state every episode starts from, or ``None`` for power-on.
+    """
+
+    def __init__(
+        self,
+        folder: str | os.PathLike[str],
+        stem: str,
+        game: str,
+        system: str,
+        players: int,
+        start_state: bytes | None,
+    ) -> None:
+        self.folder, self.stem = Path(folder), stem
+        self._movie = (game, system, players, start_state)
+        self.recorder: MovieRecorder | None = None
+
+    def start(self) -> None:
+        """Begin an episode's movie, ending the last one if it is still open."""
+        self.end()
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self.recorder = MovieRecorder(claim_movie_path(self.folder, self.stem), *self._movie)
+
+    def frames(self, first: tuple[int, ...], applied: tuple[int, ...], count: int) -> None:
+        """Record ``count`` frames: the first held ``first``, the rest ``applied``."""
+        recorder = self.recorder
+        if recorder is None:  # frames before the first reset() belong to no episode
+            return
+        recorder.record(first)
+        for _ in range(count - 1):
+            recorder.record(applied)
+
+    def end(self) -> Path | None:
+        """Write the episode's movie, if one is open; return its path."""
+        recorder, self.recorder = self.recorder, None
+        if recorder is None:
+            return None
+        try:
+            return recorder.close()
+        except FileConflictError:  # another process wrote a movie of that name meanwhile
+            recorder.path = claim_movie_path(self.folder, self.stem)
+            return recorder.close()

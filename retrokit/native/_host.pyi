@@ -91,12 +91,6 @@ class Runner:
         result says, per emulator, whether it was.
         """
 
-def convert_frame(data: bytes, width: int, height: int, pitch: int, format: int, out: npt.NDArray[np.uint8]) -> None:
-    """Convert a frame in a libretro pixel format to RGB, as screens are (for tests and tools)."""
-
-def rand_sequence(seed: int, n: int) -> list[int]:
-    """The first ``n`` numbers a core's ``rand()`` gives after ``srand(seed)`` (glibc's generator)."""
-
 def pack_buttons(
     action: npt.NDArray[Any], buttons: int, out: npt.NDArray[np.uint16], table: npt.NDArray[np.uint16] | None = None
 ) -> bool:

@@ -15,10 +15,6 @@ static PyMethodDef module_methods[] = {
     {"pack_buttons", (PyCFunction)(void (*)(void))rk_py_pack_buttons, METH_FASTCALL,
      "pack_buttons(action, buttons, out[, table]): one bit per nonzero item, a mask per player, looked up in table if "
      "given; False for an unknown format."},
-    {"rand_sequence", (PyCFunction)rk_py_rand_sequence, METH_VARARGS,
-     "rand_sequence(seed, n): the first n numbers a core's rand() gives after srand(seed)."},
-    {"convert_frame", (PyCFunction)rk_py_convert_frame, METH_VARARGS,
-     "convert_frame(data, width, height, pitch, format, out): a frame in a libretro pixel format to RGB."},
     {NULL, NULL, 0, NULL},
 };
 

@@ -42,8 +42,6 @@ PyObject *emulator_serialize(EmulatorObject *self, PyObject *arg);
 PyObject *emulator_unserialize(EmulatorObject *self, PyObject *arg);
 
 PyObject *rk_py_read_fields(PyObject *module, PyObject *const *args, Py_ssize_t nargs);
-PyObject *rk_py_convert_frame(PyObject *module, PyObject *args);
 PyObject *rk_py_pack_buttons(PyObject *module, PyObject *const *args, Py_ssize_t nargs);
-PyObject *rk_py_rand_sequence(PyObject *module, PyObject *args);
 
 #endif

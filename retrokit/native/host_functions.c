@@ -1,12 +1,10 @@
 /*
  * The module functions of retrokit.native._host: decoding RAM fields by a
- * plan, and converting a frame of any pixel format.
+ * plan, and packing button arrays into RetroPad masks.
  */
 #include "host.h"
 
 #include "fields.h"
-#include "isolate.h"
-#include "video.h"
 
 /* ---- read_fields ------------------------------------------------------------------------------------------------------ */
 
@@ -87,51 +85,6 @@ done:
     if (have_out) PyBuffer_Release(&out);
     Py_DECREF(seq);
     return result;
-}
-
-PyObject *rk_py_convert_frame(PyObject *module, PyObject *args) {
-    Py_buffer src, dst;
-    unsigned width, height;
-    Py_ssize_t pitch;
-    int format;
-    PyObject *out;
-    if (!PyArg_ParseTuple(args, "y*IIniO", &src, &width, &height, &pitch, &format, &out)) return NULL;
-    int bytes_per_pixel = format == RK_RETRO_PIXEL_FORMAT_XRGB8888 ? 4 : 2;
-    if (format < 0 || format > 2) {
-        PyBuffer_Release(&src);
-        return PyErr_Format(InvalidArgumentError, "format must be 0 (0RGB1555), 1 (XRGB8888) or 2 (RGB565), got %d", format);
-    }
-    if (pitch < (Py_ssize_t)width * bytes_per_pixel || (height > 0 && src.len < pitch * (Py_ssize_t)(height - 1) + (Py_ssize_t)width * bytes_per_pixel)) {
-        PyBuffer_Release(&src);
-        return PyErr_Format(InvalidArgumentError, "a %ux%u frame with rows %zd bytes apart needs more than the %zd bytes given",
-                            width, height, pitch, src.len);
-    }
-    if (PyObject_GetBuffer(out, &dst, PyBUF_WRITABLE | PyBUF_C_CONTIGUOUS) < 0) {
-        PyBuffer_Release(&src);
-        return NULL;
-    }
-    if (dst.len != (Py_ssize_t)width * height * 3) {
-        PyBuffer_Release(&src);
-        PyBuffer_Release(&dst);
-        return PyErr_Format(InvalidArgumentError, "the output must hold %u x %u x 3 bytes, got %zd", height, width, dst.len);
-    }
-    rk_frame_to_rgb(src.buf, (size_t)pitch, width, height, format, dst.buf);
-    PyBuffer_Release(&src);
-    PyBuffer_Release(&dst);
-    Py_RETURN_NONE;
-}
-
-
-PyObject *rk_py_rand_sequence(PyObject *module, PyObject *args) {
-    unsigned seed;
-    Py_ssize_t n;
-    if (!PyArg_ParseTuple(args, "In", &seed, &n)) return NULL;
-    if (n < 0) return PyErr_Format(InvalidArgumentError, "n must be 0 or more, got %zd", n);
-    rk_rand r;
-    rk_rand_seed(&r, seed);
-    PyObject *out = PyList_New(n);
-    for (Py_ssize_t i = 0; out && i < n; i++) PyList_SET_ITEM(out, i, PyLong_FromLong(rk_rand_next(&r)));
-    return out;
 }
 
 /* ---- pack_buttons ----------------------------------------------------------------------------------------------------- */

@@ -1,0 +1,72 @@
+#!/usr/bin/env python3
+"""Smoke test of an installed retrokit, run by CI from an empty folder in a fresh venv.
+
+It checks what a user of ``pip install retrokit`` gets, with no checkout on
+the path: the bundled games and test cartridge, the lazy public names, the
+envs on the real emulator, and the Sonic preset up to the missing-ROM error.
+Exits non-zero, naming the check, when one fails.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+
+def main() -> int:
+    import numpy as np
+
+    import retrokit
+    from retrokit.errors import RomNotFoundError
+
+    package = Path(retrokit.__file__).resolve().parent
+    if Path.cwd() in package.parents or (Path.cwd() / "retrokit").is_dir():
+        return fail("run from a folder with no retrokit checkout in it")
+    checks = {
+        "bundled Dasher": lambda: (package / "_games" / "Dasher-Genesis" / "game.yaml").is_file(),
+        "47 train levels": lambda: len(retrokit.sonic.train_levels()) == 47,
+        "11 test levels": lambda: len(retrokit.sonic.test_levels()) == 11,
+        "multiplayer": lambda: callable(retrokit.multiplayer.parallel_env),
+        "movie": lambda: callable(retrokit.movie.play),
+    }
+    for name, check in checks.items():
+        if not check():
+            return fail(name)
+
+    env = retrokit.make("Dasher-Genesis", frameskip=4, max_episode_steps=50)
+    obs, info = env.reset(seed=0)
+    total = 0.0
+    for _ in range(50):
+        obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+        total += reward
+        if terminated or truncated:
+            break
+    env.close()
+    if obs.shape != (224, 320, 3) or "p1_x" not in info:
+        return fail(f"Dasher env: observation {obs.shape}, info keys {sorted(info)[:5]}")
+
+    pz = retrokit.multiplayer.parallel_env("Dasher-Genesis")
+    observations, _ = pz.reset(seed=0)
+    pz.step({agent: pz.action_space(agent).sample() for agent in pz.agents})
+    pz.close()
+    if len(observations) != 2:
+        return fail("two-player env")
+
+    try:
+        retrokit.sonic.make("SonicTheHedgehog-Genesis", "GreenHillZone.Act1")
+    except RomNotFoundError as exc:
+        if "retrokit import" not in str(exc):
+            return fail(f"Sonic's missing-ROM error names no fix: {exc}")
+    else:
+        return fail("Sonic made without its ROM")
+    print(f"wheel smoke test: ok ({package}, Dasher reward {total:.1f}, {np.__version__=})")
+    return 0
+
+
+def fail(what: str) -> int:
+    print(f"wheel smoke test failed: {what}", file=sys.stderr)
+    return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -240,3 +240,15 @@ def test_the_default_session_name_lives_in_the_current_folder(tmp_path):
         cwd=tmp_path, capture_output=True, text=True, timeout=120, env=env, check=False,
     )  # fmt: skip
     assert done.returncode == 2 and done.stderr.count("\n") == 1 and "Traceback" not in done.stderr
+
+
+def test_a_session_claiming_a_huge_ram_is_refused_before_allocating(session, capsys):
+    from dataclasses import replace
+
+    from retrokit.ramsearch.session import encode_session, read_session
+
+    data = read_session(session)
+    huge = session.with_name("huge.session")
+    huge.write_bytes(encode_session(replace(data, regions=((0, 1 << 31),))))
+    status, _, err = run(capsys, "show", "--session", str(huge))
+    assert status == 2 and "expected at most 134,217,728 candidates" in err

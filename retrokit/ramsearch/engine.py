@@ -111,6 +111,19 @@ def check_filter(op: str, value: int | None = None, than: str | int | None = Non
     return Filter(op, value, than)
 
 
+@dataclass(frozen=True)
+class Packed:
+    """Candidates kept small, for undo, redo and the session file.
+
+    Attributes:
+        bits: The alive flags of every type's positions, one after the other, packed 8 to a byte.
+        scales: The scale index of each alive candidate, in that order.
+    """
+
+    bits: np.ndarray
+    scales: np.ndarray
+
+
 class Candidates:
     """Which (type, position) pairs are still candidates, and the scale each was matched with.
 
@@ -136,6 +149,29 @@ class Candidates:
         """How many candidates are left."""
         return int(sum(np.count_nonzero(a) for a in self.alive))
 
+    def pack(self) -> Packed:
+        """The candidates in a few bytes per alive one."""
+        alive = np.concatenate(self.alive)
+        return Packed(np.packbits(alive), np.concatenate(self.scale)[alive])
+
+    @classmethod
+    def unpack(cls, packed: Packed, types: int, size: int) -> Candidates:
+        """Candidates from :meth:`pack` of ``types`` types over ``size`` positions.
+
+        Raises:
+            ValueError: ``packed`` does not hold that many, or its scales do not match its bits.
+        """
+        if packed.bits.dtype != np.uint8 or len(packed.bits) != -(-types * size // 8):
+            raise ValueError(f"expected {types * size} packed candidate bits, found {len(packed.bits) * 8}")
+        alive = np.unpackbits(packed.bits, count=types * size).astype(bool)
+        if packed.scales.dtype != np.int8 or len(packed.scales) != np.count_nonzero(alive):
+            raise ValueError(f"expected a scale per alive candidate, found {len(packed.scales)}")
+        if len(packed.scales) and not (UNPINNED <= packed.scales.min() and packed.scales.max() < len(SCALES)):
+            raise ValueError("expected scale indices of known scales")
+        scale = np.full(types * size, UNPINNED, dtype=np.int8)
+        scale[alive] = packed.scales
+        return cls(list(alive.reshape(types, size)), list(scale.reshape(types, size)))
+
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, Candidates) or len(other.alive) != len(self.alive):
             return NotImplemented
@@ -160,8 +196,8 @@ class Engine:
         self.types = tuple(types)
         self.snapshots: list[np.ndarray] = []
         self.candidates = Candidates.everything(layout, self.types)
-        self.history: list[tuple[str, Candidates]] = []  # (filter, the candidates before it)
-        self.redo_stack: list[tuple[str, Candidates]] = []  # (filter, the candidates after it)
+        self.history: list[tuple[str, Packed]] = []  # (filter, the candidates before it)
+        self.redo_stack: list[tuple[str, Packed]] = []  # (filter, the candidates after it)
         self._decoded: dict[int, list[np.ndarray]] = {}
 
     # --- snapshots --------------------------------------------------------------------------
@@ -202,7 +238,7 @@ class Engine:
             )
         if isinstance(spec.than, int):
             self.layout.position(spec.than)  # outside RAM: a clear error now
-        before = self.candidates.copy()
+        before = self.candidates.pack()
         for t in range(len(self.types)):
             self._filter_type(t, spec)
         self.history.append((spec.describe(self.layout), before))
@@ -270,8 +306,8 @@ class Engine:
         if not self.history:
             raise RamSearchError("Expected a filter to undo; found none. Filters are undone newest first.")
         label, before = self.history.pop()
-        self.redo_stack.append((label, self.candidates))
-        self.candidates = before
+        self.redo_stack.append((label, self.candidates.pack()))
+        self.candidates = Candidates.unpack(before, len(self.types), self.layout.size)
         return label
 
     def redo(self) -> str:
@@ -283,8 +319,8 @@ class Engine:
         if not self.redo_stack:
             raise RamSearchError("Expected an undone filter to redo; found none (a new filter clears what undo kept).")
         label, after = self.redo_stack.pop()
-        self.history.append((label, self.candidates))
-        self.candidates = after
+        self.history.append((label, self.candidates.pack()))
+        self.candidates = Candidates.unpack(after, len(self.types), self.layout.size)
         return label
 
 

@@ -29,6 +29,7 @@ from typing import Self
 
 import numpy as np
 
+from retrokit import paths
 from retrokit.data.games import Game, find_game
 from retrokit.data.roms import rom_sha1
 from retrokit.data.states import read_state
@@ -352,11 +353,12 @@ class RamSearch:
             DataFileError: The game's data file is not a game.yaml (a Gym Retro folder), or is inside stable-retro.
         """
         source = self.game.info.source
-        wheel = wheel_dir()
-        if source.name != "game.yaml" or (wheel is not None and source.resolve().is_relative_to(wheel.resolve())):
+        installed = [p.resolve() for p in (wheel_dir(), Path(paths.__file__).parent) if p is not None]
+        if source.name != "game.yaml" or any(source.resolve().is_relative_to(p) for p in installed):
             raise DataFileError(
-                f"Expected {self.game.name} to have its own game.yaml; its data file is {source}, which this tool "
-                "does not edit. Pass --game-file PATH (game_file=) naming a game.yaml to write to."
+                f"Expected {self.game.name} to have its own game.yaml; its data file is {source}, inside an "
+                "installed package or in Gym Retro's format, which this tool does not edit. Copy the game's folder "
+                f"into a folder named in {paths.GAMES_ENV} and pass --game-file PATH (game_file=) to its game.yaml."
             )
         return source
 

@@ -30,13 +30,15 @@ import numpy as np
 
 from retrokit.errors import SessionError
 from retrokit.paths import atomic_write
-from retrokit.ramsearch.engine import Candidates
+from retrokit.ramsearch.engine import Candidates, Packed
 from retrokit.ramsearch.scales import SCALES
+from retrokit.ramsearch.types import SEARCH_TYPES
 
 DEFAULT_SESSION = "ramsearch.session"
 FORMAT = "retrokit-ramsearch-session"
 VERSION = 1
 MAX_UNPACKED = 1 << 28  # 256 MiB: a bigger archive is not one this tool wrote for a console's RAM
+MAX_CANDIDATES = 1 << 27  # 4 MiB of RAM as 32 types: their flags and scales take 256 MiB
 _START = "Start a new search with: retrokit ramsearch new GAME"
 
 
@@ -53,21 +55,19 @@ class SessionData:
     snapshots: np.ndarray
     labels: list[str]
     candidates: Candidates
-    history: list[tuple[str, Candidates]] = field(default_factory=list)
-    redo: list[tuple[str, Candidates]] = field(default_factory=list)
+    history: list[tuple[str, Packed]] = field(default_factory=list)
+    redo: list[tuple[str, Packed]] = field(default_factory=list)
 
 
-def _pack(prefix: str, candidates: Candidates, arrays: dict[str, np.ndarray]) -> None:
-    alive = np.concatenate(candidates.alive)
-    arrays[f"{prefix}_alive"] = np.packbits(alive)
-    arrays[f"{prefix}_scale"] = np.concatenate(candidates.scale)[alive]
+def _store(prefix: str, packed: Packed, arrays: dict[str, np.ndarray]) -> None:
+    arrays[f"{prefix}_alive"], arrays[f"{prefix}_scale"] = packed.bits, packed.scales
 
 
-def _unpack(prefix: str, archive, types: int, size: int, scales: np.ndarray) -> Candidates:
-    alive = np.unpackbits(archive[f"{prefix}_alive"], count=types * size).astype(bool)
-    scale = np.full(types * size, -1, dtype=np.int8)
-    scale[alive] = scales[archive[f"{prefix}_scale"].astype(np.int64) + 1]  # the file's indices, from -1
-    return Candidates(list(alive.reshape(types, size).copy()), list(scale.reshape(types, size).copy()))
+def _load(prefix: str, archive, types: int, size: int, scales: np.ndarray) -> Packed:
+    """Packed candidates, their scale indices mapped from the file's scale list to this version's."""
+    packed = Packed(archive[f"{prefix}_alive"], scales[archive[f"{prefix}_scale"].astype(np.int64) + 1])
+    Candidates.unpack(packed, types, size)  # checks it whole now, not at an undo
+    return packed
 
 
 def encode_session(data: SessionData) -> bytes:
@@ -90,11 +90,11 @@ def encode_session(data: SessionData) -> bytes:
         "emulator_state": np.frombuffer(data.emulator_state, dtype=np.uint8),
         "snapshots": data.snapshots,
     }
-    _pack("now", data.candidates, arrays)
-    for i, (_, candidates) in enumerate(data.history):
-        _pack(f"history{i}", candidates, arrays)
-    for i, (_, candidates) in enumerate(data.redo):
-        _pack(f"redo{i}", candidates, arrays)
+    _store("now", data.candidates.pack(), arrays)
+    for i, (_, packed) in enumerate(data.history):
+        _store(f"history{i}", packed, arrays)
+    for i, (_, packed) in enumerate(data.redo):
+        _store(f"redo{i}", packed, arrays)
     buffer = io.BytesIO()
     np.savez_compressed(buffer, **arrays)
     return buffer.getvalue()
@@ -152,13 +152,18 @@ def _decode(blob: bytes) -> SessionData:
             raise SessionError(f"expected a RAM search session file; found another kind of archive. {_START}")
         if meta.get("version") != VERSION:
             raise SessionError(f"expected session format version {VERSION}; found {meta.get('version')!r}. {_START}")
-        types, regions = tuple(meta["types"]), tuple((int(s), int(n)) for s, n in meta["regions"])
+        types, regions = tuple(str(t) for t in meta["types"]), tuple((int(s), int(n)) for s, n in meta["regions"])
+        size = sum(n for _, n in regions)
+        if not 0 < len(types) <= len(SEARCH_TYPES) * 2 or not 0 < size or len(types) * size > MAX_CANDIDATES:
+            raise SessionError(
+                f"expected at most {MAX_CANDIDATES:,} candidates (types times RAM bytes); found {len(types)} types "
+                f"over {size:,} bytes. {_START}"
+            )
         known = {scale.label: index for index, scale in enumerate(SCALES)}
         missing = [label for label in meta["scales"] if label not in known]
         if missing:
             raise SessionError(f"expected scales this version knows; found {missing}. {_START}")
         scales = np.array([-1] + [known[label] for label in meta["scales"]], dtype=np.int8)
-        size = sum(n for _, n in regions)
         snapshots = archive["snapshots"]
         if snapshots.dtype != np.uint8 or snapshots.ndim != 2 or snapshots.shape[1] != size:
             raise SessionError(
@@ -177,13 +182,13 @@ def _decode(blob: bytes) -> SessionData:
             emulator_state=archive["emulator_state"].tobytes(),
             snapshots=snapshots,
             labels=[str(label) for label in meta["labels"]],
-            candidates=_unpack("now", archive, len(types), size, scales),
+            candidates=Candidates.unpack(_load("now", archive, len(types), size, scales), len(types), size),
             history=[
-                (str(label), _unpack(f"history{i}", archive, len(types), size, scales))
+                (str(label), _load(f"history{i}", archive, len(types), size, scales))
                 for i, label in enumerate(meta["history"])
             ],
             redo=[
-                (str(label), _unpack(f"redo{i}", archive, len(types), size, scales))
+                (str(label), _load(f"redo{i}", archive, len(types), size, scales))
                 for i, label in enumerate(meta["redo"])
             ],
         )

@@ -143,6 +143,20 @@ def test_every_op_is_tested():
     assert set(OPS) == tested | {"increased", "decreased", "changed", "unchanged"}
 
 
+@pytest.mark.parametrize("dtype", ["u1", "i1", "u2", "i2", "u4", "i4", "i8"])
+@pytest.mark.parametrize("by", [0, 1, -1, 200, -200, 255, -255, 256, 70000, -70000])
+def test_changed_by_in_the_arrays_own_dtype_matches_int64(dtype, by):
+    from retrokit.ramsearch.engine import _changed_by
+
+    info = np.iinfo(dtype)
+    rng = np.random.default_rng(abs(by))
+    cur = rng.integers(info.min, info.max, 4000, endpoint=True).astype(dtype)
+    ref = rng.integers(info.min, info.max, 4000, endpoint=True).astype(dtype)
+    ref[:1000] = (cur[:1000].astype(np.int64) - by).clip(info.min, info.max).astype(dtype)  # some true matches
+    expected = cur.astype(np.int64) - ref.astype(np.int64) == by
+    assert np.array_equal(_changed_by(cur, ref, by), expected)
+
+
 def test_dense_and_sparse_filters_agree():
     rng = np.random.default_rng(3)
     first = rng.integers(0, 256, 256).astype(np.uint8)

@@ -44,6 +44,7 @@ OPS = (*COMPARISONS, "changed-by", *CHANGES)
 REFERENCES = ("previous", "first", "changes")
 _SPARSE = 8  # compare only the candidates' positions once fewer than 1 in 8 positions are left
 _DECODED_KEPT = 4  # decoded snapshots kept for the next filter
+_UNPACKED_KEPT = 4  # the newest steps of the history kept as they are (4 MiB each for 64 KiB), the rest packed
 
 
 @dataclass(frozen=True)
@@ -196,8 +197,8 @@ class Engine:
         self.types = tuple(types)
         self.snapshots: list[np.ndarray] = []
         self.candidates = Candidates.everything(layout, self.types)
-        self.history: list[tuple[str, Packed]] = []  # (filter, the candidates before it)
-        self.redo_stack: list[tuple[str, Packed]] = []  # (filter, the candidates after it)
+        self.history: list[tuple[str, Candidates | Packed]] = []  # (filter, the candidates before it)
+        self.redo_stack: list[tuple[str, Candidates | Packed]] = []  # (filter, the candidates after it)
         self._decoded: dict[int, list[np.ndarray]] = {}
 
     # --- snapshots --------------------------------------------------------------------------
@@ -238,12 +239,19 @@ class Engine:
             )
         if isinstance(spec.than, int):
             self.layout.position(spec.than)  # outside RAM: a clear error now
-        before = self.candidates.pack()
+        before = self.candidates.copy()  # packing costs more than the filter: only older steps are packed
         for t in range(len(self.types)):
             self._filter_type(t, spec)
         self.history.append((spec.describe(self.layout), before))
         self.redo_stack.clear()
+        for index in range(max(0, len(self.history) - _UNPACKED_KEPT)):
+            label, entry = self.history[index]
+            if isinstance(entry, Candidates):
+                self.history[index] = (label, entry.pack())
         return self.candidates.count()
+
+    def _restore(self, entry: Candidates | Packed) -> Candidates:
+        return entry if isinstance(entry, Candidates) else Candidates.unpack(entry, len(self.types), self.layout.size)
 
     def _filter_type(self, t: int, spec: Filter) -> None:
         alive, scales = self.candidates.alive[t], self.candidates.scale[t]
@@ -286,8 +294,7 @@ class Engine:
             ref = pick(self.decoded(0 if spec.than == "first" else -2)[t])
             ref, ref_ok = _shown(ref, scale) if scaled else (ref, None)
         if spec.op == "changed-by":
-            wide = np.int64 if shown.itemsize > 2 or not scaled and shown.dtype == np.uint32 else np.int32
-            result = np.subtract(shown, ref, dtype=wide) == spec.value
+            result = _changed_by(shown, ref, spec.value)
         else:
             result = COMPARISONS[CHANGES.get(spec.op, spec.op)](shown, ref)
         for defined in (ok, ref_ok):
@@ -306,8 +313,8 @@ class Engine:
         if not self.history:
             raise RamSearchError("Expected a filter to undo; found none. Filters are undone newest first.")
         label, before = self.history.pop()
-        self.redo_stack.append((label, self.candidates.pack()))
-        self.candidates = Candidates.unpack(before, len(self.types), self.layout.size)
+        self.redo_stack.append((label, self.candidates))
+        self.candidates = self._restore(before)
         return label
 
     def redo(self) -> str:
@@ -319,9 +326,28 @@ class Engine:
         if not self.redo_stack:
             raise RamSearchError("Expected an undone filter to redo; found none (a new filter clears what undo kept).")
         label, after = self.redo_stack.pop()
-        self.history.append((label, self.candidates.pack()))
-        self.candidates = Candidates.unpack(after, len(self.types), self.layout.size)
+        self.history.append((label, self.candidates))
+        self.candidates = self._restore(after)
         return label
+
+
+def _changed_by(cur: np.ndarray, ref: np.ndarray | int, by: int) -> np.ndarray:
+    """Where ``cur - ref == by``, computed in the arrays' own dtype.
+
+    The difference wraps modulo ``2**bits``, so equal wrapped differences are
+    told apart by the sign of the true one: ``cur >= ref`` exactly when it is
+    ``by >= 0``. That saves widening every array to int64.
+    """
+    if cur.dtype.itemsize == 8 or not isinstance(ref, np.ndarray) or ref.dtype != cur.dtype:
+        return np.subtract(cur, ref, dtype=np.int64) == by
+    bits = 8 * cur.dtype.itemsize
+    if not -(1 << bits) < by < 1 << bits:
+        return np.zeros(len(cur), dtype=bool)
+    unsigned = np.dtype(f"u{cur.dtype.itemsize}")
+    wrapped = cur.view(unsigned) - ref.view(unsigned)
+    result = wrapped == unsigned.type(by % (1 << bits))
+    result &= (cur >= ref) if by >= 0 else (cur < ref)
+    return result
 
 
 def _shown(stored: np.ndarray, scale: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -55,11 +55,12 @@ class SessionData:
     snapshots: np.ndarray
     labels: list[str]
     candidates: Candidates
-    history: list[tuple[str, Packed]] = field(default_factory=list)
-    redo: list[tuple[str, Packed]] = field(default_factory=list)
+    history: list[tuple[str, Candidates | Packed]] = field(default_factory=list)
+    redo: list[tuple[str, Candidates | Packed]] = field(default_factory=list)
 
 
-def _store(prefix: str, packed: Packed, arrays: dict[str, np.ndarray]) -> None:
+def _store(prefix: str, candidates: Candidates | Packed, arrays: dict[str, np.ndarray]) -> None:
+    packed = candidates.pack() if isinstance(candidates, Candidates) else candidates
     arrays[f"{prefix}_alive"], arrays[f"{prefix}_scale"] = packed.bits, packed.scales
 
 
@@ -90,7 +91,7 @@ def encode_session(data: SessionData) -> bytes:
         "emulator_state": np.frombuffer(data.emulator_state, dtype=np.uint8),
         "snapshots": data.snapshots,
     }
-    _store("now", data.candidates.pack(), arrays)
+    _store("now", data.candidates, arrays)
     for i, (_, packed) in enumerate(data.history):
         _store(f"history{i}", packed, arrays)
     for i, (_, packed) in enumerate(data.redo):

@@ -117,6 +117,8 @@ def test_undo_redo_round_trip_on_the_command_line(session, capsys):
         (("filter", "equal", "three"), "whole number"),
         (("run", "--press", "RIHGT"), "Did you mean 'RIGHT'?"),
         (("run", "--until", "5"), "--movie"),
+        (("run", "--movie", "m.bk2", "--frames", "5"), "either --movie"),
+        (("run", "--movie", "missing.bk2"), "missing.bk2"),
         (("poke", "0xFF002B", "300"), "from 0 to 255"),
         (("show", "--session", "missing.session"), "found no file"),
         (("new", "Dasher-Genesis"), "--force"),
@@ -125,7 +127,8 @@ def test_undo_redo_round_trip_on_the_command_line(session, capsys):
     ],
     ids=["unknown-type", "type-case", "poke-outside-ram", "save-past-the-end", "than-outside-ram",
          "filter-before-two-snapshots", "op-typo", "than-typo", "value-not-a-number", "button-typo",
-         "until-without-movie", "value-too-big", "missing-session", "session-exists", "session-of-another-game",
+         "until-without-movie", "movie-and-frames",
+         "missing-movie", "value-too-big", "missing-session", "session-exists", "session-of-another-game",
          "no-subcommand"],
 )  # fmt: skip
 def test_bad_input_gets_one_line(session, capsys, argv, message):
@@ -252,3 +255,20 @@ def test_a_session_claiming_a_huge_ram_is_refused_before_allocating(session, cap
     huge.write_bytes(encode_session(replace(data, regions=((0, 1 << 31),))))
     status, _, err = run(capsys, "show", "--session", str(huge))
     assert status == 2 and "expected at most 134,217,728 candidates" in err
+
+
+def test_run_plays_a_movie_up_to_a_frame(session, capsys):
+    from retrokit.data.states import read_state
+    from retrokit.host.systems import get_system
+    from retrokit.movie import Movie, write_bk2
+
+    right = get_system("Genesis").mask(["RIGHT"])
+    state = read_state(DASHER / "Zone1.Act1.state")
+    write_bk2("right.bk2", Movie("Dasher-Genesis", "Genesis", 1, state, [(right,)] * 90))
+    status, out, err = run(capsys, "run", "--movie", "right.bk2", "--until", "45")
+    assert status == 0, err
+    assert out == "Snapshot 2: movie right.bk2 to frame 45.\n"
+    status, out, _ = run(capsys, "filter", "increased")
+    assert status == 0
+    status, out, _ = run(capsys, "show", "--json", "--limit", "0")
+    assert {"address": 0xFF0020, "type": ">i2"} in [{k: c[k] for k in ("address", "type")} for c in json.loads(out)]

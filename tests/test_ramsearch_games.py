@@ -102,11 +102,19 @@ def test_dasher_fields_are_found_by_play(field, play, most_groups):
 def fire(search: RamSearch, frames: int) -> int:
     """Tap B (fire) for some frames, then take a snapshot."""
     for _ in range(frames // 8):
-        search.run(["B"], 4)
-        search.engine.snapshots.pop(), search.labels.pop()  # only the last snapshot counts
-        search.run([], 4)
-        search.engine.snapshots.pop(), search.labels.pop()
+        search.step(["B"], 4)
+        search.step([], 4)
     return search.snapshot(f"fired for {frames} frames")
+
+
+def test_buttons_by_name_and_port():
+    with RamSearch("Dasher-Genesis", "Zone1.Act1") as search:
+        assert search.buttons(["RIGHT", "B", "2:START"]) == [(1 << 7) | 1, 1 << 3]
+        with pytest.raises(InvalidArgumentError, match="port of 1 to 2"):
+            search.buttons(["3:START"])
+        with pytest.raises(InvalidArgumentError, match="frames of 0 or more"):
+            search.run(["RIGHT"], -1)
+        assert len(search.labels) == 1  # nothing was run
 
 
 def test_airstriker_lives_and_score_match_data_json(airstriker_fields):

@@ -64,7 +64,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         metavar="BUTTON",
         help="buttons to hold, by the game's names (RIGHT, B; 2:START for port 2)",
     )
-    p.add_argument("--frames", default="1", metavar="N", help="frames to run (default: 1)")
+    p.add_argument("--frames", metavar="N", help="frames to run (default: 1)")
     p.add_argument("--movie", metavar="FILE.bk2", help="play this movie from its start instead")
     p.add_argument("--until", metavar="FRAME", help="stop the movie after this many frames (default: its end)")
     p.add_argument("--state", help="load this save state first")
@@ -183,13 +183,13 @@ def _run(args: argparse.Namespace) -> int:
     frames, until = _number(args.frames, "--frames"), _number(args.until, "--until")
     if args.movie is None and until is not None:
         raise InvalidArgumentError("Expected --until with --movie FILE.bk2; got --until alone.")
-    if args.movie is not None and (args.press or args.frames != "1" or args.state):
+    if args.movie is not None and (args.press or frames is not None or args.state):
         raise InvalidArgumentError("Expected either --movie (with --until) or --press/--frames/--state, not both.")
     with _open(args) as search:
         if args.movie is not None:
             index = search.play(args.movie, until)
         else:
-            index = search.run(args.press, frames, state=args.state)
+            index = search.run(args.press, 1 if frames is None else frames, state=args.state)
         search.save(_session(args))
         print(f"Snapshot {index + 1}: {search.labels[index]}.")
     return 0

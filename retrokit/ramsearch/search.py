@@ -95,18 +95,22 @@ class RamSearch:
     """
 
     def __init__(self, game: str | Game, state: str | None = None, *, types: Sequence[str] | None = None) -> None:
-        self.game = find_game(game) if isinstance(game, str) else game
-        rom = self.game.require_rom()
-        self.rom_sha1 = rom_sha1(rom, self.game.system)
-        self.emulator = Emulator(self.game.system, rom, ports=max(2, self.game.players))
-        self.emulator.set_sticky(0.0, 0)
-        self.layout = RamLayout.of(self.emulator.space)
-        self.engine = Engine(self.layout, parse_search_types(types))
-        self.labels: list[str] = []
+        self._open(find_game(game) if isinstance(game, str) else game, types)
         self.state = state if state is not None else self.game.default_state
         if self.state is not None:
             self.load_state(self.state)
         self.snapshot(f"new {self.state or 'power-on'}")
+
+    def _open(self, game: Game, types: Sequence[str] | None) -> None:
+        """Load the game's ROM into a new emulator, with an empty search over its RAM."""
+        self.game = game
+        self.rom = game.require_rom()
+        self.rom_sha1 = rom_sha1(self.rom, game.system)
+        self.emulator = Emulator(game.system, self.rom, ports=max(2, game.players))
+        self.emulator.set_sticky(0.0, 0)
+        self.layout = RamLayout.of(self.emulator.space)
+        self.engine = Engine(self.layout, parse_search_types(types))
+        self.labels: list[str] = []
 
     # --- sessions ------------------------------------------------------------------------------
 
@@ -128,22 +132,24 @@ class RamSearch:
                 "Pass another --session file, or start one for this game with: retrokit ramsearch new GAME --session FILE"
             )
         self = cls.__new__(cls)
-        self.game = find_game(data.game)
-        rom = self.game.require_rom()
-        self.rom_sha1 = rom_sha1(rom, self.game.system)
+        self._open(find_game(data.game), data.types)
+        try:
+            self._resume(path, data)
+        except SessionError:
+            self.close()
+            raise
+        return self
+
+    def _resume(self, path: str | os.PathLike[str], data: SessionData) -> None:
         if self.rom_sha1 != data.rom_sha1:
             raise SessionError(
-                f"Expected the ROM {path} was made with (SHA-1 {data.rom_sha1}) for {data.game}; found {rom} with "
-                f"SHA-1 {self.rom_sha1}. The session belongs to another ROM: start a new one."
+                f"Expected the ROM {path} was made with (SHA-1 {data.rom_sha1}) for {data.game}; found {self.rom} "
+                f"with SHA-1 {self.rom_sha1}. The session belongs to another ROM: start a new one."
             )
-        self.emulator = Emulator(self.game.system, rom, ports=max(2, self.game.players))
-        self.emulator.set_sticky(0.0, 0)
-        self.layout = RamLayout.of(self.emulator.space)
         if self.layout.regions != data.regions:
             raise SessionError(
                 f"{path}: expected RAM regions {self.layout.describe()}; found {RamLayout(data.regions).describe()}."
             )
-        self.engine = Engine(self.layout, parse_search_types(data.types))
         for row in data.snapshots:
             self.engine.add_snapshot(row)
         self.engine.candidates, self.engine.history, self.engine.redo_stack = data.candidates, data.history, data.redo
@@ -154,7 +160,6 @@ class RamSearch:
             raise SessionError(
                 f"{path}: expected an emulator state of {data.game}; the core refused it ({exc})."
             ) from None
-        return self
 
     def save(self, path: str | os.PathLike[str]) -> None:
         """Write the session file (atomically)."""
@@ -221,14 +226,18 @@ class RamSearch:
             masks[index] |= self.emulator.system.mask([button])
         return masks
 
-    def run(self, press: Sequence[str] = (), frames: int = 1, *, state: str | None = None) -> int:
-        """Hold buttons for some frames (from a state, if given), then take a snapshot; return its index."""
+    def step(self, press: Sequence[str] = (), frames: int = 1) -> None:
+        """Hold buttons for some frames, without a snapshot (to script play between snapshots)."""
         if not isinstance(frames, int) or frames < 0:
             raise InvalidArgumentError(f"Expected a number of frames of 0 or more, got {frames!r}.")
-        masks = self.buttons(press)
+        self.emulator.run(self.buttons(press), frames)
+
+    def run(self, press: Sequence[str] = (), frames: int = 1, *, state: str | None = None) -> int:
+        """Hold buttons for some frames (from a state, if given), then take a snapshot; return its index."""
+        self.buttons(press)  # unknown buttons fail before the state is loaded
         if state is not None:
             self.load_state(state)
-        self.emulator.run(masks, frames)
+        self.step(press, frames)
         held = " ".join(press) if press else "nothing"
         return self.snapshot(f"{'state ' + state + ', ' if state else ''}{held} for {frames} frames")
 

@@ -7,7 +7,8 @@ import pytest
 
 from retrokit.errors import FieldTypeError, InvalidArgumentError, RamSearchError
 from retrokit.host.typecodes import parse_type
-from retrokit.ramsearch.engine import OPS, Engine
+from retrokit.ramsearch.engine import Engine
+from retrokit.ramsearch.filters import OPS
 from retrokit.ramsearch.ram import RamLayout
 from retrokit.ramsearch.scales import SCALES, Scale
 from retrokit.ramsearch.types import SEARCH_TYPES, decode_all, parse_search_types, require_type

@@ -31,7 +31,7 @@ _VALUES_SHOWN = 8  # snapshots whose values `show` prints; older ones are elided
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``ramsearch`` command and its subcommands."""
-    from retrokit.ramsearch.engine import OPS
+    from retrokit.ramsearch.filters import OPS
 
     parser = subparsers.add_parser(
         "ramsearch",

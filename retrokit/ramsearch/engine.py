@@ -7,181 +7,27 @@ per type over every position, so a filter is a few numpy comparisons over the
 type's decoded values (:mod:`retrokit.ramsearch.types`); once few candidates
 are left, only their positions are compared.
 
-Filters follow BizHawk's RAM Search: compare each candidate's value in the
-newest snapshot with a number, with its value in the previous or the first
-snapshot, or with the value at another address, by ``equal``,
-``not-equal``, ``less``, ``greater``, ``less-equal``, ``greater-equal``,
-``changed-by N``, ``increased``, ``decreased``, ``changed`` or
-``unchanged``; or compare its change count (snapshots at which its value
-differed from the one before) with a number.
+The filters themselves are described in :mod:`retrokit.ramsearch.filters`;
+the candidate set in :mod:`retrokit.ramsearch.candidates`.
 """
 
 from __future__ import annotations
 
-import operator
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Sequence
 
 import numpy as np
 
-from retrokit.errors import InvalidArgumentError, RamSearchError, did_you_mean
+from retrokit.errors import InvalidArgumentError, RamSearchError
 from retrokit.host.typecodes import FieldType
+from retrokit.ramsearch.candidates import Candidates, Packed
+from retrokit.ramsearch.filters import CHANGES, COMPARISONS, Filter, check_filter
 from retrokit.ramsearch.ram import RamLayout
 from retrokit.ramsearch.scales import SCALES, UNPINNED
 from retrokit.ramsearch.types import decode_all
 
-COMPARISONS: dict[str, Callable[[np.ndarray, object], np.ndarray]] = {
-    "equal": operator.eq,
-    "not-equal": operator.ne,
-    "less": operator.lt,
-    "greater": operator.gt,
-    "less-equal": operator.le,
-    "greater-equal": operator.ge,
-}
-#: The operations that compare with a snapshot, and the comparison each is.
-CHANGES = {"increased": "greater", "decreased": "less", "changed": "not-equal", "unchanged": "equal"}
-OPS = (*COMPARISONS, "changed-by", *CHANGES)
-REFERENCES = ("previous", "first", "changes")
 _SPARSE = 8  # compare only the candidates' positions once fewer than 1 in 8 positions are left
 _DECODED_KEPT = 4  # decoded snapshots kept for the next filter
 _UNPACKED_KEPT = 4  # the newest steps of the history kept as they are (4 MiB each for 64 KiB), the rest packed
-
-
-@dataclass(frozen=True)
-class Filter:
-    """One filter: an operation, an optional number, and what to compare with.
-
-    Attributes:
-        op: One of :data:`OPS`.
-        value: The number compared with (for ``changed-by``, the difference).
-        than: ``"previous"``, ``"first"``, ``"changes"`` or a console address;
-            ``None`` with a number means the number itself.
-    """
-
-    op: str
-    value: int | None = None
-    than: str | int | None = None
-
-    def describe(self, layout: RamLayout | None = None) -> str:
-        """The filter as the command line writes it."""
-        words = [self.op] + ([] if self.value is None else [str(self.value)])
-        if self.than is not None:
-            than = layout.format(self.than) if layout is not None and isinstance(self.than, int) else str(self.than)
-            words.append(f"--than {than}")
-        return " ".join(words)
-
-
-def check_filter(op: str, value: int | None = None, than: str | int | None = None) -> Filter:
-    """Check a filter's parts fit together and fill in the default reference.
-
-    Raises:
-        InvalidArgumentError: Unknown operation or reference, or a missing or extra number.
-    """
-    if op not in OPS:
-        raise InvalidArgumentError(
-            f"Expected a filter operation ({', '.join(OPS)}), got {op!r}." + did_you_mean(op, OPS)
-        )
-    if isinstance(than, str) and than not in REFERENCES:
-        raise InvalidArgumentError(
-            f"Expected --than previous, first, changes or a console address, got {than!r}."
-            + did_you_mean(than, REFERENCES)
-        )
-    if op in CHANGES:
-        if value is not None:
-            raise InvalidArgumentError(
-                f"Expected no number after {op!r}, got {value}. For a difference, use: changed-by N."
-            )
-        if than == "changes":
-            raise InvalidArgumentError(f"Expected --than previous, first or an address for {op!r}, got 'changes'.")
-        return Filter(op, None, "previous" if than is None else than)
-    if op == "changed-by":
-        if value is None:
-            raise InvalidArgumentError("Expected a number after 'changed-by' (the difference, e.g. -1), got none.")
-        if than == "changes":
-            raise InvalidArgumentError("Expected --than previous, first or an address for 'changed-by', got 'changes'.")
-        return Filter(op, value, "previous" if than is None else than)
-    if value is None:
-        if than == "changes":
-            raise InvalidArgumentError(f"Expected a number to compare change counts with: {op} N --than changes.")
-        return Filter(op, None, "previous" if than is None else than)
-    if than is not None and than != "changes":
-        raise InvalidArgumentError(
-            f"Expected a number or --than {than}, not both: '{op} {value}' compares with the number, "
-            f"'{op} --than {than}' with the snapshot. For a difference, use: changed-by {value} --than {than}."
-        )
-    return Filter(op, value, than)
-
-
-@dataclass(frozen=True)
-class Packed:
-    """Candidates kept small, for undo, redo and the session file.
-
-    Attributes:
-        bits: The alive flags of every type's positions, one after the other, packed 8 to a byte.
-        scales: The scale index of each alive candidate, in that order.
-    """
-
-    bits: np.ndarray
-    scales: np.ndarray
-
-
-class Candidates:
-    """Which (type, position) pairs are still candidates, and the scale each was matched with.
-
-    Args:
-        alive: Per type, a boolean array over positions.
-        scale: Per type, an ``int8`` array of scale indices (:data:`~retrokit.ramsearch.scales.UNPINNED` if none).
-    """
-
-    def __init__(self, alive: list[np.ndarray], scale: list[np.ndarray]) -> None:
-        self.alive = alive
-        self.scale = scale
-
-    @classmethod
-    def everything(cls, layout: RamLayout, types: Sequence[FieldType]) -> Candidates:
-        """Every position of every type whose bytes fit in a region."""
-        alive = [layout.valid(t.width) for t in types]
-        return cls(alive, [np.full(layout.size, UNPINNED, dtype=np.int8) for _ in types])
-
-    def copy(self) -> Candidates:
-        return Candidates([a.copy() for a in self.alive], [s.copy() for s in self.scale])
-
-    def count(self) -> int:
-        """How many candidates are left."""
-        return int(sum(np.count_nonzero(a) for a in self.alive))
-
-    def pack(self) -> Packed:
-        """The candidates in a few bytes per alive one."""
-        alive = np.concatenate(self.alive)
-        return Packed(np.packbits(alive), np.concatenate(self.scale)[alive])
-
-    @classmethod
-    def unpack(cls, packed: Packed, types: int, size: int) -> Candidates:
-        """Candidates from :meth:`pack` of ``types`` types over ``size`` positions.
-
-        Raises:
-            ValueError: ``packed`` does not hold that many, or its scales do not match its bits.
-        """
-        if packed.bits.dtype != np.uint8 or len(packed.bits) != -(-types * size // 8):
-            raise ValueError(f"expected {types * size} packed candidate bits, found {len(packed.bits) * 8}")
-        alive = np.unpackbits(packed.bits, count=types * size).astype(bool)
-        if packed.scales.dtype != np.int8 or len(packed.scales) != np.count_nonzero(alive):
-            raise ValueError(f"expected a scale per alive candidate, found {len(packed.scales)}")
-        if len(packed.scales) and not (UNPINNED <= packed.scales.min() and packed.scales.max() < len(SCALES)):
-            raise ValueError("expected scale indices of known scales")
-        scale = np.full(types * size, UNPINNED, dtype=np.int8)
-        scale[alive] = packed.scales
-        return cls(list(alive.reshape(types, size)), list(scale.reshape(types, size)))
-
-    def __eq__(self, other: object) -> bool:
-        if not isinstance(other, Candidates) or len(other.alive) != len(self.alive):
-            return NotImplemented
-        return all(
-            np.array_equal(a, b) and np.array_equal(s[a], t[b])
-            for a, b, s, t in zip(self.alive, other.alive, self.scale, other.scale)
-        )
-
-    __hash__ = None  # type: ignore[assignment]
 
 
 class Engine:

@@ -22,8 +22,6 @@ from __future__ import annotations
 import io
 import os
 from collections.abc import Sequence
-from dataclasses import dataclass
-from itertools import pairwise
 from pathlib import Path
 from typing import Self
 
@@ -38,51 +36,11 @@ from retrokit.host.emulator import Emulator
 from retrokit.host.typecodes import parse_type
 from retrokit.paths import atomic_write, wheel_dir
 from retrokit.ramsearch import gamefile
-from retrokit.ramsearch.engine import Candidates, Engine
+from retrokit.ramsearch.candidates import Candidate, list_candidates
+from retrokit.ramsearch.engine import Engine
 from retrokit.ramsearch.ram import RamLayout
-from retrokit.ramsearch.scales import scale_label
 from retrokit.ramsearch.session import SessionData, read_session, write_session
 from retrokit.ramsearch.types import parse_search_types
-
-
-@dataclass(frozen=True)
-class Candidate:
-    """One candidate, as ``show`` lists it.
-
-    Attributes:
-        address: The console address of its first byte.
-        type: Its type code, e.g. ``">u2"``.
-        values: Its stored value at each snapshot, oldest first.
-        scale: How the screen's value follows from the stored one (``""``: it is the same; see
-            :mod:`retrokit.ramsearch.scales`).
-        changes: At how many snapshots its value differed from the one before.
-    """
-
-    address: int
-    type: str
-    values: tuple[int, ...]
-    scale: str = ""
-    changes: int = 0
-
-    @property
-    def low_byte(self) -> int:
-        """The address of its least significant byte."""
-        return self.address + parse_type(self.type).significance()[0]
-
-
-def group_candidates(candidates: Sequence[Candidate]) -> list[list[Candidate]]:
-    """Group the candidates that are one variable read several ways.
-
-    Candidates with the same least significant byte, scale and values at every
-    snapshot are read from the same bytes, in types that agree so far (``|u1``
-    and ``<u2`` over a byte followed by a zero, ``>u2`` and ``>u4`` over a
-    value whose high word is zero): as Gym Retro's search, count them as one
-    find. Each group lists its narrowest type first.
-    """
-    groups: dict[tuple[int, str, tuple[int, ...]], list[Candidate]] = {}
-    for c in candidates:
-        groups.setdefault((c.low_byte, c.scale, c.values), []).append(c)
-    return [sorted(g, key=lambda c: parse_type(c.type).width) for g in groups.values()]
 
 
 class RamSearch:
@@ -336,22 +294,7 @@ class RamSearch:
 
     def candidates(self, limit: int | None = None) -> list[Candidate]:
         """The candidates by address (then simplest type first), at most ``limit`` of them."""
-        cands: Candidates = self.engine.candidates
-        picked = []
-        for t, alive in enumerate(cands.alive):
-            positions = np.flatnonzero(alive)
-            picked.extend((int(p), t) for p in (positions if limit is None else positions[:limit]))
-        picked.sort()
-        if limit is not None:
-            picked = picked[:limit]
-        out = []
-        addresses = self.layout.addresses(np.array([p for p, _ in picked], dtype=np.int64)) if picked else []
-        for (position, t), address in zip(picked, addresses):
-            ftype = self.engine.types[t]
-            values = tuple(ftype.decode(bytes(s[position : position + ftype.width])) for s in self.engine.snapshots)
-            changes = sum(a != b for a, b in pairwise(values))
-            out.append(Candidate(int(address), ftype.code, values, scale_label(int(cands.scale[t][position])), changes))
-        return out
+        return list_candidates(self.engine, limit)
 
     # --- saving a find --------------------------------------------------------------------------
 

@@ -30,7 +30,7 @@ import numpy as np
 
 from retrokit.errors import SessionError
 from retrokit.paths import atomic_write
-from retrokit.ramsearch.engine import Candidates, Packed
+from retrokit.ramsearch.candidates import Candidates, Packed
 from retrokit.ramsearch.scales import SCALES
 from retrokit.ramsearch.types import SEARCH_TYPES
 

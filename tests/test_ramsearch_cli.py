@@ -121,6 +121,8 @@ def test_undo_redo_round_trip_on_the_command_line(session, capsys):
         (("run", "--movie", "missing.bk2"), "missing.bk2"),
         (("poke", "0xFF002B", "300"), "from 0 to 255"),
         (("show", "--session", "missing.session"), "found no file"),
+        (("show", "--limit", "0"), "Expected at most 100,000 candidates to list; found 2,097,072"),
+        (("show", "--json", "--limit", "1000000000"), "Filter them first"),
         (("new", "Dasher-Genesis"), "--force"),
         (("new", "Airstriker-Genesis"), "another game, Dasher-Genesis"),
         ((), "Expected a subcommand"),
@@ -128,7 +130,7 @@ def test_undo_redo_round_trip_on_the_command_line(session, capsys):
     ids=["unknown-type", "type-case", "poke-outside-ram", "save-past-the-end", "than-outside-ram",
          "filter-before-two-snapshots", "op-typo", "than-typo", "value-not-a-number", "button-typo",
          "until-without-movie", "movie-and-frames",
-         "missing-movie", "value-too-big", "missing-session", "session-exists", "session-of-another-game",
+         "missing-movie", "value-too-big", "missing-session", "show-everything", "show-a-billion", "session-exists", "session-of-another-game",
          "no-subcommand"],
 )  # fmt: skip
 def test_bad_input_gets_one_line(session, capsys, argv, message):

@@ -27,6 +27,7 @@ if TYPE_CHECKING:
 
 _SESSION_HELP = "the session file (default: ramsearch.session in the current folder)"
 _VALUES_SHOWN = 8  # snapshots whose values `show` prints; older ones are elided
+MAX_LISTED = 100_000  # `show` lists no more: each row is decoded at every snapshot in Python
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -232,6 +233,11 @@ def _show(args: argparse.Namespace) -> int:
     if limit is None or limit < 0:
         raise InvalidArgumentError(f"Expected --limit of 0 (all) or more, got {args.limit!r}.")
     with _open(args) as search:
+        if (not limit or limit > MAX_LISTED) and search.count > MAX_LISTED:
+            raise InvalidArgumentError(
+                f"Expected at most {MAX_LISTED:,} candidates to list; found {search.count:,}. "
+                "Filter them first, or pass --limit N."
+            )
         if args.json:
             candidates = search.candidates(limit or None)
             print(json.dumps([{"address": c.address, "type": c.type, "values": list(c.values)} for c in candidates]))

@@ -38,12 +38,7 @@ def build(folder: Path) -> ctypes.CDLL | None:
     )
     lib = ctypes.CDLL(str(library))
     lib.rk_frame_to_rgb.argtypes = [
-        ctypes.c_void_p,
-        ctypes.c_size_t,
-        ctypes.c_uint,
-        ctypes.c_uint,
-        ctypes.c_int,
-        ctypes.c_void_p,
+        ctypes.c_void_p, ctypes.c_size_t, ctypes.c_uint, ctypes.c_uint, ctypes.c_int, ctypes.c_void_p,
     ]
     lib.rk_frame_to_rgb.restype = ctypes.c_int
     lib.rk_rand_seed.argtypes = [ctypes.POINTER(Rand), ctypes.c_uint]

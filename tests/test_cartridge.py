@@ -125,11 +125,9 @@ def test_game_yaml_lists_the_committed_rom(dasher_rom: Path) -> None:
 
 def _ram_h() -> dict[str, int]:
     """The fixed addresses of src/ram.h, by game.yaml's field names."""
-    defines = dict(
-        re.findall(r"^#define (\w+) (0x[0-9A-Fa-f]+)\b", (CART_DIR / "src" / "ram.h").read_text(), re.MULTILINE)
-    )
+    defines = dict(re.findall(r"^#define (\w+) (0x[0-9A-Fa-f]+)\b", (CART_DIR / "src" / "ram.h").read_text(), re.MULTILINE))
     values = {name: int(v, 16) for name, v in defines.items()}
-    out = {k[len("ADDR_") :].lower(): v for k, v in values.items() if k.startswith("ADDR_")}
+    out = {k[len("ADDR_"):].lower(): v for k, v in values.items() if k.startswith("ADDR_")}
     for player in (1, 2):
         base = values[f"ADDR_P{player}"]
         for k, v in values.items():
@@ -152,15 +150,9 @@ def test_game_yaml_addresses_match_the_source() -> None:
 
 
 def test_rom_rebuilds_byte_for_byte(dasher_rom: Path, tmp_path: Path) -> None:
-    missing = [
-        tool
-        for tool in ("make", "m68k-linux-gnu-gcc", "m68k-linux-gnu-ld", "m68k-linux-gnu-objcopy")
-        if not shutil.which(tool)
-    ]
+    missing = [tool for tool in ("make", "m68k-linux-gnu-gcc", "m68k-linux-gnu-ld", "m68k-linux-gnu-objcopy") if not shutil.which(tool)]
     if missing:
-        pytest.skip(
-            f"the m68k cross toolchain is not installed (missing {', '.join(missing)}; Debian: gcc-m68k-linux-gnu)"
-        )
+        pytest.skip(f"the m68k cross toolchain is not installed (missing {', '.join(missing)}; Debian: gcc-m68k-linux-gnu)")
     # Byte-for-byte holds for the toolchain that built the committed ROM (make install records it).
     recorded = (CART_DIR / "toolchain.txt").read_text().splitlines()
     installed = [

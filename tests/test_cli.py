@@ -118,12 +118,7 @@ def test_python_dash_m(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(REPO), "RETROKIT_DATA": str(tmp_path)}
     env.pop("RETROKIT_GAMES", None)
     done = subprocess.run(
-        [sys.executable, "-m", "retrokit", "games", "Airstriker"],
-        capture_output=True,
-        text=True,
-        env=env,
-        timeout=120,
-        check=False,
+        [sys.executable, "-m", "retrokit", "games", "Airstriker"], capture_output=True, text=True, env=env, timeout=120, check=False
     )
     assert done.returncode == 0, done.stderr
     assert "Airstriker-Genesis" in done.stdout

@@ -223,9 +223,7 @@ def test_tables(expression: str, ram: dict, expected: float) -> None:
 
 
 def test_per_player_rewards() -> None:
-    scenario = load_scenario(
-        {"rewards": ["delta(x)", "-delta(x)", "lives"], "done": "lives == 0"}, ["x", "lives"], name="t"
-    )
+    scenario = load_scenario({"rewards": ["delta(x)", "-delta(x)", "lives"], "done": "lives == 0"}, ["x", "lives"], name="t")
     assert scenario.players == 3
     run = scenario.start()
     run.reset({"x": 0, "lives": 1})
@@ -249,9 +247,7 @@ def test_actions_and_crop_pass_through() -> None:
 
 def test_include_adds_tables_and_definitions(tmp_path) -> None:
     (tmp_path / "lib").mkdir()
-    (tmp_path / "lib" / "levels.yaml").write_text(
-        "tables:\n  ends:\n    values:\n      3: 30\ndefine:\n  end: ends[zone]\n"
-    )
+    (tmp_path / "lib" / "levels.yaml").write_text("tables:\n  ends:\n    values:\n      3: 30\ndefine:\n  end: ends[zone]\n")
     (tmp_path / "s.yaml").write_text("include: [lib/levels.yaml]\nreward: end - x\n")
     scenario = load_scenario(tmp_path / "s.yaml", ["x", "zone"])
     run = scenario.start()

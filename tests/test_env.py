@@ -28,10 +28,7 @@ def fire_and_wander(env: RetroEnv, step: int) -> object:
     kind = env.actions.action_type
     if kind in ("all", "filtered"):
         return env.actions.press(names)
-    picks = [
-        combos.index(mask & gmask) if (mask & gmask) in combos else 0
-        for combos, gmask in zip(env.actions.combos, env.actions.group_masks)
-    ]
+    picks = [combos.index(mask & gmask) if (mask & gmask) in combos else 0 for combos, gmask in zip(env.actions.combos, env.actions.group_masks)]
     if kind == "multi_discrete":
         return np.array(picks)
     index, scale = 0, 1
@@ -207,13 +204,8 @@ def test_recorded_movies_replay_what_the_agent_saw(tmp_path, every_frame: bool) 
     from retrokit.movie import play, read_bk2
 
     env = retrokit.make(
-        "Dasher-Genesis",
-        frameskip=4,
-        sticky_prob=0.5,
-        max_episode_steps=40,
-        record=tmp_path,
-        action_type="all",
-        scenario_every_frame=every_frame,
+        "Dasher-Genesis", frameskip=4, sticky_prob=0.5, max_episode_steps=40, record=tmp_path,
+        action_type="all", scenario_every_frame=every_frame,
     )
     seen, ends = [], []  # each step's observation, and its last frame's index in its movie
     for episode in range(2):

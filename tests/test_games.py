@@ -255,20 +255,9 @@ def test_declared_state_list(user_games):
         ("states: {default: Zone1.Act1, list: [Zone9]}\n", "state files for the listed states"),
         ("system: Genesys\n", "Did you mean 'Genesis'"),
     ],
-    ids=[
-        "syntax",
-        "not-a-mapping",
-        "key-typo",
-        "field-key-typo",
-        "no-type",
-        "bad-address",
-        "negative-address",
-        "bad-sha1",
-        "no-players",
-        "unknown-default-state",
-        "missing-listed-state",
-        "unknown-system",
-    ],
+    ids=["syntax", "not-a-mapping", "key-typo", "field-key-typo", "no-type", "bad-address",
+         "negative-address", "bad-sha1", "no-players", "unknown-default-state", "missing-listed-state",
+         "unknown-system"],
 )
 def test_malformed_yaml(user_games, text, message):
     folder = make_yaml_game(user_games, text=text)
@@ -310,11 +299,7 @@ def test_gym_retro_folder(user_games):
     ("data", "sha1s", "message"),
     [
         ('{"info": {"lives": ', SHA_NOBODY_HAS, "data.json: expected valid JSON; found a syntax error at line 1"),
-        (
-            '{"info": {"lives": {"address": 1, "type": 5}}}',
-            SHA_NOBODY_HAS,
-            "the type of field 'lives' to be a type code",
-        ),
+        ('{"info": {"lives": {"address": 1, "type": 5}}}', SHA_NOBODY_HAS, "the type of field 'lives' to be a type code"),
         ('{"info": [1, 2]}', SHA_NOBODY_HAS, "expected 'info' to be a mapping"),
         ('{"inf": {}}', SHA_NOBODY_HAS, "Did you mean 'info'"),
         ('{"info": {}}', "not-a-sha", "rom.sha: expected line 1 to be a SHA-1"),

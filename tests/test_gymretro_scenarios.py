@@ -17,21 +17,8 @@ import pytest
 from retrokit.dsl import convert_scenario_json
 from retrokit.dsl.scenario import load_scenario
 
-OPS = [
-    None,
-    "equal",
-    "negative-equal",
-    "not-equal",
-    "less-than",
-    "greater-than",
-    "less-or-equal",
-    "greater-or-equal",
-    "nonzero",
-    "zero",
-    "positive",
-    "negative",
-    "sign",
-]
+OPS = [None, "equal", "negative-equal", "not-equal", "less-than", "greater-than", "less-or-equal",
+       "greater-or-equal", "nonzero", "zero", "positive", "negative", "sign"]
 
 # A field's values: at reset, then at each step. Deltas: 0, 10, -20, 30, 0, -15, -10, 5, 10, 3.
 V = [0, 0, 10, -10, 20, 20, 5, -5, 0, 10, 13]
@@ -83,9 +70,7 @@ def done_of(node: dict, values: dict, deltas: dict) -> bool:
     return all(results) if every else any(results)
 
 
-def gym_retro(
-    data: dict, reset: dict, steps: list[dict], frames_per_step: int = 1
-) -> list[tuple[tuple[float, ...], bool]]:
+def gym_retro(data: dict, reset: dict, steps: list[dict], frames_per_step: int = 1) -> list[tuple[tuple[float, ...], bool]]:
     """Per step: per-player rewards (variables plus time per frame) and done."""
     players = data.get("rewards") or [data.get("reward", {})]
     out, last = [], reset
@@ -103,10 +88,7 @@ def gym_retro(
 
 
 def ram(vs: list[int], **others: list[int]) -> tuple[dict, list[dict]]:
-    rows = [
-        {"v": v, "w": others.get("w", [0] * len(vs))[i], "lives": others.get("lives", [3] * len(vs))[i]}
-        for i, v in enumerate(vs)
-    ]
+    rows = [{"v": v, "w": others.get("w", [0] * len(vs))[i], "lives": others.get("lives", [3] * len(vs))[i]} for i, v in enumerate(vs)]
     return rows[0], rows[1:]
 
 
@@ -137,9 +119,7 @@ def _op_id(op: str | None) -> str:
 
 @pytest.mark.parametrize("measurement", [None, "absolute", "delta"], ids=lambda m: m or "default")
 @pytest.mark.parametrize("op", OPS, ids=_op_id)
-@pytest.mark.parametrize(
-    "reward,penalty", [(2.5, 0.5), (3.0, 0.0), (0.0, 2.0), (1.5, 1.5)], ids=["both", "reward", "penalty", "equal"]
-)
+@pytest.mark.parametrize("reward,penalty", [(2.5, 0.5), (3.0, 0.0), (0.0, 2.0), (1.5, 1.5)], ids=["both", "reward", "penalty", "equal"])
 def test_reward_ops(tmp_path, op, measurement, reward, penalty) -> None:
     spec = {"reward": reward, "penalty": penalty, "reference": 10}
     spec.update({"op": op} if op else {})
@@ -166,9 +146,7 @@ def test_reward_ops_tell_apart_every_step(tmp_path) -> None:
     reset, steps = ram(V)
     for op in OPS[1:-1]:
         for measurement in ("absolute", "delta"):
-            data = {
-                "reward": {"variables": {"v": {"op": op, "reference": 10, "reward": 1, "measurement": measurement}}}
-            }
+            data = {"reward": {"variables": {"v": {"op": op, "reference": 10, "reward": 1, "measurement": measurement}}}}
             assert {r for (r,), _ in gym_retro(data, reset, steps)} == {0.0, 1.0}, (op, measurement)
 
 
@@ -177,31 +155,13 @@ def test_reward_ops_tell_apart_every_step(tmp_path) -> None:
     [
         ("any", {}, "any"),
         ("all", {}, "all"),
-        (
-            "any",
-            {
-                "inner": {
-                    "condition": "all",
-                    "variables": {"w": {"op": "positive"}, "lives": {"op": "less-than", "reference": 3}},
-                }
-            },
-            "any",
-        ),
-        (
-            "all",
-            {
-                "a": {"variables": {"w": {"op": "zero"}}},
-                "b": {"nodes": {"c": {"variables": {"lives": {"op": "zero"}}}}},
-            },
-            "all",
-        ),
+        ("any", {"inner": {"condition": "all", "variables": {"w": {"op": "positive"}, "lives": {"op": "less-than", "reference": 3}}}}, "any"),
+        ("all", {"a": {"variables": {"w": {"op": "zero"}}}, "b": {"nodes": {"c": {"variables": {"lives": {"op": "zero"}}}}}}, "all"),
     ],
     ids=["any", "all", "any_with_all_node", "all_with_nested_nodes"],
 )
 def test_done_conditions_and_nodes(tmp_path, condition, nodes, expected_kind) -> None:
-    data = {
-        "done": {"condition": condition, "variables": {"v": {"op": "greater-than", "reference": 0}}, "nodes": nodes}
-    }
+    data = {"done": {"condition": condition, "variables": {"v": {"op": "greater-than", "reference": 0}}, "nodes": nodes}}
     reset, steps = ram(V, w=[0, 1, 0, 2, 0, 0, 3, 0, 0, 1, 0], lives=[3, 3, 2, 2, 0, 0, 2, 0, 3, 0, 0])
     results = both_ways(tmp_path, data, reset, steps)
     assert results == gym_retro(data, reset, steps)
@@ -218,13 +178,8 @@ def test_empty_done(tmp_path, condition, expected) -> None:
 
 @pytest.mark.parametrize(
     "time",
-    [
-        {"reward": -0.01},
-        {"penalty": 1.0},
-        {"op": "sign", "reward": 0.5},
-        {"op": "negative-equal", "reference": 1, "reward": 2.0},
-        {"op": "greater-than", "reference": 0, "reward": 0.25, "penalty": 9.0},
-    ],
+    [{"reward": -0.01}, {"penalty": 1.0}, {"op": "sign", "reward": 0.5}, {"op": "negative-equal", "reference": 1, "reward": 2.0},
+     {"op": "greater-than", "reference": 0, "reward": 0.25, "penalty": 9.0}],
     ids=["reward", "penalty_only_has_no_effect", "sign", "never", "greater_than"],
 )
 @pytest.mark.parametrize("frames_per_step", [1, 4])
@@ -247,10 +202,7 @@ def test_per_player_rewards(tmp_path) -> None:
 
 def test_reward_and_rewards_merge_like_gym_retro(tmp_path) -> None:
     """rewards[0] adds to reward: a variable already set keeps reward's spec."""
-    data = {
-        "reward": {"variables": {"v": {"reward": 1.0}}},
-        "rewards": [{"variables": {"v": {"reward": 100.0}, "w": {"reward": 3.0}}}],
-    }
+    data = {"reward": {"variables": {"v": {"reward": 1.0}}}, "rewards": [{"variables": {"v": {"reward": 100.0}, "w": {"reward": 3.0}}}]}
     reset, steps = ram(V, w=[0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10])
     merged = {"reward": {"variables": {"v": {"reward": 1.0}, "w": {"reward": 3.0}}}}
     assert both_ways(tmp_path, data, reset, steps) == gym_retro(merged, reset, steps)
@@ -259,9 +211,7 @@ def test_reward_and_rewards_merge_like_gym_retro(tmp_path) -> None:
 def test_actions_and_crop(tmp_path) -> None:
     actions = [[["LEFT"], ["RIGHT"], []], [["A"], []]]
     path = tmp_path / "scenario.json"
-    path.write_text(
-        json.dumps({"reward": {"variables": {"v": {"reward": 1}}}, "actions": actions, "crop": [0, 8, 320, 216]})
-    )
+    path.write_text(json.dumps({"reward": {"variables": {"v": {"reward": 1}}}, "actions": actions, "crop": [0, 8, 320, 216]}))
     for source in (path, tmp_path / "converted.yaml"):
         if source.suffix == ".yaml":
             source.write_text(convert_scenario_json(path))
@@ -271,19 +221,10 @@ def test_actions_and_crop(tmp_path) -> None:
 
 def test_converter_output_reads_well(tmp_path) -> None:
     path = tmp_path / "scenario.json"
-    path.write_text(
-        json.dumps(
-            {
-                "reward": {
-                    "variables": {"score": {"reward": 10.0}, "lives": {"penalty": 100.0}, "odd name": {"reward": 1.0}}
-                },
-                "done": {
-                    "condition": "all",
-                    "variables": {"lives": {"op": "zero"}, "frame": {"op": "greater-than", "reference": 99}},
-                },
-            }
-        )
-    )
+    path.write_text(json.dumps({
+        "reward": {"variables": {"score": {"reward": 10.0}, "lives": {"penalty": 100.0}, "odd name": {"reward": 1.0}}},
+        "done": {"condition": "all", "variables": {"lives": {"op": "zero"}, "frame": {"op": "greater-than", "reference": 99}}},
+    }))
     assert convert_scenario_json(path) == (
         "# Converted from Gym Retro's scenario.json by retrokit; see docs/scenarios.md.\n"
         "reward: 10.0 * max(delta(score), 0) + 100.0 * min(delta(lives), 0) + 1.0 * max(delta(`odd name`), 0)\n"

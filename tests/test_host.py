@@ -119,16 +119,11 @@ open(sys.argv[3], "wb").write(emu.get_state())
 """
 
 
-def test_runs_are_identical_across_processes(
-    airstriker_rom: Path, airstriker_dir: Path, airstriker_state: bytes, tmp_path: Path
-) -> None:
+def test_runs_are_identical_across_processes(airstriker_rom: Path, airstriker_dir: Path, airstriker_state: bytes, tmp_path: Path) -> None:
     repo = Path(__file__).resolve().parent.parent
     out = subprocess.run(
         [sys.executable, "-c", CHILD, str(airstriker_rom), str(airstriker_dir / "Level1.state"), str(tmp_path / "s")],
-        capture_output=True,
-        text=True,
-        cwd=repo,
-        check=True,
+        capture_output=True, text=True, cwd=repo, check=True,
     ).stdout.strip()
     with Emulator("Genesis", airstriker_rom) as emu:
         emu.set_state(airstriker_state)
@@ -292,9 +287,7 @@ def test_an_emulator_used_from_two_threads_at_once_raises(airstriker: Emulator) 
 
 
 def test_truncated_state_is_a_clear_error(airstriker: Emulator, airstriker_state: bytes) -> None:
-    with pytest.raises(
-        StateError, match=rf"expected a state of {len(airstriker_state)} bytes.*got 1000 bytes.*truncated"
-    ):
+    with pytest.raises(StateError, match=rf"expected a state of {len(airstriker_state)} bytes.*got 1000 bytes.*truncated"):
         airstriker.set_state(airstriker_state[:1000])
 
 
@@ -368,9 +361,7 @@ def test_missing_rom_file_is_a_clear_error(tmp_path: Path) -> None:
 # --- the native runner: several emulators in one call -----------------------------------------
 
 
-@pytest.mark.parametrize(
-    "count, workers", [(2, 1), (5, 1), (3, 0), (2, 3)], ids=["2-on-2", "5-on-2", "3-on-1", "2-on-4"]
-)
+@pytest.mark.parametrize("count, workers", [(2, 1), (5, 1), (3, 0), (2, 3)], ids=["2-on-2", "5-on-2", "3-on-1", "2-on-4"])
 def test_runner_steps_match_single_runs_and_screens_land_in_the_batch(
     airstriker_rom: Path, airstriker_state: bytes, count: int, workers: int
 ) -> None:
@@ -440,13 +431,10 @@ press = lambda mask: emu.run([mask, 0], 1)
 screen = lambda: emu.screen().tobytes()
 """
 
-
 def digest_in_fresh_process(setup: str, rom: Path) -> str:
     repo = Path(__file__).resolve().parent.parent
     code = SCHEDULE.format(setup=setup)
-    return subprocess.run(
-        [sys.executable, "-c", code, str(rom)], capture_output=True, text=True, cwd=repo, check=True
-    ).stdout.strip()
+    return subprocess.run([sys.executable, "-c", code, str(rom)], capture_output=True, text=True, cwd=repo, check=True).stdout.strip()
 
 
 def test_power_on_matches_stable_retro_in_a_fresh_process(airstriker_rom: Path) -> None:

@@ -34,9 +34,7 @@ def fields_after(game, state: bytes) -> dict[str, int]:
         return FieldReader(game.fields, emu.space).read()
 
 
-@pytest.mark.parametrize(
-    "name,zone,act,players", [("Zone2.Act2", 1, 1, 1), ("Zone3.Act1.2P", 2, 0, 2)], ids=["1p", "2p"]
-)
+@pytest.mark.parametrize("name,zone,act,players", [("Zone2.Act2", 1, 1, 1), ("Zone3.Act1.2P", 2, 0, 2)], ids=["1p", "2p"])
 def test_a_recipe_reaches_its_level(name: str, zone: int, act: int, players: int) -> None:
     game = find_game("Dasher-Genesis")
     values = fields_after(game, make_state(game, recipes(game)[name]))

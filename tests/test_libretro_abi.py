@@ -56,7 +56,7 @@ def our_constants() -> dict[str, str]:
 
 
 def check_source() -> str:
-    lines = ["#include <stddef.h>", f'#include "{REFERENCE}"', '#include "libretro_api.h"']
+    lines = ['#include <stddef.h>', f'#include "{REFERENCE}"', '#include "libretro_api.h"']
     for ours, theirs in our_constants().items():
         lines.append(f'_Static_assert({ours} == {theirs}, "{ours} differs from {theirs}");')
     for struct, fields in STRUCTS.items():
@@ -69,9 +69,7 @@ def check_source() -> str:
     return "\n".join(lines) + "\n"
 
 
-@pytest.mark.skipif(
-    REFERENCE is None, reason="the reference libretro.h is not installed (apt-get install retroarch-dev)"
-)
+@pytest.mark.skipif(REFERENCE is None, reason="the reference libretro.h is not installed (apt-get install retroarch-dev)")
 @pytest.mark.skipif(shutil.which("cc") is None, reason="no C compiler")
 def test_declarations_match_the_reference_header(tmp_path: Path) -> None:
     source = tmp_path / "abi.c"

@@ -44,9 +44,8 @@ class Recording:
 def stable_retro_recording(tmp_path_factory: pytest.TempPathFactory) -> Recording:
     """A movie recorded by stable-retro, with the screens it showed (after reset, then after each step)."""
     folder = tmp_path_factory.mktemp("stable_retro_movies")
-    env = stable_retro.make(
-        f"{GAME}-v0", render_mode=None, record=str(folder), use_restricted_actions=stable_retro.Actions.ALL
-    )
+    env = stable_retro.make(f"{GAME}-v0", render_mode=None, record=str(folder),
+                            use_restricted_actions=stable_retro.Actions.ALL)
     try:
         env.reset(seed=0)
         reference = env.unwrapped
@@ -204,11 +203,7 @@ def test_round_trip_keeps_players_state_and_extra_header_lines(tmp_path: Path) -
     assert read_bk2(tmp_path / "m.bk2") == movie
     header = unzip((tmp_path / "m.bk2").read_bytes())["Header.txt"].decode()
     assert header.splitlines()[:5] == [
-        "MovieVersion Retro",
-        "Author somebody",
-        "emuVersion ?",
-        "Platform GEN",
-        f"GameName {GAME}-v0",
+        "MovieVersion Retro", "Author somebody", "emuVersion ?", "Platform GEN", f"GameName {GAME}-v0",
     ]
     assert header.endswith("BoardName SEGA 315-5433\n")
 
@@ -234,20 +229,16 @@ def corrupt_deflate(data: bytes) -> bytes:
 
 MALFORMED = {
     "not a zip": (lambda m: b"this is a text file", "not a complete zip"),
-    "truncated zip": (
-        lambda m: encode_bk2(Movie(GAME, "Genesis", 1, bytes(5000), [(1,)]))[:-300],
-        "not a complete zip",
-    ),
-    "corrupt data": (
-        lambda m: corrupt_deflate(encode_bk2(Movie(GAME, "Genesis", 1, bytes(5000), [(1,)]))),
-        "not a complete zip",
-    ),
+    "truncated zip": (lambda m: encode_bk2(Movie(GAME, "Genesis", 1, bytes(5000), [(1,)]))[:-300], "not a complete zip"),
+    "corrupt data": (lambda m: corrupt_deflate(encode_bk2(Movie(GAME, "Genesis", 1, bytes(5000), [(1,)]))),
+                     "not a complete zip"),
     "no Header.txt": (lambda m: {k: v for k, v in m.items() if k != "Header.txt"}, "holding 'Header.txt'"),
     "no Input Log.txt": (lambda m: {k: v for k, v in m.items() if k != "Input Log.txt"}, "holding 'Input Log.txt'"),
     "no Platform": (lambda m: {**m, "Header.txt": b"GameName x\n"}, "'Platform' line"),
     "unknown Platform": (lambda m: {**m, "Header.txt": b"Platform Dreamcast\n"}, "unknown platform"),
     "no [Input]": (lambda m: edit_log(m, "[Input]\n", ""), "expected '[Input]'"),
-    "no key line": (lambda m: {**m, "Input Log.txt": b"[Input]\n|..|...........B|............|\n[/Input]"}, "key line"),
+    "no key line": (lambda m: {**m, "Input Log.txt": b"[Input]\n|..|...........B|............|\n[/Input]"},
+                    "key line"),
     "unknown button": (lambda m: edit_log(m, "P1 Mode|", "P1 Turbo|"), "'P1 Turbo'"),
     "players out of order": (lambda m: edit_log(m, "P1 B|P2 Z|", "P2 B|P1 Z|"), "out of order"),
     "wrong letter": (lambda m: edit_log(m, "|..|...........B|", "|..|...........Q|"), "found 'Q'"),
@@ -402,9 +393,8 @@ BAD_EXPORTS = {
 
 
 @pytest.mark.parametrize("case", BAD_EXPORTS)
-def test_export_rejects_what_it_cannot_write(
-    short_movie: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, case: str
-) -> None:
+def test_export_rejects_what_it_cannot_write(short_movie: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch,
+                                             case: str) -> None:
     name, every, expected = BAD_EXPORTS[case]
     monkeypatch.setitem(sys.modules, "imageio", None)  # as if not installed
     with pytest.raises(InvalidArgumentError, match=expected):

@@ -34,7 +34,7 @@ AIRSTRIKER_SHA1 = "a8be7b0ca850119b167f9644e6a4a22e983d61a4"
     ],
 )
 def test_detect_system(filename, system):
-    assert system_for_extension(filename.rsplit(".", 1)[1]).name == system
+    assert system_for_extension(filename.rsplit('.', 1)[1]).name == system
 
 
 @pytest.mark.parametrize(("filename", "suggestion"), [("Mario.nez", "'.nes'"), ("Zelda.sfx", "'.sfc'")])

@@ -53,12 +53,7 @@ def test_making_a_level_without_the_rom_says_how_to_import(monkeypatch: pytest.M
 @pytest.mark.parametrize(
     "game,state,error,message",
     [
-        (
-            "SonicTheHedgehog4-Genesis",
-            "GreenHillZone.Act1",
-            InvalidArgumentError,
-            "Did you mean 'SonicTheHedgehog-Genesis'",
-        ),
+        ("SonicTheHedgehog4-Genesis", "GreenHillZone.Act1", InvalidArgumentError, "Did you mean 'SonicTheHedgehog-Genesis'"),
         ("SonicTheHedgehog-Genesis", "GreenHilZone.Act1", StateNotFoundError, "Did you mean 'GreenHillZone.Act1'"),
     ],
     ids=["unknown-game", "unknown-level"],
@@ -93,9 +88,7 @@ def test_allow_backtracking_rewards_only_new_progress() -> None:
 
 
 @pytest.mark.parametrize("level", sonic.levels(), ids=lambda level: f"{level[0].split('-')[0]}/{level[1]}")
-def test_every_level_is_ready_but_for_the_rom(
-    level: tuple[str, str], monkeypatch: pytest.MonkeyPatch, tmp_path
-) -> None:
+def test_every_level_is_ready_but_for_the_rom(level: tuple[str, str], monkeypatch: pytest.MonkeyPatch, tmp_path) -> None:
     from retrokit.data.states import read_state
     from retrokit.dsl.scenario import load_scenario
 

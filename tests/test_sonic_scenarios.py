@@ -37,9 +37,7 @@ except ImportError:  # pragma: no cover - stable-retro is a dependency
     pass
 
 GAMES = ("SonicTheHedgehog-Genesis", "SonicTheHedgehog2-Genesis", "SonicAndKnuckles3-Genesis")
-needs_wheel = pytest.mark.skipif(
-    not (WHEEL / "SonicTheHedgehog-Genesis-v0").is_dir(), reason="stable-retro's Sonic data not installed"
-)
+needs_wheel = pytest.mark.skipif(not (WHEEL / "SonicTheHedgehog-Genesis-v0").is_dir(), reason="stable-retro's Sonic data not installed")
 
 
 # --- The original Lua, transcribed -------------------------------------------------------------
@@ -205,11 +203,7 @@ class Sonic3KLua(Sonic1Lua):
         return self.x_past_end()
 
 
-LUA = {
-    "SonicTheHedgehog-Genesis": Sonic1Lua,
-    "SonicTheHedgehog2-Genesis": Sonic2Lua,
-    "SonicAndKnuckles3-Genesis": Sonic3KLua,
-}
+LUA = {"SonicTheHedgehog-Genesis": Sonic1Lua, "SonicTheHedgehog2-Genesis": Sonic2Lua, "SonicAndKnuckles3-Genesis": Sonic3KLua}
 FUNCTIONS = {"contest": ("contest_reward", "contest_done"), "xpos": ("xpos_rew", "xpos_done")}
 
 
@@ -294,15 +288,9 @@ def trajectories(game: str) -> dict[str, Trajectory]:
         act_change.step(1, act=1, x=act_change.ram["x"] - 0x2C00, screen_x=act_change.ram["screen_x"] - 0x2C00)
         t["act_change"] = act_change.step(60, dx=48)
         t["act_change_and_camera_drift"] = (
-            Trajectory(game, 0, 0, 0x2E00)
-            .step(5, dx=40)
-            .step(1, act=1, x=0x300, screen_x=0x180)
-            .step(10, dx=-20)
-            .step(30, dx=90)
+            Trajectory(game, 0, 0, 0x2E00).step(5, dx=40).step(1, act=1, x=0x300, screen_x=0x180).step(10, dx=-20).step(30, dx=90)
         )
-        t["special_stage"] = (
-            Trajectory(game, 0, 0, 0x50).step(10, dx=20).step(1, special_stage=1).step(3, special_stage=0)
-        )
+        t["special_stage"] = Trajectory(game, 0, 0, 0x50).step(10, dx=20).step(1, special_stage=1).step(3, special_stage=0)
         t["special_stage_at_reset"] = Trajectory(game, 0, 0, 0x50, lives=2)
         t["special_stage_at_reset"].reset["special_stage"] = -1
         t["special_stage_at_reset"].step(3, dx=5)
@@ -321,14 +309,8 @@ def random_trajectory(game: str, seed: int) -> Trajectory:
     key = rng.choice(list(lua_table(game)))
     zone, act = (int(v) for v in re.findall(r"\d+", key))
     end = end_of(game, zone, act)
-    t = Trajectory(
-        game,
-        zone,
-        act,
-        rng.randrange(0, max(1, end - 0x100)),
-        lives=rng.choice([1, 2, 3, 3, 3, 4]),
-        frames_per_step=rng.choice([1, 4, 4, 400]),
-    )
+    t = Trajectory(game, zone, act, rng.randrange(0, max(1, end - 0x100)), lives=rng.choice([1, 2, 3, 3, 3, 4]),
+                   frames_per_step=rng.choice([1, 4, 4, 400]))
     for _ in range(rng.randrange(20, 120)):
         event = rng.random()
         if event < 0.03:
@@ -339,12 +321,7 @@ def random_trajectory(game: str, seed: int) -> Trajectory:
             t.step(1, game_mode=rng.choice([12, 12, 16]))
         elif event < 0.09:
             jump = rng.randrange(0, 0x1000)
-            t.step(
-                1,
-                act=rng.choice([act, act + 1]),
-                x=max(0, t.ram["x"] - jump),
-                screen_x=max(0, t.ram["screen_x"] - jump),
-            )
+            t.step(1, act=rng.choice([act, act + 1]), x=max(0, t.ram["x"] - jump), screen_x=max(0, t.ram["screen_x"] - jump))
             act = t.ram["act"]
         else:
             t.step(1, dx=rng.randrange(-60, 120))

@@ -60,22 +60,14 @@ CASES = [
     ("<u8", 2**63 + 5, (2**63 + 5).to_bytes(8, "little")),
     (">i8", -(2**40), (-(2**40)).to_bytes(8, "big", signed=True)),
     # big-endian words of little-endian bytes: high word first
-    (
-        "><u4",
-        0x11223344,
-        halves(0x11223344, 4)[0].to_bytes(2, "little") + halves(0x11223344, 4)[1].to_bytes(2, "little"),
-    ),
+    ("><u4", 0x11223344, halves(0x11223344, 4)[0].to_bytes(2, "little") + halves(0x11223344, 4)[1].to_bytes(2, "little")),
     # little-endian words of big-endian bytes: low word first
     ("<>u4", 0x11223344, halves(0x11223344, 4)[1].to_bytes(2, "big") + halves(0x11223344, 4)[0].to_bytes(2, "big")),
     ("><i4", -5, halves(2**32 - 5, 4)[0].to_bytes(2, "little") + halves(2**32 - 5, 4)[1].to_bytes(2, "little")),
     ("><u8", 0x0102030405060708, (0x01020304).to_bytes(4, "little") + (0x05060708).to_bytes(4, "little")),
     # host-relative orders on a little-endian host
     ("=u2", 0x1234, (0x1234).to_bytes(2, "little")),
-    (
-        ">=u4",
-        0x11223344,
-        halves(0x11223344, 4)[0].to_bytes(2, "little") + halves(0x11223344, 4)[1].to_bytes(2, "little"),
-    ),
+    (">=u4", 0x11223344, halves(0x11223344, 4)[0].to_bytes(2, "little") + halves(0x11223344, 4)[1].to_bytes(2, "little")),
     ("<=u4", 0x11223344, (0x11223344).to_bytes(4, "little")),
 ]
 
@@ -110,9 +102,7 @@ def test_poke_writes_through_the_genesis_swap() -> None:
 def test_bcd_nibbles_above_nine_wrap_like_gym_retro() -> None:
     space, ram = make_space(1)
     place(ram, 1, BASE, bytes([0xAB, 0x1F]))
-    assert (
-        FieldReader([FieldSpec("f", BASE, ">d2")], space).read()["f"] == ((0xB % 10) + (0xA % 10) * 10) * 100 + 5 + 10
-    )
+    assert FieldReader([FieldSpec("f", BASE, ">d2")], space).read()["f"] == ((0xB % 10) + (0xA % 10) * 10) * 100 + 5 + 10
 
 
 def test_mask_applies_after_decoding() -> None:
@@ -167,9 +157,7 @@ def test_bad_type_code_suggests_a_close_one() -> None:
 
 def test_address_outside_ram_is_a_clear_error() -> None:
     space, _ = make_space(2)
-    with pytest.raises(
-        InvalidArgumentError, match=r"inside the mapped memory \(0xff0000-0xff00ff\).*0xff00ff \(width 2\)"
-    ):
+    with pytest.raises(InvalidArgumentError, match=r"inside the mapped memory \(0xff0000-0xff00ff\).*0xff00ff \(width 2\)"):
         FieldReader([FieldSpec("f", BASE + 0xFF, ">u2")], space)
 
 
@@ -197,33 +185,12 @@ class MappedEmulator:
 
     def memory_maps(self) -> list[dict]:
         return [
-            {
-                "flags": 1,
-                "start": 0x000000,
-                "select": 0,
-                "disconnect": 0,
-                "length": 0x100,
-                "addrspace": "",
-                "memory": memoryview(self.rom),
-            },  # read-only: skipped
-            {
-                "flags": 4,
-                "start": 0x7E0000,
-                "select": 0xFE0000,
-                "disconnect": 0,
-                "length": 0x20000,
-                "addrspace": "",
-                "memory": memoryview(self.wram),
-            },
-            {
-                "flags": 8,
-                "start": 0x700000,
-                "select": 0xFFF800,
-                "disconnect": 0,
-                "length": 0,
-                "addrspace": "",
-                "memory": memoryview(self.sram),
-            },  # length from select: 0x800
+            {"flags": 1, "start": 0x000000, "select": 0, "disconnect": 0, "length": 0x100,
+             "addrspace": "", "memory": memoryview(self.rom)},  # read-only: skipped
+            {"flags": 4, "start": 0x7E0000, "select": 0xFE0000, "disconnect": 0, "length": 0x20000,
+             "addrspace": "", "memory": memoryview(self.wram)},
+            {"flags": 8, "start": 0x700000, "select": 0xFFF800, "disconnect": 0, "length": 0,
+             "addrspace": "", "memory": memoryview(self.sram)},  # length from select: 0x800
         ]
 
     def memory(self, kind: int) -> None:

@@ -23,9 +23,7 @@ MID_STEP = {"reward": "delta(score)", "done": "frame >= 37 or gameover == 1"}
 
 
 @pytest.mark.parametrize("every_frame", [False, True], ids=["per-step", "per-frame"])
-@pytest.mark.parametrize(
-    "n, threads", [(2, None), (5, 2), (3, 1)], ids=["2-envs", "5-envs-2-threads", "3-envs-1-thread"]
-)
+@pytest.mark.parametrize("n, threads", [(2, None), (5, 2), (3, 1)], ids=["2-envs", "5-envs-2-threads", "3-envs-1-thread"])
 def test_vector_equals_single_envs_through_autoreset(n: int, threads: int | None, every_frame: bool) -> None:
     seed, steps = 10, 60
     options = {**OPTIONS, "scenario_every_frame": every_frame, "scenario": MID_STEP if every_frame else None}
@@ -126,13 +124,9 @@ def test_vector_takes_actions_as_a_list_too() -> None:
     vec.close()
 
 
-@pytest.mark.parametrize(
-    "mode, kind", [(None, ThreadedVectorEnv), ("sync", gymnasium.vector.SyncVectorEnv)], ids=["default", "sync"]
-)
+@pytest.mark.parametrize("mode, kind", [(None, ThreadedVectorEnv), ("sync", gymnasium.vector.SyncVectorEnv)], ids=["default", "sync"])
 def test_gymnasium_make_vec_gives_the_threaded_vector_by_default(mode: str | None, kind: type) -> None:
-    vec = gymnasium.make_vec(
-        "retrokit/Airstriker-Genesis", num_envs=2, vectorization_mode=mode, frameskip=4, max_episode_steps=3
-    )
+    vec = gymnasium.make_vec("retrokit/Airstriker-Genesis", num_envs=2, vectorization_mode=mode, frameskip=4, max_episode_steps=3)
     assert isinstance(vec, kind) and vec.num_envs == 2
     vec.reset(seed=0)
     for _ in range(3):
@@ -148,14 +142,8 @@ def test_vector_movies_replay_what_each_env_saw(tmp_path, every_frame: bool) -> 
     theirs = tmp_path / "Dasher-Genesis-Zone1.Act1-000000.bk2"
     theirs.write_bytes(b"a file the user made")
     vec = retrokit.make_vec(
-        "Dasher-Genesis",
-        2,
-        frameskip=4,
-        sticky_prob=0.5,
-        max_episode_steps=12,
-        record=tmp_path,
-        action_type="all",
-        scenario_every_frame=every_frame,
+        "Dasher-Genesis", 2, frameskip=4, sticky_prob=0.5, max_episode_steps=12, record=tmp_path,
+        action_type="all", scenario_every_frame=every_frame,
     )
     vec.reset(seed=0)
     rng = np.random.default_rng(1)

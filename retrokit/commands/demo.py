@@ -76,13 +76,8 @@ def run(args: argparse.Namespace) -> int:
         )
     state = retrokit.State.DEFAULT if args.state is None else args.state
     env = retrokit.make(
-        args.game,
-        state,
-        frameskip=4,
-        sticky_prob=0.25,
-        max_episode_steps=args.max_steps,
-        action_type="all",
-        render_mode="rgb_array",
+        args.game, state, frameskip=4, sticky_prob=0.25, max_episode_steps=args.max_steps,
+        action_type="all", render_mode="rgb_array",
     )
     rng = np.random.default_rng(args.seed)
     agent = RunAndJump(env, rng)

@@ -15,9 +15,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="List the known games with their states (the default one marked *) and "
         "whether each game's ROM is available (bundled with the game, or imported).",
     )
-    parser.add_argument(
-        "pattern", nargs="?", metavar="PATTERN", help="only games whose name matches this glob, or contains this text"
-    )
+    parser.add_argument("pattern", nargs="?", metavar="PATTERN",
+                        help="only games whose name matches this glob, or contains this text")
     parser.add_argument("--imported", action="store_true", help="only games whose ROM is available")
     add_data_dir_option(parser)
     parser.set_defaults(run=run)
@@ -50,8 +49,6 @@ def run(args: argparse.Namespace) -> int:
             continue
         shown += 1
         print(line)
-    print(
-        f"{shown} game{'s' * (shown != 1)} shown; {available} of {len(games)} have their ROM. "
-        "Import ROMs with: retrokit import /path/to/your/roms"
-    )
+    print(f"{shown} game{'s' * (shown != 1)} shown; {available} of {len(games)} have their ROM. "
+          "Import ROMs with: retrokit import /path/to/your/roms")
     return 0

@@ -19,9 +19,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "already imported is never replaced unless --overwrite is given.",
     )
     parser.add_argument("paths", nargs="*", metavar="PATH", help="files, folders or zip files to search")
-    parser.add_argument(
-        "--game", metavar="NAME", help="show the SHA-1s this game expects, and whether its ROM is present"
-    )
+    parser.add_argument("--game", metavar="NAME", help="show the SHA-1s this game expects, and whether its ROM is present")
     parser.add_argument("--overwrite", action="store_true", help="replace a different ROM already imported")
     parser.add_argument("-v", "--verbose", action="store_true", help="list every file that matched nothing")
     add_data_dir_option(parser)
@@ -54,9 +52,7 @@ def run(args: argparse.Namespace) -> int:
     status = 0
     if args.paths:
         report = import_roms(args.paths, data_dir=args.data_dir, overwrite=args.overwrite)
-        print(
-            f"Imported {len(report.imported)} ROM{'s' * (len(report.imported) != 1)} into {report.data_dir / 'roms'}."
-        )
+        print(f"Imported {len(report.imported)} ROM{'s' * (len(report.imported) != 1)} into {report.data_dir / 'roms'}.")
         _section("Imported", [f"{r.game} <- {r.source}" for r in report.imported], True)
         _section("Already imported", [f"{r.game} <- {r.source}" for r in report.already_present], args.verbose)
         _section(
@@ -76,8 +72,6 @@ def run(args: argparse.Namespace) -> int:
         if path is not None:
             print(f"Its ROM is {where}: {path}")
         else:
-            print(
-                f"Its ROM is missing: expected at {game.imported_rom_path(args.data_dir)}. "
-                "Import it with: retrokit import /path/to/your/roms"
-            )
+            print(f"Its ROM is missing: expected at {game.imported_rom_path(args.data_dir)}. "
+                  "Import it with: retrokit import /path/to/your/roms")
     return status

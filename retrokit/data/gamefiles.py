@@ -100,11 +100,8 @@ def _check_keys(source: Path, where: str, mapping: Mapping[str, Any], allowed: t
     for key in mapping:
         if key not in allowed:
             raise data_error(
-                source,
-                f"{where} to have only the keys {', '.join(allowed)}",
-                f"the key {key!r}",
-                "rename or remove it",
-                did_you_mean(str(key), allowed),
+                source, f"{where} to have only the keys {', '.join(allowed)}", f"the key {key!r}",
+                "rename or remove it", did_you_mean(str(key), allowed),
             )
 
 
@@ -178,7 +175,9 @@ def read_game_yaml(path: str | os.PathLike[str]) -> GameInfo:
         if did_you_mean(str(key), _YAML_KEYS):  # a typo of a known key
             _check_keys(source, "the file", doc, _YAML_KEYS)
     roms_list = _expect(source, "'roms'", doc.get("roms", []), list, "a list of {sha1: ..., label: ...}")
-    sha1s = tuple(_sha1(source, "each rom", r.get("sha1") if isinstance(r, Mapping) else r) for r in roms_list)
+    sha1s = tuple(
+        _sha1(source, "each rom", r.get("sha1") if isinstance(r, Mapping) else r) for r in roms_list
+    )
     states = _expect(source, "'states'", doc.get("states") or {}, Mapping, "a mapping with default, list, by_players")
     _check_keys(source, "'states'", states, ("default", "list", "by_players"))
     default = states.get("default")
@@ -211,9 +210,7 @@ def _read_json(path: Path, required: bool) -> dict[str, Any]:
         doc = json.loads(path.read_text(encoding="utf-8"))
     except json.JSONDecodeError as exc:
         raise data_error(
-            path,
-            "valid JSON",
-            f"a syntax error at line {exc.lineno}, column {exc.colno}: {exc.msg}",
+            path, "valid JSON", f"a syntax error at line {exc.lineno}, column {exc.colno}: {exc.msg}",
             "fix the JSON syntax",
         ) from exc
     except (OSError, UnicodeDecodeError) as exc:

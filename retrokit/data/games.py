@@ -160,7 +160,8 @@ class Game:
             )
         raise StateNotFoundError(
             f"Expected a state of {self.name}: one of {', '.join(self.states) or '(none)'}; "
-            f"found no file {key}{STATE_SUFFIX} in {where}." + did_you_mean(key, self._state_files)
+            f"found no file {key}{STATE_SUFFIX} in {where}."
+            + did_you_mean(key, self._state_files)
         )
 
     @property
@@ -272,19 +273,16 @@ class Game:
             missing = [s for s in info.states if s not in self._state_files]
             if missing:
                 raise data_error(
-                    info.source,
-                    f"state files for the listed states {missing}",
+                    info.source, f"state files for the listed states {missing}",
                     f"no such file in {', '.join(map(str, self.folders))}",
                     "add the .state files or remove the names from the list",
                 )
         made_or_makeable = set(self._state_files) | set(self.state_recipes)
         if info.default_state is not None and info.default_state not in made_or_makeable:
             raise data_error(
-                info.source,
-                f"the default state {info.default_state!r} to be one of the game's states",
+                info.source, f"the default state {info.default_state!r} to be one of the game's states",
                 f"{', '.join(self.states) or 'no states'}",
-                "fix the default state's name",
-                did_you_mean(info.default_state, self._state_files),
+                "fix the default state's name", did_you_mean(info.default_state, self._state_files),
             )
         try:
             self.system  # noqa: B018 -- an unknown system fails here, when the game loads

@@ -115,9 +115,7 @@ def _too_big(size: int) -> bool:
     return size > roms.MAX_FILE_SIZE
 
 
-def _zip_candidates(
-    label: str, opener: Callable[[], zipfile.ZipFile], report: ImportReport, depth: int
-) -> Iterator[_Candidate]:
+def _zip_candidates(label: str, opener: Callable[[], zipfile.ZipFile], report: ImportReport, depth: int) -> Iterator[_Candidate]:
     try:
         with opener() as archive:
             for info in sorted(archive.infolist(), key=lambda i: i.filename):

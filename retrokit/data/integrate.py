@@ -77,9 +77,7 @@ def _recipe(game: Game, name: str, spec: Any) -> Recipe:
     for part in ("set", "until"):
         for key in spec.get(part) or {}:
             if key not in game.fields:
-                raise DataFileError(
-                    f"{where}: {part} names no field of the game: {key!r}." + did_you_mean(key, game.fields)
-                )
+                raise DataFileError(f"{where}: {part} names no field of the game: {key!r}." + did_you_mean(key, game.fields))
     if not spec.get("until"):
         raise DataFileError(f"{where}: expected 'until', the field values that mark arrival, such as {{game_mode: 1}}.")
     press = spec.get("press") or {}
@@ -106,9 +104,7 @@ def make_state(game: Game, recipe: Recipe) -> bytes:
         masks = [0] * emu.ports
         for port, buttons in recipe.press.items():
             if not 1 <= port <= emu.ports:
-                raise InvalidArgumentError(
-                    f"Expected ports 1 to {emu.ports} in the recipe of {recipe.name!r}, got {port}."
-                )
+                raise InvalidArgumentError(f"Expected ports 1 to {emu.ports} in the recipe of {recipe.name!r}, got {port}.")
             masks[port - 1] = emu.system.mask(buttons)
         for frame in range(recipe.max_frames):
             for name, value in recipe.set.items():
@@ -166,9 +162,7 @@ def integrate(game: Game, names: list[str] | None = None, *, force: bool = False
     folder = game.folders[0]
     for name in wanted:
         if name not in known:
-            raise StateNotFoundError(
-                f"Expected a state with a recipe ({', '.join(known)}), got {name!r}." + did_you_mean(name, known)
-            )
+            raise StateNotFoundError(f"Expected a state with a recipe ({', '.join(known)}), got {name!r}." + did_you_mean(name, known))
         made = make_state(game, known[name])
         path = folder / f"{name}.state"
         if not path.exists():

@@ -55,17 +55,9 @@ FUNCTIONS = {
 }
 
 _ARITHMETIC = {
-    "+": operator.add,
-    "-": operator.sub,
-    "*": operator.mul,
-    "/": operator.truediv,
-    "//": operator.floordiv,
-    "%": operator.mod,
-    "&": operator.and_,
-    "|": operator.or_,
-    "^": operator.xor,
-    "<<": operator.lshift,
-    ">>": operator.rshift,
+    "+": operator.add, "-": operator.sub, "*": operator.mul, "/": operator.truediv,
+    "//": operator.floordiv, "%": operator.mod, "&": operator.and_, "|": operator.or_,
+    "^": operator.xor, "<<": operator.lshift, ">>": operator.rshift,
 }
 _UNARY = {"-": operator.neg, "+": operator.pos, "~": operator.invert}
 _DIVISIONS = ("/", "//", "%")
@@ -148,20 +140,14 @@ class Checker:
 
     def _check_define_name(self, name: str, where: Snippet) -> None:
         if name in RESERVED:
-            raise where.error(
-                ScenarioCompileError, 0, len(where.text), f"{name!r} is a reserved word; choose another name"
-            )
+            raise where.error(ScenarioCompileError, 0, len(where.text), f"{name!r} is a reserved word; choose another name")
         if name in self._field_set:
             raise where.error(
-                ScenarioCompileError,
-                0,
-                len(where.text),
+                ScenarioCompileError, 0, len(where.text),
                 f"{name!r} is already a field of this game; choose another name for the definition",
             )
         if name in self.spec.tables:
-            raise where.error(
-                ScenarioCompileError, 0, len(where.text), f"{name!r} is already a table; choose another name"
-            )
+            raise where.error(ScenarioCompileError, 0, len(where.text), f"{name!r} is already a table; choose another name")
 
     def _parse(self, snippet: Snippet) -> n.Node:
         root = parse(snippet)
@@ -179,9 +165,7 @@ class Checker:
             self._resolve_lookup(node, sn)
         elif isinstance(node, n.Binary) and node.op in _DIVISIONS and constant(node.right) == 0:
             what = {"/": "division", "//": "floor division", "%": "remainder"}[node.op]
-            raise sn.error(
-                ScenarioCompileError, node.right.start, node.right.end, f"{what} by zero: the divisor is the constant 0"
-            )
+            raise sn.error(ScenarioCompileError, node.right.start, node.right.end, f"{what} by zero: the divisor is the constant 0")
 
     def _resolve_name(self, node: n.Name, sn: Snippet) -> None:
         name = node.id

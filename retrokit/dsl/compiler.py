@@ -46,16 +46,9 @@ class Program:
         self._tables = spec.tables
         namespace = {
             "__builtins__": {},
-            "_abs": abs,
-            "_min": min,
-            "_max": max,
-            "_float": float,
-            "_divzero": self._divzero,
-            "_nokey": self._nokey,
-            "_missing": self._missing,
-            "_fail": self._fail,
-            "_RuntimeError": ScenarioRuntimeError,
-            "_KeyError": KeyError,
+            "_abs": abs, "_min": min, "_max": max, "_float": float,
+            "_divzero": self._divzero, "_nokey": self._nokey, "_missing": self._missing, "_fail": self._fail,
+            "_RuntimeError": ScenarioRuntimeError, "_KeyError": KeyError,
             "_Errors": (ArithmeticError, TypeError, ValueError),
         }
         for name, local in gen.table_names.items():
@@ -74,9 +67,7 @@ class Program:
         node = site.node
         divisor = site.snippet.text[node.op_start + len(node.op) : node.end].strip()  # type: ignore[attr-defined]
         raise site.snippet.error(
-            ScenarioRuntimeError,
-            node.start,
-            node.end,
+            ScenarioRuntimeError, node.start, node.end,
             f"scenario {self.name!r}: division by zero: the divisor {divisor} is 0",
         )
 
@@ -89,9 +80,7 @@ class Program:
         else:
             shown = ", ".join(str(p) for p in parts)
         raise site.snippet.error(
-            ScenarioRuntimeError,
-            site.node.start,
-            site.node.end,
+            ScenarioRuntimeError, site.node.start, site.node.end,
             f"scenario {self.name!r}: table {table.name!r} has no entry for {shown}; "
             f"add one (at {table.origin.where()}) or give the table a default",
         )

@@ -45,13 +45,7 @@ class _Reader:
         self.source = source
 
     def error(self, node: yaml.Node, message: str) -> ScenarioError:
-        return located(
-            ScenarioError,
-            self.source,
-            node.start_mark.index,
-            max(node.end_mark.index, node.start_mark.index + 1),
-            message,
-        )
+        return located(ScenarioError, self.source, node.start_mark.index, max(node.end_mark.index, node.start_mark.index + 1), message)
 
     def compose(self) -> yaml.MappingNode | None:
         try:
@@ -59,16 +53,12 @@ class _Reader:
         except yaml.MarkedYAMLError as exc:
             mark = exc.problem_mark or exc.context_mark
             index = mark.index if mark is not None else 0
-            raise located(
-                ScenarioError, self.source, index, index + 1, f"this is not valid YAML: {exc.problem or exc}"
-            ) from None
+            raise located(ScenarioError, self.source, index, index + 1, f"this is not valid YAML: {exc.problem or exc}") from None
         if root is not None and not isinstance(root, yaml.MappingNode):
             raise self.error(root, "a scenario file holds a mapping (key: value lines) at its top")
         return root
 
-    def mapping(
-        self, node: yaml.Node, what: str, allowed: tuple[str, ...] | None = None
-    ) -> dict[str, tuple[yaml.Node, yaml.Node]]:
+    def mapping(self, node: yaml.Node, what: str, allowed: tuple[str, ...] | None = None) -> dict[str, tuple[yaml.Node, yaml.Node]]:
         """The entries of a mapping node, checking for duplicate and unknown keys."""
         if not isinstance(node, yaml.MappingNode):
             raise self.error(node, f"{what} must be a mapping (key: value lines)")
@@ -81,22 +71,14 @@ class _Reader:
                 line = entries[name][0].start_mark.line + 1
                 raise self.error(key, f"{name!r} is given twice in {what} (first on line {line})")
             if allowed is not None and name not in allowed:
-                raise self.error(
-                    key,
-                    f"unknown key {name!r} in {what}."
-                    + did_you_mean(name, allowed)
-                    + f" Known keys: {', '.join(allowed)}",
-                )
+                raise self.error(key, f"unknown key {name!r} in {what}." + did_you_mean(name, allowed) + f" Known keys: {', '.join(allowed)}")
             entries[name] = (key, value)
         return entries
 
     def snippet(self, node: yaml.Node, role: str) -> Snippet:
         """An expression written as a YAML scalar, mapped character by character into the file."""
         if not isinstance(node, yaml.ScalarNode):
-            raise self.error(
-                node,
-                f"{role} must be an expression (text), not a {'list' if isinstance(node, yaml.SequenceNode) else 'mapping'}",
-            )
+            raise self.error(node, f"{role} must be an expression (text), not a {'list' if isinstance(node, yaml.SequenceNode) else 'mapping'}")
         start, end = node.start_mark.index, node.end_mark.index
         offsets = align(node.value, self.source.text[start:end], start)
         return Snippet(node.value, self.source, role, offsets)
@@ -137,15 +119,11 @@ class _Reader:
             if arity is None:
                 arity = len(parts)
             if len(parts) != arity:
-                raise self.error(
-                    k, f"{what} is keyed by {arity} value{'s' if arity > 1 else ''}, and this key has {len(parts)}"
-                )
+                raise self.error(k, f"{what} is keyed by {arity} value{'s' if arity > 1 else ''}, and this key has {len(parts)}")
             data[parts] = self.number(v, f"the value of {what} at {text}")
         if arity is None:
             raise self.error(key, f"{what} has no values")
-        origin = Snippet(
-            name, self.source, what, tuple(range(key.start_mark.index, key.start_mark.index + len(name) + 1))
-        )
+        origin = Snippet(name, self.source, what, tuple(range(key.start_mark.index, key.start_mark.index + len(name) + 1)))
         return Table(name, data, arity, by, default, origin)
 
     def _key_part(self, node: yaml.Node, part: str) -> Scalar:
@@ -157,9 +135,7 @@ class _Reader:
         try:
             return float(text)
         except ValueError:
-            raise self.error(
-                node, f"a table key is one or more numbers separated by commas, e.g. '0, 1'; got {node.value!r}"
-            ) from None
+            raise self.error(node, f"a table key is one or more numbers separated by commas, e.g. '0, 1'; got {node.value!r}") from None
 
     def name_snippet(self, key: yaml.Node, role: str) -> Snippet:
         start = key.start_mark.index
@@ -192,9 +168,7 @@ class DocumentLoader:
         root = reader.compose()
         if root is None:
             return
-        entries = reader.mapping(
-            root, "an included file" if not top else "a scenario", TOP_KEYS if top else INCLUDE_KEYS
-        )
+        entries = reader.mapping(root, "an included file" if not top else "a scenario", TOP_KEYS if top else INCLUDE_KEYS)
         spec = self.spec
         if "include" in entries:
             for item in self._list(reader, entries["include"][1], "include"):
@@ -218,10 +192,7 @@ class DocumentLoader:
                 spec.defines[def_name] = reader.snippet(node, f"define {def_name!r}")
                 spec.define_names[def_name] = where
         if "reward" in entries and "rewards" in entries:
-            raise reader.error(
-                entries["rewards"][0],
-                "give either 'reward' (one player) or 'rewards' (a list, one per player), not both",
-            )
+            raise reader.error(entries["rewards"][0], "give either 'reward' (one player) or 'rewards' (a list, one per player), not both")
         if "reward" in entries:
             spec.rewards = [reader.snippet(entries["reward"][1], "reward")]
         if "rewards" in entries:
@@ -233,11 +204,7 @@ class DocumentLoader:
             spec.actions = self._actions(reader, entries["actions"][1])
         if "crop" in entries:
             crop = reader.plain(entries["crop"][1])
-            if not (
-                isinstance(crop, list)
-                and len(crop) == 4
-                and all(isinstance(c, int) and not isinstance(c, bool) and c >= 0 for c in crop)
-            ):
+            if not (isinstance(crop, list) and len(crop) == 4 and all(isinstance(c, int) and not isinstance(c, bool) and c >= 0 for c in crop)):
                 raise reader.error(entries["crop"][1], "crop is [x, y, width, height], four whole numbers of pixels")
             spec.crop = (crop[0], crop[1], crop[2], crop[3])
 
@@ -257,15 +224,11 @@ class DocumentLoader:
     def _actions(reader: _Reader, node: yaml.Node) -> list:
         actions = reader.plain(node)
         ok = isinstance(actions, list) and all(
-            isinstance(group, list)
-            and all(isinstance(combo, list) and all(isinstance(b, str) for b in combo) for combo in group)
+            isinstance(group, list) and all(isinstance(combo, list) and all(isinstance(b, str) for b in combo) for combo in group)
             for group in actions
         )
         if not ok:
-            raise reader.error(
-                node,
-                "actions is a list of groups, each a list of button combinations: [[[], [LEFT], [RIGHT]], [[], [B]]]",
-            )
+            raise reader.error(node, "actions is a list of groups, each a list of button combinations: [[[], [LEFT], [RIGHT]], [[], [B]]]")
         return actions
 
 
@@ -279,9 +242,7 @@ def load_document(path: str | os.PathLike[str], *, name: str | None = None) -> S
     return loader.spec
 
 
-def document_from_dict(
-    data: dict, *, name: str | None = None, game_dir: str | os.PathLike[str] | None = None
-) -> ScenarioSpec:
+def document_from_dict(data: dict, *, name: str | None = None, game_dir: str | os.PathLike[str] | None = None) -> ScenarioSpec:
     """Build a spec from an already-parsed scenario dict.
 
     The dict is written back as YAML and read like a file named

@@ -99,7 +99,7 @@ class Graph:
             path.append(item)
             for dep in sorted(deps(self.expression(item), FIRST, self.a), key=repr):
                 if state.get(dep) == 1:
-                    self._cycle_error(path[path.index(dep) :] + [dep])
+                    self._cycle_error(path[path.index(dep):] + [dep])
                 if dep not in state:
                     visit(dep)
             path.pop()
@@ -153,9 +153,7 @@ class Graph:
         node = self._reference(self.expression(first), target) or self.expression(first)
         name = self._label(first)
         raise snippet.error(
-            ScenarioCompileError,
-            node.start,
-            node.end,
+            ScenarioCompileError, node.start, node.end,
             f"{name!r} depends on itself: {chain}. A definition can use its own earlier value "
             f"only through prev(name, value_at_reset), e.g. prev({name}, 0)",
         )
@@ -163,6 +161,7 @@ class Graph:
     def _reference(self, root: n.Node, target: Item) -> n.Node | None:
         """The smallest name or call under ``root`` that reads ``target`` now."""
         found = [
-            node for node in n.walk(root) if isinstance(node, (n.Name, n.Call)) and target in deps(node, FIRST, self.a)
+            node for node in n.walk(root)
+            if isinstance(node, (n.Name, n.Call)) and target in deps(node, FIRST, self.a)
         ]
         return min(found, key=lambda node: node.end - node.start, default=None)

@@ -118,10 +118,7 @@ class _Converter:
             raise self.error(path, "expected an object ({...})")
         for key in obj:
             if key not in allowed:
-                raise self.error(
-                    [*path, key],
-                    f"unknown key {key!r}." + did_you_mean(key, allowed) + f" Known keys: {', '.join(allowed)}",
-                )
+                raise self.error([*path, key], f"unknown key {key!r}." + did_you_mean(key, allowed) + f" Known keys: {', '.join(allowed)}")
         if "script" in obj:
             raise self.error(
                 [*path, "script"],
@@ -133,10 +130,7 @@ class _Converter:
     def convert(self) -> dict:
         data = self.check_keys(self.data, TOP_KEYS, [])
         if "scripts" in data:
-            raise self.error(
-                ["scripts"],
-                "Lua scripts cannot be converted; write the scenario in retrokit's language (docs/scenarios.md)",
-            )
+            raise self.error(["scripts"], "Lua scripts cannot be converted; write the scenario in retrokit's language (docs/scenarios.md)")
         if "crops" in data:
             raise self.error(["crops"], "per-player crops are not supported; give one 'crop'")
         players = [dict(self.check_keys(data["reward"], REWARD_KEYS, ["reward"]))] if "reward" in data else [{}]
@@ -145,11 +139,7 @@ class _Converter:
             reward = self.check_keys(reward, REWARD_KEYS, ["rewards", str(i)])
             if i == 0:  # Gym Retro adds rewards[0] to reward: variables already set win, time is replaced
                 variables = {**reward.get("variables", {}), **players[0].get("variables", {})}
-                players[0] = {
-                    **players[0],
-                    **({"time": reward["time"]} if "time" in reward else {}),
-                    "variables": variables,
-                }
+                players[0] = {**players[0], **({"time": reward["time"]} if "time" in reward else {}), "variables": variables}
                 paths[0] = ["reward"] if "reward" in data else ["rewards", "0"]
             else:
                 players.append(dict(reward))
@@ -171,20 +161,13 @@ class _Converter:
         """The DSL text of a variable's measure, its op, and its reference."""
         spec = self.check_keys(spec, VARIABLE_KEYS, path)
         if self.fields is not None and name not in self.fields:
-            raise self.error(
-                path,
-                f"unknown variable {name!r}: the game has no such field." + did_you_mean(name, self.fields),
-                ScenarioCompileError,
-            )
+            raise self.error(path, f"unknown variable {name!r}: the game has no such field." + did_you_mean(name, self.fields), ScenarioCompileError)
         measurement = spec.get("measurement", default)
         if measurement not in MEASUREMENTS:
             raise self.error([*path, "measurement"], f"unknown measurement {measurement!r}; use 'absolute' or 'delta'")
         op = spec.get("op", "")
         if op not in OPS:
-            raise self.error(
-                [*path, "op"],
-                f"unknown op {op!r}." + did_you_mean(str(op), OPS[1:]) + f" Known ops: {', '.join(OPS[1:])}",
-            )
+            raise self.error([*path, "op"], f"unknown op {op!r}." + did_you_mean(str(op), OPS[1:]) + f" Known ops: {', '.join(OPS[1:])}")
         ref = name if _IDENTIFIER.fullmatch(name) and name not in RESERVED else f"`{name}`"
         return (f"delta({ref})" if measurement == "delta" else ref), op, _int(spec.get("reference", 0))
 

@@ -23,32 +23,13 @@ _GRAMMAR = Path(__file__).with_name("grammar.lark")
 
 #: How lark's terminal names read in a message.
 _TERMINALS = {
-    "LPAR": "'('",
-    "RPAR": "')'",
-    "LSQB": "'['",
-    "RSQB": "']'",
-    "COMMA": "','",
-    "NAME": "a name",
-    "QUOTED_NAME": "a name",
-    "INT": "a number",
-    "HEX": "a number",
-    "FLOAT": "a number",
-    "TRUE": "'true'",
-    "FALSE": "'false'",
-    "NOT": "'not'",
-    "IF": "'if'",
-    "ELSE": "'else'",
-    "AND": "'and'",
-    "OR": "'or'",
-    "COMP_OP": "a comparison",
-    "ADD_OP": "'+' or '-'",
-    "MUL_OP": "'*', '/', '//' or '%'",
-    "UNARY_OP": "'-'",
-    "SHIFT_OP": "'<<' or '>>'",
-    "BIT_OR": "'|'",
-    "BIT_XOR": "'^'",
-    "BIT_AND": "'&'",
-    "$END": "the end of the expression",
+    "LPAR": "'('", "RPAR": "')'", "LSQB": "'['", "RSQB": "']'", "COMMA": "','",
+    "NAME": "a name", "QUOTED_NAME": "a name", "INT": "a number", "HEX": "a number",
+    "FLOAT": "a number", "TRUE": "'true'", "FALSE": "'false'", "NOT": "'not'",
+    "IF": "'if'", "ELSE": "'else'", "AND": "'and'", "OR": "'or'",
+    "COMP_OP": "a comparison", "ADD_OP": "'+' or '-'", "MUL_OP": "'*', '/', '//' or '%'",
+    "UNARY_OP": "'-'", "SHIFT_OP": "'<<' or '>>'", "BIT_OR": "'|'", "BIT_XOR": "'^'",
+    "BIT_AND": "'&'", "$END": "the end of the expression",
 }
 
 #: Terminals summed up as "an operator" in messages.
@@ -88,9 +69,7 @@ class ToAst(Transformer):
         text = _literal(children[0])
         if len(text) > 1 and text[0] == "0" and text[1] not in "xX":
             raise self._snippet.error(
-                ScenarioSyntaxError,
-                meta.start_pos,
-                meta.end_pos,
+                ScenarioSyntaxError, meta.start_pos, meta.end_pos,
                 f"the number {text} has a leading zero; write {int(text)} (decimal) or 0x{text.lstrip('0') or '0'} (hex)",
             )
         return n.Number(start=meta.start_pos, end=meta.end_pos, value=int(text, 0))
@@ -126,16 +105,12 @@ class ToAst(Transformer):
 
     def binary(self, meta, children):
         left, op, right = children
-        return n.Binary(
-            start=meta.start_pos, end=meta.end_pos, op=str(op), op_start=op.start_pos, left=left, right=right
-        )
+        return n.Binary(start=meta.start_pos, end=meta.end_pos, op=str(op), op_start=op.start_pos, left=left, right=right)
 
     def compare(self, meta, children):
         return n.Compare(
-            start=meta.start_pos,
-            end=meta.end_pos,
-            ops=tuple(str(op) for op in children[1::2]),
-            operands=tuple(children[0::2]),
+            start=meta.start_pos, end=meta.end_pos,
+            ops=tuple(str(op) for op in children[1::2]), operands=tuple(children[0::2]),
         )
 
     def and_(self, meta, children):

@@ -147,7 +147,5 @@ def load_scenario(
     elif suffix in (".yaml", ".yml"):
         spec = load_document(path, name=name)
     else:
-        raise ScenarioError(
-            f"{str(path)!r}: a scenario is a .yaml file (retrokit) or a .json file (Gym Retro); got {suffix or 'no suffix'!r}"
-        )
+        raise ScenarioError(f"{str(path)!r}: a scenario is a .yaml file (retrokit) or a .json file (Gym Retro); got {suffix or 'no suffix'!r}")
     return Scenario(spec, fields)

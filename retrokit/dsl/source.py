@@ -134,3 +134,4 @@ def located(cls: type[RetrokitError], source: SourceText, start: int, end: int, 
     line, col = source.line_col(start)
     err.file, err.line, err.column = source.name, line, col  # type: ignore[attr-defined]
     return err
+

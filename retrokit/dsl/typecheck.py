@@ -53,18 +53,14 @@ class TypeChecker:
         for root, snippet in zip(a.rewards, a.spec.rewards):
             if self.type_of(root, snippet) == BOOL:
                 raise snippet.error(
-                    ScenarioCompileError,
-                    root.start,
-                    root.end,
+                    ScenarioCompileError, root.start, root.end,
                     f"a reward must be a number, and this is a condition (boolean); {_COUNT_HINT}",
                 )
         if a.done is not None:
             assert a.spec.done is not None
             if self.type_of(a.done, a.spec.done) != BOOL:
                 raise a.spec.done.error(
-                    ScenarioCompileError,
-                    a.done.start,
-                    a.done.end,
+                    ScenarioCompileError, a.done.start, a.done.end,
                     f"done must be a condition (boolean), and this is a number; {_TEST_HINT}",
                 )
         a.types = dict(self.types)
@@ -185,9 +181,7 @@ class TypeChecker:
         kind = self.type_of(node, sn)
         if kind not in NUMBERS:
             raise sn.error(
-                ScenarioCompileError,
-                node.start,
-                node.end,
+                ScenarioCompileError, node.start, node.end,
                 f"a condition (boolean) is used where a number is needed, by {what}; {_COUNT_HINT}",
             )
         return kind
@@ -196,9 +190,7 @@ class TypeChecker:
         """Check ``node`` is a condition."""
         if self.type_of(node, sn) != BOOL:
             raise sn.error(
-                ScenarioCompileError,
-                node.start,
-                node.end,
+                ScenarioCompileError, node.start, node.end,
                 f"a number is used where a condition (boolean) is needed, by {what}; {_TEST_HINT}",
             )
 
@@ -207,8 +199,6 @@ class TypeChecker:
         """Check a number is an integer (for bit operations)."""
         if kind != INT:
             raise sn.error(
-                ScenarioCompileError,
-                node.start,
-                node.end,
+                ScenarioCompileError, node.start, node.end,
                 f"{what} needs integers, and this is a decimal number (made by '/' or a decimal literal)",
             )

@@ -48,8 +48,7 @@ class ActionMap:
     ) -> None:
         if action_type not in ACTION_TYPES:
             raise InvalidArgumentError(
-                f"Expected an action type in {ACTION_TYPES}, got {action_type!r}."
-                + did_you_mean(str(action_type), ACTION_TYPES)
+                f"Expected an action type in {ACTION_TYPES}, got {action_type!r}." + did_you_mean(str(action_type), ACTION_TYPES)
             )
         self.system, self.action_type, self.players = system, action_type, players
         groups = system.actions if groups is None else groups

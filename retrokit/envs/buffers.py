@@ -123,9 +123,7 @@ class StepArrays(Tracked):
         self.flags = (memoryview(self.rewards), memoryview(self.terminations), memoryview(self.truncations))
         self._all_masks = memoryview(self.masks).cast("B")
         self._ones = b"\x01" * self.masks.size
-        super().__init__(
-            [self.rewards, self.terminations, self.truncations, self.fields, self.masks, *columns, *mask_rows]
-        )
+        super().__init__([self.rewards, self.terminations, self.truncations, self.fields, self.masks, *columns, *mask_rows])
 
     def refill_masks(self) -> None:
         """Set every mask back to True, in case a caller changed one before letting go."""

@@ -68,8 +68,7 @@ class RetroParallelEnv(ParallelEnv):
     def _check_agent(self, agent: str) -> None:
         if agent not in self.possible_agents:
             raise UnknownNameError(
-                f"Expected an agent of {self.possible_agents}, got {agent!r}."
-                + did_you_mean(agent, self.possible_agents)
+                f"Expected an agent of {self.possible_agents}, got {agent!r}." + did_you_mean(agent, self.possible_agents)
             )
 
     def reset(self, seed: int | None = None, options: dict | None = None) -> tuple[dict, dict]:

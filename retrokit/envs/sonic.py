@@ -26,19 +26,9 @@ GAMES = ("SonicTheHedgehog-Genesis", "SonicTheHedgehog2-Genesis", "SonicAndKnuck
 
 #: The paper's test levels; every other state of the three games is a training level.
 TEST_LEVELS = {
-    "SonicTheHedgehog-Genesis": (
-        "SpringYardZone.Act1",
-        "GreenHillZone.Act2",
-        "StarLightZone.Act3",
-        "ScrapBrainZone.Act1",
-    ),
+    "SonicTheHedgehog-Genesis": ("SpringYardZone.Act1", "GreenHillZone.Act2", "StarLightZone.Act3", "ScrapBrainZone.Act1"),
     "SonicTheHedgehog2-Genesis": ("MetropolisZone.Act3", "HillTopZone.Act2", "CasinoNightZone.Act2"),
-    "SonicAndKnuckles3-Genesis": (
-        "LavaReefZone.Act1",
-        "FlyingBatteryZone.Act2",
-        "HydrocityZone.Act1",
-        "AngelIslandZone.Act2",
-    ),
+    "SonicAndKnuckles3-Genesis": ("LavaReefZone.Act1", "FlyingBatteryZone.Act2", "HydrocityZone.Act1", "AngelIslandZone.Act2"),
 }
 
 #: The baselines' 7 button combinations.
@@ -134,14 +124,10 @@ def make(
         RomNotFoundError: The game's ROM has not been imported; the message says how.
     """
     if game not in GAMES:
-        raise InvalidArgumentError(
-            f"Expected one of the benchmark's games {GAMES}, got {game!r}." + did_you_mean(game, GAMES)
-        )
+        raise InvalidArgumentError(f"Expected one of the benchmark's games {GAMES}, got {game!r}." + did_you_mean(game, GAMES))
     states = find_game(game).states
     if state not in states:
-        raise StateNotFoundError(
-            f"Expected a level of {game} ({', '.join(sorted(states))}), got {state!r}." + did_you_mean(state, states)
-        )
+        raise StateNotFoundError(f"Expected a level of {game} ({', '.join(sorted(states))}), got {state!r}." + did_you_mean(state, states))
     settings = {
         "frameskip": FRAMESKIP,
         "sticky_prob": STICKY_PROB,

@@ -107,11 +107,7 @@ class ThreadedVectorEnv(VectorEnv):
         return [done[i] if i in done else futures[i].result() for i in range(self.num_envs)]
 
     def reset(self, *, seed: int | Sequence[int | None] | None = None, options: dict[str, Any] | None = None):
-        seeds = (
-            [None if seed is None else seed + i for i in range(self.num_envs)]
-            if not isinstance(seed, Sequence)
-            else list(seed)
-        )
+        seeds = [None if seed is None else seed + i for i in range(self.num_envs)] if not isinstance(seed, Sequence) else list(seed)
         if len(seeds) != self.num_envs:
             raise InvalidArgumentError(f"Expected {self.num_envs} seeds, got {len(seeds)}.")
         results = self._each(lambda i: self.envs[i].reset(seed=seeds[i], options=options))

@@ -30,9 +30,7 @@ class Viewer:
         try:
             pygame.display.init()
         except pygame.error as exc:
-            raise EnvError(
-                f"Expected a display for render_mode='human', found none ({exc}). Use render_mode='rgb_array'."
-            ) from None
+            raise EnvError(f"Expected a display for render_mode='human', found none ({exc}). Use render_mode='rgb_array'.") from None
         self.title, self.fps, self.scale = title, fps, scale
         self._screen = None
         self._clock = pygame.time.Clock()

@@ -73,9 +73,7 @@ class System:
     def mask(self, buttons: Iterable[str]) -> int:
         """Return the RetroPad bit mask that presses the named buttons."""
         if isinstance(buttons, str):
-            raise InvalidArgumentError(
-                f"Expected a list of button names, got the string {buttons!r}; write [{buttons!r}]."
-            )
+            raise InvalidArgumentError(f"Expected a list of button names, got the string {buttons!r}; write [{buttons!r}].")
         value = 0
         for name in buttons:
             value |= 1 << self.button_bit(name)

@@ -104,7 +104,9 @@ class FieldType:
 
         low, high = self.value_range()
         if not low <= value <= high:
-            raise InvalidArgumentError(f"Expected a value from {low} to {high} for type {self.code!r}, got {value}.")
+            raise InvalidArgumentError(
+                f"Expected a value from {low} to {high} for type {self.code!r}, got {value}."
+            )
         out = bytearray(self.width)
         rest = value % (1 << (8 * self.width)) if self.kind == SIGNED else value
         for index in self.significance():

@@ -165,9 +165,7 @@ def _parse_key_line(where: str, numbered: tuple[int, str], lay: Layout) -> list[
             raise MovieError(f"{where} line {number}: expected each button once per player; found {entry!r} twice.")
         groups.setdefault(player, []).append(by_name[name])
     if not groups:
-        raise MovieError(
-            f"{where} line {number}: expected a key line naming the buttons (e.g. 'P1 B|'); found {line!r}."
-        )
+        raise MovieError(f"{where} line {number}: expected a key line naming the buttons (e.g. 'P1 B|'); found {line!r}.")
     return list(groups.values())
 
 

@@ -15,22 +15,11 @@ from retrokit.host.systems import get_system
 
 #: retrokit button name -> (the frame letter, the key-line name), as stable-retro writes them.
 LETTERS: dict[str, tuple[str, str]] = {
-    "A": ("A", "A"),
-    "B": ("B", "B"),
-    "C": ("C", "C"),
-    "X": ("X", "X"),
-    "Y": ("Y", "Y"),
-    "Z": ("Z", "Z"),
-    "START": ("S", "Start"),
-    "SELECT": ("s", "Select"),
-    "MODE": ("M", "Mode"),
-    "UP": ("U", "Up"),
-    "DOWN": ("D", "Down"),
-    "LEFT": ("L", "Left"),
-    "RIGHT": ("R", "Right"),
-    "L": ("l", "L"),
-    "R": ("r", "R"),
-    "BUTTON": ("B", "Button"),
+    "A": ("A", "A"), "B": ("B", "B"), "C": ("C", "C"),
+    "X": ("X", "X"), "Y": ("Y", "Y"), "Z": ("Z", "Z"),
+    "START": ("S", "Start"), "SELECT": ("s", "Select"), "MODE": ("M", "Mode"),
+    "UP": ("U", "Up"), "DOWN": ("D", "Down"), "LEFT": ("L", "Left"), "RIGHT": ("R", "Right"),
+    "L": ("l", "L"), "R": ("r", "R"), "BUTTON": ("B", "Button"),
 }
 
 #: retrokit system name -> the Platform header value, where the two differ.
@@ -38,12 +27,7 @@ PLATFORMS = {"Genesis": "GEN", "Snes": "SNES", "Nes": "NES", "Atari2600": "A26"}
 
 #: The header lines stable-retro writes besides Platform and GameName, in its order.
 DEFAULT_HEADER = {
-    "MovieVersion": "Retro",
-    "Author": "?",
-    "emuVersion": "?",
-    "SHA1": "?",
-    "Core": "?",
-    "rerecordCount": "1",
+    "MovieVersion": "Retro", "Author": "?", "emuVersion": "?", "SHA1": "?", "Core": "?", "rerecordCount": "1",
 }
 
 

@@ -245,3 +245,23 @@ def test_human_rendering_draws_into_a_window(monkeypatch: pytest.MonkeyPatch) ->
     shown = pygame.surfarray.array3d(surface).swapaxes(0, 1)[::2, ::2]
     assert (shown == obs).all()
     env.close()
+
+
+@pytest.mark.parametrize(
+    ("crop", "shape"),
+    [
+        ([8, 16, 100, 50], (50, 100, 3)),
+        ([8, 16, 0, 0], (224 - 16, 320 - 8, 3)),  # 0 reaches the screen's edge, as in Gym Retro
+        ([300, 200, 100, 100], (24, 20, 3)),  # clipped at the edge
+    ],
+    ids=["inside", "zero-to-the-edge", "clipped"],
+)
+def test_scenario_crop_shapes_the_observation(crop: list[int], shape: tuple[int, int, int]) -> None:
+    env = retrokit.make(AIRSTRIKER, scenario={"reward": "score", "crop": crop}, render_mode="rgb_array")
+    x, y = crop[0], crop[1]
+    obs, _ = env.reset(seed=0)
+    for _ in range(30):
+        assert obs.shape == shape == env.observation_space.shape
+        assert (obs == env.render()[y : y + shape[0], x : x + shape[1]]).all()
+        obs = env.step(env.action_space.sample())[0]
+    env.close()

@@ -1,10 +1,14 @@
-"""``retrokit games [--imported] [PATTERN]``: the known games, their states, and their ROMs."""
+"""``retrokit games [--imported] [PATTERN]``: the known games, their ROMs, scenarios and states."""
 
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from retrokit.commands._common import add_data_dir_option, rom_status
+
+if TYPE_CHECKING:
+    from retrokit.data.games import Game
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -12,8 +16,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser = subparsers.add_parser(
         "games",
         help="list the known games, their states, and whether their ROM is available",
-        description="List the known games with their states (the default one marked *) and "
-        "whether each game's ROM is available (bundled with the game, or imported).",
+        description="List the known games with their states (the default one marked *), "
+        "whether each game's ROM is available (bundled with the game, or imported), and whether "
+        "each of its scenarios compiles ('ok', 'none', or 'refused:' and the names of those that do not).",
     )
     parser.add_argument("pattern", nargs="?", metavar="PATTERN",
                         help="only games whose name matches this glob, or contains this text")
@@ -36,19 +41,42 @@ def run(args: argparse.Namespace) -> int:
             + did_you_mean(args.pattern, names)
         )
     width = max(len(g.name) for g in games)
-    shown = available = 0
+    shown = available = refused = 0
     for game in games:
         try:
             status, _ = rom_status(game, args.data_dir)
-            states = ", ".join(s + ("*" if s == game.default_state else "") for s in game.states)
-            line = f"{game.name:<{width}}  ROM {status:<8}  states: {states or '(none)'}"
         except RetrokitError as exc:
             status, line = "broken", f"{game.name:<{width}}  (cannot be read: {exc})"
         available += status in ("bundled", "imported")
         if args.imported and status not in ("bundled", "imported"):
             continue
+        if status != "broken":
+            try:
+                states = ", ".join(s + ("*" if s == game.default_state else "") for s in game.states)
+                broken = scenarios_refused(game)
+                scenarios = "refused: " + ", ".join(broken) if broken else "ok" if game.scenarios else "none"
+                line = f"{game.name:<{width}}  ROM {status:<8}  scenarios {scenarios}  states: {states or '(none)'}"
+                refused += bool(broken)
+            except RetrokitError as exc:
+                line = f"{game.name:<{width}}  (cannot be read: {exc})"
         shown += 1
         print(line)
-    print(f"{shown} game{'s' * (shown != 1)} shown; {available} of {len(games)} have their ROM. "
-          "Import ROMs with: retrokit import /path/to/your/roms")
+    print(f"{shown} game{'s' * (shown != 1)} shown; {available} of {len(games)} have their ROM"
+          + (f"; {refused} shown {'has' if refused == 1 else 'have'} a scenario that does not compile" if refused else "")
+          + ". Import ROMs with: retrokit import /path/to/your/roms")
     return 0
+
+
+def scenarios_refused(game: Game) -> list[str]:
+    """The names of the game's scenarios that do not load and compile (empty if all do, or it has none)."""
+    from retrokit.dsl.scenario import load_scenario
+    from retrokit.errors import RetrokitError
+
+    fields = list(game.fields)
+    refused = []
+    for name, path in game.scenarios.items():
+        try:
+            load_scenario(path, fields)
+        except RetrokitError:
+            refused.append(name)
+    return refused

@@ -8,7 +8,10 @@ data file (``game.yaml``, or Gym Retro's ``data.json``, ``metadata.json`` and
 
 When several search folders hold a game of the same name, the first one's data
 file wins and the others add their states and scenarios: so a ``games/`` folder
-can use the states of the wheel's folder of the same game.
+can use the states of the wheel's folder of the same game. A folder holding
+only scenario files (no data file) adds its scenarios to a game found in a
+later folder: ``games/1942-Nes/scenario.yaml`` replaces the wheel's Lua
+``scenario.json`` while the wheel's data, ROM hashes and states stay in use.
 
 :func:`list_games` only lists folders; a :class:`Game` reads its files the
 first time one of its properties is used. :func:`find_game` reads and checks
@@ -78,8 +81,8 @@ class Game:
 
     @cached_property
     def info(self) -> GameInfo:
-        """The game's data file, parsed (read on first use)."""
-        return read_game_folder(self.folders[0])
+        """The game's data file, parsed (read on first use): the first folder's that has one."""
+        return read_game_folder(next((f for f in self.folders if _is_game_folder(f)), self.folders[0]))
 
     @property
     def system(self) -> System:
@@ -300,6 +303,11 @@ def _is_game_folder(path: Path) -> bool:
     return any((path / marker).is_file() for marker in ("game.yaml", "rom.sha", "data.json"))
 
 
+def _is_scenario_folder(path: Path) -> bool:
+    """Whether a folder without a data file holds scenario files (to add to a game found elsewhere)."""
+    return any(p.name not in _NOT_SCENARIOS for pattern in ("*.yaml", "*.json") for p in path.glob(pattern))
+
+
 def _index() -> dict[str, tuple[Path, ...]]:
     """Map each game name to its folders, in search order (cached until a search folder changes)."""
     dirs = paths.game_search_dirs()
@@ -307,15 +315,20 @@ def _index() -> dict[str, tuple[Path, ...]]:
     if key in _index_cache:
         return _index_cache[key]
     index: dict[str, list[Path]] = {}
+    has_data: set[str] = set()
     for directory in dirs:
         with os.scandir(directory) as entries:
             for entry in sorted(entries, key=lambda e: e.name):
                 if entry.name[:1] in "._" or not entry.is_dir():
                     continue
-                path = Path(entry.path)
+                path, name = Path(entry.path), normalize_name(entry.name)
                 if _is_game_folder(path):
-                    index.setdefault(normalize_name(entry.name), []).append(path)
-    result = {name: tuple(folders) for name, folders in sorted(index.items())}
+                    has_data.add(name)
+                elif not _is_scenario_folder(path):
+                    continue
+                index.setdefault(name, []).append(path)
+    # A name with scenario folders only is no game: nothing says its system, ROM or fields.
+    result = {name: tuple(folders) for name, folders in sorted(index.items()) if name in has_data}
     _index_cache.clear()
     _index_cache[key] = result
     return result

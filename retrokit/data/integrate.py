@@ -155,7 +155,7 @@ def integrate(game: Game, names: list[str] | None = None, *, force: bool = False
     if not known:
         raise StateNotFoundError(
             f"Expected state recipes under 'integrate' in {game.info.source}; found none. "
-            f"Add one per state (see retrokit/integrate.py)."
+            f"Add one per state (see retrokit/data/integrate.py)."
         )
     wanted = list(known) if names is None else names
     outcomes = []

@@ -26,7 +26,7 @@ import yaml
 
 from retrokit.dsl.check import constant
 from retrokit.dsl.parser import parse
-from retrokit.dsl.source import Snippet, SourceText, align, located
+from retrokit.dsl.source import Snippet, SourceText, align, located, read_source
 from retrokit.dsl.spec import Scalar, ScenarioSpec, Table
 from retrokit.errors import ScenarioError, did_you_mean
 
@@ -156,10 +156,7 @@ class DocumentLoader:
         if resolved in self._seen:
             raise ScenarioError(f"{path}: included more than once (includes must not loop)")
         self._seen.append(resolved)
-        try:
-            text = path.read_text()
-        except OSError as exc:
-            raise ScenarioError(f"cannot read scenario file {str(path)!r}: {exc.strerror or exc}") from None
+        text = read_source(path)
         self.load_text(text, str(path), path.parent, top=top)
 
     def load_text(self, text: str, name: str, base: Path | None, *, top: bool = True) -> None:

@@ -15,8 +15,9 @@ Gym Retro's rules (its ``src/data.cpp``), which the conversion keeps:
   nested ``nodes``; an empty ``all`` is always true, an empty ``any`` never.
 - ``rewards`` is a list of per-player rewards; ``reward`` also fills player 1.
 
-Lua ``script`` rewards cannot be converted; the Sonic contest scripts are
-rewritten by hand in ``games/*/contest.yaml``.
+Lua ``script`` rewards cannot be converted; every Lua scenario of the
+stable-retro wheel is rewritten by hand in ``games/<Game>/`` under its own
+name (``docs/scenarios.md``).
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ import yaml
 
 from retrokit.dsl.check import RESERVED
 from retrokit.dsl.document import document_from_dict
-from retrokit.dsl.source import SourceText, located
+from retrokit.dsl.source import SourceText, located, read_source
 from retrokit.dsl.spec import ScenarioSpec
 from retrokit.errors import ScenarioCompileError, ScenarioError, did_you_mean
 
@@ -123,7 +124,7 @@ class _Converter:
             raise self.error(
                 [*path, "script"],
                 "Lua scripts cannot be converted; write the reward and done in retrokit's language "
-                "(docs/scenarios.md; the Sonic contest scripts are in games/*/contest.yaml)",
+                "(docs/scenarios.md; the wheel's Lua scenarios are rewritten in games/<Game>/)",
             )
         return obj
 
@@ -220,10 +221,7 @@ def _find_key(text: str, path: Sequence[str]) -> int:
 
 
 def _read_json(path: Path) -> tuple[dict, SourceText]:
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise ScenarioError(f"cannot read scenario file {str(path)!r}: {exc.strerror or exc}") from None
+    text = read_source(path)
     source = SourceText(str(path), text)
     try:
         data = json.loads(text)

@@ -14,8 +14,26 @@ from __future__ import annotations
 
 import bisect
 from dataclasses import dataclass, field
+from pathlib import Path
 
-from retrokit.errors import RetrokitError
+from retrokit.errors import RetrokitError, ScenarioError
+
+
+def read_source(path: Path) -> str:
+    """Return a scenario file's text.
+
+    Raises:
+        ScenarioError: The file cannot be read, or is not UTF-8 text.
+    """
+    try:
+        return path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ScenarioError(f"cannot read scenario file {str(path)!r}: {exc.strerror or exc}") from None
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(
+            f"{path}: expected a UTF-8 text file; found a byte that is not UTF-8 at offset {exc.start}. "
+            "Save the scenario as UTF-8 text."
+        ) from None
 
 
 @dataclass(frozen=True)

@@ -191,7 +191,8 @@ class RetroEnv(gymnasium.Env):
         height, width = self._screen_shape
         if self._crop is not None:
             x, y, w, h = self._crop
-            width, height = min(w, width - x), min(h, height - y)
+            # A width or height of 0 reaches the screen's edge, as in Gym Retro's data files.
+            width, height = min(w or width - x, width - x), min(h or height - y, height - y)
         return spaces.Box(0, 255, (height, width, 3), np.uint8)
 
     def _start(self) -> None:

@@ -247,16 +247,28 @@ def test_the_default_session_name_lives_in_the_current_folder(tmp_path):
     assert done.returncode == 2 and done.stderr.count("\n") == 1 and "Traceback" not in done.stderr
 
 
-def test_a_session_claiming_a_huge_ram_is_refused_before_allocating(session, capsys):
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"regions": ((0, 1 << 31),)}, "expected at most 134,217,728 candidates"),
+        ({"types": ("|u1", "|x1")}, "expected the searched type codes"),
+        ({"emulator_state": b"not a core state"}, "the core refused it"),
+        ({"rom_sha1": "0" * 40}, "belongs to another ROM"),
+        ({"regions": ((0xFF0000, 0x8000), (0, 0x8000))}, "expected RAM regions 0xFF0000-0xFFFFFF"),
+        ({"game": "Airstriker-Genesis"}, "belongs to another ROM"),
+    ],
+    ids=["huge-ram", "unknown-type", "bad-emulator-state", "other-rom", "other-regions", "other-game"],
+)
+def test_sessions_that_do_not_fit_are_refused_in_one_line(session, capsys, change, message):
     from dataclasses import replace
 
     from retrokit.ramsearch.session import encode_session, read_session
 
     data = read_session(session)
-    huge = session.with_name("huge.session")
-    huge.write_bytes(encode_session(replace(data, regions=((0, 1 << 31),))))
-    status, _, err = run(capsys, "show", "--session", str(huge))
-    assert status == 2 and "expected at most 134,217,728 candidates" in err
+    bad = session.with_name("bad.session")
+    bad.write_bytes(encode_session(replace(data, **change)))
+    status, _, err = run(capsys, "show", "--session", str(bad))
+    assert status == 2 and message in err and err.count("\n") == 1, err
 
 
 def test_run_plays_a_movie_up_to_a_frame(session, capsys):

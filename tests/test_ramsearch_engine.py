@@ -205,6 +205,8 @@ def test_undo_and_redo_round_trip():
         (("changed-by",), InvalidArgumentError, "difference"),
         (("equal", None, "frist"), InvalidArgumentError, "Did you mean 'first'"),
         (("equal", None, 0x10), InvalidArgumentError, "address in RAM"),
+        (("equal", 2.5), InvalidArgumentError, "whole number"),
+        (("equal", True), InvalidArgumentError, "whole number"),
     ],
     ids=[
         "decreased-first",
@@ -216,6 +218,8 @@ def test_undo_and_redo_round_trip():
         "changed-by-nothing",
         "than-typo",
         "than-outside-ram",
+        "float",
+        "bool",
     ],
 )
 def test_bad_filters(args, error, message):

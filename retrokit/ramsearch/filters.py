@@ -59,12 +59,21 @@ class Filter:
         return " ".join(words)
 
 
+def _is_int(value: object) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+
+
 def check_filter(op: str, value: int | None = None, than: str | int | None = None) -> Filter:
     """Check a filter's parts fit together and fill in the default reference.
 
     Raises:
         InvalidArgumentError: Unknown operation or reference, or a missing or extra number.
     """
+    for what, number in (("number", value), ("address", than)):
+        if number is not None and not isinstance(number, str) and not _is_int(number):
+            raise InvalidArgumentError(f"Expected a whole number as the filter's {what}, got {number!r}.")
+    value = None if value is None else int(value)  # numpy integers become plain ones
+    than = int(than) if _is_int(than) else than
     if op not in OPS:
         raise InvalidArgumentError(
             f"Expected a filter operation ({', '.join(OPS)}), got {op!r}." + did_you_mean(op, OPS)

@@ -239,6 +239,8 @@ class RamSearch:
         """
         ftype = parse_type(type_code)
         self.layout.position(address, ftype.width)
+        if not isinstance(value, int) or isinstance(value, bool):
+            raise InvalidArgumentError(f"Expected a whole number to poke, got {value!r}.")
         self.emulator.poke(address, value, type_code)
 
     def screen(self) -> np.ndarray:

@@ -28,11 +28,11 @@ from pathlib import Path
 
 import numpy as np
 
-from retrokit.errors import SessionError
+from retrokit.errors import FieldTypeError, SessionError
 from retrokit.paths import atomic_write
 from retrokit.ramsearch.candidates import Candidates, Packed
 from retrokit.ramsearch.scales import SCALES
-from retrokit.ramsearch.types import SEARCH_TYPES
+from retrokit.ramsearch.types import SEARCH_TYPES, parse_search_types
 
 DEFAULT_SESSION = "ramsearch.session"
 FORMAT = "retrokit-ramsearch-session"
@@ -154,6 +154,10 @@ def _decode(blob: bytes) -> SessionData:
         if meta.get("version") != VERSION:
             raise SessionError(f"expected session format version {VERSION}; found {meta.get('version')!r}. {_START}")
         types, regions = tuple(str(t) for t in meta["types"]), tuple((int(s), int(n)) for s, n in meta["regions"])
+        try:
+            parse_search_types(types)
+        except FieldTypeError as exc:
+            raise SessionError(f"expected the searched type codes; found {list(types)} ({exc}) {_START}") from None
         size = sum(n for _, n in regions)
         if not 0 < len(types) <= len(SEARCH_TYPES) * 2 or not 0 < size or len(types) * size > MAX_CANDIDATES:
             raise SessionError(

@@ -174,6 +174,14 @@ def test_dense_and_sparse_filters_agree():
     assert sparse == {(a, t) for a, t in found(searches[0]) if a < BASE + 16}
 
 
+def test_change_counts_over_many_snapshots():
+    rows = [{0x10: k % 3, 0x11: 5, 0x12: k // 4} for k in range(10)]  # changes 9, 0 and 2 times
+    search = engine(*rows, types="|u1")
+    assert [int(search.change_counts()[0][p]) for p in (0x10, 0x11, 0x12)] == [9, 0, 2]
+    search.filter("greater-equal", 2, "changes")
+    assert {0x10, 0x12} <= set(np.flatnonzero(search.candidates.alive[0])) and not search.candidates.alive[0][0x11]
+
+
 def test_undo_and_redo_round_trip():
     search = engine({0x10: 3}, {0x10: 2})
     start = search.candidates.copy()

@@ -46,6 +46,7 @@ class Engine:
         self.history: list[tuple[str, Candidates | Packed]] = []  # (filter, the candidates before it)
         self.redo_stack: list[tuple[str, Candidates | Packed]] = []  # (filter, the candidates after it)
         self._decoded: dict[int, list[np.ndarray]] = {}
+        self._counts: list[np.ndarray] = []  # change counts, while a filter on them runs
 
     # --- snapshots --------------------------------------------------------------------------
 
@@ -65,6 +66,18 @@ class Engine:
                 del self._decoded[next(iter(self._decoded))]
             self._decoded[index] = decode_all(self.snapshots[index], self.types)
         return self._decoded[index]
+
+    def change_counts(self) -> list[np.ndarray]:
+        """Per type, at how many snapshots the value at each position differed from the one before.
+
+        Snapshots are decoded in order, two at a time, whatever their number.
+        """
+        counts = [np.zeros(self.layout.size, dtype=np.int32) for _ in self.types]
+        for k in range(1, len(self.snapshots)):
+            before, after = self.decoded(k - 1), self.decoded(k)
+            for count, old, new in zip(counts, before, after):
+                count += old != new
+        return counts
 
     # --- filtering ----------------------------------------------------------------------------
 
@@ -86,8 +99,10 @@ class Engine:
         if isinstance(spec.than, int):
             self.layout.position(spec.than)  # outside RAM: a clear error now
         before = self.candidates.copy()  # packing costs more than the filter: only older steps are packed
+        self._counts = self.change_counts() if spec.than == "changes" else []
         for t in range(len(self.types)):
             self._filter_type(t, spec)
+        self._counts = []
         self.history.append((spec.describe(self.layout), before))
         self.redo_stack.clear()
         for index in range(max(0, len(self.history) - _UNPACKED_KEPT)):
@@ -121,11 +136,7 @@ class Engine:
         if spec.than is None and spec.op == "equal":
             return _value_search(ftype, cur, scale, spec.value)
         if spec.than == "changes":
-            counts = sum(
-                (pick(self.decoded(k)[t]) != pick(self.decoded(k - 1)[t])).astype(np.int32)
-                for k in range(1, len(self.snapshots))
-            )
-            return COMPARISONS[spec.op](counts, spec.value)
+            return COMPARISONS[spec.op](pick(self._counts[t]), spec.value)
         scaled = bool((scale > 0).any())  # else every value is shown as stored: compare the compact arrays
         shown, ok = _shown(cur, scale) if scaled else (cur, None)
         if spec.than is None:

@@ -55,8 +55,12 @@ class RamSearch:
     def __init__(self, game: str | Game, state: str | None = None, *, types: Sequence[str] | None = None) -> None:
         self._open(find_game(game) if isinstance(game, str) else game, types)
         self.state = state if state is not None else self.game.default_state
-        if self.state is not None:
-            self.load_state(self.state)
+        try:
+            if self.state is not None:
+                self.load_state(self.state)
+        except BaseException:
+            self.close()
+            raise
         self.snapshot(f"new {self.state or 'power-on'}")
 
     def _open(self, game: Game, types: Sequence[str] | None) -> None:
@@ -93,7 +97,7 @@ class RamSearch:
         self._open(find_game(data.game), data.types)
         try:
             self._resume(path, data)
-        except SessionError:
+        except BaseException:
             self.close()
             raise
         return self

@@ -286,3 +286,29 @@ def test_run_plays_a_movie_up_to_a_frame(session, capsys):
     assert status == 0
     status, out, _ = run(capsys, "show", "--json", "--limit", "0")
     assert {"address": 0xFF0020, "type": ">i2"} in [{k: c[k] for k in ("address", "type")} for c in json.loads(out)]
+
+
+def test_the_shell_runs_subcommands_line_by_line(tmp_path):
+    lines = [
+        "new Dasher-Genesis --state Zone1.Act1",
+        "# comments and blank lines are skipped",
+        "",
+        "filter equal 3",
+        "run --press RIGHT --frames 150",
+        "filter decreased",
+        "filter equl 2",
+        "filter equal 2 --than 'unclosed",
+        "show --limit 2",
+        "quit",
+        "filter changed",
+    ]
+    script = "\n".join(lines)
+    done = subprocess.run(
+        [sys.executable, "-m", "retrokit", "ramsearch", "shell", "--session", "s.session"],
+        cwd=tmp_path, input=script, capture_output=True, text=True, timeout=120, check=False,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert "decreased --than previous: 1," in done.stdout and "0xFF002B  |u1" in done.stdout
+    assert "changed" not in done.stdout  # after quit
+    errors = done.stderr.splitlines()
+    assert len(errors) == 2 and "Did you mean 'equal'?" in errors[0] and "a line of words" in errors[1]

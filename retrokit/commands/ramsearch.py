@@ -12,6 +12,7 @@ thing and writes it back. See ``docs/ramsearch.md``::
     retrokit ramsearch poke ADDRESS VALUE [--type TYPE] [--session FILE]
     retrokit ramsearch screenshot FILE.png [--session FILE]
     retrokit ramsearch save NAME ADDRESS TYPE [--game-file PATH] [--session FILE]
+    retrokit ramsearch shell [--session FILE]       # the others typed at a prompt, one a line
 """
 
 from __future__ import annotations
@@ -87,6 +88,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     sub("undo", "undo the last filter", _undo)
     sub("redo", "apply the last undone filter again", _redo)
+    sub("shell", "read subcommands from a prompt (or standard input), one a line, until 'quit'", _shell)
 
     p = sub("poke", "write a value into RAM, to test a guess", _poke)
     p.add_argument("address", metavar="ADDRESS", help="the console address, e.g. 0xFF002B")
@@ -106,7 +108,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.set_defaults(run=run)
 
 
-SUBCOMMANDS = ("new", "run", "filter", "show", "undo", "redo", "poke", "screenshot", "save")
+SUBCOMMANDS = ("new", "run", "filter", "show", "undo", "redo", "poke", "screenshot", "save", "shell")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -303,6 +305,42 @@ def _screenshot(args: argparse.Namespace) -> int:
         height, width = search.emulator.screen_shape()
         print(f"Saved the screen ({width}x{height}) to {path}.")
     return 0
+
+
+def _shell(args: argparse.Namespace) -> int:
+    """Run subcommands typed one a line (``filter equal 3``), each as its own command, on one session."""
+    import shlex
+    import sys
+
+    from retrokit.cli import build_parser
+    from retrokit.errors import RetrokitError
+
+    parser, interactive = build_parser(), sys.stdin.isatty()
+    session = ["--session", args.session] if args.session else []
+    while True:
+        try:
+            line = input("ramsearch> " if interactive else "")
+        except EOFError:
+            return 0
+        try:
+            words = shlex.split(line)
+        except ValueError as exc:
+            print(f"retrokit: error: Expected a line of words, as a shell splits them; found {exc}.", file=sys.stderr)
+            continue
+        if not words or words[0].startswith("#"):
+            continue
+        if words[0] in ("quit", "exit"):
+            return 0
+        if words[0] == "shell":
+            print("retrokit: error: Expected a subcommand other than shell inside the shell.", file=sys.stderr)
+            continue
+        try:
+            parsed = parser.parse_args(["ramsearch", *words, *session])
+            parsed.run(parsed)
+        except SystemExit:  # argparse printed its usage error or help
+            continue
+        except RetrokitError as exc:
+            print(f"retrokit: error: {exc}", file=sys.stderr)
 
 
 def _save(args: argparse.Namespace) -> int:

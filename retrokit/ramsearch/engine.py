@@ -98,7 +98,7 @@ class Engine:
             )
         if isinstance(spec.than, int):
             self.layout.position(spec.than)  # outside RAM: a clear error now
-        before = self.candidates.copy()  # packing costs more than the filter: only older steps are packed
+        before = Candidates(list(self.candidates.alive), list(self.candidates.scale))  # filters replace arrays
         self._counts = self.change_counts() if spec.than == "changes" else []
         for t in range(len(self.types)):
             self._filter_type(t, spec)
@@ -115,10 +115,15 @@ class Engine:
         return entry if isinstance(entry, Candidates) else Candidates.unpack(entry, len(self.types), self.layout.size)
 
     def _filter_type(self, t: int, spec: Filter) -> None:
+        # New arrays replace the type's old ones, never changing them: the
+        # history holds the old ones as they were, without a copy.
         alive, scales = self.candidates.alive[t], self.candidates.scale[t]
         left = np.count_nonzero(alive)
         if not left:
             return
+        value_search = spec.than is None and spec.op == "equal"
+        if value_search:  # it pins scales: on a copy
+            scales = self.candidates.scale[t] = scales.copy()
         if left * _SPARSE < len(alive):  # few left: compare only their positions
             positions = np.flatnonzero(alive)
 
@@ -126,10 +131,13 @@ class Engine:
                 return a[positions]
 
             scale = scales[positions]
-            alive[positions] = self._compare(t, spec, pick(self.decoded(-1)[t]), scale, pick)
-            scales[positions] = scale
-        else:  # scale is changed in place
-            alive &= self._compare(t, spec, self.decoded(-1)[t], scales, lambda a: a)
+            kept = alive.copy()
+            kept[positions] = self._compare(t, spec, pick(self.decoded(-1)[t]), scale, pick)
+            self.candidates.alive[t] = kept
+            if value_search:
+                scales[positions] = scale
+        else:
+            self.candidates.alive[t] = alive & self._compare(t, spec, self.decoded(-1)[t], scales, lambda a: a)
 
     def _compare(self, t: int, spec: Filter, cur: np.ndarray, scale: np.ndarray, pick) -> np.ndarray:
         ftype = self.types[t]

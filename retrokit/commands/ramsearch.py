@@ -269,6 +269,7 @@ def _show(args: argparse.Namespace) -> int:
         widths = [max(len(r[i]) for r in rows) for i in range(4)]
         for row in rows:
             print("  ".join(cell.ljust(width) for cell, width in zip(row[:4], widths)) + "  " + row[4])
+        print("snapshots: " + "; ".join(f"{i + 1} {label}" for i, label in enumerate(search.labels) if i >= first))
     return 0
 
 

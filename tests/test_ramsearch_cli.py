@@ -88,6 +88,7 @@ def test_show_lists_groups_with_addresses_as_game_yaml_writes_them(session, caps
     assert lines[0].startswith(f"{len(RamSearch.load(session).candidates())} candidates in ")
     assert lines[1].split()[:4] == ["address", "type", "scale", "changes"]
     assert lines[2].split()[:6] == ["0xFF002B", "|u1", "-", "1", "3", "2"]
+    assert lines[-1] == "snapshots: 1 new Zone1.Act1; 2 RIGHT for 150 frames"
 
 
 def test_undo_redo_round_trip_on_the_command_line(session, capsys):

@@ -174,7 +174,7 @@ def _new(args: argparse.Namespace) -> int:
             "Pass --force to start over, or --session OTHER."
         )
     with RamSearch(game, args.state, types=args.types) as search:
-        search.save(path)
+        search.save(path, overwrite=args.force)
         print(
             f"New search of {game.name} from {search.state or 'power-on'}: {search.count:,} candidates "
             f"({len(search.types)} types at every address of {search.layout.describe()}). Session: {path}"

@@ -123,9 +123,18 @@ class RamSearch:
                 f"{path}: expected an emulator state of {data.game}; the core refused it ({exc})."
             ) from None
 
-    def save(self, path: str | os.PathLike[str]) -> None:
-        """Write the session file (atomically)."""
-        write_session(path, self.session_data())
+    def save(self, path: str | os.PathLike[str], *, overwrite: bool = True) -> None:
+        """Write the session file (atomically).
+
+        Raises:
+            FileConflictError: ``path`` exists and ``overwrite`` is false.
+        """
+        try:
+            write_session(path, self.session_data(), overwrite=overwrite)
+        except FileExistsError:
+            raise FileConflictError(
+                f"Expected no file at {path}; found one. Pass --force (overwrite=True) to replace it, or another name."
+            ) from None
 
     def session_data(self) -> SessionData:
         """Everything a session file holds."""

@@ -101,9 +101,13 @@ def encode_session(data: SessionData) -> bytes:
     return buffer.getvalue()
 
 
-def write_session(path: str | os.PathLike[str], data: SessionData) -> None:
-    """Write a session file atomically (replacing the one there)."""
-    atomic_write(path, encode_session(data), overwrite=True)
+def write_session(path: str | os.PathLike[str], data: SessionData, *, overwrite: bool = True) -> None:
+    """Write a session file atomically, replacing the one there unless ``overwrite`` is false.
+
+    Raises:
+        FileExistsError: ``path`` exists and ``overwrite`` is false.
+    """
+    atomic_write(path, encode_session(data), overwrite=overwrite)
 
 
 def read_session(path: str | os.PathLike[str]) -> SessionData:

@@ -179,14 +179,16 @@ def _entry_end(lines: list[str], first: int, column: int) -> int:
 def _dump_round_trip(doc: Any, fields: Any, name: str, address: str, type_code: str) -> str:
     """A file whose fields are one flow mapping: let ruamel.yaml write it (comments kept, alignment not)."""
     from ruamel.yaml.comments import CommentedMap
+    from ruamel.yaml.scalarint import HexCapsInt
     from ruamel.yaml.scalarstring import DoubleQuotedScalarString
 
-    entry = CommentedMap(address=int(address, 0), type=DoubleQuotedScalarString(type_code))
+    value = HexCapsInt(int(address, 0), width=len(address) - 2) if address.lower().startswith("0x") else int(address)
+    entry = CommentedMap(address=value, type=DoubleQuotedScalarString(type_code))
     entry.fa.set_flow_style()
     fields[name] = entry
     out = io.StringIO()
     _yaml().dump(doc, out)
-    return out.getvalue().replace(f"address: {int(address, 0)}", f"address: {address}")
+    return out.getvalue()
 
 
 def _check(path: Path, old_text: str, new_text: str, name: str, address: str, type_code: str) -> None:

@@ -158,8 +158,10 @@ def test_poke_shows_on_the_next_snapshot_and_screen(tmp_path):
     with RamSearch("Dasher-Genesis", "Zone1.Act1") as search:
         before = search.screen()
         search.poke(0xFF002B, 9)  # lives
+        ram = search.layout.read(search.emulator.space)
         after = search.screenshot(tmp_path / "lives9.png")
         poked = search.screen()
+        assert np.array_equal(search.layout.read(search.emulator.space), ram)  # the screenshots ran on a scratch copy
         assert not np.array_equal(before[:8], poked[:8])  # the HUD's top line shows 9 lives
         assert np.array_equal(before[16:], poked[16:])  # nothing else changed
         search.run([], 1)

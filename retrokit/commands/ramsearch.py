@@ -274,20 +274,19 @@ def _show(args: argparse.Namespace) -> int:
 
 
 def _undo(args: argparse.Namespace) -> int:
-    with _open(args) as search:
-        before = search.count
-        label = search.undo()
-        search.save(_session(args))
-        print(f"Undid {label}: {before:,} -> {search.count:,} candidates.")
-    return 0
+    return _step_history(args, redo=False)
 
 
 def _redo(args: argparse.Namespace) -> int:
+    return _step_history(args, redo=True)
+
+
+def _step_history(args: argparse.Namespace, *, redo: bool) -> int:
     with _open(args) as search:
         before = search.count
-        label = search.redo()
+        label = search.redo() if redo else search.undo()
         search.save(_session(args))
-        print(f"Redid {label}: {before:,} -> {search.count:,} candidates.")
+        print(f"{'Redid' if redo else 'Undid'} {label}: {before:,} -> {search.count:,} candidates.")
     return 0
 
 

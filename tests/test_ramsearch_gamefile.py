@@ -87,17 +87,29 @@ def test_flow_style_fields_are_rewritten_with_comments_kept(tmp_path):
         ("fields: [1, 2]\n", "lives", DataFileError, "'fields' to be a mapping"),
         ("fields: {a: 1\n", "lives", DataFileError, "valid YAML"),
         ("- 1\n- 2\n", "lives", DataFileError, "mapping at the top"),
+        ("fields: {}\n# \udcff\n", "lives", DataFileError, "UTF-8"),
     ],
-    ids=["digit-first", "space", "fields-a-list", "broken-yaml", "top-a-list"],
+    ids=["digit-first", "space", "fields-a-list", "broken-yaml", "top-a-list", "not-utf8"],
 )
 def test_bad_files_and_names_are_refused_untouched(tmp_path, text, name, error, message):
     path = tmp_path / "game.yaml"
-    path.write_text(text)
+    path.write_bytes(text.encode("utf-8", "surrogateescape"))
     with pytest.raises(error, match=message):
         add_field(path, name, "0xFF002B", "|u1")
-    assert path.read_text() == text
+    assert path.read_bytes() == text.encode("utf-8", "surrogateescape")
 
 
 def test_a_missing_file_is_an_error(tmp_path):
     with pytest.raises(DataFileError, match="Expected a game.yaml"):
         add_field(tmp_path / "nope.yaml", "lives", "0xFF002B", "|u1")
+
+
+def test_windows_line_ends_are_kept(tmp_path):
+    path = tmp_path / "game.yaml"
+    original = DASHER_YAML.read_text().replace("\n", "\r\n")
+    path.write_bytes(original.encode())
+    add_field(path, "lives", "0xFF002B", "|u1")
+    add_field(path, "p1_y", "0xFF0022", ">u2", force=True)
+    data = path.read_bytes().decode()
+    assert data.count("\r\n") == data.count("\n") == original.count("\n") + 1
+    assert '  p1_y:        {address: 0xFF0022, type: ">u2"}   # feet; the usual floor is 192\r\n' in data

@@ -90,7 +90,9 @@ def add_field(path: str | os.PathLike[str], name: str, address: str, type_code: 
             "Scenarios use field names as variables."
         )
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_bytes().decode("utf-8")  # as it is: read_text would turn \r\n into \n
+    except UnicodeDecodeError as exc:
+        raise DataFileError(f"{path}: expected a UTF-8 text file; found {exc.reason} at byte {exc.start}.") from None
     except OSError as exc:
         raise DataFileError(f"Expected a game.yaml at {str(path)!r}; found an error: {exc.strerror or exc}.") from None
     doc = _load(text, path)
@@ -120,17 +122,18 @@ def add_field(path: str | os.PathLike[str], name: str, address: str, type_code: 
 
 def _insert(text: str, doc: Any, fields: Any, name: str, address: str, type_code: str) -> str:
     lines = text.splitlines(keepends=True)
+    nl = "\r\n" if lines and lines[0].endswith("\r\n") else "\n"  # the file's own line ends
     if lines and not lines[-1].endswith("\n"):
-        lines[-1] += "\n"
+        lines[-1] += nl
     if not fields:  # no fields yet: a new block at the end, or in place of an empty 'fields:'
-        entry = field_line("  ", name, address, type_code) + "\n"
+        entry = field_line("  ", name, address, type_code) + nl
         if "fields" in doc:
             line = doc.lc.key("fields")[0]
             comment = lines[line].partition("#")[2]
-            lines[line] = "fields:" + (f"  #{comment}" if comment else "\n")
+            lines[line] = "fields:" + (f"  #{comment}" if comment else nl)
             lines.insert(line + 1, entry)
         else:
-            lines.append("fields:\n" + entry)
+            lines.append("fields:" + nl + entry)
         return "".join(lines)
     if getattr(fields, "fa", None) is not None and fields.fa.flow_style():
         return _dump_round_trip(doc, fields, name, address, type_code)
@@ -144,21 +147,21 @@ def _insert(text: str, doc: Any, fields: Any, name: str, address: str, type_code
         first = fields.lc.key(name)[0]
         last = _entry_end(lines, first, column)
         comment = _trailing_comment(lines[first]) if first == last else ""
-        lines[first : last + 1] = [entry + comment + "\n"]
+        lines[first : last + 1] = [entry + comment + nl]
     else:
         last = _entry_end(lines, fields.lc.key(names[-1])[0], column)
-        lines.insert(last + 1, entry + "\n")
+        lines.insert(last + 1, entry + nl)
     return "".join(lines)
 
 
 def _value_column(line: str) -> int:
     """The column a one-line flow entry's value starts at (0 if the line is not one)."""
-    match = _FLOW_VALUE.match(line.rstrip("\n"))
+    match = _FLOW_VALUE.match(line.rstrip("\r\n"))
     return match.start(4) if match else 0
 
 
 def _trailing_comment(line: str) -> str:
-    match = _FLOW_VALUE.match(line.rstrip("\n"))
+    match = _FLOW_VALUE.match(line.rstrip("\r\n"))
     rest = match.group(5) if match else ""
     return rest if rest.strip().startswith("#") else ""
 

@@ -9,12 +9,18 @@ small shared library of their own and check them directly.
 from __future__ import annotations
 
 import ctypes
+import re
 import shutil
 import subprocess
 from pathlib import Path
 
 NATIVE = Path(__file__).resolve().parent.parent / "retrokit" / "native"
 RAND_DEGREE = 31
+#: libretro's pixel formats by name, as the header the C is built with declares them.
+PIXEL_FORMATS = {
+    name: int(value)
+    for name, value in re.findall(r"#define RK_RETRO_PIXEL_FORMAT_(\w+) (\d+)", (NATIVE / "libretro_api.h").read_text())
+}
 
 
 class Rand(ctypes.Structure):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import ctypes
 
 import native_c as native_c_module
+from native_c import PIXEL_FORMATS
 import numpy as np
 import pytest
 
@@ -27,23 +28,28 @@ def test_core_loads_declares_its_options_and_unloads(core, tmp_path) -> None:
 
 def test_two_copies_of_one_core_are_independent(tmp_path) -> None:
     core = next(p for p in CORES if p.name.startswith("gambatte"))
-    a = _host.Emulator(str(core), str(tmp_path), str(tmp_path))
-    b = _host.Emulator(str(core), str(tmp_path), str(tmp_path))
-    key = next(iter(a.options()))
-    allowed = a.options()[key][2]
-    a.set_option(key, allowed[-1])
-    b.set_option(key, allowed[0])
+    probe = _host.Emulator(str(core), str(tmp_path), str(tmp_path))
+    key, (_, _, allowed) = next(iter(probe.options().items()))
+    probe.close()
+    a = _host.Emulator(str(core), str(tmp_path), str(tmp_path), {key: allowed[-1]})
+    b = _host.Emulator(str(core), str(tmp_path), str(tmp_path), {key: allowed[0]})
     assert a.options()[key][1] == allowed[-1] and b.options()[key][1] == allowed[0]
     a.close()
     b.close()
 
 
+@pytest.mark.parametrize("options", [{"\udc80": "x"}, {"key": "\udc80"}], ids=["key", "value"])
+def test_an_option_utf8_cannot_hold_raises_instead_of_crashing(tmp_path, options: dict[str, str]) -> None:
+    with pytest.raises(UnicodeEncodeError):
+        _host.Emulator(str(CORES[0]), str(tmp_path), str(tmp_path), options)
+
+
 def reference(pixels: np.ndarray, fmt: int) -> np.ndarray:
     """The expected RGB of pixels, written with numpy, channels widened by shifting as stable-retro does."""
     p = pixels.astype(np.uint32)
-    if fmt == _host.PIXEL_FORMAT_XRGB8888:
+    if fmt == PIXEL_FORMATS["XRGB8888"]:
         r, g, b = (p >> 16) & 0xFF, (p >> 8) & 0xFF, p & 0xFF
-    elif fmt == _host.PIXEL_FORMAT_RGB565:
+    elif fmt == PIXEL_FORMATS["RGB565"]:
         r, g, b = ((p >> 11) & 0x1F) << 3, ((p >> 5) & 0x3F) << 2, (p & 0x1F) << 3
     else:
         r, g, b = ((p >> 10) & 0x1F) << 3, ((p >> 5) & 0x1F) << 3, (p & 0x1F) << 3
@@ -51,9 +57,9 @@ def reference(pixels: np.ndarray, fmt: int) -> np.ndarray:
 
 
 FORMATS = [
-    (_host.PIXEL_FORMAT_0RGB1555, np.uint16),
-    (_host.PIXEL_FORMAT_XRGB8888, np.uint32),
-    (_host.PIXEL_FORMAT_RGB565, np.uint16),
+    (PIXEL_FORMATS["0RGB1555"], np.uint16),
+    (PIXEL_FORMATS["XRGB8888"], np.uint32),
+    (PIXEL_FORMATS["RGB565"], np.uint16),
 ]
 
 

@@ -1,6 +1,7 @@
 /*
  * Shared by the files of retrokit.native._host: the exceptions, the Emulator
- * object, and claiming an emulator for a call. Not part of any interface.
+ * object, claiming an emulator for a call, and checking arguments. Not part
+ * of any interface.
  */
 #ifndef RETROKIT_HOST_H
 #define RETROKIT_HOST_H
@@ -20,7 +21,7 @@ typedef struct {
     int closed;
 } EmulatorObject;
 
-extern PyTypeObject EmulatorType, MemoryType, RunnerType;
+extern PyTypeObject EmulatorType, MemoryType;
 
 /* Claim an emulator for one call (raises and returns -1 if closed, without a
  * game when one is needed, or busy in another thread); leave releases it
@@ -28,20 +29,20 @@ extern PyTypeObject EmulatorType, MemoryType, RunnerType;
 int rk_py_enter(EmulatorObject *self, int need_game);
 void rk_py_leave(EmulatorObject *self);
 
-void rk_py_really_close(EmulatorObject *self);
+/* Raise `type` with a printf-style message and return -1 (for int-returning functions). */
+int rk_py_fail(PyObject *type, const char *format, ...);
 
-/* Emulator methods defined in host_data.c. */
-PyObject *emulator_screen_shape(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_screen(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_memory(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_memory_maps(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_capture_audio(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_take_audio(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_serialize_size(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_serialize(EmulatorObject *self, PyObject *arg);
-PyObject *emulator_unserialize(EmulatorObject *self, PyObject *arg);
+/* For a function that releases what it holds at its `done:` label: unless
+ * `ok`, raise `type` with a printf-style message and go there. */
+#define RK_CHECK(ok, type, ...) \
+    do { if (!(ok)) { PyErr_Format(type, __VA_ARGS__); goto done; } } while (0)
 
-PyObject *rk_py_read_fields(PyObject *module, PyObject *const *args, Py_ssize_t nargs);
-PyObject *rk_py_pack_buttons(PyObject *module, PyObject *const *args, Py_ssize_t nargs);
+/* Release `view` (a no-op if it holds nothing) and return `result`: the way
+ * out of a call that holds a buffer, whether it fails or not. */
+PyObject *rk_py_release(Py_buffer *view, PyObject *result);
+
+/* Get `obj` as a writable C-contiguous uint8 array of shape (height, width, 3),
+ * of this height and width unless they are 0; else raise and return -1. */
+int rk_py_get_screen(PyObject *obj, Py_buffer *view, unsigned height, unsigned width);
 
 #endif

@@ -1,6 +1,7 @@
 /*
- * The Emulator type of retrokit.native._host: loading, information, running.
- * What it hands out (screen, memory, audio, states) is in host_data.c.
+ * The Emulator type of retrokit.native._host: loading, information, running,
+ * and what it hands out: its screen as RGB, zero-copy views of its memory
+ * (Memory objects keep their emulator alive), audio, and states.
  *
  * Arguments are checked before the core is touched, and every failure
  * raises; the GIL is released while frames run.
@@ -9,7 +10,7 @@
 
 #include <string.h>
 
-/* ---- helpers ----------------------------------------------------------------------------- */
+#include "video.h"
 
 static void flush_log(EmulatorObject *self) {
     rk_core *core = &self->core;
@@ -26,20 +27,14 @@ static void flush_log(EmulatorObject *self) {
 
 /* Claim the emulator for this call; a second thread gets an error, not a race. */
 int rk_py_enter(EmulatorObject *self, int need_game) {
-    if (self->closed) {
-        PyErr_SetString(CoreError, "this emulator is closed; make a new one");
-        return -1;
-    }
-    if (need_game && !self->core.game_loaded) {
-        PyErr_SetString(CoreError, "no game is loaded; call load_game first");
-        return -1;
-    }
     int expected = 0;
-    if (!atomic_compare_exchange_strong(&self->core.busy, &expected, 1)) {
-        PyErr_SetString(CoreError, "this emulator is running in another thread; use one emulator per thread");
-        return -1;
-    }
-    return 0;
+    const char *error = NULL;
+    if (self->closed) error = "this emulator is closed; make a new one";
+    else if (need_game && !self->core.game_loaded) error = "no game is loaded; call load_game first";
+    else if (!atomic_compare_exchange_strong(&self->core.busy, &expected, 1))
+        error = "this emulator is running in another thread; use one emulator per thread";
+    if (error) PyErr_SetString(CoreError, error);
+    return error ? -1 : 0;
 }
 
 void rk_py_leave(EmulatorObject *self) {
@@ -47,111 +42,81 @@ void rk_py_leave(EmulatorObject *self) {
     flush_log(self);
 }
 
-void rk_py_really_close(EmulatorObject *self) {
-    if (self->core.handle || self->core.system_dir) {
-        rk_core_close(&self->core);
-        flush_log(self);
-    }
+static void really_close(EmulatorObject *self) {
+    if (!self->core.handle && !self->core.system_dir) return;
+    rk_core_close(&self->core);
+    flush_log(self);
 }
-
-/* ---- Emulator: life cycle ---------------------------------------------------------------------- */
 
 static int emulator_init(EmulatorObject *self, PyObject *args, PyObject *kwargs) {
     static char *kwlist[] = {"core_path", "system_dir", "save_dir", "options", "log", "ports", NULL};
     const char *path, *system_dir, *save_dir;
-    PyObject *options = Py_None, *log = Py_None;
+    PyObject *options = Py_None, *log = Py_None, *key, *value;
+    Py_ssize_t pos = 0;
     int ports = 2;
     if (!PyArg_ParseTupleAndKeywords(args, kwargs, "sss|OOi", kwlist, &path, &system_dir, &save_dir, &options,
                                      &log, &ports))
         return -1;
-    if (self->core.handle) {
-        PyErr_SetString(InvalidArgumentError, "Emulator.__init__ was called twice; make a new Emulator instead");
-        return -1;
-    }
-    if (ports < 1 || ports > RK_MAX_PORTS) {
-        PyErr_Format(InvalidArgumentError, "ports must be between 1 and %d, got %d", RK_MAX_PORTS, ports);
-        return -1;
-    }
-    if (options != Py_None && !PyDict_Check(options)) {
-        PyErr_Format(InvalidArgumentError, "options must be a dict of str to str, got %s", Py_TYPE(options)->tp_name);
-        return -1;
-    }
-    if (log != Py_None && !PyCallable_Check(log)) {
-        PyErr_SetString(InvalidArgumentError, "log must be a callable taking (level, text), or None");
-        return -1;
-    }
+    if (self->core.handle)
+        return rk_py_fail(InvalidArgumentError, "Emulator.__init__ was called twice; make a new Emulator instead");
+    if (ports < 1 || ports > RK_MAX_PORTS)
+        return rk_py_fail(InvalidArgumentError, "ports must be between 1 and %d, got %d", RK_MAX_PORTS, ports);
+    if (options != Py_None && !PyDict_Check(options))
+        return rk_py_fail(InvalidArgumentError, "options must be a dict of str to str, got %s",
+                          Py_TYPE(options)->tp_name);
+    if (log != Py_None && !PyCallable_Check(log))
+        return rk_py_fail(InvalidArgumentError, "log must be a callable taking (level, text), or None");
     self->core.n_ports = ports;
-    if (options != Py_None) {
-        PyObject *key, *value;
-        Py_ssize_t pos = 0;
-        while (PyDict_Next(options, &pos, &key, &value)) {
-            if (!PyUnicode_Check(key) || !PyUnicode_Check(value)) {
-                PyErr_SetString(InvalidArgumentError, "options must map str keys to str values");
-                return -1;
-            }
-            rk_core_set_option(&self->core, PyUnicode_AsUTF8(key), PyUnicode_AsUTF8(value));
-        }
+    while (options != Py_None && PyDict_Next(options, &pos, &key, &value)) {
+        if (!PyUnicode_Check(key) || !PyUnicode_Check(value))
+            return rk_py_fail(InvalidArgumentError, "options must map str keys to str values");
+        const char *k = PyUnicode_AsUTF8(key), *v = k ? PyUnicode_AsUTF8(value) : NULL;
+        if (!v) return -1; /* a str UTF-8 cannot hold (a lone surrogate): UnicodeEncodeError */
+        rk_core_set_option(&self->core, k, v);
     }
-    Py_XINCREF(log);
-    self->log = log;
+    self->log = Py_NewRef(log);
     int rc;
     Py_BEGIN_ALLOW_THREADS
     rc = rk_core_open(&self->core, path, system_dir, save_dir);
     Py_END_ALLOW_THREADS
     flush_log(self);
-    if (rc) {
-        PyErr_SetString(CoreError, self->core.error);
-        rk_py_really_close(self);
-        self->closed = 1;
-        return -1;
-    }
-    return 0;
+    if (!rc) return 0;
+    self->closed = 1;
+    really_close(self); /* before raising: it may call the log callback */
+    return rk_py_fail(CoreError, "%s", self->core.error);
 }
 
 static void emulator_dealloc(EmulatorObject *self) {
-    rk_py_really_close(self);
+    really_close(self);
     Py_XDECREF(self->log);
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
 
 static PyObject *emulator_close(EmulatorObject *self, PyObject *unused) {
-    if (atomic_load(&self->core.busy)) {
-        PyErr_SetString(CoreError, "cannot close an emulator that is running in another thread");
-        return NULL;
-    }
+    if (atomic_load(&self->core.busy))
+        return PyErr_Format(CoreError, "cannot close an emulator that is running in another thread");
     self->closed = 1;
     /* Live memory views keep the core loaded until they are released. */
-    if (self->exports == 0) rk_py_really_close(self);
+    if (self->exports == 0) really_close(self);
     Py_RETURN_NONE;
 }
 
 static PyObject *emulator_load_game(EmulatorObject *self, PyObject *args) {
     const char *path;
     Py_buffer data = {0};
+    if (self->core.game_loaded)
+        return PyErr_Format(CoreError, "a game is already loaded; make a new Emulator for another game");
     if (!PyArg_ParseTuple(args, "s|z*", &path, &data)) return NULL;
-    if (self->core.game_loaded) {
-        PyBuffer_Release(&data);
-        PyErr_SetString(CoreError, "a game is already loaded; make a new Emulator for another game");
-        return NULL;
-    }
-    if (rk_py_enter(self, 0)) {
-        PyBuffer_Release(&data);
-        return NULL;
-    }
+    if (rk_py_enter(self, 0)) return rk_py_release(&data, NULL);
     int rc;
     Py_BEGIN_ALLOW_THREADS
     rc = rk_core_load_game(&self->core, path, data.buf, (size_t)data.len);
     Py_END_ALLOW_THREADS
     PyBuffer_Release(&data);
     rk_py_leave(self);
-    if (rc) {
-        PyErr_SetString(CoreError, self->core.error);
-        return NULL;
-    }
+    if (rc) return PyErr_Format(CoreError, "%s", self->core.error);
     Py_RETURN_NONE;
 }
-
-/* ---- Emulator: information ------------------------------------------------------------------------ */
 
 static PyObject *emulator_system_info(EmulatorObject *self, PyObject *unused) {
     if (rk_py_enter(self, 0)) return NULL;
@@ -183,40 +148,17 @@ static PyObject *emulator_options(EmulatorObject *self, PyObject *unused) {
     for (int i = 0; result && i < self->core.n_options; i++) {
         rk_option *o = &self->core.options[i];
         PyObject *allowed = PyTuple_New(o->n_allowed);
-        for (int j = 0; allowed && j < o->n_allowed; j++)
-            PyTuple_SET_ITEM(allowed, j, PyUnicode_FromString(o->allowed[j]));
-        PyObject *entry = allowed ? Py_BuildValue("(ssN)", o->desc, o->value, allowed) : NULL;
+        for (int j = 0; allowed && j < o->n_allowed; j++) {
+            PyObject *value = PyUnicode_FromString(o->allowed[j]); /* fails if the core's text is not UTF-8 */
+            if (value) PyTuple_SET_ITEM(allowed, j, value);
+            else Py_CLEAR(allowed);
+        }
+        PyObject *entry = Py_BuildValue("(ssN)", o->desc, o->value, allowed); /* N passes a NULL's error on */
         if (!entry || PyDict_SetItemString(result, o->key, entry) < 0) Py_CLEAR(result);
         Py_XDECREF(entry);
     }
     return result;
 }
-
-static PyObject *emulator_set_option(EmulatorObject *self, PyObject *args) {
-    const char *key, *value;
-    if (!PyArg_ParseTuple(args, "ss", &key, &value)) return NULL;
-    if (self->closed) return PyErr_Format(CoreError, "this emulator is closed; make a new one");
-    if (rk_core_set_option(&self->core, key, value)) {
-        PyErr_SetString(InvalidArgumentError, self->core.error);
-        return NULL;
-    }
-    Py_RETURN_NONE;
-}
-
-static PyObject *emulator_set_controller(EmulatorObject *self, PyObject *args) {
-    unsigned port, device;
-    if (!PyArg_ParseTuple(args, "II", &port, &device)) return NULL;
-    if (port >= (unsigned)self->core.n_ports)
-        return PyErr_Format(InvalidArgumentError, "port must be below %d, got %u", self->core.n_ports, port);
-    if (rk_py_enter(self, 1)) return NULL;
-    rk_enter(&self->core);
-    self->core.api.set_controller_port_device(port, device);
-    rk_leave();
-    rk_py_leave(self);
-    Py_RETURN_NONE;
-}
-
-/* ---- Emulator: running --------------------------------------------------------------------------------- */
 
 static PyObject *emulator_set_sticky(EmulatorObject *self, PyObject *args) {
     double prob;
@@ -242,33 +184,18 @@ static PyObject *emulator_run(EmulatorObject *self, PyObject *const *args, Py_ss
     if (frames < 0) return PyErr_Format(InvalidArgumentError, "frames must be 0 or more, got %ld", frames);
     Py_buffer buf, screen = {0};
     if (PyObject_GetBuffer(args[0], &buf, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0) return NULL;
-    int ok = buf.itemsize == 2 && buf.format && (strcmp(buf.format, "H") == 0 || strcmp(buf.format, "=H") == 0 ||
-                                                 strcmp(buf.format, "<H") == 0);
-    Py_ssize_t n = ok ? buf.len / 2 : 0;
-    if (!ok || n > self->core.n_ports) {
-        PyErr_Format(InvalidArgumentError,
-                     "actions must be a uint16 array of at most %d button masks (one per port), got format %s "
-                     "with %zd bytes",
-                     self->core.n_ports, buf.format ? buf.format : "B", buf.len);
-        PyBuffer_Release(&buf);
-        return NULL;
-    }
+    const char *f = buf.format ? buf.format : "B";
+    Py_ssize_t n = buf.len / 2;
+    if (buf.itemsize != 2 || (strcmp(f, "H") && strcmp(f, "=H") && strcmp(f, "<H")) || n > self->core.n_ports)
+        return rk_py_release(&buf, PyErr_Format(InvalidArgumentError,
+                                                "actions must be a uint16 array of at most %d button masks (one per "
+                                                "port), got format %s with %zd bytes", self->core.n_ports, f, buf.len));
     uint16_t actions[RK_MAX_PORTS] = {0};
     memcpy(actions, buf.buf, (size_t)n * 2);
     PyBuffer_Release(&buf);
     int want_screen = nargs == 3 && args[2] != Py_None;
-    if (want_screen) {
-        if (PyObject_GetBuffer(args[2], &screen, PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0)
-            return NULL;
-        if (screen.ndim != 3 || screen.shape[2] != 3 || screen.itemsize != 1) {
-            PyBuffer_Release(&screen);
-            return PyErr_Format(InvalidArgumentError, "the screen buffer must be a uint8 array of shape (height, width, 3)");
-        }
-    }
-    if (rk_py_enter(self, 1)) {
-        if (want_screen) PyBuffer_Release(&screen);
-        return NULL;
-    }
+    if (want_screen && rk_py_get_screen(args[2], &screen, 0, 0)) return NULL;
+    if (rk_py_enter(self, 1)) return rk_py_release(&screen, NULL);
     int converted = 0;
     rk_core *c = &self->core;
     Py_BEGIN_ALLOW_THREADS
@@ -278,11 +205,7 @@ static PyObject *emulator_run(EmulatorObject *self, PyObject *const *args, Py_ss
         converted = rk_core_screen_into(c, screen.buf, (unsigned)screen.shape[1], (unsigned)screen.shape[0]);
     Py_END_ALLOW_THREADS
     rk_py_leave(self);
-    if (want_screen) {
-        PyBuffer_Release(&screen);
-        return PyBool_FromLong(converted);
-    }
-    Py_RETURN_NONE;
+    return rk_py_release(&screen, want_screen ? PyBool_FromLong(converted) : Py_NewRef(Py_None));
 }
 
 static PyObject *emulator_reset(EmulatorObject *self, PyObject *unused) {
@@ -295,15 +218,8 @@ static PyObject *emulator_reset(EmulatorObject *self, PyObject *unused) {
     Py_RETURN_NONE;
 }
 
-static PyObject *emulator_get_frame(EmulatorObject *self, void *closure) {
-    return PyLong_FromUnsignedLongLong(self->core.frame);
-}
-
-static PyObject *emulator_get_pixel_format(EmulatorObject *self, void *closure) {
-    return PyLong_FromLong(self->core.pixel_format);
-}
-
-static PyObject *emulator_get_stuck(EmulatorObject *self, void *closure) { return PyBool_FromLong(self->core.last_stuck); }
+static PyObject *emulator_get_frame(EmulatorObject *self, void *c) { return PyLong_FromUnsignedLongLong(self->core.frame); }
+static PyObject *emulator_get_stuck(EmulatorObject *self, void *c) { return PyBool_FromLong(self->core.last_stuck); }
 
 static PyObject *emulator_held(EmulatorObject *self, PyObject *unused) {
     PyObject *out = PyTuple_New(self->core.n_ports);
@@ -312,21 +228,183 @@ static PyObject *emulator_held(EmulatorObject *self, PyObject *unused) {
     return out;
 }
 
-static PyObject *emulator_get_closed(EmulatorObject *self, void *closure) { return PyBool_FromLong(self->closed); }
+typedef struct {
+    PyObject_HEAD
+    EmulatorObject *owner;
+    void *ptr;
+    Py_ssize_t size;
+} MemoryObject;
+
+static int memory_getbuffer(MemoryObject *self, Py_buffer *view, int flags) {
+    if (self->owner->closed && !self->owner->core.handle)
+        return rk_py_fail(CoreError, "the emulator behind this memory is closed");
+    if (PyBuffer_FillInfo(view, (PyObject *)self, self->ptr, self->size, 0, flags) < 0) return -1;
+    self->owner->exports++;
+    return 0;
+}
+
+static void memory_releasebuffer(MemoryObject *self, Py_buffer *view) { self->owner->exports--; }
+
+static void memory_dealloc(MemoryObject *self) {
+    Py_XDECREF(self->owner);
+    Py_TYPE(self)->tp_free((PyObject *)self);
+}
+
+static PyBufferProcs memory_as_buffer = {(getbufferproc)memory_getbuffer, (releasebufferproc)memory_releasebuffer};
+
+PyTypeObject MemoryType = {
+    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "retrokit.native._host.Memory",
+    .tp_basicsize = sizeof(MemoryObject),
+    .tp_dealloc = (destructor)memory_dealloc,
+    .tp_as_buffer = &memory_as_buffer,
+    .tp_flags = Py_TPFLAGS_DEFAULT,
+    .tp_doc = "A region of a core's memory; it keeps its emulator alive.",
+};
+
+static PyObject *memory_view(EmulatorObject *self, void *ptr, size_t size) {
+    MemoryObject *m = PyObject_New(MemoryObject, &MemoryType);
+    if (!m) return NULL;
+    Py_INCREF(self);
+    m->owner = self;
+    m->ptr = ptr;
+    m->size = (Py_ssize_t)size;
+    PyObject *view = PyMemoryView_FromObject((PyObject *)m);
+    Py_DECREF(m);
+    return view;
+}
+
+static PyObject *emulator_screen_shape(EmulatorObject *self, PyObject *unused) {
+    if (rk_py_enter(self, 1)) return NULL;
+    rk_core *c = &self->core; /* before the first frame, the size the core announced */
+    unsigned w = c->frame_data ? c->frame_width : c->av.geometry.base_width;
+    unsigned h = c->frame_data ? c->frame_height : c->av.geometry.base_height;
+    rk_py_leave(self);
+    return Py_BuildValue("(II)", h, w);
+}
+
+static PyObject *emulator_screen(EmulatorObject *self, PyObject *out) {
+    if (rk_py_enter(self, 1)) return NULL;
+    rk_core *c = &self->core;
+    unsigned w = c->frame_data ? c->frame_width : c->av.geometry.base_width;
+    unsigned h = c->frame_data ? c->frame_height : c->av.geometry.base_height;
+    Py_buffer buf;
+    if (rk_py_get_screen(out, &buf, h, w)) {
+        rk_py_leave(self);
+        return NULL;
+    }
+    int rc;
+    Py_BEGIN_ALLOW_THREADS
+    rc = rk_frame_to_rgb(c->frame_data, c->frame_pitch, w, h, c->pixel_format, buf.buf);
+    Py_END_ALLOW_THREADS
+    rk_py_leave(self);
+    if (rc) PyErr_Format(CoreError, "the core uses pixel format %d, which retrokit cannot convert", c->pixel_format);
+    return rk_py_release(&buf, rc ? NULL : Py_NewRef(Py_None));
+}
+
+static PyObject *emulator_memory(EmulatorObject *self, PyObject *arg) {
+    long kind = PyLong_AsLong(arg);
+    if (kind == -1 && PyErr_Occurred()) return NULL;
+    if (kind < 0 || kind > 255) return PyErr_Format(InvalidArgumentError, "memory kind must be 0..255, got %ld", kind);
+    if (rk_py_enter(self, 1)) return NULL;
+    rk_enter(&self->core);
+    void *ptr = self->core.api.get_memory_data((unsigned)kind);
+    size_t size = self->core.api.get_memory_size((unsigned)kind);
+    rk_leave();
+    rk_py_leave(self);
+    if (!ptr || !size) Py_RETURN_NONE;
+    return memory_view(self, ptr, size);
+}
+
+static PyObject *emulator_memory_maps(EmulatorObject *self, PyObject *unused) {
+    if (rk_py_enter(self, 1)) return NULL;
+    rk_py_leave(self);
+    PyObject *list = PyList_New(0);
+    for (int i = 0; list && i < self->core.n_maps; i++) {
+        rk_memmap *m = &self->core.maps[i];
+        /* If making the view fails, Py_BuildValue's N passes the error on. */
+        PyObject *view = m->ptr && m->len ? memory_view(self, (uint8_t *)m->ptr + m->offset, m->len)
+                                          : Py_NewRef(Py_None);
+        PyObject *d = Py_BuildValue("{s:K,s:n,s:n,s:n,s:n,s:s,s:N}", "flags", (unsigned long long)m->flags, "start",
+                                    (Py_ssize_t)m->start, "select", (Py_ssize_t)m->select, "disconnect",
+                                    (Py_ssize_t)m->disconnect, "length", (Py_ssize_t)m->len, "addrspace",
+                                    m->addrspace, "memory", view);
+        if (!d || PyList_Append(list, d) < 0) Py_CLEAR(list);
+        Py_XDECREF(d);
+    }
+    return list;
+}
+
+static PyObject *emulator_capture_audio(EmulatorObject *self, PyObject *arg) {
+    int on = PyObject_IsTrue(arg);
+    if (on < 0) return NULL;
+    self->core.capture_audio = on;
+    if (!on) self->core.audio_len = 0;
+    Py_RETURN_NONE;
+}
+
+static PyObject *emulator_take_audio(EmulatorObject *self, PyObject *unused) {
+    PyObject *out = PyBytes_FromStringAndSize((const char *)self->core.audio, (Py_ssize_t)(self->core.audio_len * 2));
+    self->core.audio_len = 0;
+    return out;
+}
+
+static PyObject *emulator_serialize(EmulatorObject *self, PyObject *unused) {
+    if (rk_py_enter(self, 1)) return NULL;
+    rk_enter(&self->core);
+    size_t size = self->core.api.serialize_size();
+    rk_leave();
+    PyObject *out = PyBytes_FromStringAndSize(NULL, (Py_ssize_t)size);
+    char *dst = out ? PyBytes_AS_STRING(out) : NULL;
+    bool ok = false;
+    if (out) {
+        Py_BEGIN_ALLOW_THREADS
+        rk_enter(&self->core);
+        ok = self->core.api.serialize(dst, size);
+        rk_leave();
+        Py_END_ALLOW_THREADS
+    }
+    rk_py_leave(self);
+    if (out && !ok) Py_SETREF(out, PyErr_Format(CoreError, "the core refused to serialize its state"));
+    return out;
+}
+
+static PyObject *emulator_unserialize(EmulatorObject *self, PyObject *arg) {
+    Py_buffer buf;
+    if (PyObject_GetBuffer(arg, &buf, PyBUF_SIMPLE) < 0) return NULL;
+    if (rk_py_enter(self, 1)) return rk_py_release(&buf, NULL);
+    rk_enter(&self->core);
+    size_t size = self->core.api.serialize_size();
+    rk_leave();
+    bool fits = (size_t)buf.len == size, ok = false;
+    if (fits) {
+        Py_BEGIN_ALLOW_THREADS
+        rk_enter(&self->core);
+        ok = self->core.api.unserialize(buf.buf, size);
+        rk_leave();
+        Py_END_ALLOW_THREADS
+        self->core.have_held = 0;
+    }
+    rk_py_leave(self); /* before raising: it may call the log callback */
+    if (!fits)
+        PyErr_Format(StateError, "expected a state of %zu bytes for this core, got %zd bytes: the state is truncated, "
+                     "corrupt, or was made by another core or core version; make it again with this core",
+                     size, buf.len);
+    else if (!ok)
+        PyErr_Format(StateError, "the core refused the state (%zu bytes): it is corrupt or was made by another core; "
+                     "make it again with this core", size);
+    return rk_py_release(&buf, ok ? Py_NewRef(Py_None) : NULL);
+}
 
 static PyMethodDef emulator_methods[] = {
     {"load_game", (PyCFunction)emulator_load_game, METH_VARARGS, "Load a game from a path, with its bytes unless the core needs the path."},
     {"system_info", (PyCFunction)emulator_system_info, METH_NOARGS, "The core's name, version and extensions."},
     {"av_info", (PyCFunction)emulator_av_info, METH_NOARGS, "Frame rate, sample rate and geometry."},
     {"options", (PyCFunction)emulator_options, METH_NOARGS, "Core options: key -> (description, value, allowed)."},
-    {"set_option", (PyCFunction)emulator_set_option, METH_VARARGS, "Set a core option."},
-    {"set_controller", (PyCFunction)emulator_set_controller, METH_VARARGS, "Plug a device into a port."},
     {"set_sticky", (PyCFunction)emulator_set_sticky, METH_VARARGS, "Set the sticky-action probability and seed the RNG."},
     {"forget_action", (PyCFunction)emulator_forget_action, METH_NOARGS, "Apply the next action from its first frame."},
     {"held", (PyCFunction)emulator_held, METH_NOARGS, "The buttons of the last frame run, one mask per port."},
     {"run", (PyCFunction)(void (*)(void))emulator_run, METH_FASTCALL,
-     "run(actions, frames[, screen]): run frames with one button mask per port; with a screen buffer, convert "
-     "the last frame into it and return whether it fitted."},
+     "run(actions, frames[, screen]): run frames; convert the last into screen and say if it fitted."},
     {"reset", (PyCFunction)emulator_reset, METH_NOARGS, "Hard-reset the console."},
     {"screen_shape", (PyCFunction)emulator_screen_shape, METH_NOARGS, "(height, width) of the last frame."},
     {"screen", (PyCFunction)emulator_screen, METH_O, "Write the last frame as RGB into a uint8 array."},
@@ -334,7 +412,6 @@ static PyMethodDef emulator_methods[] = {
     {"memory_maps", (PyCFunction)emulator_memory_maps, METH_NOARGS, "The core's memory descriptors, with views."},
     {"capture_audio", (PyCFunction)emulator_capture_audio, METH_O, "Start or stop keeping audio samples."},
     {"take_audio", (PyCFunction)emulator_take_audio, METH_NOARGS, "Return and clear the captured int16 stereo samples."},
-    {"serialize_size", (PyCFunction)emulator_serialize_size, METH_NOARGS, "The size of a serialized state."},
     {"serialize", (PyCFunction)emulator_serialize, METH_NOARGS, "The core's state as bytes."},
     {"unserialize", (PyCFunction)emulator_unserialize, METH_O, "Restore a state made by serialize."},
     {"close", (PyCFunction)emulator_close, METH_NOARGS, "Unload the game and the core."},
@@ -343,8 +420,6 @@ static PyMethodDef emulator_methods[] = {
 
 static PyGetSetDef emulator_getset[] = {
     {"frame", (getter)emulator_get_frame, NULL, "Frames run since the core was loaded.", NULL},
-    {"pixel_format", (getter)emulator_get_pixel_format, NULL, "The core's libretro pixel format.", NULL},
-    {"closed", (getter)emulator_get_closed, NULL, "Whether close() was called.", NULL},
     {"stuck", (getter)emulator_get_stuck, NULL, "Whether the last run's first frame kept the previous buttons.", NULL},
     {NULL, NULL, NULL, NULL, NULL},
 };

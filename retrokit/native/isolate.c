@@ -89,10 +89,8 @@ static const struct {
     const char *name;
     void *replacement;
 } shims[] = {
-    {"rand", (void *)shim_rand},
-    {"random", (void *)shim_random_long},
-    {"srand", (void *)shim_srand},
-    {"srandom", (void *)shim_srand},
+    {"rand", (void *)shim_rand}, {"random", (void *)shim_random_long},
+    {"srand", (void *)shim_srand}, {"srandom", (void *)shim_srand},
 };
 
 /* ---- pointing a loaded library's relocations at the shims -------------------------------------- */
@@ -112,36 +110,22 @@ static int patch_slot(void **slot, void *value, uintptr_t relro_start, uintptr_t
     return 0;
 }
 
-static void patch_table(uintptr_t base, const ElfW(Rela) *rela, size_t size, const ElfW(Sym) *symtab,
-                        const char *strtab, uintptr_t relro_start, uintptr_t relro_end, int *patched) {
-    for (size_t i = 0; rela && i < size / sizeof(ElfW(Rela)); i++) {
-        size_t sym = ELF64_R_SYM(rela[i].r_info);
-        if (sym == 0) continue;
-        const char *name = strtab + symtab[sym].st_name;
-        for (size_t k = 0; k < sizeof shims / sizeof shims[0]; k++) {
-            if (strcmp(name, shims[k].name) == 0 &&
-                patch_slot((void **)(base + rela[i].r_offset), shims[k].replacement, relro_start, relro_end) == 0)
-                (*patched)++;
-        }
-    }
-}
-
 int rk_isolate_core(rk_core *core) {
     struct link_map *map = NULL;
     if (dlinfo(core->handle, RTLD_DI_LINKMAP, &map) != 0 || !map) return -1;
     uintptr_t base = (uintptr_t)map->l_addr;
     const ElfW(Sym) *symtab = NULL;
     const char *strtab = NULL;
-    const ElfW(Rela) *jmprel = NULL, *rela = NULL;
-    size_t jmprel_size = 0, rela_size = 0;
+    const ElfW(Rela) *tables[2] = {NULL, NULL}; /* the PLT's relocations, then the others */
+    size_t sizes[2] = {0, 0};
     for (const ElfW(Dyn) *d = map->l_ld; d->d_tag != DT_NULL; d++) {
         switch (d->d_tag) {
         case DT_SYMTAB: symtab = (const ElfW(Sym) *)absolute(base, d->d_un.d_ptr); break;
         case DT_STRTAB: strtab = (const char *)absolute(base, d->d_un.d_ptr); break;
-        case DT_JMPREL: jmprel = (const ElfW(Rela) *)absolute(base, d->d_un.d_ptr); break;
-        case DT_PLTRELSZ: jmprel_size = d->d_un.d_val; break;
-        case DT_RELA: rela = (const ElfW(Rela) *)absolute(base, d->d_un.d_ptr); break;
-        case DT_RELASZ: rela_size = d->d_un.d_val; break;
+        case DT_JMPREL: tables[0] = (const ElfW(Rela) *)absolute(base, d->d_un.d_ptr); break;
+        case DT_PLTRELSZ: sizes[0] = d->d_un.d_val; break;
+        case DT_RELA: tables[1] = (const ElfW(Rela) *)absolute(base, d->d_un.d_ptr); break;
+        case DT_RELASZ: sizes[1] = d->d_un.d_val; break;
         }
     }
     if (!symtab || !strtab) return -1;
@@ -160,7 +144,15 @@ int rk_isolate_core(rk_core *core) {
         }
     }
     int patched = 0;
-    patch_table(base, jmprel, jmprel_size, symtab, strtab, relro_start, relro_end, &patched);
-    patch_table(base, rela, rela_size, symtab, strtab, relro_start, relro_end, &patched);
+    for (int t = 0; t < 2; t++) {
+        for (size_t i = 0; tables[t] && i < sizes[t] / sizeof(ElfW(Rela)); i++) {
+            const ElfW(Rela) *r = &tables[t][i];
+            size_t sym = ELF64_R_SYM(r->r_info); /* 0: the relocation names no symbol */
+            for (size_t k = 0; sym && k < sizeof shims / sizeof shims[0]; k++)
+                if (strcmp(strtab + symtab[sym].st_name, shims[k].name) == 0 &&
+                    patch_slot((void **)(base + r->r_offset), shims[k].replacement, relro_start, relro_end) == 0)
+                    patched++;
+        }
+    }
     return patched;
 }

@@ -13,32 +13,15 @@
 #include <stdint.h>
 
 #define RK_RETRO_API_VERSION 1
-
-#define RK_RETRO_DEVICE_NONE 0
 #define RK_RETRO_DEVICE_JOYPAD 1
 #define RK_RETRO_DEVICE_ID_JOYPAD_MASK 256
-
-#define RK_RETRO_MEMORY_SAVE_RAM 0
-#define RK_RETRO_MEMORY_RTC 1
 #define RK_RETRO_MEMORY_SYSTEM_RAM 2
-#define RK_RETRO_MEMORY_VIDEO_RAM 3
+#define RK_RETRO_LOG_INFO 1
+#define RK_RETRO_NUM_CORE_OPTION_VALUES_MAX 128
 
 #define RK_RETRO_PIXEL_FORMAT_0RGB1555 0
 #define RK_RETRO_PIXEL_FORMAT_XRGB8888 1
 #define RK_RETRO_PIXEL_FORMAT_RGB565 2
-
-#define RK_RETRO_LOG_DEBUG 0
-#define RK_RETRO_LOG_INFO 1
-#define RK_RETRO_LOG_WARN 2
-#define RK_RETRO_LOG_ERROR 3
-
-#define RK_RETRO_MEMDESC_CONST (1 << 0)
-#define RK_RETRO_MEMDESC_BIGENDIAN (1 << 1)
-#define RK_RETRO_MEMDESC_SYSTEM_RAM (1 << 2)
-#define RK_RETRO_MEMDESC_SAVE_RAM (1 << 3)
-#define RK_RETRO_MEMDESC_VIDEO_RAM (1 << 4)
-
-#define RK_RETRO_NUM_CORE_OPTION_VALUES_MAX 128
 
 #define RK_ENV_EXPERIMENTAL 0x10000
 /* Environment commands, with the experimental bit where the API sets it. */
@@ -46,7 +29,6 @@
 #define RK_ENV_GET_OVERSCAN 2
 #define RK_ENV_GET_CAN_DUPE 3
 #define RK_ENV_SET_MESSAGE 6
-#define RK_ENV_SHUTDOWN 7
 #define RK_ENV_SET_PERFORMANCE_LEVEL 8
 #define RK_ENV_GET_SYSTEM_DIRECTORY 9
 #define RK_ENV_SET_PIXEL_FORMAT 10
@@ -72,121 +54,46 @@
 #define RK_ENV_SET_CORE_OPTIONS_INTL 54
 #define RK_ENV_SET_CORE_OPTIONS_DISPLAY 55
 #define RK_ENV_GET_MESSAGE_INTERFACE_VERSION 59
-#define RK_ENV_SET_MESSAGE_EXT 60
 #define RK_ENV_GET_INPUT_MAX_USERS 61
 #define RK_ENV_SET_CORE_OPTIONS_V2 67
 #define RK_ENV_SET_CORE_OPTIONS_V2_INTL 68
-#define RK_ENV_SET_CORE_OPTIONS_UPDATE_DISPLAY_CALLBACK 69
 
-struct rk_retro_variable {
-    const char *key;
-    const char *value;
-};
-
-struct rk_retro_game_info {
-    const char *path;
-    const void *data;
-    size_t size;
-    const char *meta;
-};
-
+struct rk_retro_variable { const char *key, *value; };
+struct rk_retro_game_info { const char *path; const void *data; size_t size; const char *meta; };
 struct rk_retro_system_info {
-    const char *library_name;
-    const char *library_version;
-    const char *valid_extensions;
-    bool need_fullpath;
-    bool block_extract;
+    const char *library_name, *library_version, *valid_extensions;
+    bool need_fullpath, block_extract;
 };
-
-struct rk_retro_game_geometry {
-    unsigned base_width;
-    unsigned base_height;
-    unsigned max_width;
-    unsigned max_height;
-    float aspect_ratio;
-};
-
-struct rk_retro_system_timing {
-    double fps;
-    double sample_rate;
-};
-
-struct rk_retro_system_av_info {
-    struct rk_retro_game_geometry geometry;
-    struct rk_retro_system_timing timing;
-};
-
-typedef void (*rk_retro_log_printf_t)(int level, const char *fmt, ...);
-
-struct rk_retro_log_callback {
-    rk_retro_log_printf_t log;
-};
-
-struct rk_retro_message {
-    const char *msg;
-    unsigned frames;
-};
-
+struct rk_retro_game_geometry { unsigned base_width, base_height, max_width, max_height; float aspect_ratio; };
+struct rk_retro_system_timing { double fps, sample_rate; };
+struct rk_retro_system_av_info { struct rk_retro_game_geometry geometry; struct rk_retro_system_timing timing; };
+struct rk_retro_log_callback { void (*log)(int level, const char *fmt, ...); };
+struct rk_retro_message { const char *msg; unsigned frames; };
 struct rk_retro_memory_descriptor {
     uint64_t flags;
     void *ptr;
-    size_t offset;
-    size_t start;
-    size_t select;
-    size_t disconnect;
-    size_t len;
+    size_t offset, start, select, disconnect, len;
     const char *addrspace;
 };
+struct rk_retro_memory_map { const struct rk_retro_memory_descriptor *descriptors; unsigned num_descriptors; };
 
-struct rk_retro_memory_map {
-    const struct rk_retro_memory_descriptor *descriptors;
-    unsigned num_descriptors;
-};
-
-struct rk_retro_core_option_value {
-    const char *value;
-    const char *label;
-};
-
+struct rk_retro_core_option_value { const char *value, *label; };
 struct rk_retro_core_option_definition {
-    const char *key;
-    const char *desc;
-    const char *info;
+    const char *key, *desc, *info;
     struct rk_retro_core_option_value values[RK_RETRO_NUM_CORE_OPTION_VALUES_MAX];
     const char *default_value;
 };
-
-struct rk_retro_core_options_intl {
-    struct rk_retro_core_option_definition *us;
-    struct rk_retro_core_option_definition *local;
-};
-
-struct rk_retro_core_option_v2_category {
-    const char *key;
-    const char *desc;
-    const char *info;
-};
-
+struct rk_retro_core_options_intl { struct rk_retro_core_option_definition *us, *local; };
 struct rk_retro_core_option_v2_definition {
-    const char *key;
-    const char *desc;
-    const char *desc_categorized;
-    const char *info;
-    const char *info_categorized;
-    const char *category_key;
+    const char *key, *desc, *desc_categorized, *info, *info_categorized, *category_key;
     struct rk_retro_core_option_value values[RK_RETRO_NUM_CORE_OPTION_VALUES_MAX];
     const char *default_value;
 };
-
 struct rk_retro_core_options_v2 {
-    struct rk_retro_core_option_v2_category *categories;
+    const void *categories; /* retro_core_option_v2_category: the host shows no categories */
     struct rk_retro_core_option_v2_definition *definitions;
 };
-
-struct rk_retro_core_options_v2_intl {
-    struct rk_retro_core_options_v2 *us;
-    struct rk_retro_core_options_v2 *local;
-};
+struct rk_retro_core_options_v2_intl { struct rk_retro_core_options_v2 *us, *local; };
 
 /* Callbacks the frontend hands to the core. */
 typedef bool (*rk_retro_environment_t)(unsigned cmd, void *data);

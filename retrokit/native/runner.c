@@ -65,10 +65,6 @@ static void *worker_main(void *arg) {
     }
 }
 
-static void wake(rk_worker *w) {
-    if (atomic_load(&w->sleeping)) sem_post(&w->wake);
-}
-
 int rk_runner_init(rk_runner *r, int threads) {
     memset(r, 0, sizeof *r);
     r->workers = calloc((size_t)(threads > 0 ? threads : 1), sizeof(rk_worker));
@@ -95,7 +91,7 @@ void rk_runner_run(rk_runner *r, rk_task *tasks, int n) {
     for (int i = 0; i < helpers; i++) {
         rk_worker *w = &r->workers[i];
         atomic_fetch_add(&w->start, 1);
-        wake(w);
+        if (atomic_load(&w->sleeping)) sem_post(&w->wake);
     }
     take_tasks(r);
     for (int i = 0; i < helpers; i++) {

@@ -7,7 +7,6 @@
 #include <stdint.h>
 
 #include "core.h"
-#include "video.h"
 
 /* One emulator's share of a batched step. */
 typedef struct {

@@ -20,44 +20,24 @@ static inline uint8_t widen6(unsigned v) { return (uint8_t)(v << 2); }
 #define RK_VECTORISED
 #endif
 
-RK_VECTORISED static void rows_xrgb8888(const uint8_t *restrict src, size_t pitch, unsigned w, unsigned h,
-                                       uint8_t *restrict dst) {
-    for (size_t y = 0; y < h; y++) {
-        const uint32_t *restrict row = (const uint32_t *)(src + y * pitch);
-        for (size_t x = 0; x < w; x++, dst += 3) {
-            uint32_t p = row[x];
-            dst[0] = (uint8_t)(p >> 16);
-            dst[1] = (uint8_t)(p >> 8);
-            dst[2] = (uint8_t)p;
-        }
+/* One row loop per pixel format: each `type` pixel p becomes the bytes r, g, b. */
+#define RK_ROWS(name, type, r, g, b)                                                                            \
+    RK_VECTORISED static void name(const uint8_t *restrict src, size_t pitch, unsigned w, unsigned h,           \
+                                   uint8_t *restrict dst) {                                                     \
+        for (size_t y = 0; y < h; y++) {                                                                        \
+            const type *restrict row = (const type *)(src + y * pitch);                                         \
+            for (size_t x = 0; x < w; x++, dst += 3) {                                                          \
+                unsigned p = row[x];                                                                            \
+                dst[0] = (uint8_t)(r);                                                                          \
+                dst[1] = (uint8_t)(g);                                                                          \
+                dst[2] = (uint8_t)(b);                                                                          \
+            }                                                                                                   \
+        }                                                                                                       \
     }
-}
 
-RK_VECTORISED static void rows_rgb565(const uint8_t *restrict src, size_t pitch, unsigned w, unsigned h,
-                                     uint8_t *restrict dst) {
-    for (size_t y = 0; y < h; y++) {
-        const uint16_t *restrict row = (const uint16_t *)(src + y * pitch);
-        for (size_t x = 0; x < w; x++, dst += 3) {
-            unsigned p = row[x];
-            dst[0] = widen5((p >> 11) & 0x1f);
-            dst[1] = widen6((p >> 5) & 0x3f);
-            dst[2] = widen5(p & 0x1f);
-        }
-    }
-}
-
-RK_VECTORISED static void rows_0rgb1555(const uint8_t *restrict src, size_t pitch, unsigned w, unsigned h,
-                                       uint8_t *restrict dst) {
-    for (size_t y = 0; y < h; y++) {
-        const uint16_t *restrict row = (const uint16_t *)(src + y * pitch);
-        for (size_t x = 0; x < w; x++, dst += 3) {
-            unsigned p = row[x];
-            dst[0] = widen5((p >> 10) & 0x1f);
-            dst[1] = widen5((p >> 5) & 0x1f);
-            dst[2] = widen5(p & 0x1f);
-        }
-    }
-}
+RK_ROWS(rows_xrgb8888, uint32_t, p >> 16, p >> 8, p)
+RK_ROWS(rows_rgb565, uint16_t, widen5((p >> 11) & 0x1f), widen6((p >> 5) & 0x3f), widen5(p & 0x1f))
+RK_ROWS(rows_0rgb1555, uint16_t, widen5((p >> 10) & 0x1f), widen5((p >> 5) & 0x1f), widen5(p & 0x1f))
 
 int rk_frame_to_rgb(const void *frame, size_t pitch, unsigned width, unsigned height, int format, uint8_t *dst) {
     if (!frame) {
@@ -65,16 +45,9 @@ int rk_frame_to_rgb(const void *frame, size_t pitch, unsigned width, unsigned he
         return 0;
     }
     switch (format) {
-    case RK_RETRO_PIXEL_FORMAT_XRGB8888:
-        rows_xrgb8888(frame, pitch, width, height, dst);
-        return 0;
-    case RK_RETRO_PIXEL_FORMAT_RGB565:
-        rows_rgb565(frame, pitch, width, height, dst);
-        return 0;
-    case RK_RETRO_PIXEL_FORMAT_0RGB1555:
-        rows_0rgb1555(frame, pitch, width, height, dst);
-        return 0;
-    default:
-        return -1;
+    case RK_RETRO_PIXEL_FORMAT_XRGB8888: rows_xrgb8888(frame, pitch, width, height, dst); return 0;
+    case RK_RETRO_PIXEL_FORMAT_RGB565: rows_rgb565(frame, pitch, width, height, dst); return 0;
+    case RK_RETRO_PIXEL_FORMAT_0RGB1555: rows_0rgb1555(frame, pitch, width, height, dst); return 0;
+    default: return -1;
     }
 }

@@ -13,7 +13,7 @@ filters, look at them, and write the one you found into the game's
     search.filter("decreased")
     for candidate in search.candidates():
         print(candidate.address, candidate.type, candidate.values)
-    search.save_field("lives", 0xFF002B, "|u1")
+    search.save_field("lives", 0xFF002B, "|u1", game_file="my-games/Dasher-Genesis/game.yaml")
     search.save("dasher.session")              # resume with RamSearch.load
 """
 

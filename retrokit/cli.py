@@ -2,12 +2,14 @@
 
 The commands live in :mod:`retrokit.commands`, one module each. Errors that
 retrokit raises on purpose (:class:`~retrokit.errors.RetrokitError`) are printed
-as one message, without a traceback, and exit with status 2.
+as one message, without a traceback, and exit with status 2; so, as a last
+resort, is a file-system error that escaped them.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from collections.abc import Sequence
 
@@ -45,6 +47,16 @@ def main(argv: Sequence[str] | None = None) -> int:
         return int(args.run(args) or 0)
     except RetrokitError as exc:
         print(f"retrokit: error: {exc}", file=sys.stderr)
+        return ERROR_STATUS
+    except BrokenPipeError:
+        # Whoever read the output stopped (`retrokit games | head`): end quietly, as other
+        # command-line tools do. Point stdout at /dev/null so that flushing it at exit
+        # does not raise a second time.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 1
+    except OSError as exc:  # the last resort (file code raises RetrokitError); after BrokenPipeError, an OSError
+        where = f" ({exc.filename})" if exc.filename else ""
+        print(f"retrokit: error: a file operation failed{where}: {exc.strerror or exc}.", file=sys.stderr)
         return ERROR_STATUS
     except KeyboardInterrupt:
         print("retrokit: interrupted", file=sys.stderr)

@@ -66,6 +66,26 @@ class CoreNotFoundError(CoreError):
     """No libretro core for a system was found in any search location."""
 
 
+class CoreBuildError(RetrokitError):
+    """Building a core from source failed (retrokit build-core)."""
+
+
+class BuildToolError(CoreBuildError):
+    """A tool the build needs (a C compiler, make, pip) is not installed."""
+
+
+class SourceFetchError(CoreBuildError):
+    """The package index could not be reached to fetch a core's source."""
+
+
+class SourceNotFoundError(CoreBuildError):
+    """The package index has no source package (sdist) of that stable-retro version."""
+
+
+class PatchError(CoreBuildError):
+    """A patch does not apply to the source it was given."""
+
+
 class UnsupportedSystemError(UnknownNameError):
     """A ROM, file extension or system name maps to no known system."""
 
@@ -99,6 +119,10 @@ class RomMismatchError(RomError, ValueError):
 
 class FileConflictError(RetrokitError, FileExistsError):
     """Writing would replace a different file the user already has."""
+
+
+class FileSystemError(RetrokitError, OSError):
+    """A file or folder cannot be read or written: a file where a folder should be, no permission, a full disk."""
 
 
 class MovieError(RetrokitError, ValueError):

@@ -17,12 +17,18 @@ The stable-retro wheel is located without importing its Python code.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import importlib.metadata
 import importlib.util
 import os
+import stat
 import tempfile
+from collections.abc import Iterator
 from pathlib import Path
+from typing import BinaryIO
+
+from retrokit.errors import FileSystemError
 
 GAMES_ENV = "RETROKIT_GAMES"
 DATA_ENV = "RETROKIT_DATA"
@@ -148,16 +154,37 @@ def atomic_write(path: Path | str, data: bytes, *, overwrite: bool = False) -> N
 
     Raises:
         FileExistsError: ``path`` exists and ``overwrite`` is false.
+        FileSystemError: The folder cannot be made or written (a file in its
+            way, no permission, a read-only or full disk).
+    """
+    with atomic_output(path, overwrite=overwrite) as f:
+        f.write(data)
+
+
+@contextlib.contextmanager
+def atomic_output(path: Path | str, *, overwrite: bool = False) -> Iterator[BinaryIO]:
+    """Open a temporary file beside ``path`` to write into; put it in place when the block ends.
+
+    Like :func:`atomic_write`, for output written piece by piece (a long GIF)
+    that should never be held in memory whole. If the block raises, the
+    temporary file is deleted and ``path`` is left as it was.
+
+    Raises:
+        FileExistsError: ``path`` exists and ``overwrite`` is false.
+        FileSystemError: The folder cannot be made or written.
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    ensure_folder(path.parent, f"to write {path.name} into")
+    try:
+        fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    except OSError as exc:
+        raise _cannot(path.parent, f"to write {path.name} into", exc) from None
     tmp = Path(tmp_name)
     try:
         # mkstemp makes the file private (0600); give it the mode any new file gets.
         os.chmod(fd, 0o666 & ~_umask())
         with os.fdopen(fd, "wb") as f:
-            f.write(data)
+            yield f
             f.flush()
             os.fsync(f.fileno())
         if overwrite:
@@ -171,5 +198,76 @@ def atomic_write(path: Path | str, data: bytes, *, overwrite: bool = False) -> N
             if path.exists():
                 raise FileExistsError(path) from None
             os.replace(tmp, path)
+    except FileExistsError:
+        raise
+    except FileSystemError:
+        raise
+    except OSError as exc:  # a full disk, a file system gone read-only meanwhile
+        raise _cannot(path, "written", exc) from None
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def _cannot(path: Path, purpose: str, exc: OSError) -> FileSystemError:
+    """The error for a folder that exists but cannot be written, or a file that cannot be."""
+    reason = exc.strerror or str(exc)
+    if purpose == "written":
+        return FileSystemError(
+            f"Expected to write {str(path)!r}; found it cannot be written: {reason}. "
+            "Free some space, or choose another place."
+        )
+    return FileSystemError(
+        f"Expected a writable folder at {str(path)!r} {purpose}; found it cannot be written: {reason}. "
+        "Choose another place, or make the folder writable."
+    )
+
+
+def ensure_folder(folder: Path | str, purpose: str = "written") -> Path:
+    """Create ``folder`` (and its parents) if needed; return it.
+
+    Args:
+        folder: The folder.
+        purpose: What it is for, in the error message (``"to write x.gif into"``).
+
+    Raises:
+        FileSystemError: A file stands where the folder or one of its parents
+            should be, or the folder cannot be created.
+    """
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:  # mkdir says FileExistsError for a file in the way: not a conflict, a wrong path
+        if folder.exists():
+            reason = "a file, not a folder"
+        elif isinstance(exc, (FileExistsError, NotADirectoryError)):
+            reason = "a file where one of its parent folders should be"
+        else:
+            reason = exc.strerror or str(exc)
+        raise FileSystemError(
+            f"Expected a folder at {str(folder)!r} {purpose}; found {reason}. Choose another place, or move the file."
+        ) from None
+    return folder
+
+
+def require_regular_file(path: Path | str, what: str) -> Path:
+    """Return ``path`` if it is a regular file (symlinks followed).
+
+    A FIFO would block a reader forever and a device (``/dev/zero``) never
+    end, so neither is ever read as a data file.
+
+    Args:
+        path: The file.
+        what: What it should be, for the error (``"a .bk2 movie"``).
+
+    Raises:
+        FileSystemError: ``path`` is missing, a folder, a device, a FIFO or a socket.
+    """
+    path = Path(path)
+    try:
+        mode = path.stat().st_mode
+    except OSError as exc:
+        raise FileSystemError(f"Expected {what} at {str(path)!r}; found {exc.strerror or exc}.") from None
+    if not stat.S_ISREG(mode):
+        kind = "a folder" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode) else "a device or socket"
+        raise FileSystemError(f"Expected {what} at {str(path)!r}; found {kind}, which is not a file retrokit reads.")
+    return path

@@ -122,3 +122,16 @@ def test_python_dash_m(tmp_path):
     )
     assert done.returncode == 0, done.stderr
     assert "Airstriker-Genesis" in done.stdout
+
+
+@pytest.mark.parametrize("command", [["games"], ["cores"]], ids=["games", "cores"])
+def test_a_closed_pipe_ends_the_command_quietly(command: list[str]) -> None:
+    # `retrokit games | head -1`: the reader goes away after one line.
+    process = subprocess.Popen(
+        [sys.executable, "-m", "retrokit", *command], stdout=subprocess.PIPE, stderr=subprocess.PIPE
+    )
+    process.stdout.readline()
+    process.stdout.close()
+    stderr = process.stderr.read().decode()
+    process.wait(timeout=120)
+    assert "Traceback" not in stderr and "BrokenPipeError" not in stderr

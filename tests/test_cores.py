@@ -5,9 +5,9 @@ from __future__ import annotations
 import ctypes
 
 import native_c as native_c_module
-from native_c import PIXEL_FORMATS
 import numpy as np
 import pytest
+from native_c import PIXEL_FORMATS
 
 from retrokit.native import _host
 from retrokit.paths import wheel_cores_dir

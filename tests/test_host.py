@@ -349,7 +349,8 @@ def test_missing_core_says_where_it_looked(monkeypatch: pytest.MonkeyPatch, tmp_
     monkeypatch.setattr(cores, "wheel_cores_dir", lambda: None)
     monkeypatch.setattr(cores, "_DEBIAN_DIRS", ())
     monkeypatch.setenv("RETROKIT_CORES", str(tmp_path))
-    with pytest.raises(CoreNotFoundError, match=rf"genesis_plus_gx_libretro.so in one of: {tmp_path}.*RETROKIT_CORES"):
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))  # no core built by retrokit build-core either
+    with pytest.raises(CoreNotFoundError, match=rf"genesis_plus_gx_libretro.so in one of: {tmp_path}, {tmp_path}/data/cores.*RETROKIT_CORES"):
         cores.find_core("genesis_plus_gx")
 
 

@@ -25,8 +25,10 @@ def run(args: argparse.Namespace) -> int:
     """Convert, then print or write the YAML."""
     from retrokit.dsl import convert_scenario_json
     from retrokit.errors import FileConflictError
-    from retrokit.paths import atomic_write
+    from retrokit.paths import atomic_write, require_regular_file
 
+    if args.source.exists():  # a FIFO would block, a device never end
+        require_regular_file(args.source, "a Gym Retro scenario.json")
     text = convert_scenario_json(args.source)
     if args.out is None:
         print(text, end="")

@@ -12,6 +12,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from retrokit.errors import FileConflictError
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``demo`` command."""
@@ -55,7 +57,9 @@ def free_names(folder: Path, stem: str) -> tuple[Path, Path]:
         gif, png = folder / f"{base}.gif", folder / f"{base}.png"
         if not gif.exists() and not png.exists():
             return gif, png
-    raise FileExistsError(f"Expected a free file name for {stem} in {folder}; all 10000 are taken.")
+    raise FileConflictError(
+        f"Expected a free file name for {stem} in {folder}; found all 10000 taken. Delete some, or pass --out."
+    )
 
 
 def run(args: argparse.Namespace) -> int:
@@ -68,12 +72,13 @@ def run(args: argparse.Namespace) -> int:
 
     import retrokit
     from retrokit.errors import InvalidArgumentError
-    from retrokit.paths import atomic_write
+    from retrokit.paths import atomic_write, ensure_folder
 
     if args.episodes < 1 or args.max_steps < 1:
         raise InvalidArgumentError(
             f"Expected --episodes and --max-steps of 1 or more, got {args.episodes} and {args.max_steps}."
         )
+    ensure_folder(args.out, "for the GIF and PNG")  # before playing, so a bad --out costs nothing
     state = retrokit.State.DEFAULT if args.state is None else args.state
     env = retrokit.make(
         args.game, state, frameskip=4, sticky_prob=0.25, max_episode_steps=args.max_steps,
@@ -113,7 +118,10 @@ def run(args: argparse.Namespace) -> int:
     gif_bytes, png_bytes = io.BytesIO(), io.BytesIO()
     pictures[0].save(gif_bytes, "GIF", save_all=True, append_images=pictures[1:], duration=2 * 4 * 1000 // 60, loop=0)
     pictures[-1].save(png_bytes, "PNG")
-    atomic_write(gif, gif_bytes.getvalue())
-    atomic_write(png, png_bytes.getvalue())
+    try:
+        atomic_write(gif, gif_bytes.getvalue())
+        atomic_write(png, png_bytes.getvalue())
+    except FileExistsError:  # another demo took the name meanwhile
+        raise FileConflictError(f"Expected {gif} and {png} to be free; found one written meanwhile. Run again.") from None
     print(f"saved {gif} ({len(pictures)} frames) and {png}")
     return 0

@@ -16,7 +16,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="import ROMs of known games from folders and zip files",
         description="Search files, folders and zip files for the ROMs of known games (by SHA-1, "
         "by stable-retro's rules), and copy each match into the data folder. A different ROM "
-        "already imported is never replaced unless --overwrite is given.",
+        "already imported is never replaced unless --overwrite is given. A progress bar counts the files "
+        "searched, on standard error.",
     )
     parser.add_argument("paths", nargs="*", metavar="PATH", help="files, folders or zip files to search")
     parser.add_argument("--game", metavar="NAME", help="show the SHA-1s this game expects, and whether its ROM is present")
@@ -51,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
     game = find_game(args.game) if args.game else None
     status = 0
     if args.paths:
-        report = import_roms(args.paths, data_dir=args.data_dir, overwrite=args.overwrite)
+        report = import_roms(args.paths, data_dir=args.data_dir, overwrite=args.overwrite, progress=True)
         print(f"Imported {len(report.imported)} ROM{'s' * (len(report.imported) != 1)} into {report.data_dir / 'roms'}.")
         _section("Imported", [f"{r.game} <- {r.source}" for r in report.imported], True)
         _section("Already imported", [f"{r.game} <- {r.source}" for r in report.already_present], args.verbose)

@@ -29,8 +29,8 @@ def run(args: argparse.Namespace) -> int:
     width = max(len(o.name) for o in outcomes)
     for outcome in outcomes:
         print(f"{outcome.name:<{width}}  {outcome.status:<10}  {outcome.path}")
-    differs = [o.name for o in outcomes if o.status == "differs"]
+    differs = [o.name for o in outcomes if o.status in ("differs", "damaged")]
     if differs:
-        print(f"{len(differs)} state(s) differ from their recipe; rerun with --force to replace them.")
+        print(f"{len(differs)} state(s) differ from their recipe or are damaged; rerun with --force to replace them.")
         return 1
     return 0

@@ -12,7 +12,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="replay a .bk2 movie into PNG frames, a GIF or an MP4",
         description="Replay a .bk2 movie (recorded by retrokit or stable-retro) on its game's ROM, "
         "and write the screens: into a folder as frame_000000.png, ... (numbered by movie frame), "
-        "or into OUT.gif, or OUT.mp4 (needs: pip install 'retrokit[video]').",
+        "or into OUT.gif (30 frames a second at most), or OUT.mp4 (needs: pip install 'retrokit[video]'). "
+        "A progress bar shows on standard error.",
     )
     parser.add_argument("movie", metavar="MOVIE.bk2", help="the movie to replay")
     parser.add_argument("out", metavar="OUT", help="a folder for PNG frames, or a .gif or .mp4 file")
@@ -25,6 +26,6 @@ def run(args: argparse.Namespace) -> int:
     """Replay the movie and write its screens."""
     from retrokit.movie import export
 
-    count = export(args.movie, args.out, every=args.every, overwrite=args.overwrite)
+    count = export(args.movie, args.out, every=args.every, overwrite=args.overwrite, progress=True)
     print(f"Wrote {count} frame{'s' * (count != 1)} of {args.movie} to {args.out}.")
     return 0

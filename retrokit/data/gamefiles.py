@@ -128,6 +128,16 @@ def _field(source: Path, name: str, entry: Any) -> FieldSpec:
     mask = None if entry.get("mask") is None else _int(source, f"the mask of {where}", entry["mask"])
     if address < 0:  # masks may be negative: Gym Retro's are two's complement (Amidar-Atari2600)
         raise data_error(source, f"{where} to have a non-negative address", repr(entry), "fix the address")
+    if address >= 1 << 64:
+        raise data_error(source, f"{where} to have an address below 2**64", f"{address:#x}", "fix the address")
+    if mask is not None:
+        if not -(1 << 63) <= mask < 1 << 64:
+            raise data_error(
+                source, f"the mask of {where} to fit in 64 bits (the widest field is 8 bytes)", f"{mask:#x}",
+                "fix the mask",
+            )
+        if mask >= 1 << 63:  # the same 64 bits as a signed number, as fields are decoded
+            mask -= 1 << 64
     try:
         return FieldSpec(name, address, code, mask)
     except FieldTypeError as exc:  # the type code; FieldSpec parses it
@@ -159,13 +169,17 @@ def read_game_yaml(path: str | os.PathLike[str]) -> GameInfo:
     """
     import yaml
 
+    from retrokit.data.yamlfile import DuplicateKeyError, load_yaml
+
     source = Path(path)
     try:
-        doc = yaml.load(source.read_text(encoding="utf-8"), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+        doc = load_yaml(source.read_text(encoding="utf-8"))
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
         problem = getattr(exc, "problem", None) or exc
+        if isinstance(exc, DuplicateKeyError):
+            raise data_error(source, "each key once in a mapping", f"{problem}{at}", "remove or rename one") from exc
         raise data_error(source, "valid YAML", f"a syntax error{at}: {problem}", "fix the YAML syntax") from exc
     except (OSError, UnicodeDecodeError) as exc:
         raise data_error(source, "a readable UTF-8 file", str(exc), "check the file") from exc
@@ -207,6 +221,7 @@ def _read_json(path: Path, required: bool) -> dict[str, Any]:
     if not path.is_file() and not required:
         return {}
     try:
+        # Duplicate keys are kept as json keeps them (the last wins): the wheel's own data files have some.
         doc = json.loads(path.read_text(encoding="utf-8"))
     except json.JSONDecodeError as exc:
         raise data_error(

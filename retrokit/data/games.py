@@ -228,7 +228,7 @@ class Game:
         only if its SHA-1 is one the game accepts.
         """
         for path in self._rom_candidates(data_dir):
-            if _cached_sha1(path, self.system) in self.sha1s:
+            if cached_rom_sha1(path, self.system) in self.sha1s:
                 return path
         return None
 
@@ -251,7 +251,7 @@ class Game:
         expected = ", ".join(self.sha1s)
         candidates = self._rom_candidates(data_dir)
         if candidates:
-            found = "; ".join(f"{p} has SHA-1 {_cached_sha1(p, self.system)}" for p in candidates)
+            found = "; ".join(f"{p} has SHA-1 {cached_rom_sha1(p, self.system)}" for p in candidates)
             raise RomMismatchError(
                 f"Expected a ROM of {self.name} with SHA-1 {expected}; found {found}. "
                 "Delete that file, then import the right ROM with: retrokit import /path/to/your/roms"
@@ -393,7 +393,9 @@ def find_game(name: str) -> Game:
 _sha1_cache: dict[tuple[str, int, int, str], str] = {}
 
 
-def _cached_sha1(path: Path, system: System) -> str:
+def cached_rom_sha1(path: Path, system: System | str) -> str:
+    """Return a ROM file's SHA-1 (stable-retro's rules), hashed once per file version."""
+    system = get_system(system)
     stat = path.stat()
     key = (str(path), stat.st_size, stat.st_mtime_ns, system.name)
     if key not in _sha1_cache:

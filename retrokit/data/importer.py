@@ -1,7 +1,8 @@
 """ROM import: find the ROMs of known games in folders and zip files, and copy them in.
 
-Every file under the given paths is a candidate, as are the members of zip
-files (read in memory, nested zips too) and the zip files themselves (FBNeo
+Every regular file under the given paths is a candidate (devices, FIFOs and
+sockets are skipped: they would block or never end), as are the members of zip
+files (nested zips too, spooled to a temporary file) and the zip files themselves (FBNeo
 arcade sets are zips). Each candidate is hashed by stable-retro's rules (see
 :mod:`retrokit.data.roms`) and matched against the SHA-1s of every known game. A
 match is written, through a temporary file, to ``<data>/roms/<Game>/rom.<ext>``
@@ -12,12 +13,17 @@ never replaced unless asked. Folders whose names start with ``.`` (``.git``,
 
 from __future__ import annotations
 
-import io
 import os
+import stat
+import tempfile
 import zipfile
+import zlib
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import IO, BinaryIO
+
+from tqdm import tqdm
 
 from retrokit import paths
 from retrokit.data import roms
@@ -26,6 +32,9 @@ from retrokit.errors import RetrokitError, RomError
 from retrokit.host.systems import extension_of
 
 MAX_ZIP_DEPTH = 3
+MAX_NESTED_ZIP_SIZE = 256 * 2**20
+"""The largest zip inside a zip that is searched (spooled to a temporary file, never held in memory)."""
+_CHUNK = 2**20
 _TOO_BIG = f"larger than {roms.MAX_ROM_SIZE // 2**20} MiB"
 
 
@@ -115,6 +124,31 @@ def _too_big(size: int) -> bool:
     return size > roms.MAX_FILE_SIZE
 
 
+def _read_capped(stream: BinaryIO, limit: int) -> bytes | None:
+    """Read ``stream`` whole, or return ``None`` once it proves longer than ``limit`` bytes.
+
+    Sizes that files and zip headers declare can lie (a device, a growing
+    file, a forged header), so only the bytes really read count.
+    """
+    data = stream.read(limit + 1)
+    return None if len(data) > limit else data
+
+
+def _spool_member(archive: zipfile.ZipFile, info: zipfile.ZipInfo) -> IO[bytes] | None:
+    """A nested zip member, copied to memory (small) or a temporary file, or ``None`` past the cap."""
+    spool = tempfile.SpooledTemporaryFile(max_size=roms.MAX_FILE_SIZE)  # noqa: SIM115 - handed to the caller
+    with archive.open(info) as member:
+        copied = 0
+        while chunk := member.read(_CHUNK):
+            copied += len(chunk)
+            if copied > MAX_NESTED_ZIP_SIZE:
+                spool.close()
+                return None
+            spool.write(chunk)
+    spool.seek(0)
+    return spool
+
+
 def _zip_candidates(label: str, opener: Callable[[], zipfile.ZipFile], report: ImportReport, depth: int) -> Iterator[_Candidate]:
     try:
         with opener() as archive:
@@ -123,53 +157,88 @@ def _zip_candidates(label: str, opener: Callable[[], zipfile.ZipFile], report: I
                     continue
                 member = f"{label}!{info.filename}"
                 ext = extension_of(info.filename)
-                if _too_big(info.file_size) and ext != "zip":
+                if _too_big(info.file_size) and ext != "zip":  # declared too big: no need to read it
                     report.skipped.append((member, _TOO_BIG))
                     continue
                 try:
-                    data = archive.read(info)
-                except (zipfile.BadZipFile, OSError, RuntimeError, NotImplementedError) as exc:
+                    if ext == "zip" and depth < MAX_ZIP_DEPTH:
+                        yield from _nested_zip_candidates(member, archive, info, report, depth)
+                        continue
+                    with archive.open(info) as stream:
+                        data = _read_capped(stream, roms.MAX_FILE_SIZE)
+                except (zipfile.BadZipFile, OSError, RuntimeError, NotImplementedError, EOFError, zlib.error) as exc:
                     report.skipped.append((member, f"unreadable zip member: {exc}"))
                     continue
-                yield from _blob_candidates(member, ext, data, report, depth + 1)
-    except (zipfile.BadZipFile, OSError) as exc:
+                if data is None:
+                    report.skipped.append((member, _TOO_BIG))
+                    continue
+                yield member, ext, lambda data=data: data
+    except (zipfile.BadZipFile, OSError, EOFError) as exc:
         report.skipped.append((label, f"not a readable zip file: {exc}"))
 
 
-def _blob_candidates(label: str, ext: str, data: bytes, report: ImportReport, depth: int) -> Iterator[_Candidate]:
-    if ext == "zip" and depth <= MAX_ZIP_DEPTH:
-        if not _too_big(len(data)):
-            yield label, ext, lambda: data
-        yield from _zip_candidates(label, lambda: zipfile.ZipFile(io.BytesIO(data)), report, depth)
-    elif not _too_big(len(data)):
-        yield label, ext, lambda: data
+def _nested_zip_candidates(
+    member: str, archive: zipfile.ZipFile, info: zipfile.ZipInfo, report: ImportReport, depth: int
+) -> Iterator[_Candidate]:
+    """A zip inside a zip: itself (an arcade set) if small enough, and its members."""
+    spool = _spool_member(archive, info)
+    if spool is None:
+        report.skipped.append((member, f"a zip larger than {MAX_NESTED_ZIP_SIZE // 2**20} MiB inside a zip"))
+        return
+    with spool:
+        size = spool.seek(0, os.SEEK_END)
+        spool.seek(0)
+        if not _too_big(size):
+            data = spool.read()
+            spool.seek(0)
+            yield member, "zip", lambda: data
+        yield from _zip_candidates(member, lambda: zipfile.ZipFile(spool), report, depth + 1)
+
+
+def _regular_file_size(path: Path, report: ImportReport) -> int | None:
+    """The size of ``path`` if it is a regular file (after symlinks); else note why it is skipped."""
+    try:
+        info = path.stat()
+    except OSError as exc:
+        report.skipped.append((str(path), f"unreadable: {exc.strerror or exc}"))
+        return None
+    if not stat.S_ISREG(info.st_mode):  # a FIFO would block, a device (/dev/zero) never end
+        report.skipped.append((str(path), "not a regular file (a device, FIFO or socket)"))
+        return None
+    return info.st_size
+
+
+def _read_file(path: Path) -> bytes:
+    with open(path, "rb") as f:
+        data = _read_capped(f, roms.MAX_FILE_SIZE)
+    if data is None:
+        raise RomError(f"{path}: expected a ROM of at most {roms.MAX_ROM_SIZE // 2**20} MiB; found a file that grew past it.")
+    return data
 
 
 def _file_candidates(path: Path, report: ImportReport) -> Iterator[_Candidate]:
     label, ext = str(path), extension_of(path)
-    try:
-        size = path.stat().st_size
-    except OSError as exc:
-        report.skipped.append((label, f"unreadable: {exc.strerror or exc}"))
+    size = _regular_file_size(path, report)
+    if size is None:
         return
     if ext == "zip":
         if not _too_big(size):
-            yield label, ext, path.read_bytes
+            yield label, ext, lambda: _read_file(path)
         yield from _zip_candidates(label, lambda: zipfile.ZipFile(path), report, 1)
     elif _too_big(size):
         report.skipped.append((label, _TOO_BIG))
     else:
-        yield label, ext, path.read_bytes
+        yield label, ext, lambda: _read_file(path)
 
 
 def _walk(path: Path, report: ImportReport) -> Iterator[_Candidate]:
-    if path.is_file():
-        yield from _file_candidates(path, report)
-    elif path.is_dir():
+    if path.is_dir():
         for root, dirs, files in os.walk(path):
             dirs[:] = sorted(d for d in dirs if not d.startswith("."))
             for name in sorted(files):
                 yield from _file_candidates(Path(root) / name, report)
+    elif path.exists():
+        yield from _file_candidates(path, report)
     else:
         report.skipped.append((str(path), "no such file or folder"))
 
@@ -204,6 +273,7 @@ def import_roms(
     data_dir: str | os.PathLike[str] | None = None,
     overwrite: bool = False,
     games: Iterable[Game] | None = None,
+    progress: bool = False,
 ) -> ImportReport:
     """Find the ROMs of known games under ``sources`` and copy them into the data folder.
 
@@ -212,22 +282,26 @@ def import_roms(
         data_dir: The data folder; by default :func:`retrokit.paths.data_dir`.
         overwrite: Replace a different ROM already imported for the same game.
         games: The games to match against; by default every known game.
+        progress: Show a progress bar (on standard error) of the files searched.
 
     Returns:
         What was imported, already present, in conflict, unmatched and skipped.
     """
     report = ImportReport(Path(data_dir) if data_dir is not None else paths.data_dir())
     table, report.broken_games = known_hashes(games)
-    for label, ext, read in (c for source in sources for c in _walk(Path(source), report)):
-        try:
-            data, sha1 = roms.groom_rom(read(), ext)
-        except (OSError, RomError) as exc:
-            report.skipped.append((label, str(exc)))
-            continue
-        matches = table.get(sha1)
-        if not matches:
-            report.unmatched.append(label)
-            continue
-        for game in matches:
-            _store(game, label, data, sha1, report, overwrite)
+    candidates = (c for source in sources for c in _walk(Path(source), report))
+    # closed on any error too, so an error prints on a line of its own
+    with tqdm(candidates, desc="Searching", unit=" files", disable=not progress) as bar:
+        for label, ext, read in bar:
+            try:
+                data, sha1 = roms.groom_rom(read(), ext)
+            except (OSError, RomError) as exc:
+                report.skipped.append((label, str(exc)))
+                continue
+            matches = table.get(sha1)
+            if not matches:
+                report.unmatched.append(label)
+                continue
+            for game in matches:
+                _store(game, label, data, sha1, report, overwrite)
     return report

@@ -27,8 +27,9 @@ from typing import Any
 
 import numpy as np
 
-from retrokit.data.games import Game
-from retrokit.data.states import read_state, write_state
+from retrokit.data.games import Game, cached_rom_sha1
+from retrokit.data.statecheck import load_state
+from retrokit.data.states import StateRecord, write_state
 from retrokit.errors import DataFileError, InvalidArgumentError, StateError, StateNotFoundError, did_you_mean
 from retrokit.host.emulator import Emulator
 from retrokit.host.memory import FieldReader
@@ -58,39 +59,115 @@ def recipes(game: Game) -> dict[str, Recipe]:
     raw = game.info.extra.get("integrate") or {}
     if not isinstance(raw, Mapping):
         raise DataFileError(
-            f"{game.info.source}: expected 'integrate' to map state names to recipes, got {type(raw).__name__}."
+            f"{game.info.source}: expected 'integrate' to map state names to recipes; found {_show(raw)}."
         )
     return {str(name): _recipe(game, str(name), spec) for name, spec in raw.items()}
+
+
+_RECIPE_KEYS = ("set", "press", "until", "settle", "max_frames")
+MAX_RECIPE_FRAMES = 1_000_000  # about 4.6 hours of play: a recipe that needs more is a mistake
 
 
 def _recipe(game: Game, name: str, spec: Any) -> Recipe:
     where = f"{game.info.source}: the recipe of state {name!r}"
     if not isinstance(spec, Mapping):
-        raise DataFileError(f"{where}: expected a mapping with set, press, until, got {spec!r}.")
-    unknown = set(spec) - {"set", "press", "until", "settle", "max_frames"}
+        raise DataFileError(f"{where}: expected a mapping with set, press, until; found {_show(spec)}.")
+    unknown = set(map(str, spec)) - set(_RECIPE_KEYS)
     if unknown:
         key = min(unknown)
         raise DataFileError(
-            f"{where}: expected only the keys set, press, until, settle, max_frames; got {key!r}."
-            + did_you_mean(key, ["set", "press", "until", "settle", "max_frames"])
+            f"{where}: expected only the keys {', '.join(_RECIPE_KEYS)}; found {key!r}." + did_you_mean(key, _RECIPE_KEYS)
         )
-    for part in ("set", "until"):
-        for key in spec.get(part) or {}:
-            if key not in game.fields:
-                raise DataFileError(f"{where}: {part} names no field of the game: {key!r}." + did_you_mean(key, game.fields))
     if not spec.get("until"):
         raise DataFileError(f"{where}: expected 'until', the field values that mark arrival, such as {{game_mode: 1}}.")
-    press = spec.get("press") or {}
-    if not isinstance(press, Mapping):
-        press = {1: press}
     return Recipe(
         name=name,
-        set={str(k): int(v) for k, v in (spec.get("set") or {}).items()},
-        press={int(port): tuple(buttons) for port, buttons in press.items()},
-        until={str(k): int(v) for k, v in spec["until"].items()},
-        settle=int(spec.get("settle", 0)),
-        max_frames=int(spec.get("max_frames", 3000)),
+        set=_values(game, where, "set", spec.get("set")),
+        press=_press(game, where, spec.get("press")),
+        until=_values(game, where, "until", spec["until"]),
+        settle=_count(where, "settle", spec.get("settle", 0), 0),
+        max_frames=_count(where, "max_frames", spec.get("max_frames", 3000), 1),
     )
+
+
+def _show(value: Any) -> str:
+    text = repr(value)
+    return f"{type(value).__name__} {text if len(text) <= 60 else text[:57] + '...'}"
+
+
+def _integer(value: Any) -> int | None:
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, int):
+        return value
+    if isinstance(value, str):
+        try:
+            return int(value, 0)
+        except ValueError:
+            return None
+    return None
+
+
+def _values(game: Game, where: str, part: str, raw: Any) -> dict[str, int]:
+    """``set`` or ``until``: field names to values that fit the field."""
+    if raw is None:
+        return {}
+    if not isinstance(raw, Mapping):
+        raise DataFileError(f"{where}: expected {part!r} to map field names to values, such as {{zone: 0}}; found {_show(raw)}.")
+    values = {}
+    for key, value in raw.items():
+        key = str(key)
+        if key not in game.fields:
+            raise DataFileError(f"{where}: {part} names no field of the game: {key!r}." + did_you_mean(key, game.fields))
+        number = _integer(value)
+        if number is None:
+            raise DataFileError(f"{where}: expected {part} {key!r} to be an integer; found {_show(value)}.")
+        low, high = game.fields[key].field_type.value_range()
+        if not low <= number <= high:
+            raise DataFileError(
+                f"{where}: expected {part} {key!r} to fit its type {game.fields[key].type} ({low} to {high}); found {number}."
+            )
+        values[key] = number
+    return values
+
+
+def _press(game: Game, where: str, raw: Any) -> dict[int, tuple[str, ...]]:
+    """``press``: a list of buttons for port 1, or ports (1, 2, ...) to lists of buttons."""
+    if raw is None:
+        return {}
+    by_port = raw if isinstance(raw, Mapping) else {1: raw}
+    system = game.system
+    press = {}
+    for port, buttons in by_port.items():
+        number = _integer(port)
+        ports = _ports(game)
+        if number is None or not 1 <= number <= ports:
+            raise DataFileError(f"{where}: expected press to name ports 1 to {ports}; found {_show(port)}.")
+        if not isinstance(buttons, list) or not all(isinstance(b, str) for b in buttons):
+            raise DataFileError(
+                f"{where}: expected press to list button names, such as [START]; found {_show(buttons)}."
+            )
+        for button in buttons:
+            if button not in system.buttons:
+                known = [b for b in system.buttons if b]
+                raise DataFileError(
+                    f"{where}: expected {system.name} buttons ({', '.join(known)}); found {button!r}."
+                    + did_you_mean(button, known)
+                )
+        press[number] = tuple(buttons)
+    return press
+
+
+def _ports(game: Game) -> int:
+    """The controller ports a recipe's emulator has: one per player, and at least two, as an env's."""
+    return max(2, game.players)
+
+
+def _count(where: str, key: str, value: Any, least: int) -> int:
+    number = _integer(value)
+    if number is None or not least <= number <= MAX_RECIPE_FRAMES:
+        raise DataFileError(f"{where}: expected {key} to be a number of frames from {least} to {MAX_RECIPE_FRAMES}; found {_show(value)}.")
+    return number
 
 
 def make_state(game: Game, recipe: Recipe) -> bytes:
@@ -99,7 +176,7 @@ def make_state(game: Game, recipe: Recipe) -> bytes:
     Raises:
         StateError: The recipe did not arrive within its frame budget.
     """
-    with Emulator(game.system, game.require_rom()) as emu:
+    with Emulator(game.system, game.require_rom(), ports=_ports(game)) as emu:
         reader = FieldReader(game.fields, emu.space)
         masks = [0] * emu.ports
         for port, buttons in recipe.press.items():
@@ -135,7 +212,7 @@ class Outcome:
     """What integrating one state did."""
 
     name: str
-    status: str  # "made", "up to date", "replaced", "differs"
+    status: str  # "made", "up to date", "replaced", "differs", "damaged" (unreadable, or crashes the core)
     path: Path
 
 
@@ -149,7 +226,8 @@ def integrate(game: Game, names: list[str] | None = None, *, force: bool = False
 
     Returns:
         One outcome per state. ``"differs"`` means the file was kept although
-        it does not match its recipe (rerun with ``force`` to replace it).
+        it does not match its recipe, ``"damaged"`` that it was kept although it
+        is not a state the core can load (rerun with ``force`` to replace either).
     """
     known = recipes(game)
     if not known:
@@ -164,15 +242,21 @@ def integrate(game: Game, names: list[str] | None = None, *, force: bool = False
         if name not in known:
             raise StateNotFoundError(f"Expected a state with a recipe ({', '.join(known)}), got {name!r}." + did_you_mean(name, known))
         made = make_state(game, known[name])
+        record = StateRecord.of(game.name, cached_rom_sha1(game.require_rom(), game.system), made)
         path = folder / f"{name}.state"
         if not path.exists():
-            write_state(path, made)
+            write_state(path, made, record=record)
             outcomes.append(Outcome(name, "made", path))
-        elif fingerprint(game, read_state(path)) == fingerprint(game, made):
+            continue
+        try:  # a damaged file is probed in a child first, so it cannot crash this process
+            existing = load_state(game, path)
+        except StateError:
+            existing = None
+        if existing is not None and fingerprint(game, existing) == fingerprint(game, made):
             outcomes.append(Outcome(name, "up to date", path))
         elif force:
-            write_state(path, made, overwrite=True)
+            write_state(path, made, overwrite=True, record=record)
             outcomes.append(Outcome(name, "replaced", path))
         else:
-            outcomes.append(Outcome(name, "differs", path))
+            outcomes.append(Outcome(name, "differs" if existing is not None else "damaged", path))
     return outcomes

@@ -3,32 +3,60 @@
 A ``.state`` file is the bytes a libretro core's ``retro_serialize`` returns,
 gzip-compressed. Whether a state fits a core (its size) is checked when it is
 loaded into an emulator; this module checks that the file is a whole, valid
-gzip stream.
+gzip stream, no larger than any core's state once inflated.
+
+States retrokit writes carry a :class:`StateRecord` (the game, its ROM's SHA-1
+and the state's SHA-256) in the gzip header's extra field (RFC 1952, subfield
+``RK``), which every gzip reader, stable-retro's included, skips: the file
+stays an ordinary ``.state``.
 """
 
 from __future__ import annotations
 
 import gzip
+import hashlib
+import io
+import json
 import os
+import stat
 import zlib
+from dataclasses import dataclass
 from pathlib import Path
 
 from retrokit.errors import FileConflictError, StateError
 from retrokit.paths import atomic_write
 
 GZIP_MAGIC = b"\x1f\x8b"
+MAX_STATE_SIZE = 16 * 2**20
+"""The largest core state read (Genesis Plus GX's is 1 MiB; no supported core's is near 16 MiB)."""
+MAX_STATE_FILE_SIZE = MAX_STATE_SIZE + 2**20
+"""The largest ``.state`` file read: a state that deflate could not shrink, with room for gzip's framing."""
 
 
-def decompress_state(blob: bytes, *, source: str = "the state") -> bytes:
+def _inflate(blob: bytes, max_size: int) -> bytes | None:
+    """Inflate a gzip stream, or return ``None`` as soon as it would pass ``max_size`` bytes.
+
+    A gzip bomb (1 MiB inflating to 1 GiB) is refused after ``max_size`` bytes,
+    never inflated whole. Raises what :func:`gzip.decompress` raises for a bad stream.
+    """
+    with gzip.GzipFile(fileobj=io.BytesIO(blob)) as stream:
+        data = stream.read(max_size + 1)
+    return None if len(data) > max_size else data
+
+
+def decompress_state(blob: bytes, *, source: str = "the state", max_size: int | None = None) -> bytes:
     """Return the core state inside a gzip-compressed ``blob``.
 
     Args:
         blob: The contents of a ``.state`` file.
         source: What to call the blob in error messages (usually its path).
+        max_size: Refuse a state that inflates past this many bytes (by default
+            :data:`MAX_STATE_SIZE`; the core's own size when it is known).
 
     Raises:
-        StateError: ``blob`` is empty, not gzip, truncated or corrupt.
+        StateError: ``blob`` is empty, not gzip, truncated, corrupt or too large.
     """
+    max_size = MAX_STATE_SIZE if max_size is None else max_size
     fix = "Record the state again, or copy it again from where it came from."
     if not blob:
         raise StateError(f"{source}: expected a gzip-compressed save state; found an empty file. {fix}")
@@ -39,7 +67,7 @@ def decompress_state(blob: bytes, *, source: str = "the state") -> bytes:
             "core state, compress it with retrokit.data.states.write_state. " + fix
         )
     try:
-        data = gzip.decompress(blob)
+        data = _inflate(blob, max_size)
     except EOFError as exc:
         raise StateError(
             f"{source}: expected a complete gzip stream; found one that ends early after "
@@ -47,6 +75,11 @@ def decompress_state(blob: bytes, *, source: str = "the state") -> bytes:
         ) from exc
     except (gzip.BadGzipFile, zlib.error, OSError) as exc:
         raise StateError(f"{source}: expected a valid gzip stream; found a corrupt one ({exc}). {fix}") from exc
+    if data is None:
+        raise StateError(
+            f"{source}: expected a save state of at most {max_size} bytes once inflated (no core's state is "
+            f"larger); found a gzip stream of {len(blob)} bytes that inflates past that: it is not a save state."
+        )
     if not data:
         raise StateError(f"{source}: expected a serialized core state; found a gzip stream of 0 bytes. {fix}")
     return data
@@ -56,24 +89,111 @@ def read_state(path: str | os.PathLike[str]) -> bytes:
     """Read a ``.state`` file and return the serialized core state.
 
     Raises:
+        StateError: The file is missing, empty, not gzip, truncated, corrupt or too large.
+    """
+    return read_state_file(path).data
+
+
+def read_state_file(path: str | os.PathLike[str]) -> StateFile:
+    """Read a ``.state`` file: the serialized core state, and retrokit's record if it has one.
+
+    Raises:
         StateError: The file is missing, empty, not gzip, truncated or corrupt.
     """
     path = Path(path)
     try:
-        blob = path.read_bytes()
+        if not stat.S_ISREG(path.stat().st_mode):  # a FIFO would block, a device never end
+            raise StateError(f"Expected a save state file at {str(path)!r}; found a folder, device or FIFO.")
+        with open(path, "rb") as f:
+            blob = f.read(MAX_STATE_FILE_SIZE + 1)
     except OSError as exc:
         raise StateError(
             f"Expected a readable save state at {str(path)!r}; found an error: {exc.strerror or exc}."
         ) from exc
-    return decompress_state(blob, source=str(path))
+    if len(blob) > MAX_STATE_FILE_SIZE:
+        raise StateError(
+            f"{path}: expected a save state file of at most {MAX_STATE_FILE_SIZE} bytes; found a larger one. "
+            "It is not a save state."
+        )
+    return StateFile(decompress_state(blob, source=str(path)), state_record(blob))
 
 
-def compress_state(data: bytes) -> bytes:
-    """Return ``data`` gzip-compressed the way ``.state`` files are (reproducibly: no timestamp)."""
-    return gzip.compress(bytes(data), compresslevel=9, mtime=0)
+@dataclass(frozen=True)
+class StateRecord:
+    """What retrokit records in a state it writes.
+
+    Attributes:
+        game: The game's name, ``<Name>-<System>``.
+        rom_sha1: The SHA-1 of the ROM the state was made on.
+        sha256: The SHA-256 of the serialized state, so a file changed since is told apart.
+    """
+
+    game: str
+    rom_sha1: str
+    sha256: str
+
+    @classmethod
+    def of(cls, game: str, rom_sha1: str, data: bytes) -> StateRecord:
+        """The record of ``data``, a state of ``game`` made on the ROM with SHA-1 ``rom_sha1``."""
+        return cls(game, rom_sha1, hashlib.sha256(data).hexdigest())
+
+    def describes(self, data: bytes) -> bool:
+        """Whether ``data`` is exactly the state this record was written with."""
+        return hashlib.sha256(data).hexdigest() == self.sha256
 
 
-def write_state(path: str | os.PathLike[str], data: bytes, *, overwrite: bool = False) -> Path:
+@dataclass(frozen=True)
+class StateFile:
+    """A ``.state`` file's contents: the serialized state, and retrokit's record if it has one."""
+
+    data: bytes
+    record: StateRecord | None
+
+
+_FEXTRA = 4
+_RECORD_ID = b"RK"
+
+
+def state_record(blob: bytes) -> StateRecord | None:
+    """Return the record in a gzip-compressed state's header, or ``None`` (stable-retro's states have none)."""
+    if len(blob) < 12 or blob[:2] != GZIP_MAGIC or not blob[3] & _FEXTRA:
+        return None
+    end = 12 + int.from_bytes(blob[10:12], "little")
+    at = 12
+    while at + 4 <= end:
+        size = int.from_bytes(blob[at + 2 : at + 4], "little")
+        if blob[at : at + 2] == _RECORD_ID:
+            try:
+                doc = json.loads(blob[at + 4 : at + 4 + size].decode("utf-8"))
+                return StateRecord(str(doc["game"]), str(doc["rom_sha1"]), str(doc["sha256"]))
+            except (ValueError, KeyError, TypeError):
+                return None  # not ours after all: treat the state as one without a record
+        at += 4 + size
+    return None
+
+
+def compress_state(data: bytes, record: StateRecord | None = None) -> bytes:
+    """Return ``data`` gzip-compressed the way ``.state`` files are (reproducibly: no timestamp).
+
+    Args:
+        data: The serialized state.
+        record: What to record in the gzip header's extra field.
+    """
+    if record is None:
+        return gzip.compress(bytes(data), compresslevel=9, mtime=0)
+    payload = json.dumps({"game": record.game, "rom_sha1": record.rom_sha1, "sha256": record.sha256}).encode()
+    extra = _RECORD_ID + len(payload).to_bytes(2, "little") + payload
+    # ID1 ID2, deflate, FEXTRA, mtime 0, XFL 2 (best compression), OS 255 (unknown), as gzip.compress writes.
+    header = GZIP_MAGIC + bytes([8, _FEXTRA]) + bytes(4) + bytes([2, 255]) + len(extra).to_bytes(2, "little") + extra
+    deflate = zlib.compressobj(9, zlib.DEFLATED, -zlib.MAX_WBITS)
+    body = deflate.compress(bytes(data)) + deflate.flush()
+    trailer = (zlib.crc32(data) & 0xFFFFFFFF).to_bytes(4, "little") + (len(data) & 0xFFFFFFFF).to_bytes(4, "little")
+    return header + body + trailer
+
+
+def write_state(
+    path: str | os.PathLike[str], data: bytes, *, overwrite: bool = False, record: StateRecord | None = None
+) -> Path:
     """Write a serialized core state to a ``.state`` file, gzip-compressed.
 
     The file is written to a temporary file and renamed into place. Writing the
@@ -83,6 +203,7 @@ def write_state(path: str | os.PathLike[str], data: bytes, *, overwrite: bool = 
         path: The destination file.
         data: The serialized core state (uncompressed).
         overwrite: Replace a different existing file.
+        record: What to record in the file (see :class:`StateRecord`).
 
     Returns:
         The path written.
@@ -104,7 +225,7 @@ def write_state(path: str | os.PathLike[str], data: bytes, *, overwrite: bool = 
             return path
         raise _conflict(path)
     try:
-        atomic_write(path, compress_state(data), overwrite=overwrite)
+        atomic_write(path, compress_state(data, record), overwrite=overwrite)
     except FileExistsError:
         raise _conflict(path) from None
     return path

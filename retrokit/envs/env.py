@@ -20,7 +20,7 @@ import numpy as np
 from gymnasium import spaces
 
 from retrokit.data.games import Game, find_game
-from retrokit.data.states import read_state
+from retrokit.data.statecheck import load_state
 from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
 from retrokit.envs.stepper import Stepper, drive
@@ -59,6 +59,9 @@ class RetroEnv(gymnasium.Env):
             rewards and stopping at the frame it is done, as Gym Retro's
             frame-skip wrappers do. Off, it runs once per step.
         options: Core options overriding the system's defaults.
+        skip_video: Tell the core that only a step's last frame is seen (none
+            with RAM observations and no render mode), so a core that asks
+            skips drawing the rest (``retrokit build-core``); False draws all.
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 60}
@@ -79,6 +82,7 @@ class RetroEnv(gymnasium.Env):
         record: str | os.PathLike[str] | None = None,
         scenario_every_frame: bool = False,
         options: Mapping[str, str] | None = None,
+        skip_video: bool = True,
     ) -> None:
         self.game: Game = find_game(game)
         _check_choice("obs_type", obs_type, OBS_TYPES)
@@ -128,6 +132,8 @@ class RetroEnv(gymnasium.Env):
         self._first_obs: np.ndarray | None = None
         self._first_frame: np.ndarray | None = None
         self._at_start = False
+        seen = "last" if obs_type == "rgb" or render_mode is not None else "none"
+        self.emulator.set_video_frames(seen if skip_video else "all")
 
     @property
     def direct_screen(self) -> bool:
@@ -140,13 +146,13 @@ class RetroEnv(gymnasium.Env):
         if state is None or state is State.DEFAULT:
             by_players = self.game.default_player_states
             name = by_players[self.players - 1] if len(by_players) >= self.players else self.game.default_state
-            return (name, read_state(self.game.state_path(name))) if name else (None, None)
+            return (name, load_state(self.game, self.game.state_path(name))) if name else (None, None)
         if state is State.NONE:
             return None, None
         path = Path(state)
         if path.suffix == ".state" and path.is_file():
-            return path.stem, read_state(path)
-        return str(state), read_state(self.game.state_path(str(state)))
+            return path.stem, load_state(self.game, path)
+        return str(state), load_state(self.game, self.game.state_path(str(state)))
 
     def _load_scenario(self, scenario: str | os.PathLike[str] | Mapping[str, Any] | None) -> Any:
         from retrokit.dsl.scenario import load_scenario

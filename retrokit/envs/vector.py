@@ -93,7 +93,8 @@ class ThreadedVectorEnv(VectorEnv):
         names = {tuple(env.reader.names) for env in envs}
         if len(names) == 1 and all(env.players == 1 and env.reader.fits_int64 for env in envs):
             keys = names.pop()
-            self._step_arrays = Pool(lambda: StepArrays(self.num_envs, keys))
+            num_envs = self.num_envs  # not self: a closure over self would keep the envs alive until GC
+            self._step_arrays = Pool(lambda: StepArrays(num_envs, keys))
             self._field_values = [memoryview(env.reader.values) for env in envs]
         return Runner([env.emulator for env in envs], self.threads - 1)
 

@@ -1,30 +1,44 @@
 """Finding libretro cores on disk.
 
-Cores are searched, in order, in the folders of ``RETROKIT_CORES`` (separated
-by ``os.pathsep``), the stable-retro wheel's ``cores/`` folder, and Debian's
-libretro folders.
+Cores are searched, in order, in:
+
+1. the folders of ``RETROKIT_CORES`` (separated by ``os.pathsep``),
+2. the cores built by ``retrokit build-core`` in the data folder
+   (``<data>/cores``), each used only while it was built from the installed
+   stable-retro version (its save states must fit the wheel's),
+3. the stable-retro wheel's ``cores/`` folder,
+4. Debian's libretro folders.
 """
 
 from __future__ import annotations
 
+import importlib.metadata
+import json
 import os
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 from retrokit.errors import CoreNotFoundError
-from retrokit.paths import wheel_cores_dir
+from retrokit.paths import data_dir, wheel_cores_dir
 
+CORES_ENV = "RETROKIT_CORES"
 _DEBIAN_DIRS = ("/usr/lib/x86_64-linux-gnu/libretro", "/usr/lib/aarch64-linux-gnu/libretro", "/usr/lib/libretro")
 
 
-def core_dirs() -> list[Path]:
-    """Return the folders searched for cores, in order."""
-    dirs = [Path(p) for p in os.environ.get("RETROKIT_CORES", "").split(os.pathsep) if p]
-    wheel = wheel_cores_dir()
-    if wheel is not None:
-        dirs.append(wheel)
-    dirs.extend(Path(d) for d in _DEBIAN_DIRS)
-    return dirs
+@dataclass(frozen=True)
+class FoundCore:
+    """A core's shared library and where it came from.
+
+    Attributes:
+        path: The shared library.
+        origin: ``"RETROKIT_CORES"``, ``"built"``, ``"wheel"`` or ``"system"``.
+        note: A short remark for listings (a built core's patch and source version).
+    """
+
+    path: Path
+    origin: str
+    note: str = ""
 
 
 def core_filename(core: str) -> str:
@@ -33,20 +47,82 @@ def core_filename(core: str) -> str:
     return f"{core}_libretro{suffix}"
 
 
+def stable_retro_version() -> str | None:
+    """Return the installed stable-retro version, or ``None``."""
+    try:
+        return importlib.metadata.version("stable-retro")
+    except importlib.metadata.PackageNotFoundError:
+        return None
+
+
+def built_cores_dir(data: Path | str | None = None) -> Path:
+    """Return where ``retrokit build-core`` installs cores: ``<data>/cores``."""
+    return (Path(data) if data is not None else data_dir()) / "cores"
+
+
+def build_record_path(core: str, data: Path | str | None = None) -> Path:
+    """Return the file that describes a built core: ``<data>/cores/<core>.build.json``."""
+    return built_cores_dir(data) / f"{core}.build.json"
+
+
+def read_build_record(core: str, data: Path | str | None = None) -> dict[str, str] | None:
+    """Return what ``retrokit build-core`` recorded about a built core, or ``None`` if nothing readable."""
+    try:
+        record = json.loads(build_record_path(core, data).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return record if isinstance(record, dict) else None
+
+
+def built_core(core: str, data: Path | str | None = None) -> FoundCore | None:
+    """Return the core ``retrokit build-core`` made, if it exists and fits the installed stable-retro."""
+    path = built_cores_dir(data) / core_filename(core)
+    record = read_build_record(core, data)
+    if not path.is_file() or record is None or record.get("stable_retro") != stable_retro_version():
+        return None
+    return FoundCore(path, "built", f"{record.get('patch', 'unpatched')}, from stable-retro {record['stable_retro']}")
+
+
+def locate_core(core: str) -> FoundCore:
+    """Return a core's shared library and where it was found, searching in the order above.
+
+    Raises:
+        CoreNotFoundError: No search folder holds the core.
+    """
+    name = core_filename(core)
+    searched = [Path(p) for p in os.environ.get(CORES_ENV, "").split(os.pathsep) if p]
+    for folder in searched:
+        if (folder / name).is_file():
+            return FoundCore(folder / name, CORES_ENV)
+    built = built_core(core)
+    if built is not None:
+        return built
+    searched.append(built_cores_dir())
+    wheel = wheel_cores_dir()
+    others = [(wheel, "wheel")] if wheel is not None else []
+    others += [(Path(d), "system") for d in _DEBIAN_DIRS]
+    for folder, origin in others:
+        if (folder / name).is_file():
+            return FoundCore(folder / name, origin)
+        searched.append(folder)
+    raise CoreNotFoundError(
+        f"Expected the libretro core {name} in one of: {', '.join(str(d) for d in searched)}; found it in none. "
+        f"Install the stable-retro wheel (pip install 'stable-retro>=1.0,<2'), or put the core in a folder "
+        f"and name that folder in {CORES_ENV}."
+    )
+
+
 def find_core(core: str) -> Path:
     """Return the path of a core's shared library, such as ``genesis_plus_gx``.
 
     Raises:
         CoreNotFoundError: No search folder holds the core.
     """
-    name = core_filename(core)
-    searched = core_dirs()
-    for folder in searched:
-        candidate = folder / name
-        if candidate.is_file():
-            return candidate
-    raise CoreNotFoundError(
-        f"Expected the libretro core {name} in one of: {', '.join(str(d) for d in searched)}; found it in none. "
-        f"Install the stable-retro wheel (pip install 'stable-retro>=1.0,<2'), or put the core in a folder "
-        f"and name that folder in RETROKIT_CORES."
-    )
+    return locate_core(core).path
+
+
+def wheel_core(core: str) -> Path | None:
+    """Return the stable-retro wheel's own build of a core, or ``None`` (to compare a built core with)."""
+    folder = wheel_cores_dir()
+    path = folder / core_filename(core) if folder is not None else None
+    return path if path is not None and path.is_file() else None

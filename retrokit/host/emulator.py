@@ -18,6 +18,7 @@ import numpy as np
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean
 from retrokit.host import primitives
 from retrokit.host.cores import find_core
+from retrokit.host.elf import check_core_file
 from retrokit.host.memory import AddressSpace
 from retrokit.host.systems import System, get_system, system_for_extension
 from retrokit.paths import data_dir
@@ -63,6 +64,7 @@ class Emulator:
             raise InvalidArgumentError(f"Expected 1 to {primitives.MAX_PORTS} ports, got {ports}.")
         self.ports = ports
         core = Path(core_path) if core_path is not None else find_core(self.system.core)
+        check_core_file(core)  # a damaged library would make the loader kill the process
         merged = {**self.system.options, **(options or {})}
         folder = data_dir()
         system_dir, save_dir = folder / "system", folder / "saves"
@@ -133,6 +135,29 @@ class Emulator:
         if not 0.0 <= float(prob) <= 1.0:
             raise InvalidArgumentError(f"Expected a sticky-action probability in [0, 1], got {prob}.")
         self._emu.set_sticky(float(prob), int(seed) & 0xFFFFFFFFFFFFFFFF)
+
+    def set_video_frames(self, which: str) -> None:
+        """Tell the core which frames of each ``run`` anyone will look at.
+
+        The host answers libretro's ``GET_AUDIO_VIDEO_ENABLE`` with it: a core
+        that asks (the Genesis Plus GX ``retrokit build-core`` makes) skips
+        drawing the others; emulation, and so RAM, is unchanged. With
+        ``"last"`` or ``"none"`` audio is reported unwanted unless captured.
+
+        Args:
+            which: ``"all"`` (the default), ``"last"`` or ``"none"``.
+        """
+        modes = {"all": primitives.VIDEO_ALL, "last": primitives.VIDEO_LAST, "none": primitives.VIDEO_NONE}
+        if which not in modes:
+            raise InvalidArgumentError(
+                f"Expected video frames 'all', 'last' or 'none', got {which!r}." + did_you_mean(str(which), modes)
+            )
+        self._emu.set_video_frames(modes[which])
+
+    @property
+    def av_asked(self) -> int:
+        """How often the core asked whether video and audio are wanted (0: it never asks, so never skips)."""
+        return self._emu.av_asked
 
     def forget_action(self) -> None:
         """Make the next ``run`` apply its buttons from its first frame."""

@@ -134,7 +134,10 @@ class FieldReader:
         self.plan = np.zeros((len(specs), primitives.PLAN_COLUMNS), dtype=np.int64)
         for row, spec in zip(self.plan, specs):
             ftype = spec.field_type
-            index, offs = space.offsets(spec.address, ftype.width)
+            try:
+                index, offs = space.offsets(spec.address, ftype.width)
+            except InvalidArgumentError as exc:  # name the field, so the data file can be fixed
+                raise InvalidArgumentError(f"Field {spec.name!r} ({spec.address:#x}, {spec.type}): {exc}") from None
             row[0], row[1], row[2] = index, ftype.width, ftype.kind
             row[3] = -1 if spec.mask is None else spec.mask
             row[4 : 4 + ftype.width] = [offs[i] for i in ftype.significance()]

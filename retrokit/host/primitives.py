@@ -24,3 +24,7 @@ read_fields = _host.read_fields
 MAX_PORTS: int = _host.MAX_PORTS
 PLAN_COLUMNS: int = _host.PLAN_COLUMNS
 MEMORY_SYSTEM_RAM: int = _host.MEMORY_SYSTEM_RAM
+# Which frames of a run the core is told are seen (GET_AUDIO_VIDEO_ENABLE; docs/cores.md).
+VIDEO_ALL: int = _host.VIDEO_ALL
+VIDEO_LAST: int = _host.VIDEO_LAST
+VIDEO_NONE: int = _host.VIDEO_NONE

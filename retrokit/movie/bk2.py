@@ -35,10 +35,13 @@ import zipfile
 import zlib
 from pathlib import Path
 
+from retrokit.data.states import MAX_STATE_SIZE
 from retrokit.errors import FileConflictError, MovieError, UnsupportedSystemError
 from retrokit.movie.model import Layout, Movie, layout, platform_of, system_of_platform
-from retrokit.paths import atomic_write
+from retrokit.paths import atomic_write, require_regular_file
 
+MAX_TEXT_SIZE = 32 * 2**20
+"""The largest header or input log read: about a million frames (over four hours at 60 fps)."""
 INPUT_LOG = "Input Log.txt"
 HEADER = "Header.txt"
 STATE = "Core.bin"
@@ -59,6 +62,10 @@ def read_bk2(path: str | os.PathLike[str]) -> Movie:
             the file, what was expected and what was found.
     """
     path = Path(path)
+    if path.is_dir():
+        raise MovieError(f"Expected a .bk2 movie at {path}; found a folder.")
+    if path.exists():
+        require_regular_file(path, "a .bk2 movie")  # a FIFO would block, a device never end
     try:
         with zipfile.ZipFile(path) as archive:
             names = archive.namelist()
@@ -70,7 +77,7 @@ def read_bk2(path: str | os.PathLike[str]) -> Movie:
                     )
             header_text = _text(path, archive, HEADER)
             log_text = _text(path, archive, INPUT_LOG)
-            state = archive.read(STATE) if STATE in names else None
+            state = _member(path, archive, STATE, MAX_STATE_SIZE) if STATE in names else None
     except FileNotFoundError:
         raise MovieError(f"Expected a .bk2 movie at {path}; found no such file.") from None
     except IsADirectoryError:
@@ -85,9 +92,21 @@ def read_bk2(path: str | os.PathLike[str]) -> Movie:
     return Movie(game, system, players, state or None, frames, header)
 
 
+def _member(path: Path, archive: zipfile.ZipFile, member: str, limit: int) -> bytes:
+    """A member's bytes, refused once more than ``limit`` of them inflate (a zip bomb is never inflated whole)."""
+    with archive.open(member) as stream:
+        data = stream.read(limit + 1)
+    if len(data) > limit:
+        raise MovieError(
+            f"{path}: expected {member!r} to hold at most {limit} bytes; found more. It is not a movie retrokit "
+            "or stable-retro wrote."
+        )
+    return data
+
+
 def _text(path: Path, archive: zipfile.ZipFile, member: str) -> str:
     try:
-        return archive.read(member).decode("utf-8")
+        return _member(path, archive, member, MAX_TEXT_SIZE).decode("utf-8")
     except UnicodeDecodeError as exc:
         raise MovieError(f"{path}: expected {member!r} to be UTF-8 text; found bytes that are not ({exc}).") from None
 

@@ -31,6 +31,10 @@ DEFAULT_HEADER = {
 }
 
 
+#: The header key under which retrokit records its start state's SHA-256 (beside the ROM's, under SHA1).
+STATE_DIGEST = "StateSHA256"
+
+
 def _default_header() -> dict[str, str]:
     return dict(DEFAULT_HEADER)
 

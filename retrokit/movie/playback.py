@@ -2,21 +2,33 @@
 
 from __future__ import annotations
 
-import io
 import os
+import re
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
+from tqdm import tqdm
 
-from retrokit.errors import FileConflictError, GameNotFoundError, InvalidArgumentError, MovieError, RomError
+from retrokit.data.states import StateRecord
+from retrokit.errors import (
+    DataFileError,
+    FileConflictError,
+    FileSystemError,
+    GameNotFoundError,
+    InvalidArgumentError,
+    MovieError,
+    RomError,
+)
 from retrokit.host.emulator import Emulator
 from retrokit.movie.bk2 import read_bk2
-from retrokit.movie.model import Movie
-from retrokit.paths import atomic_write
+from retrokit.movie.gif import GifWriter, gif_step
+from retrokit.movie.model import STATE_DIGEST, Movie
+from retrokit.paths import atomic_output, atomic_write, ensure_folder
 
 FRAME_PATTERN = "frame_{:06d}.png"
+_SHA1 = re.compile(r"[0-9a-f]{40}")
 VIDEO_SUFFIXES = (".gif", ".mp4")
 
 
@@ -33,7 +45,33 @@ def open_emulator(movie: Movie) -> Emulator:
     return Emulator(movie.system, rom, ports=max(2, movie.players))
 
 
-def play(movie: Movie | str | os.PathLike[str], *, emulator: Emulator | None = None) -> Iterator[np.ndarray]:
+def check_movie_state(movie: Movie, emu: Emulator, source: str) -> None:
+    """Refuse a movie's start state that is for another ROM, or that crashes or hangs the core.
+
+    A movie retrokit recorded names its ROM's SHA-1 and its state's SHA-256 in
+    its header; one that does not (stable-retro's), or whose state changed
+    since, is probed in a child process first (see :mod:`retrokit.data.statecheck`).
+
+    Raises:
+        StateError: The state is for another ROM, or the core cannot run it.
+    """
+    from retrokit.data.games import cached_rom_sha1, find_game
+    from retrokit.data.probe import vet_state
+    from retrokit.data.statecheck import check_state
+
+    sha1 = movie.header.get("SHA1", "?").strip().lower()
+    record = StateRecord(movie.game, sha1, movie.header.get(STATE_DIGEST, "")) if _SHA1.fullmatch(sha1) else None
+    try:
+        game = find_game(movie.game)
+    except (GameNotFoundError, DataFileError):  # a movie of a game retrokit does not know: probe it all the same
+        vet_state(movie.state, emu.system.name, emu.rom, cached_rom_sha1(emu.rom, emu.system), source=source)
+        return
+    check_state(game, movie.state, record, source=source, rom=emu.rom)
+
+
+def play(
+    movie: Movie | str | os.PathLike[str], *, emulator: Emulator | None = None, source: str | None = None
+) -> Iterator[np.ndarray]:
     """Replay a movie, yielding the screen after each of its frames.
 
     The emulator is set to the movie's start state (or reset to power-on if it
@@ -43,6 +81,7 @@ def play(movie: Movie | str | os.PathLike[str], *, emulator: Emulator | None = N
         movie: A movie, or the path of a ``.bk2`` file.
         emulator: An emulator of the movie's game to replay on; its sticky-action
             probability is set to 0. By default one is opened (and closed after).
+        source: What to call the movie's start state in errors (by default its path, or its game).
 
     Yields:
         RGB ``uint8`` arrays of shape (H, W, 3), one per movie frame.
@@ -50,6 +89,8 @@ def play(movie: Movie | str | os.PathLike[str], *, emulator: Emulator | None = N
     Raises:
         MovieError: The movie is malformed, or ``emulator`` runs another system or has too few ports.
     """
+    if source is None:
+        source = f"the start state (Core.bin) of the {movie.game} movie" if isinstance(movie, Movie) else f"{movie}: Core.bin"
     if not isinstance(movie, Movie):
         movie = read_bk2(movie)
     own = emulator is None
@@ -63,6 +104,7 @@ def play(movie: Movie | str | os.PathLike[str], *, emulator: Emulator | None = N
         emu.set_sticky(0.0, 0)
         emu.forget_action()
         if movie.state is not None:
+            check_movie_state(movie, emu, source)
             emu.set_state(movie.state)
         else:
             emu.reset()
@@ -80,6 +122,7 @@ def export(
     *,
     every: int = 1,
     overwrite: bool = False,
+    progress: bool = False,
 ) -> int:
     """Replay a movie into PNG frames, an animated GIF or an MP4 video.
 
@@ -89,6 +132,7 @@ def export(
             file ending in ``.gif`` (Pillow) or ``.mp4`` (needs ``imageio`` with ffmpeg).
         every: Keep one frame in ``every`` (the video's frame rate shrinks to match).
         overwrite: Replace the output file, or frames already in the folder.
+        progress: Show a progress bar (on standard error) while the movie plays.
 
     Returns:
         How many images were written.
@@ -115,16 +159,25 @@ def export(
         emu = open_emulator(movie)
     except (GameNotFoundError, RomError) as exc:
         raise type(exc)(f"{movie_path} plays {movie.game}. {exc}") from None
-    try:
+    bar = tqdm(total=len(movie.frames), unit="frame", disable=not progress, desc=Path(movie_path).name)
+    try:  # the bar is closed on any error, so the error prints on a line of its own
+        ensure_folder(out if kind is None else out.parent, "for the frames" if kind is None else f"to write {out.name} into")
         fps = float(emu.av_info()["fps"]) / every
-        frames = ((i, f) for i, f in enumerate(play(movie, emulator=emu)) if i % every == 0)
+        frames = ((i, f) for i, f in enumerate(_counted(play(movie, emulator=emu, source=f"{movie_path}: Core.bin"), bar)) if i % every == 0)
         if kind is None:
             return _write_pngs(frames, out)
         if kind == ".gif":
             return _write_gif(frames, out, fps, overwrite)
         return _write_mp4(imageio, frames, out, fps, overwrite)
     finally:
+        bar.close()
         emu.close()
+
+
+def _counted(screens: Iterator[np.ndarray], bar: tqdm) -> Iterator[np.ndarray]:
+    for screen in screens:
+        bar.update(1)
+        yield screen
 
 
 def _output_kind(out: Path) -> str | None:
@@ -137,6 +190,11 @@ def _output_kind(out: Path) -> str | None:
     if suffix:
         raise InvalidArgumentError(
             f"Expected the output to be a folder (for PNG frames), a .gif or an .mp4 file; found {str(out)!r}."
+        )
+    if out.exists():
+        raise InvalidArgumentError(
+            f"Expected the output to be a folder (for PNG frames), a .gif or an .mp4 file; found {str(out)!r}, "
+            "a file without a suffix. Name a folder, or a file ending in .gif or .mp4."
         )
     return None
 
@@ -156,28 +214,39 @@ def _require_imageio(out: Path):  # the imageio.v2 module
 def _write_pngs(frames: Iterator[tuple[int, np.ndarray]], folder: Path) -> int:
     from PIL import Image
 
-    folder.mkdir(parents=True, exist_ok=True)
+    ensure_folder(folder, "for PNG frames")
     count = 0
     for index, frame in frames:
-        Image.fromarray(frame).save(folder / FRAME_PATTERN.format(index))
+        path = folder / FRAME_PATTERN.format(index)
+        try:
+            Image.fromarray(frame).save(path)
+        except OSError as exc:
+            raise FileSystemError(f"Expected to write {path}; found it cannot be written: {exc}.") from None
         count += 1
     return count
 
 
 def _write_gif(frames: Iterator[tuple[int, np.ndarray]], out: Path, fps: float, overwrite: bool) -> int:
-    from PIL import Image
-
-    images = [Image.fromarray(frame) for _, frame in frames]
-    if not images:
-        raise MovieError(f"Expected a movie with frames to write {out}; found none.")
-    buffer = io.BytesIO()
-    images[0].save(buffer, "GIF", save_all=True, append_images=images[1:], duration=round(1000 / fps), loop=0)
-    _place(out, buffer.getvalue(), overwrite)
-    return len(images)
+    """Stream the frames into a GIF at 30 fps at most, one frame encoded at a time (see :mod:`retrokit.movie.gif`)."""
+    step = gif_step(fps)
+    try:
+        with atomic_output(out, overwrite=overwrite) as stream:
+            writer = GifWriter(stream, fps / step)
+            for k, (_, frame) in enumerate(frames):
+                if k % step == 0:
+                    writer.add(frame)
+            if writer.count == 0:
+                raise MovieError(f"Expected a movie with frames to write {out}; found none.")
+            writer.close()
+    except FileExistsError:
+        raise FileConflictError(
+            f"Expected no file at {out}; found one. Choose another path, or pass overwrite (--overwrite)."
+        ) from None
+    return writer.count
 
 
 def _write_mp4(imageio, frames: Iterator[tuple[int, np.ndarray]], out: Path, fps: float, overwrite: bool) -> int:
-    out.parent.mkdir(parents=True, exist_ok=True)
+    ensure_folder(out.parent, f"to write {out.name} into")
     fd, tmp_name = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=".mp4", dir=out.parent)
     os.close(fd)
     count = 0

@@ -8,28 +8,74 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Self
 
-from retrokit.errors import FileConflictError, MovieError
+from retrokit.data.games import cached_rom_sha1, find_game
+from retrokit.data.states import StateRecord
+from retrokit.errors import FileConflictError, FileSystemError, MovieError, RetrokitError
 from retrokit.movie.bk2 import write_bk2
-from retrokit.movie.model import Movie, layout
+from retrokit.movie.model import STATE_DIGEST, Movie, layout
 
 _claims: dict[tuple[Path, str], int] = {}
+_reserved: set[Path] = set()
 _claims_lock = threading.Lock()
 
 
 def claim_movie_path(folder: str | os.PathLike[str], stem: str) -> Path:
-    """The first ``<stem>-NNNNNN.bk2`` in ``folder`` that no file has and no earlier call in this process gave.
+    """Reserve the first free ``<stem>-NNNNNN.bk2`` in ``folder`` and return it.
 
-    Envs that record into one folder (a vector env's, or a second run's)
-    each get their own names, so none writes over another's movies or a
-    file already there.
+    The name is reserved on disk at once, as an empty file created with
+    ``O_EXCL``, so envs recording into one folder, in this process or in others
+    running at the same time, each get names of their own, and none writes
+    over another's movie or a file already there. The recorder given the path
+    replaces the empty file with the movie.
+
+    Raises:
+        FileSystemError: The folder cannot be written.
     """
     folder = Path(folder).resolve()
     with _claims_lock:
         n = _claims.get((folder, stem), 0)
-        while (folder / f"{stem}-{n:06d}.bk2").exists():
+        while True:
+            path = folder / f"{stem}-{n:06d}.bk2"
             n += 1
-        _claims[folder, stem] = n + 1
-        return folder / f"{stem}-{n:06d}.bk2"
+            try:
+                os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+            except FileExistsError:
+                continue
+            except OSError as exc:
+                raise FileSystemError(
+                    f"Expected a folder to record movies into at {str(folder)!r}; found it cannot be written: "
+                    f"{exc.strerror or exc}. Choose another folder with record=."
+                ) from None
+            _claims[folder, stem] = n
+            _reserved.add(path)
+            return path
+
+
+def _is_reservation(path: Path) -> bool:
+    """Whether ``path`` is a name this process reserved and nothing has been written to yet."""
+    try:
+        return path.resolve() in _reserved and path.stat().st_size == 0
+    except OSError:
+        return False
+
+
+def state_header(game: str, state: bytes) -> dict[str, str]:
+    """The header lines that record what a movie's start state is for, as retrokit's states do.
+
+    ``SHA1`` is the ROM's SHA-1 (the key's meaning in BizHawk, whose format
+    ``.bk2`` is; stable-retro writes ``?`` and reads it never), and
+    ``StateSHA256`` the start state's digest, so playback can tell a state for
+    another ROM, or one changed since, from the one recorded.
+    """
+    try:
+        found = find_game(game)
+        rom = found.rom_path()
+    except RetrokitError:
+        return {}
+    if rom is None:
+        return {}
+    record = StateRecord.of(found.name, cached_rom_sha1(rom, found.system), state)
+    return {"SHA1": record.rom_sha1, STATE_DIGEST: record.sha256}
 
 
 class MovieRecorder:
@@ -64,12 +110,14 @@ class MovieRecorder:
         overwrite: bool = False,
     ) -> None:
         self.path = Path(path)
-        if not overwrite and self.path.exists():  # fail before the episode, not after it
+        if not overwrite and self.path.exists() and not _is_reservation(self.path):  # fail before the episode
             raise FileConflictError(
                 f"Expected no file at {self.path} to record a movie into; found one. "
                 "Delete it, choose another name, or pass overwrite=True to replace it."
             )
         self.movie = Movie(game, system, players, start_state)
+        if start_state is not None:
+            self.movie.header.update(state_header(self.movie.game, start_state))
         self._layout = layout(self.movie.system)
         self._players = self.movie.players
         self._overwrite = overwrite
@@ -113,7 +161,10 @@ class MovieRecorder:
             FileConflictError: A different file appeared at the path meanwhile.
         """
         if not self._closed:
-            write_bk2(self.path, self.movie, overwrite=self._overwrite)
+            reserved = _is_reservation(self.path)
+            write_bk2(self.path, self.movie, overwrite=self._overwrite or reserved)
+            if reserved:
+                _reserved.discard(self.path.resolve())
             self._closed = True
         return self.path
 

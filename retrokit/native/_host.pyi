@@ -14,6 +14,9 @@ import numpy.typing as npt
 MEMORY_SYSTEM_RAM: int
 MAX_PORTS: int
 PLAN_COLUMNS: int
+VIDEO_ALL: int
+VIDEO_LAST: int
+VIDEO_NONE: int
 
 class Emulator:
     """One libretro core, privately loaded, with at most one game."""
@@ -33,6 +36,14 @@ class Emulator:
     def options(self) -> dict[str, tuple[str, str, tuple[str, ...]]]:
         """Map each core option key to (description, current value, allowed values)."""
     def set_sticky(self, prob: float, seed: int) -> None: ...
+    def set_video_frames(self, mode: int) -> None:
+        """Which frames of each ``run`` the core is told to draw (``VIDEO_ALL``, ``VIDEO_LAST``, ``VIDEO_NONE``).
+
+        Also: audio is wanted with ``VIDEO_ALL`` or while captured, else not.
+        """
+    @property
+    def av_asked(self) -> int:
+        """How often the core asked whether video and audio are wanted (GET_AUDIO_VIDEO_ENABLE)."""
     def forget_action(self) -> None:
         """Make the next ``run`` apply its action from the first frame, as after a reset."""
     def run(

@@ -29,19 +29,22 @@ void rk_set_error(rk_core *core, const char *fmt, ...) {
 
 /* ---- loading a private copy ---------------------------------------------------------------- */
 
-static int copy_to_private_file(rk_core *core, const char *path, char *out, size_t out_size) {
+/* Copies the core to a temporary file, unlinks it at once (a crash can leave no file behind)
+ * and returns its open descriptor, which names the copy for dlopen. */
+static int copy_to_private_file(rk_core *core, const char *path) {
     const char *tmp = getenv("TMPDIR");
-    snprintf(out, out_size, "%s/retrokit-core-XXXXXX.so", tmp && *tmp ? tmp : "/tmp");
-    int dst = mkstemps(out, 3);
+    char name[4096];
+    snprintf(name, sizeof name, "%s/retrokit-core-XXXXXX.so", tmp && *tmp ? tmp : "/tmp");
+    int dst = mkstemps(name, 3);
     if (dst < 0) {
-        rk_set_error(core, "cannot create a private copy of the core in %s: %s", out, strerror(errno));
+        rk_set_error(core, "cannot create a private copy of the core in %s: %s", name, strerror(errno));
         return -1;
     }
+    unlink(name);
     int src = open(path, O_RDONLY | O_CLOEXEC);
     if (src < 0) {
         rk_set_error(core, "cannot open the core %s: %s", path, strerror(errno));
         close(dst);
-        unlink(out);
         return -1;
     }
     char buf[1 << 16];
@@ -54,11 +57,13 @@ static int copy_to_private_file(rk_core *core, const char *path, char *out, size
         }
     }
     if (n < 0) rc = -1;
-    if (rc) rk_set_error(core, "cannot copy the core %s to %s: %s", path, out, strerror(errno));
+    if (rc) rk_set_error(core, "cannot copy the core %s to %s: %s", path, name, strerror(errno));
     close(src);
-    close(dst);
-    if (rc) unlink(out);
-    return rc;
+    if (rc) {
+        close(dst);
+        return -1;
+    }
+    return dst;
 }
 
 #define RESOLVE(field, name)                                                      \
@@ -96,12 +101,15 @@ static int resolve(rk_core *core, const char *path) {
 }
 
 int rk_core_open(rk_core *core, const char *path, const char *system_dir, const char *save_dir) {
-    char private_path[4096];
-    if (copy_to_private_file(core, path, private_path, sizeof private_path)) return -1;
-    /* The copy has a name of its own, so the loader maps it anew instead of
-     * handing back a library another emulator already uses. */
+    int fd = copy_to_private_file(core, path);
+    if (fd < 0) return -1;
+    /* The copy is a file of its own, so the loader maps it anew instead of handing back a
+     * library another emulator already uses; its descriptor stays open while the core is
+     * loaded, so no later copy gets the same /proc name while this one is mapped. */
+    char private_path[64];
+    snprintf(private_path, sizeof private_path, "/proc/self/fd/%d", fd);
+    core->copy_fd = fd + 1;
     core->handle = dlopen(private_path, RTLD_NOW | RTLD_LOCAL);
-    unlink(private_path);
     if (!core->handle) {
         rk_set_error(core, "cannot load the core %s: %s", path, dlerror());
         return -1;
@@ -120,6 +128,7 @@ int rk_core_open(rk_core *core, const char *path, const char *system_dir, const 
     core->system_dir = strdup(system_dir);
     core->save_dir = strdup(save_dir);
     core->pixel_format = RK_RETRO_PIXEL_FORMAT_0RGB1555;
+    core->av_enable = 1 | 2; /* video and audio, until a run says otherwise */
     rk_enter(core);
     core->api.set_environment(rk_cb_environment);
     core->api.set_video_refresh(rk_cb_video);
@@ -158,6 +167,8 @@ void rk_core_close(rk_core *core) {
         dlclose(core->handle);
         core->handle = NULL;
     }
+    if (core->copy_fd) close(core->copy_fd - 1);
+    core->copy_fd = 0;
     core->game_loaded = core->initialized = 0;
     rk_free_options(core);
     for (int i = 0; i < 2 * core->n_overrides; i++) free(core->overrides[i]);
@@ -216,6 +227,9 @@ void rk_core_run(rk_core *core, const uint16_t *actions, int n_ports, int frames
     for (int f = 0; f < frames; f++) {
         /* The first frame of a new action keeps the last applied one when it sticks. */
         memcpy(core->buttons, (f == 0 && stick) ? core->held : action, sizeof core->buttons);
+        int all = core->video_frames == RK_VIDEO_ALL;
+        core->av_enable = (all || (core->video_frames == RK_VIDEO_LAST && f == frames - 1)) |
+                          (all || core->capture_audio) << 1;
         core->api.run();
         core->frame++;
     }

@@ -19,6 +19,9 @@
 #define RK_MAX_LOG 256
 #define RK_MAX_MAPS 64
 
+/* Which frames of a run the core is told to draw (GET_AUDIO_VIDEO_ENABLE). */
+enum { RK_VIDEO_ALL, RK_VIDEO_LAST, RK_VIDEO_NONE };
+
 typedef struct {
     char *key;
     char *desc;
@@ -74,6 +77,7 @@ typedef struct {
 
 typedef struct rk_core {
     void *handle;
+    int copy_fd; /* the unlinked private copy's descriptor + 1 (0: none), open while loaded */
     rk_core_api api;
     int initialized;
     int game_loaded;
@@ -103,6 +107,12 @@ typedef struct rk_core {
     double sticky_prob;
     uint64_t rng[4];
     int n_ports;
+
+    /* What GET_AUDIO_VIDEO_ENABLE answers: a frame nobody sees needs no
+     * drawing, audio nobody captures no mixing (cores that ask skip them). */
+    int video_frames; /* RK_VIDEO_*, for the frames of each run */
+    int av_enable;    /* the answer for the frame running now */
+    uint64_t av_asked; /* how often the core asked */
 
     /* Audio, captured only when asked. */
     int capture_audio;

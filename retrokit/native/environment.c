@@ -270,7 +270,8 @@ bool rk_cb_environment(unsigned cmd, void *data) {
         *(unsigned *)data = 0; /* English */
         return true;
     case RK_ENV_GET_AUDIO_VIDEO_ENABLE:
-        if (data) *(int *)data = 1 | 2; /* video and audio */
+        core->av_asked++;
+        if (data) *(int *)data = core->av_enable;
         return true;
     case RK_ENV_GET_FASTFORWARDING:
         if (data) *(bool *)data = false;

@@ -301,5 +301,8 @@ PyMODINIT_FUNC PyInit__host(void) {
     PyModule_AddIntConstant(m, "MEMORY_SYSTEM_RAM", RK_RETRO_MEMORY_SYSTEM_RAM);
     PyModule_AddIntConstant(m, "MAX_PORTS", RK_MAX_PORTS);
     PyModule_AddIntConstant(m, "PLAN_COLUMNS", RK_PLAN_COLUMNS);
+    PyModule_AddIntConstant(m, "VIDEO_ALL", RK_VIDEO_ALL);
+    PyModule_AddIntConstant(m, "VIDEO_LAST", RK_VIDEO_LAST);
+    PyModule_AddIntConstant(m, "VIDEO_NONE", RK_VIDEO_NONE);
     return m;
 }

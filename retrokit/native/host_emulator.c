@@ -171,6 +171,15 @@ static PyObject *emulator_set_sticky(EmulatorObject *self, PyObject *args) {
     Py_RETURN_NONE;
 }
 
+static PyObject *emulator_set_video_frames(EmulatorObject *self, PyObject *arg) {
+    long mode = PyLong_AsLong(arg);
+    if (mode == -1 && PyErr_Occurred()) return NULL;
+    if (mode < RK_VIDEO_ALL || mode > RK_VIDEO_NONE)
+        return PyErr_Format(InvalidArgumentError, "video frames must be VIDEO_ALL, VIDEO_LAST or VIDEO_NONE, got %ld", mode);
+    self->core.video_frames = (int)mode;
+    Py_RETURN_NONE;
+}
+
 static PyObject *emulator_forget_action(EmulatorObject *self, PyObject *unused) {
     self->core.have_held = 0;
     Py_RETURN_NONE;
@@ -226,6 +235,10 @@ static PyObject *emulator_held(EmulatorObject *self, PyObject *unused) {
     for (int i = 0; out && i < self->core.n_ports; i++)
         PyTuple_SET_ITEM(out, i, PyLong_FromLong(self->core.have_held ? self->core.held[i] : 0));
     return out;
+}
+
+static PyObject *emulator_get_av_asked(EmulatorObject *self, void *closure) {
+    return PyLong_FromUnsignedLongLong(self->core.av_asked);
 }
 
 typedef struct {
@@ -401,6 +414,8 @@ static PyMethodDef emulator_methods[] = {
     {"av_info", (PyCFunction)emulator_av_info, METH_NOARGS, "Frame rate, sample rate and geometry."},
     {"options", (PyCFunction)emulator_options, METH_NOARGS, "Core options: key -> (description, value, allowed)."},
     {"set_sticky", (PyCFunction)emulator_set_sticky, METH_VARARGS, "Set the sticky-action probability and seed the RNG."},
+    {"set_video_frames", (PyCFunction)emulator_set_video_frames, METH_O,
+     "Which frames of each run the core is told to draw: VIDEO_ALL, VIDEO_LAST or VIDEO_NONE."},
     {"forget_action", (PyCFunction)emulator_forget_action, METH_NOARGS, "Apply the next action from its first frame."},
     {"held", (PyCFunction)emulator_held, METH_NOARGS, "The buttons of the last frame run, one mask per port."},
     {"run", (PyCFunction)(void (*)(void))emulator_run, METH_FASTCALL,
@@ -420,6 +435,8 @@ static PyMethodDef emulator_methods[] = {
 
 static PyGetSetDef emulator_getset[] = {
     {"frame", (getter)emulator_get_frame, NULL, "Frames run since the core was loaded.", NULL},
+    {"av_asked", (getter)emulator_get_av_asked, NULL, "How often the core asked whether video and audio are wanted.",
+     NULL},
     {"stuck", (getter)emulator_get_stuck, NULL, "Whether the last run's first frame kept the previous buttons.", NULL},
     {NULL, NULL, NULL, NULL, NULL},
 };

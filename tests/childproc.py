@@ -1,0 +1,78 @@
+"""Running a hostile input in a child process, so a regression fails a test instead of killing or hanging the suite.
+
+The child runs a snippet of Python under a wall-clock timeout and an address
+space limit; it prints its peak resident memory (``ru_maxrss``) on its last
+line, so a test can hold it to the 500 MB every input must stay under.
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import signal
+import subprocess
+import sys
+import textwrap
+from dataclasses import dataclass
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+MAX_RSS_MB = 500
+ADDRESS_SPACE = 3 * 2**30  # far above what Python, numpy and a core map, far below what a blow-up wants
+_MARK = "childproc-peak-rss-kb:"
+
+
+@dataclass
+class Child:
+    """How a child ended."""
+
+    returncode: int
+    stdout: str
+    stderr: str
+    peak_rss_mb: float
+
+    @property
+    def signal(self) -> str | None:
+        """The signal that killed the child (``"SIGSEGV"``), or ``None``."""
+        return signal.Signals(-self.returncode).name if self.returncode < 0 else None
+
+    def describe(self) -> str:
+        """Everything a failing assertion should show."""
+        return f"exit {self.returncode} ({self.signal}), peak {self.peak_rss_mb:.0f} MB\n{self.stdout}\n{self.stderr}"
+
+
+def _limits() -> None:
+    resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE, ADDRESS_SPACE))
+    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))  # a crash must leave no core file
+
+
+def run_child(code: str, *, timeout: float = 60, env: dict[str, str] | None = None, cwd: Path | None = None) -> Child:
+    """Run ``code`` in a fresh interpreter; return how it ended and its peak RSS.
+
+    A child still running after ``timeout`` seconds is killed, and the test
+    fails with a clear message rather than hanging.
+    """
+    script = textwrap.dedent(code) + (
+        f"\nimport resource as _r\nprint({_MARK!r}, _r.getrusage(_r.RUSAGE_SELF).ru_maxrss, flush=True)\n"
+        "raise SystemExit(globals().get('exit_status', 0))\n"
+    )
+    try:
+        done = subprocess.run(
+            [sys.executable, "-c", script], capture_output=True, text=True, timeout=timeout, check=False,
+            env={**os.environ, **(env or {})}, cwd=cwd or REPO, preexec_fn=_limits, stdin=subprocess.DEVNULL,
+        )
+    except subprocess.TimeoutExpired as exc:
+        raise AssertionError(f"the child hung: still running after {timeout} s\n{exc.stdout}\n{exc.stderr}") from None
+    peak = 0.0
+    lines = []
+    for line in done.stdout.splitlines():
+        if line.startswith(_MARK):
+            peak = int(line.split()[-1]) / 1024
+        else:
+            lines.append(line)
+    return Child(done.returncode, "\n".join(lines), done.stderr, peak)
+
+
+def run_cli(args: list[str], *, timeout: float = 60, env: dict[str, str] | None = None, cwd: Path | None = None) -> Child:
+    """Run ``retrokit ARGS...`` in a child process."""
+    return run_child(f"from retrokit.cli import main\nexit_status = main({args!r})", timeout=timeout, env=env, cwd=cwd)

@@ -1,0 +1,284 @@
+"""``retrokit build-core``: every failure is one line, and a build lands where find_core looks first.
+
+The compiler, make, the package index and the sdist are fakes here (a PATH
+of scripts, an unreachable or local index, a small tarball), so these tests
+run anywhere in a second; the real build runs in CI (.ci/run).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import re
+import tarfile
+from pathlib import Path
+
+import pytest
+
+from retrokit.cli import main
+from retrokit.errors import PatchError
+from retrokit.host import build
+from retrokit.host.cores import CORES_ENV, built_cores_dir, locate_core
+from retrokit.host.patching import apply_patch, parse_patch
+
+RECIPE = build.RECIPES["genesis_plus_gx"]
+PATCHED_FILE = "libretro/libretro.c"
+
+
+@pytest.fixture(autouse=True)
+def isolated(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> Path:
+    """An empty data folder, no CC, and no RETROKIT_CORES."""
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    monkeypatch.delenv("CC", raising=False)
+    monkeypatch.delenv(CORES_ENV, raising=False)
+    return tmp_path / "data"
+
+
+def tools(tmp_path: Path, make: str | None = "ok", cc: bool = True) -> Path:
+    """A folder of fake build tools to be the whole PATH: ``cc`` and a ``make`` that succeeds or fails."""
+    folder = tmp_path / "bin"
+    folder.mkdir(exist_ok=True)
+    scripts = {}
+    if cc:
+        scripts["cc"] = "#!/bin/sh\nexit 0\n"
+    if make == "ok":  # lists one compile for the dry run, then "links" the library
+        scripts["make"] = ('#!/bin/sh\nfor a in "$@"; do [ "$a" = -n ] && { echo "cc -c core/a.c"; exit 0; }; done\n'
+                           'echo "cc -c core/a.c"\necho fake-core > genesis_plus_gx_libretro.so\n')  # fmt: skip
+    elif make == "fails":
+        scripts["make"] = '#!/bin/sh\necho "cc -c core/vdp.c"\necho "core/vdp.c:12: error: boom"\nexit 2\n'
+    for name, text in scripts.items():
+        (folder / name).write_text(text)
+        (folder / name).chmod(0o755)
+    return folder
+
+
+def original_source() -> bytes:
+    """A libretro.c holding exactly the lines the patch expects (its hunks' old side)."""
+    (patch,) = parse_patch(build.patch_text(RECIPE))
+    return "".join(line for hunk in patch.hunks for line in hunk.old).encode()
+
+
+def fake_sdist(tmp_path: Path, files: dict[str, bytes], version: str = "1.0.1") -> Path:
+    """A stable-retro-like sdist with these files (paths below its top folder)."""
+    path = tmp_path / f"stable_retro-{version}.tar.gz"
+    with tarfile.open(path, "w:gz") as tar:
+        for name, data in files.items():
+            info = tarfile.TarInfo(name if name.startswith("/") or ".." in name else f"stable_retro-{version}/{name}")
+            info.size = len(data)
+            tar.addfile(info, io.BytesIO(data))
+    return path
+
+
+def run_cli(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
+    status = main(["build-core", "genesis_plus_gx", *args])
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def assert_one_line_error(status: int, err: str, *fragments: str) -> None:
+    lines = [line for line in err.splitlines() if line.startswith("retrokit: error:")]
+    assert status == 2 and len(lines) == 1, err
+    assert "Traceback" not in err
+    for fragment in fragments:
+        assert fragment in lines[0], lines[0]
+
+
+# --- the failures the command names -------------------------------------------------------------
+
+
+def test_no_compiler(monkeypatch, tmp_path, capsys) -> None:
+    monkeypatch.setenv("PATH", str(tools(tmp_path, cc=False)))
+    assert_one_line_error(*run_cli(capsys)[::2], "Expected a C compiler (cc) on PATH", "build-essential")
+
+
+def test_no_make(monkeypatch, tmp_path, capsys) -> None:
+    monkeypatch.setenv("PATH", str(tools(tmp_path, make=None)))
+    assert_one_line_error(*run_cli(capsys)[::2], "Expected make (make) on PATH")
+
+
+def test_a_compiler_named_by_cc_must_exist(monkeypatch, tmp_path, capsys) -> None:
+    monkeypatch.setenv("PATH", str(tools(tmp_path)))
+    monkeypatch.setenv("CC", "clang-99")
+    assert_one_line_error(*run_cli(capsys)[::2], "(clang-99)")
+
+
+def test_cc_may_carry_a_wrapper_or_flags(tmp_path) -> None:
+    folder = tools(tmp_path)
+    cc, make = build.check_tools({"PATH": str(folder), "CC": "cc -O2"})
+    assert (cc, make) == (f"{folder}/cc -O2", f"{folder}/make")
+
+
+@pytest.fixture
+def pip_without_config(monkeypatch: pytest.MonkeyPatch) -> None:
+    """pip with no configuration file or PIP_ variable: only the index a test names."""
+    for name in [n for n in os.environ if n.startswith("PIP_")]:
+        monkeypatch.delenv(name)
+    monkeypatch.setenv("PIP_CONFIG_FILE", os.devnull)
+
+
+def test_no_network(monkeypatch, tmp_path, capsys, pip_without_config) -> None:
+    monkeypatch.setenv("PATH", str(tools(tmp_path)))
+    status, _, err = run_cli(capsys, "--index-url", "http://127.0.0.1:9/simple")  # nothing listens on port 9
+    assert_one_line_error(status, err, "could not reach it", "http://127.0.0.1:9/simple", "network")
+
+
+def local_index(tmp_path: Path, *files: str) -> str:
+    """A PEP 503 index on disk whose stable-retro page links these file names."""
+    page = tmp_path / "index" / "stable-retro"
+    page.mkdir(parents=True)
+    links = "".join(f'<a href="{name}">{name}</a>\n' for name in files)
+    (page / "index.html").write_text(f"<html><body>\n{links}</body></html>\n")
+    return (tmp_path / "index").as_uri()
+
+
+def test_a_version_with_only_wheels_has_no_source(monkeypatch, tmp_path, capsys, pip_without_config) -> None:
+    monkeypatch.setenv("PATH", str(tools(tmp_path)))
+    index = local_index(tmp_path, "stable_retro-1.0.1-cp311-cp311-manylinux_2_17_x86_64.manylinux2014_x86_64.whl")
+    status, _, err = run_cli(capsys, "--index-url", index, "--stable-retro", "1.0.1")
+    assert_one_line_error(status, err, "Expected a source package (sdist) of stable-retro 1.0.1", "found none")
+
+
+def test_a_version_that_does_not_exist(monkeypatch, tmp_path, capsys, pip_without_config) -> None:
+    monkeypatch.setenv("PATH", str(tools(tmp_path)))
+    index = local_index(tmp_path, "stable_retro-1.0.1.tar.gz")
+    status, _, err = run_cli(capsys, "--index-url", index, "--stable-retro", "0.0.7")
+    assert_one_line_error(status, err, "sdist) of stable-retro 0.0.7", "versions there: 1.0.1")
+
+
+def test_a_patch_against_a_modified_source(monkeypatch, tmp_path, capsys) -> None:
+    monkeypatch.setenv("PATH", str(tools(tmp_path)))
+    source = original_source().replace(b"system_frame_gen(0);", b"system_frame_gen(frameskip);")
+    sdist = fake_sdist(tmp_path, {f"{RECIPE.folder}/{PATCHED_FILE}": source})
+    status, _, err = run_cli(capsys, "--sdist", str(sdist))
+    assert_one_line_error(status, err, "hunk 1 of genesis_plus_gx-av-enable.patch", PATCHED_FILE, "not the one")
+
+
+def test_make_failing_quotes_its_error_and_keeps_the_log(monkeypatch, tmp_path, capsys, isolated) -> None:
+    monkeypatch.setenv("PATH", str(tools(tmp_path, make="fails")))
+    sdist = fake_sdist(tmp_path, {f"{RECIPE.folder}/{PATCHED_FILE}": original_source()})
+    status, _, err = run_cli(capsys, "--sdist", str(sdist))
+    log = built_cores_dir(isolated) / "genesis_plus_gx.build.log"
+    assert_one_line_error(status, err, "exit 2", "core/vdp.c:12: error: boom", f"Full log: {log}")
+    assert "error: boom" in log.read_text()
+    assert not (built_cores_dir(isolated) / "genesis_plus_gx_libretro.so").exists()
+
+
+@pytest.mark.parametrize(
+    "files, found",
+    [({"../evil.c": b"x"}, "reading it failed"), ({"README": b"x"}, "found no such folder")],
+    ids=["path-leaving-the-folder", "no-core-folder"],
+)
+def test_hostile_or_foreign_sdists_are_refused(monkeypatch, tmp_path, capsys, files, found) -> None:
+    monkeypatch.setenv("PATH", str(tools(tmp_path)))
+    if "../evil.c" in files:  # a member under the core's folder that climbs out of it
+        files = {f"stable_retro-1.0.1/{RECIPE.folder}/../../../../evil.c": b"x"}
+    sdist = fake_sdist(tmp_path, files)
+    assert_one_line_error(*run_cli(capsys, "--sdist", str(sdist))[::2], found)
+    assert not (tmp_path / "evil.c").exists() and not (tmp_path.parent / "evil.c").exists()
+
+
+def test_a_corrupt_sdist_is_refused(monkeypatch, tmp_path, capsys) -> None:
+    monkeypatch.setenv("PATH", str(tools(tmp_path)))
+    sdist = tmp_path / "stable_retro-1.0.1.tar.gz"
+    sdist.write_bytes(b"\x1f\x8b" + os.urandom(4000))
+    assert_one_line_error(*run_cli(capsys, "--sdist", str(sdist))[::2], "Expected a readable .tar.gz")
+
+
+def test_an_unknown_core_suggests_the_known_one(capsys) -> None:
+    status = main(["build-core", "genesis_plus"])
+    assert_one_line_error(status, capsys.readouterr().err, "got 'genesis_plus'", "Did you mean 'genesis_plus_gx'?")
+
+
+# --- a build, and where it goes -------------------------------------------------------------------
+
+
+def test_a_build_is_installed_recorded_and_found_first(monkeypatch, tmp_path, capsys, isolated) -> None:
+    path = os.environ["PATH"]
+    monkeypatch.setenv("PATH", str(tools(tmp_path)))
+    sdist = fake_sdist(tmp_path, {f"{RECIPE.folder}/{PATCHED_FILE}": original_source(), "cores/nes/x.c": b"x"})
+    status, out, err = run_cli(capsys, "--sdist", str(sdist))
+    installed = built_cores_dir(isolated) / "genesis_plus_gx_libretro.so"
+    assert status == 0 and out.strip() == str(installed), err
+    for step in ("Unpacking cores/genesis/", "Applying genesis_plus_gx-av-enable.patch", "Compiling", "Installed"):
+        assert step in err
+    assert "  unpack: 100%" in err and "  compile: 50%" in err  # progress, as lines: stderr is not a terminal
+    record = json.loads((built_cores_dir(isolated) / "genesis_plus_gx.build.json").read_text())
+    assert record["stable_retro"] == "1.0.1" and record["patch"] == RECIPE.patch
+    found = locate_core("genesis_plus_gx")
+    assert (found.path, found.origin) == (installed, "built")
+    assert run_cli(capsys, "--sdist", str(sdist))[2].startswith("Already built")  # nothing fetched or compiled again
+    monkeypatch.setenv("PATH", path)
+    assert main(["cores"]) == 0
+    assert f"genesis_plus_gx    built           {installed}" in capsys.readouterr().out
+
+
+def test_a_build_for_another_stable_retro_version_is_not_used(monkeypatch, tmp_path, capsys, isolated) -> None:
+    monkeypatch.setenv("PATH", str(tools(tmp_path)))
+    sdist = fake_sdist(tmp_path, {f"{RECIPE.folder}/{PATCHED_FILE}": original_source()}, version="0.9.9")
+    assert run_cli(capsys, "--sdist", str(sdist), "--stable-retro", "0.9.9")[0] == 0
+    assert locate_core("genesis_plus_gx").origin == "wheel"  # its states would not fit the installed wheel's
+
+
+def test_a_core_retrokit_did_not_build_is_not_replaced(monkeypatch, tmp_path, capsys, isolated) -> None:
+    monkeypatch.setenv("PATH", str(tools(tmp_path)))
+    mine = built_cores_dir(isolated) / "genesis_plus_gx_libretro.so"
+    mine.parent.mkdir(parents=True)
+    mine.write_bytes(b"the user's own core")
+    sdist = fake_sdist(tmp_path, {f"{RECIPE.folder}/{PATCHED_FILE}": original_source()})
+    assert_one_line_error(*run_cli(capsys, "--sdist", str(sdist))[::2], "retrokit did not build", "--force")
+    assert mine.read_bytes() == b"the user's own core"
+    assert run_cli(capsys, "--sdist", str(sdist), "--force")[0] == 0
+    assert mine.read_bytes() == b"fake-core\n"
+
+
+# --- the patch applier -------------------------------------------------------------------------------
+
+
+def test_a_failed_patch_leaves_the_tree_as_it_was(tmp_path) -> None:
+    text = (
+        "--- a/one.c\n+++ b/one.c\n@@ -1,2 +1,2 @@\n a\n-b\n+B\n"
+        "--- a/two.c\n+++ b/two.c\n@@ -1,1 +1,1 @@\n-x\n+X\n"
+    )
+    (tmp_path / "one.c").write_text("a\nb\n")
+    (tmp_path / "two.c").write_text("y\n")
+    with pytest.raises(PatchError, match="hunk 1 of the patch in two.c"):
+        apply_patch(text, tmp_path)
+    assert (tmp_path / "one.c").read_text() == "a\nb\n"  # not half-patched
+    (tmp_path / "two.c").write_text("x\n")
+    apply_patch(text, tmp_path)
+    assert (tmp_path / "one.c").read_text() == "a\nB\n" and (tmp_path / "two.c").read_text() == "X\n"
+
+
+def test_hunks_apply_where_their_lines_moved_to(tmp_path) -> None:
+    (tmp_path / "f.c").write_bytes(b"new\r\nlines\r\nfirst\r\na\r\nb\r\n")  # CRLF kept as it is
+    apply_patch("--- a/f.c\n+++ b/f.c\n@@ -2,2 +2,2 @@\n a\r\n-b\r\n+c\r\n", tmp_path)
+    assert (tmp_path / "f.c").read_bytes() == b"new\r\nlines\r\nfirst\r\na\r\nc\r\n"
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [("not a diff at all\n", "Expected a unified diff"), ("--- a/f\n+++ b/f\n@@ -1 +1 @@\n?x\n", "found '?x'")],
+    ids=["no-diff", "bad-hunk-line"],
+)
+def test_malformed_patches_are_refused(tmp_path, text: str, message: str) -> None:
+    with pytest.raises(PatchError, match=re.escape(message)):
+        apply_patch(text, tmp_path)
+
+
+# --- what find_core and retrokit cores make of the data folder ------------------------------------
+
+
+def test_without_a_build_the_wheel_core_is_listed(capsys) -> None:
+    assert main(["cores"]) == 0
+    out = capsys.readouterr().out
+    assert "Genesis     genesis_plus_gx    wheel " in out and "retrokit build-core CORE" in out
+
+
+@pytest.mark.parametrize("record", [b"{not json", b"[1, 2]", b""], ids=["corrupt", "not-a-dict", "empty"])
+def test_a_build_with_an_unreadable_record_is_not_used(isolated, record: bytes) -> None:
+    folder = built_cores_dir(isolated)
+    folder.mkdir(parents=True)
+    (folder / "genesis_plus_gx_libretro.so").write_bytes(b"whatever")
+    (folder / "genesis_plus_gx.build.json").write_bytes(record)
+    assert locate_core("genesis_plus_gx").origin == "wheel"

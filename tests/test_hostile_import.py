@@ -1,0 +1,93 @@
+"""Hostile inputs to ``retrokit import``: devices, FIFOs and zip bombs neither hang it nor blow up its memory.
+
+Each case runs in a child process with a timeout and an address-space limit
+(tests/childproc.py), so a regression fails here instead of hanging the suite.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import zipfile
+from pathlib import Path
+
+import pytest
+from bombs import zip_bytes, zip_parts
+from childproc import MAX_RSS_MB, run_cli
+
+from retrokit import paths
+
+AIRSTRIKER_ROM = paths.wheel_dir() / "data" / "stable" / "Airstriker-Genesis-v0" / "rom.md"
+
+
+def _fifo(folder: Path) -> None:
+    os.mkfifo(folder / "pipe.md")  # nobody ever writes: reading it blocks forever
+
+
+def _dev_zero(folder: Path) -> None:
+    (folder / "zero.md").symlink_to("/dev/zero")  # reading it never ends
+
+
+def _zip_with_big_inner_zip(folder: Path) -> None:
+    # inner.zip is 1 GiB (one stored member of zeros); the outer zip deflates it to about 1 MiB.
+    inner = zip_parts([("big.bin", [1024], False)])
+    (folder / "outer.zip").write_bytes(zip_bytes([("inner.zip", inner, True)]))
+
+
+def _zip_bomb_member(folder: Path) -> None:
+    # 1 GiB of zeros deflated to about 1 MiB: a ROM-named member whose real size is far past the cap.
+    (folder / "bomb.zip").write_bytes(zip_bytes([("bomb.md", [1024], True)]))
+
+
+def _lying_zip_header(folder: Path) -> None:
+    # The member's header claims 10 bytes; its data inflates to 64 MiB.
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+        archive.writestr("liar.md", bytes(64 * 2**20))
+    data = bytearray(buffer.getvalue())
+    for offset in (data.find(b"PK\x03\x04") + 22, data.find(b"PK\x01\x02") + 24):  # uncompressed size fields
+        data[offset : offset + 4] = (10).to_bytes(4, "little")
+    (folder / "liar.zip").write_bytes(bytes(data))
+
+
+CASES = {
+    "fifo": (_fifo, "not a regular file"),
+    "symlink-to-dev-zero": (_dev_zero, "not a regular file"),
+    "zip-holding-a-1GiB-inner-zip": (_zip_with_big_inner_zip, "larger than 256 MiB inside a zip"),
+    "zip-bomb-member": (_zip_bomb_member, "larger than 32 MiB"),
+    "zip-member-lying-about-its-size": (_lying_zip_header, "liar.md"),
+}
+
+
+@pytest.mark.parametrize("case", list(CASES), ids=list(CASES))
+def test_import_skips_hostile_files_quickly_and_in_little_memory(tmp_path: Path, case: str) -> None:
+    make, expected = CASES[case]
+    folder = tmp_path / "roms"
+    folder.mkdir()
+    make(folder)
+    (folder / "Airstriker.bin").write_bytes(AIRSTRIKER_ROM.read_bytes())  # the good ROM beside it still imports
+    child = run_cli(["import", "-v", str(folder), "--data-dir", str(tmp_path / "data")], timeout=60)
+    assert child.returncode == 0, child.describe()
+    assert "Airstriker-Genesis <- " in child.stdout, child.describe()
+    assert expected in child.stdout, child.describe()
+    assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
+    assert (tmp_path / "data" / "roms" / "Airstriker-Genesis" / "rom.md").is_file()
+
+
+def test_a_fifo_named_on_the_command_line_is_skipped(tmp_path: Path) -> None:
+    os.mkfifo(tmp_path / "pipe.zip")
+    child = run_cli(["import", str(tmp_path / "pipe.zip"), "--data-dir", str(tmp_path / "data")], timeout=30)
+    assert child.returncode == 0, child.describe()
+    assert "not a regular file" in child.stdout, child.describe()
+
+
+def test_import_shows_a_progress_bar(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    from retrokit.cli import main
+
+    folder = tmp_path / "roms"
+    folder.mkdir()
+    for i in range(3):
+        (folder / f"junk{i}.bin").write_bytes(bytes([i]) * 100)
+    assert main(["import", str(folder), "--data-dir", str(tmp_path / "data")]) == 0
+    err = capsys.readouterr().err
+    assert "Searching: " in err and "3 files" in err, err

@@ -1,0 +1,125 @@
+"""Movies under stress: processes recording into one folder at once, and exports of long movies."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from retrokit.movie import read_bk2
+from retrokit.movie.recorder import MovieRecorder, claim_movie_path
+
+RECORD = """
+import sys, retrokit
+env = retrokit.make("Dasher-Genesis", record=sys.argv[1], max_episode_steps=2)
+for episode in range(int(sys.argv[2])):
+    env.reset(seed=episode)
+    done = False
+    while not done:
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        done = terminated or truncated
+env.close()
+"""
+
+
+@pytest.mark.parametrize("processes", [2, 4], ids=["2-processes", "4-processes"])
+def test_processes_recording_into_one_folder_never_conflict(tmp_path: Path, processes: int) -> None:
+    episodes = 6
+    children = [
+        subprocess.Popen([sys.executable, "-c", RECORD, str(tmp_path), str(episodes)], stderr=subprocess.PIPE, text=True)
+        for _ in range(processes)
+    ]
+    errors = []
+    for child in children:
+        try:
+            _, err = child.communicate(timeout=120)
+        except subprocess.TimeoutExpired:
+            child.kill()
+            raise
+        if child.returncode:
+            errors.append(err)
+    assert errors == []
+    movies = sorted(tmp_path.glob("*.bk2"))
+    assert len(movies) == processes * episodes
+    assert all(len(read_bk2(m).frames) == 2 * 1 for m in movies)  # each a whole movie (2 steps of 1 frame)
+
+
+def test_a_claimed_name_is_reserved_on_disk(tmp_path: Path) -> None:
+    first = claim_movie_path(tmp_path, "Game-State")
+    assert first.is_file() and first.stat().st_size == 0  # another process now skips it
+    (tmp_path / "Game-State-000001.bk2").write_bytes(b"someone else's")
+    second = claim_movie_path(tmp_path, "Game-State")
+    assert second.name == "Game-State-000002.bk2"
+    recorder = MovieRecorder(first, "Dasher-Genesis", "Genesis")
+    recorder.record([0])
+    assert recorder.close() == first and len(read_bk2(first).frames) == 1
+    assert (tmp_path / "Game-State-000001.bk2").read_bytes() == b"someone else's"
+
+
+# --- exporting long movies ----------------------------------------------------------------------
+
+GENESIS_FPS = 59.922743  # Genesis Plus GX's NTSC frame rate (its av_info)
+
+
+@pytest.fixture(scope="module")
+def long_movie(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """2,400 frames (40 s) of Dasher running right and jumping: 2,400 RGB frames would take over 500 MB."""
+    from retrokit.data.games import find_game
+    from retrokit.data.states import read_state
+    from retrokit.host.systems import get_system
+    from retrokit.movie import Movie, write_bk2
+
+    genesis = get_system("Genesis")
+    run, jump = genesis.mask(["RIGHT"]), genesis.mask(["RIGHT", "B"])
+    frames = [(jump if i % 90 < 20 else run,) for i in range(2400)]
+    state = read_state(find_game("Dasher-Genesis").state_path("Zone1.Act1"))
+    path = tmp_path_factory.mktemp("long") / "long.bk2"
+    write_bk2(path, Movie("Dasher-Genesis", "Genesis", 1, state, frames))
+    return path
+
+
+def test_a_long_gif_export_streams_its_frames_at_30_fps(long_movie: Path, tmp_path: Path) -> None:
+    from childproc import MAX_RSS_MB, run_cli
+    from PIL import Image, ImageSequence
+
+    out = tmp_path / "long.gif"
+    child = run_cli(["playback", str(long_movie), str(out)], timeout=240)
+    assert child.returncode == 0, child.describe()
+    assert child.peak_rss_mb < MAX_RSS_MB / 2, child.describe()  # Pillow's save_all held every frame: over 500 MB
+    assert "2400/2400" in child.stderr  # the progress bar reached the end
+    assert "Wrote 1200 frames" in child.stdout
+    with Image.open(out) as gif:
+        delays = [frame.info["duration"] for frame in ImageSequence.Iterator(gif)]
+    assert len(delays) == 1200
+    assert set(delays) == {30, 40}  # 30 fps: every other frame of the console's 59.92
+    assert abs(sum(delays) - 2400 / GENESIS_FPS * 1000) <= 10  # the movie's true length, to the hundredth
+
+
+@pytest.mark.parametrize(("fps", "step", "delays"), [(60, 2, [30, 40, 30]), (12, 1, [80, 90, 80]), (50, 2, [40, 40, 40])],
+                         ids=["60fps", "12fps", "50fps"])
+def test_gif_frame_delays_add_up_to_the_true_time(fps: float, step: int, delays: list[int]) -> None:
+    import io
+
+    from retrokit.movie.gif import GifWriter, gif_step
+
+    assert gif_step(fps) == step
+    writer = GifWriter(io.BytesIO(), fps / step)
+    assert [writer.delay_ms(i) for i in range(3)] == delays
+    assert sum(writer.delay_ms(i) for i in range(300)) == round(300 * 1000 * step / fps, -1)
+
+
+@pytest.mark.parametrize("member", ["Input Log.txt", "Header.txt"], ids=["input-log-bomb", "header-bomb"])
+def test_a_movie_member_that_inflates_to_a_gigabyte_is_refused(tmp_path: Path, member: str) -> None:
+    from bombs import zip_bytes
+    from childproc import MAX_RSS_MB, run_cli
+
+    small = {"Input Log.txt": b"[Input]\nP1 B|\n|..|.|\n[/Input]", "Header.txt": b"Platform GEN\nGameName Dasher-Genesis-v0\n"}
+    members = [(name, [1024] if name == member else [data], True) for name, data in small.items()]
+    path = tmp_path / "bomb.bk2"
+    path.write_bytes(zip_bytes(members))
+    child = run_cli(["playback", str(path), str(tmp_path / "out")], timeout=60)
+    assert child.returncode == 2, child.describe()
+    assert f"expected {member!r} to hold at most" in child.stderr, child.describe()
+    assert child.peak_rss_mb < MAX_RSS_MB, child.describe()

@@ -1,0 +1,236 @@
+"""Hostile save states: corrupt bodies, gzip bombs and other games' states, through make(), playback and integrate.
+
+A corrupt state crashes Genesis Plus GX (SIGSEGV), so every case runs in a
+child process (tests/childproc.py): a regression fails the test instead of
+killing the suite.
+"""
+
+from __future__ import annotations
+
+import gzip
+import random
+import shutil
+import zipfile
+from pathlib import Path
+
+import pytest
+from bombs import gzip_of_zeros, zip_bytes
+from childproc import MAX_RSS_MB, REPO, run_child, run_cli
+
+from retrokit.data.games import cached_rom_sha1, find_game
+from retrokit.data.probe import probe_key, probe_state
+from retrokit.data.states import StateRecord, compress_state, read_state, read_state_file, state_record, write_state
+from retrokit.errors import StateError
+from retrokit.movie import Movie, write_bk2
+
+DASHER = REPO / "games" / "Dasher-Genesis"
+
+
+@pytest.fixture(scope="module")
+def good_state() -> bytes:
+    return read_state(DASHER / "Zone1.Act1.state")
+
+
+@pytest.fixture(scope="module")
+def corrupt_state(good_state: bytes) -> bytes:
+    """The right size and a valid header (GENPLUS-GX 1.7.5), then random bytes: it crashes the core."""
+    rng = random.Random(1)
+    return good_state[:16] + rng.randbytes(len(good_state) - 16)
+
+
+@pytest.fixture(scope="module")
+def bomb() -> bytes:
+    """About 1 MiB of gzip that inflates to 1 GiB."""
+    return gzip_of_zeros(1024)
+
+
+def test_the_corrupt_state_really_crashes_the_core(corrupt_state: bytes) -> None:
+    verdict = probe_state(corrupt_state, "Genesis", DASHER / "rom.md", frames=60)
+    assert not verdict.safe and "SIGSEGV" in verdict.reason
+
+
+def _movie(tmp_path: Path, state: bytes, game: str = "Dasher-Genesis", header: dict[str, str] | None = None) -> Path:
+    path = tmp_path / "hostile.bk2"
+    movie = Movie(game, "Genesis", 1, state, [(0,)] * 30)
+    movie.header.update(header or {})
+    write_bk2(path, movie)
+    return path
+
+
+def _bomb_movie(tmp_path: Path) -> Path:
+    """A movie whose Core.bin inflates to 1 GiB (its zip is about 1 MiB)."""
+    with zipfile.ZipFile(_movie(tmp_path, b"\0")) as archive:
+        text = [(name, [archive.read(name)], True) for name in ("Input Log.txt", "Header.txt")]
+    path = tmp_path / "bomb.bk2"
+    path.write_bytes(zip_bytes([*text, ("Core.bin", [1024], True)]))
+    return path
+
+
+MAKE = "import retrokit\nenv = retrokit.make('Dasher-Genesis', {state!r})\nenv.reset()\nprint('played')"
+
+
+@pytest.mark.parametrize("kind", ["corrupt", "gzip-bomb"], ids=["corrupt-body", "gzip-bomb"])
+def test_make_refuses_a_hostile_state_file(tmp_path: Path, kind: str, corrupt_state: bytes, bomb: bytes) -> None:
+    path = tmp_path / "hostile.state"
+    path.write_bytes(compress_state(corrupt_state) if kind == "corrupt" else bomb)
+    child = run_child(
+        "from retrokit.errors import StateError\ntry:\n" + "\n".join("    " + line for line in MAKE.format(state=str(path)).splitlines())
+        + "\nexcept StateError as exc:\n    print('refused:', exc)",
+        env={"RETROKIT_DATA": str(tmp_path / "data")},
+    )
+    assert child.returncode == 0, child.describe()
+    assert "refused:" in child.stdout and "played" not in child.stdout, child.describe()
+    assert ("SIGSEGV" if kind == "corrupt" else "inflates past") in child.stdout, child.describe()
+    assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
+
+
+def test_a_probe_verdict_is_cached_by_sha256(tmp_path: Path, corrupt_state: bytes, monkeypatch) -> None:
+    from retrokit.data import probe
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    rom = DASHER / "rom.md"
+    sha1 = cached_rom_sha1(rom, "Genesis")
+    with pytest.raises(StateError, match="SIGSEGV"):
+        probe.vet_state(corrupt_state, "Genesis", rom, sha1, source="x")
+    cache = tmp_path / "data" / "state-probes" / probe_key(corrupt_state, "Genesis", sha1)
+    assert cache.is_file()
+    monkeypatch.setattr(probe, "probe_state", lambda *a, **k: pytest.fail("probed again"))
+    with pytest.raises(StateError, match="SIGSEGV"):
+        probe.vet_state(corrupt_state, "Genesis", rom, sha1, source="x")
+
+
+def test_shipped_and_recorded_states_need_no_probe(tmp_path: Path, good_state: bytes, monkeypatch) -> None:
+    from retrokit.data import probe, statecheck
+
+    monkeypatch.setattr(probe, "probe_state", lambda *a, **k: pytest.fail("a trusted state was probed"))
+    monkeypatch.setattr(statecheck, "vet_state", lambda *a, **k: pytest.fail("a trusted state was vetted"))
+    game = find_game("Dasher-Genesis")
+    assert statecheck.load_state(game, DASHER / "Zone1.Act1.state") == good_state  # shipped
+    mine = write_state(tmp_path / "mine.state", good_state, record=StateRecord.of(game.name, game.sha1s[0], good_state))
+    assert statecheck.load_state(game, mine) == good_state  # written by retrokit, unchanged
+
+
+def test_a_state_changed_since_retrokit_wrote_it_is_probed(tmp_path: Path, corrupt_state: bytes, monkeypatch) -> None:
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    from retrokit.data import statecheck
+
+    game = find_game("Dasher-Genesis")
+    record = StateRecord.of(game.name, game.sha1s[0], b"some other state")  # the record no longer describes the body
+    path = tmp_path / "edited.state"
+    path.write_bytes(compress_state(corrupt_state, record))
+    with pytest.raises(StateError, match="SIGSEGV"):
+        statecheck.load_state(game, path)
+
+
+@pytest.mark.parametrize("kind", ["corrupt", "gzip-bomb"], ids=["corrupt-core-bin", "gzip-bomb-core-bin"])
+def test_playback_refuses_a_hostile_core_bin(tmp_path: Path, kind: str, corrupt_state: bytes) -> None:
+    movie = _movie(tmp_path, corrupt_state) if kind == "corrupt" else _bomb_movie(tmp_path)
+    child = run_cli(["playback", str(movie), str(tmp_path / "out.gif")], env={"RETROKIT_DATA": str(tmp_path / "data")})
+    assert child.returncode == 2, child.describe()
+    last = child.stderr.strip().splitlines()[-1]
+    assert last.startswith(f"retrokit: error: {movie}") and "Traceback" not in child.stderr, child.describe()
+    assert ("SIGSEGV" if kind == "corrupt" else "at most") in last, child.describe()
+    assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
+    assert not (tmp_path / "out.gif").exists()
+
+
+@pytest.fixture
+def dasher_copy(tmp_path: Path) -> Path:
+    folder = tmp_path / "games" / "Dasher-Genesis"
+    folder.mkdir(parents=True)
+    for name in ("game.yaml", "rom.md", "scenario.yaml"):
+        shutil.copy(DASHER / name, folder / name)
+    return folder
+
+
+@pytest.mark.parametrize("force", [False, True], ids=["check", "force"])
+def test_integrate_over_a_damaged_state(tmp_path: Path, dasher_copy: Path, corrupt_state: bytes, force: bool) -> None:
+    damaged = dasher_copy / "Zone1.Act1.state"
+    damaged.write_bytes(compress_state(corrupt_state))
+    args = ["integrate", "Dasher-Genesis", "--state", "Zone1.Act1"] + (["--force"] if force else [])
+    env = {"RETROKIT_GAMES": str(dasher_copy.parent), "RETROKIT_DATA": str(tmp_path / "data")}
+    child = run_cli(args, env=env)
+    assert child.returncode == (0 if force else 1), child.describe()
+    assert ("replaced" if force else "damaged") in child.stdout, child.describe()
+    if force:
+        assert read_state_file(damaged).record.describes(read_state(damaged))
+    else:
+        assert damaged.read_bytes() == compress_state(corrupt_state)  # kept as it was
+
+
+# --- another game's state ---------------------------------------------------------------------
+
+
+def test_states_retrokit_writes_record_game_and_rom_and_stay_plain_gzip(good_state: bytes) -> None:
+    blob = (DASHER / "Zone1.Act1.state").read_bytes()
+    record = state_record(blob)
+    assert record == StateRecord("Dasher-Genesis", find_game("Dasher-Genesis").sha1s[0], record.sha256)
+    assert record.describes(good_state)
+    assert gzip.decompress(blob) == good_state  # any gzip reader (stable-retro's is Python's) reads it
+
+
+def test_stable_retro_loads_a_state_retrokit_wrote(tmp_path: Path) -> None:
+    stable_retro = pytest.importorskip("stable_retro")
+    env = stable_retro.make("Airstriker-Genesis-v0", render_mode=None)
+    try:
+        game = find_game("Airstriker-Genesis")
+        data = read_state(game.state_path("Level1"))
+        path = write_state(tmp_path / "Level1.state", data, record=StateRecord.of(game.name, game.sha1s[0], data))
+        env.load_state(str(path))
+        env.reset()
+        assert env.unwrapped.em.get_state() is not None
+    finally:
+        env.close()
+
+
+def test_make_refuses_another_games_recorded_state() -> None:
+    import retrokit
+
+    with pytest.raises(StateError, match="recorded on another ROM .*, of Dasher-Genesis"):
+        retrokit.make("Airstriker-Genesis", str(DASHER / "Zone1.Act1.state"))
+
+
+def test_playback_refuses_a_movie_recorded_with_another_games_state(tmp_path: Path, good_state: bytes) -> None:
+    # A Dasher movie's Core.bin and header, under Airstriker's name.
+    dasher = find_game("Dasher-Genesis")
+    header = {"SHA1": dasher.sha1s[0], "StateSHA256": StateRecord.of(dasher.name, dasher.sha1s[0], good_state).sha256}
+    movie = _movie(tmp_path, good_state, game="Airstriker-Genesis", header=header)
+    child = run_cli(["playback", str(movie), str(tmp_path / "out")])
+    assert child.returncode == 2, child.describe()
+    assert f"recorded on another ROM (SHA-1 {dasher.sha1s[0]})" in child.stderr, child.describe()
+
+
+def test_a_recorded_movie_names_its_rom_and_state(tmp_path: Path) -> None:
+    import retrokit
+    from retrokit.movie import read_bk2
+
+    env = retrokit.make("Dasher-Genesis", record=tmp_path, max_episode_steps=3)
+    env.reset(seed=0)
+    for _ in range(3):
+        env.step(env.action_space.sample())
+    env.close()
+    (path,) = tmp_path.glob("*.bk2")
+    movie = read_bk2(path)
+    game = find_game("Dasher-Genesis")
+    assert movie.header["SHA1"] == game.sha1s[0]
+    assert StateRecord.of(game.name, game.sha1s[0], movie.state).sha256 == movie.header["StateSHA256"]
+
+
+def test_make_refuses_a_state_from_another_games_folder(airstriker_dir: Path) -> None:
+    import retrokit
+    from retrokit.paths import wheel_data_dirs
+
+    sonic = next(d / "SonicTheHedgehog-Genesis-v0" for d in wheel_data_dirs() if (d / "SonicTheHedgehog-Genesis-v0").is_dir())
+    with pytest.raises(StateError, match="in the folder of SonicTheHedgehog-Genesis, a game on another ROM"):
+        retrokit.make("Airstriker-Genesis", str(sonic / "GreenHillZone.Act1.state"))
+
+
+def test_games_sharing_a_rom_may_share_states(tmp_path: Path, good_state: bytes, monkeypatch) -> None:
+    from retrokit.data.statecheck import load_state
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    twin = tmp_path / "DasherTwin-Genesis"  # another integration of Dasher's ROM, with a state of its own
+    twin.mkdir()
+    shutil.copy(DASHER / "game.yaml", twin / "game.yaml")
+    (twin / "Start.state").write_bytes(compress_state(good_state))  # as stable-retro writes it: no record
+    assert load_state(find_game("Dasher-Genesis"), twin / "Start.state") == good_state

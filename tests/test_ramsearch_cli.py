@@ -11,6 +11,7 @@ import sys
 import zipfile
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from retrokit import cli
@@ -313,3 +314,28 @@ def test_the_shell_runs_subcommands_line_by_line(tmp_path):
     assert "changed" not in done.stdout  # after quit
     errors = done.stderr.splitlines()
     assert len(errors) == 2 and "Did you mean 'equal'?" in errors[0] and "a line of words" in errors[1]
+
+
+def test_a_session_whose_state_changed_is_probed_before_it_is_loaded(session, capsys, monkeypatch):
+    from retrokit.data import statecheck
+    from retrokit.errors import StateError
+
+    probed = []
+
+    def crashing_probe(data, system, rom, rom_sha1, *, source):
+        probed.append(source)
+        raise StateError(f"{source}: expected a state the core can run; found one that kills it (SIGSEGV).")
+
+    monkeypatch.setattr(statecheck, "vet_state", crashing_probe)
+    assert run(capsys, "show")[0] == 0 and probed == []  # the state this tool wrote is trusted
+    with np.load(session) as archive:
+        arrays = dict(archive)
+    meta = json.loads(bytes(arrays["meta"]))
+    meta["state_sha256"] = "0" * 64  # as if the state's bytes had been edited since
+    arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
+    tampered = session.with_name("tampered.session")
+    with tampered.open("wb") as out:
+        np.savez_compressed(out, **arrays)
+    status, _, err = run(capsys, "show", "--session", str(tampered))
+    assert probed == [str(tampered)]
+    assert status == 2 and "SIGSEGV" in err and err.count("\n") == 1

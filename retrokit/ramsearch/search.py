@@ -28,9 +28,10 @@ from typing import Self
 import numpy as np
 
 from retrokit import paths
+from retrokit.data import statecheck
 from retrokit.data.games import Game, find_game
 from retrokit.data.roms import rom_sha1
-from retrokit.data.states import read_state
+from retrokit.data.states import StateRecord
 from retrokit.errors import DataFileError, FileConflictError, InvalidArgumentError, MovieError, SessionError, StateError
 from retrokit.host.emulator import Emulator
 from retrokit.host.typecodes import parse_type
@@ -117,6 +118,10 @@ class RamSearch:
         self.engine.candidates, self.engine.history, self.engine.redo_stack = data.candidates, data.history, data.redo
         self.labels, self.state = list(data.labels), data.state
         try:
+            # Trusted when it is the state this tool wrote (its SHA-256 is in the session);
+            # otherwise first run in a child process, so a state that crashes the core cannot.
+            record = StateRecord(data.game, data.rom_sha1, data.state_sha256)
+            statecheck.check_state(self.game, data.emulator_state, record, source=str(path), rom=self.rom)
             self.emulator.set_state(data.emulator_state)
         except StateError as exc:
             raise SessionError(
@@ -171,7 +176,7 @@ class RamSearch:
 
     def load_state(self, name: str) -> None:
         """Put the game in one of its save states (no snapshot is taken)."""
-        self.emulator.set_state(read_state(self.game.state_path(name)))
+        self.emulator.set_state(statecheck.load_state(self.game, self.game.state_path(name)))
         self.emulator.forget_action()
 
     def snapshot(self, label: str = "snapshot") -> int:
@@ -219,6 +224,7 @@ class RamSearch:
             MovieError: The movie is malformed or of another game.
         """
         from retrokit.movie import read_bk2
+        from retrokit.movie.playback import check_movie_state
 
         recorded = read_bk2(movie)
         if recorded.game != self.game.name:
@@ -235,6 +241,7 @@ class RamSearch:
                 f"Expected --until from 0 to the movie's {len(recorded.frames)} frames, got {until!r}."
             )
         if recorded.state is not None:
+            check_movie_state(recorded, self.emulator, str(movie))  # a state that could crash the core is refused
             self.emulator.set_state(recorded.state)
         else:
             self.emulator.reset()

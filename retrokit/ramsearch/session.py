@@ -5,8 +5,9 @@ session file, doing one thing and writing it back, so a search can be
 scripted and resumed. The file is a numpy ``.npz`` archive (a zip) holding:
 
 - ``meta``: JSON: the format's name and version, the game, its ROM's SHA-1,
-  the start state, the searched types, the RAM regions, each snapshot's label
-  and the history's filters;
+  the start state, the searched types, the RAM regions, each snapshot's label,
+  the history's filters, and the emulator state's SHA-256 (a state that does
+  not match it is run in a child process before it is loaded);
 - ``emulator_state``: the core's serialized state now;
 - ``snapshots``: one row of console-order RAM bytes per snapshot;
 - the candidates now, before each filter that can be undone, and after each
@@ -19,6 +20,7 @@ half-written. Reading checks everything and says what is wrong in one line.
 
 from __future__ import annotations
 
+import hashlib
 import io
 import json
 import os
@@ -57,6 +59,7 @@ class SessionData:
     candidates: Candidates
     history: list[tuple[str, Candidates | Packed]] = field(default_factory=list)
     redo: list[tuple[str, Candidates | Packed]] = field(default_factory=list)
+    state_sha256: str = ""  # what the file says the emulator state's SHA-256 is (read, never trusted blindly)
 
 
 def _store(prefix: str, candidates: Candidates | Packed, arrays: dict[str, np.ndarray]) -> None:
@@ -83,6 +86,7 @@ def encode_session(data: SessionData) -> bytes:
         "regions": [list(r) for r in data.regions],
         "labels": data.labels,
         "scales": [scale.label for scale in SCALES],
+        "state_sha256": hashlib.sha256(data.emulator_state).hexdigest(),
         "history": [label for label, _ in data.history],
         "redo": [label for label, _ in data.redo],
     }
@@ -191,6 +195,7 @@ def _decode(blob: bytes) -> SessionData:
             emulator_state=archive["emulator_state"].tobytes(),
             snapshots=snapshots,
             labels=[str(label) for label in meta["labels"]],
+            state_sha256=str(meta.get("state_sha256", "")),
             candidates=Candidates.unpack(_load("now", archive, len(types), size, scales), len(types), size),
             history=[
                 (str(label), _load(f"history{i}", archive, len(types), size, scales))

@@ -35,6 +35,8 @@ host = Extension(
     sources=[
         "retrokit/native/host.c",
         "retrokit/native/host_emulator.c",
+        "retrokit/native/host_functions.c",
+        "retrokit/native/host_runner.c",
         "retrokit/native/core.c",
         "retrokit/native/environment.c",
         "retrokit/native/isolate.c",

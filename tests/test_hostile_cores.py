@@ -15,6 +15,7 @@ import pytest
 from childproc import run_child
 
 from retrokit.host.cores import core_filename, find_core
+from retrokit.paths import wheel_cores_dir
 
 CORE = find_core("genesis_plus_gx")
 OPEN = """
@@ -94,7 +95,7 @@ def test_side_by_side_emulators_still_get_private_copies(dasher_rom: Path) -> No
         assert one.ram[0] == 0x55
 
 
-@pytest.mark.parametrize("core", sorted(CORE.parent.glob("*_libretro.so")), ids=lambda p: p.name)
+@pytest.mark.parametrize("core", sorted(wheel_cores_dir().glob("*_libretro.so")), ids=lambda p: p.name)
 def test_every_wheel_core_passes_the_elf_check(core: Path) -> None:
     from retrokit.host.elf import check_core_file
 

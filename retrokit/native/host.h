@@ -21,7 +21,10 @@ typedef struct {
     int closed;
 } EmulatorObject;
 
-extern PyTypeObject EmulatorType, MemoryType;
+extern PyTypeObject EmulatorType, MemoryType, RunnerType;
+
+PyObject *rk_py_read_fields(PyObject *module, PyObject *const *args, Py_ssize_t nargs);
+PyObject *rk_py_pack_buttons(PyObject *module, PyObject *const *args, Py_ssize_t nargs);
 
 /* Claim an emulator for one call (raises and returns -1 if closed, without a
  * game when one is needed, or busy in another thread); leave releases it

@@ -32,6 +32,7 @@ _MODULES = {
     "sonic": "retrokit.envs.sonic",
     "multiplayer": "retrokit.envs.multiplayer",
     "movie": "retrokit.movie",
+    "testing": "retrokit.testing",
 }
 
 __all__ = [
@@ -45,10 +46,11 @@ __all__ = [
     "multiplayer",
     "register_envs",
     "sonic",
+    "testing",
 ]
 
 if TYPE_CHECKING:
-    from retrokit import movie
+    from retrokit import movie, testing
     from retrokit.envs import multiplayer, sonic
     from retrokit.envs.env import RetroEnv, State, make
     from retrokit.envs.registration import register_envs

@@ -155,6 +155,25 @@ class EnvError(RetrokitError, RuntimeError):
     """An environment was used out of order, e.g. stepped before reset."""
 
 
+# --- Benchmarks and evaluation -----------------------------------------------------------------
+
+
+class BenchmarkFileError(DataFileError):
+    """A benchmark YAML file is malformed."""
+
+
+class RunFolderError(DataFileError):
+    """An evaluation's run folder cannot be resumed: missing, damaged, or made with other settings."""
+
+
+class AgentError(RetrokitError, RuntimeError):
+    """An agent raised, or gave an action its env cannot take, while it was evaluated."""
+
+
+class BackendUnavailableError(RetrokitError, ImportError):
+    """An evaluation backend (Ray) is not installed, or its cluster cannot be reached."""
+
+
 # --- RAM search ----------------------------------------------------------------------------------
 
 

@@ -3,12 +3,16 @@
 Game folders are searched, in order, in:
 
 1. every folder in ``RETROKIT_GAMES`` (separated by :data:`os.pathsep`),
-2. the bundled integrations: the checkout's ``games/`` folder (next to the
+2. the per-user data folder's ``games/`` (what ``retrokit integrate`` and
+   ``retrokit play`` make: a game folder there extends or overrides the
+   shipped one, and may hold only states and scenarios),
+3. the bundled integrations: the checkout's ``games/`` folder (next to the
    ``retrokit`` package), or its copy inside an installed package,
-3. the stable-retro wheel's ``data/stable``, ``data/experimental`` and
+4. the stable-retro wheel's ``data/stable``, ``data/experimental`` and
    ``data/contrib`` folders.
 
-The per-user data folder holds imported ROMs (``<data>/roms/<Game>/rom.<ext>``).
+The per-user data folder holds imported ROMs (``<data>/roms/<Game>/rom.<ext>``)
+and the user's game folders (``<data>/games/<Game>/``).
 It is ``RETROKIT_DATA`` if set, else ``$XDG_DATA_HOME/retrokit``, else
 ``~/.local/share/retrokit``.
 
@@ -89,9 +93,14 @@ def env_games_dirs() -> list[Path]:
     return [Path(part).expanduser() for part in value.split(os.pathsep) if part.strip()]
 
 
+def user_games_dir(data: Path | str | None = None) -> Path:
+    """Return the folder of the user's game folders: ``<data>/games`` (it may not exist yet)."""
+    return (Path(data) if data is not None else data_dir()) / "games"
+
+
 def game_search_dirs() -> list[Path]:
     """Return the existing folders that hold game folders, in search order."""
-    candidates = [*env_games_dirs()]
+    candidates = [*env_games_dirs(), user_games_dir()]
     repo = repo_games_dir()
     if repo is not None:
         candidates.append(repo)

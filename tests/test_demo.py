@@ -1,29 +1,41 @@
-"""The README's main job: ``retrokit demo`` on the bundled test cartridge."""
+"""The README's main job: ``retrokit demo``, JERK against random on the Dasher benchmark."""
 
 from __future__ import annotations
+
+import json
 
 from PIL import Image
 
 from retrokit.cli import main
 
-
-def test_demo_plays_and_saves_a_gif_and_a_png(tmp_path, capsys) -> None:
-    assert main(["demo", "--episodes", "2", "--max-steps", "60", "--out", str(tmp_path)]) == 0
-    out = capsys.readouterr().out
-    assert "mean score" in out and out.count("done") + out.count("time limit") == 2
-    gif = Image.open(tmp_path / "Dasher-Genesis.gif")
-    assert gif.n_frames > 5 and gif.size == (320, 224)
-    assert Image.open(tmp_path / "Dasher-Genesis.png").size == (320, 224)
+SMALL = ["demo", "--levels", "Zone2.Act2", "--timesteps", "400", "--workers", "1", "--no-progress"]
 
 
-def test_demo_never_replaces_earlier_pictures(tmp_path, capsys) -> None:
-    mine = tmp_path / "Dasher-Genesis.gif"
-    mine.write_bytes(b"mine")
-    assert main(["demo", "--episodes", "1", "--max-steps", "20", "--out", str(tmp_path)]) == 0
-    assert mine.read_bytes() == b"mine"
-    assert (tmp_path / "Dasher-Genesis-1.gif").is_file() and (tmp_path / "Dasher-Genesis-1.png").is_file()
+def test_demo_evaluates_jerk_and_random_and_saves_the_report_plots_and_a_gif(tmp_path, capsys) -> None:
+    out = tmp_path / "demo"
+    assert main([*SMALL, "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    table = printed[printed.index("level "):]
+    assert "jerk" in table and "random" in table and "aggregate" in table and "Dasher-Genesis/Zone2.Act2" in table
+    for agent in ("jerk", "random"):
+        data = json.loads((out / agent / "summary.json").read_text())
+        assert data["agent"] == agent and data["levels"]["Dasher-Genesis/Zone2.Act2"]["timesteps"] == 400
+        assert (out / agent / "report.md").is_file() and (out / agent / "learning-curves.png").is_file()
+    with Image.open(out / "scores.png") as image:
+        assert image.format == "PNG"
+    with Image.open(out / "jerk-best.gif") as gif:
+        assert gif.n_frames > 10 and gif.size == (320, 224)
 
 
-def test_demo_refuses_zero_episodes(tmp_path, capsys) -> None:
-    assert main(["demo", "--episodes", "0", "--out", str(tmp_path)]) == 2
-    assert "--episodes and --max-steps of 1 or more" in capsys.readouterr().err
+def test_demo_never_replaces_an_earlier_demo(tmp_path, capsys) -> None:
+    out = tmp_path / "demo"
+    out.mkdir()
+    (out / "mine.txt").write_text("mine")
+    assert main([*SMALL, "--timesteps", "100", "--out", str(out)]) == 0
+    assert (out / "mine.txt").read_text() == "mine" and sorted(p.name for p in out.iterdir()) == ["mine.txt"]
+    assert (tmp_path / "demo-1" / "jerk" / "summary.json").is_file()
+
+
+def test_demo_refuses_zero_timesteps(tmp_path, capsys) -> None:
+    assert main([*SMALL, "--timesteps", "0", "--out", str(tmp_path / "demo")]) == 2
+    assert "--workers and --timesteps of 1 or more" in capsys.readouterr().err

@@ -59,8 +59,11 @@ CASES = {
     "png-output-under-a-file": (lambda place, mp: ["playback", "m.bk2", "afile/frames"], "parent folders"),
     "unwritable-output-folder": (lambda place, mp: ["playback", "m.bk2", "/proc/out.gif"], "cannot be written"),
     "convert-output-under-a-file": (lambda place, mp: ["convert", str(SCENARIO_JSON), "afile/x.yaml"], "a file, not a folder"),
-    "demo-out-is-a-file": (lambda place, mp: ["demo", "--episodes", "1", "--max-steps", "1", "--out", "afile"],
-                           "a file, not a folder"),
+    "demo-out-is-a-file": (lambda place, mp: ["demo", "--timesteps", "1", "--out", "afile"], "a file, not a folder"),
+    "evaluate-out-is-a-file": (lambda place, mp: ["evaluate", "--timesteps", "1", "--out", "afile"],
+                               "a file, not a folder"),
+    "evaluate-out-under-a-file": (lambda place, mp: ["evaluate", "--timesteps", "1", "--out", "afile/run"],
+                                  "parent folders"),
 }
 
 
@@ -79,7 +82,7 @@ def test_a_file_system_failure_is_one_line(place: Path, monkeypatch: pytest.Monk
 
 
 def test_the_demo_refuses_a_bad_out_before_playing(place: Path, capsys) -> None:
-    assert main(["demo", "--episodes", "1", "--max-steps", "1", "--out", "afile"]) == ERROR_STATUS
+    assert main(["demo", "--timesteps", "1", "--out", "afile"]) == ERROR_STATUS
     assert "step" not in capsys.readouterr().err  # no progress bar: nothing was played
 
 
@@ -87,8 +90,10 @@ def test_the_demo_says_when_every_name_is_taken(place: Path, monkeypatch: pytest
     from retrokit.commands import demo
 
     monkeypatch.setattr(Path, "exists", lambda self: True)
+    monkeypatch.setattr(Path, "is_dir", lambda self: True)
+    monkeypatch.setattr(Path, "iterdir", lambda self: iter([self]))
     with pytest.raises(demo.FileConflictError, match="all 10000 taken"):
-        demo.free_names(place, "Dasher-Genesis")
+        demo.free_folder(place / "retrokit-demo")
 
 
 def test_atomic_write_names_the_folder_in_the_way(place: Path) -> None:

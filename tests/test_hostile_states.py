@@ -147,7 +147,8 @@ def dasher_copy(tmp_path: Path) -> Path:
 def test_integrate_over_a_damaged_state(tmp_path: Path, dasher_copy: Path, corrupt_state: bytes, force: bool) -> None:
     damaged = dasher_copy / "Zone1.Act1.state"
     damaged.write_bytes(compress_state(corrupt_state))
-    args = ["integrate", "Dasher-Genesis", "--state", "Zone1.Act1"] + (["--force"] if force else [])
+    args = ["integrate", "Dasher-Genesis", "--state", "Zone1.Act1", "--out", str(dasher_copy)]  # over the damaged one
+    args += ["--force"] if force else []
     env = {"RETROKIT_GAMES": str(dasher_copy.parent), "RETROKIT_DATA": str(tmp_path / "data")}
     child = run_cli(args, env=env)
     assert child.returncode == (0 if force else 1), child.describe()

@@ -58,16 +58,18 @@ def test_integrate_makes_then_checks_then_keeps_what_differs(dasher_copy: Path) 
 
 
 def test_the_committed_states_match_their_recipes() -> None:
-    outcomes = integrate(find_game("Dasher-Genesis"))
+    game = find_game("Dasher-Genesis")
+    outcomes = integrate(game, out=game.folders[-1])  # the repository's folder: checked, and up to date
     assert {o.status for o in outcomes} == {"up to date"}
     assert len(outcomes) == 9
 
 
 def test_cli_exits_1_when_a_state_differs(dasher_copy: Path, monkeypatch: pytest.MonkeyPatch, capsys) -> None:
     monkeypatch.setenv("RETROKIT_GAMES", str(dasher_copy.parent))
-    assert main(["integrate", "Dasher-Genesis", "--state", "Zone1.Act1", "--state", "Zone1.Act2"]) == 0
+    out = ["--out", str(dasher_copy)]
+    assert main(["integrate", "Dasher-Genesis", "--state", "Zone1.Act1", "--state", "Zone1.Act2", *out]) == 0
     shutil.copy(dasher_copy / "Zone1.Act2.state", dasher_copy / "Zone1.Act1.state")
-    assert main(["integrate", "Dasher-Genesis", "--state", "Zone1.Act1"]) == 1
+    assert main(["integrate", "Dasher-Genesis", "--state", "Zone1.Act1", *out]) == 1
     assert "--force" in capsys.readouterr().out
 
 

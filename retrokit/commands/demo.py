@@ -1,127 +1,99 @@
-"""``retrokit demo``: an agent plays the bundled test cartridge, then shows how it went.
+"""``retrokit demo``: the benchmark on the bundled test cartridge, JERK against random.
 
 It needs no ROM import: Dasher, retrokit's own Genesis game, ships in
-``games/``. A scripted agent runs right and jumps now and then (sticky frame
-skip 4, as in the Sonic benchmark); the command prints each episode's score
-and saves a GIF of the best episode and a PNG of its last frame (under new
-names if earlier ones are there: nothing is replaced).
+``games/``. The command runs ``retrokit evaluate --benchmark dasher`` twice,
+with the paper's JERK and with random actions, on the test levels, with a
+progress bar per level; prints the per-level table and the aggregates; and
+writes each run's folder (episodes, summary, report, plots), a plot of the two
+agents' scores, and a GIF of JERK's best episode. The output folder gets a new
+name if the given one is taken: nothing is replaced.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import shutil
 from pathlib import Path
 
 from retrokit.errors import FileConflictError
+from retrokit.paths import ensure_folder
+
+AGENTS = ("jerk", "random")
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``demo`` command."""
     parser = subparsers.add_parser(
         "demo",
-        help="play the bundled test cartridge with a scripted agent; save a GIF and a PNG",
-        description="A scripted agent plays episodes of Dasher-Genesis (no ROM import needed), with a "
-        "progress bar; then the episodes' scores are printed and a GIF of the best episode and a PNG of "
-        "its last frame are saved.",
+        help="evaluate JERK against random on the bundled Dasher benchmark: table, report, plots and a GIF",
+        description="Run the Dasher benchmark (no ROM import needed) with the paper's JERK agent and with random "
+        "actions, with a progress bar per level; print the per-level scores and aggregates, and write the reports, "
+        "the plots and a GIF of JERK's best episode.",
     )
-    parser.add_argument("--game", default="Dasher-Genesis", help="the game (default: Dasher-Genesis)")
-    parser.add_argument("--state", default=None, help="the start state (default: the game's)")
-    parser.add_argument("--episodes", type=int, default=3, help="episodes to play (default: 3)")
-    parser.add_argument("--max-steps", type=int, default=400, help="steps per episode at most (default: 400)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the agent and the sticky actions")
-    parser.add_argument("--out", type=Path, default=Path("retrokit-demo"), help="folder for the GIF and PNG")
+    parser.add_argument("--levels", default="test", help="test, train, all, or LEVEL,... (default: test)")
+    parser.add_argument("--timesteps", type=int, default=None, help="timesteps per level (default: the benchmark's)")
+    parser.add_argument("--seed", type=int, default=0, help="the run's seed (default: 0)")
+    parser.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1), help="processes (default: up to 2)")
+    parser.add_argument("--out", type=Path, default=Path("retrokit-demo"), help="the output folder (default: retrokit-demo)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bars")
     parser.set_defaults(run=run)
 
 
-class RunAndJump:
-    """Hold RIGHT; now and then hold a jump button for a few steps."""
+def free_folder(path: Path) -> Path:
+    """``path``, or ``path-1``, ``path-2``...: the first that does not exist or is an empty folder.
 
-    def __init__(self, env, rng) -> None:  # a RetroEnv and a numpy Generator
-        actions = env.unwrapped.actions
-        self.run, self.jump = actions.press(["RIGHT"]), actions.press(["RIGHT", "B"])
-        self.rng, self.jumping = rng, 0
-
-    def act(self):  # an action of the env
-        if self.jumping == 0 and self.rng.random() < 0.2:
-            self.jumping = int(self.rng.integers(2, 6))
-        if self.jumping:
-            self.jumping -= 1
-            return self.jump
-        return self.run
-
-
-def free_names(folder: Path, stem: str) -> tuple[Path, Path]:
-    """A GIF and a PNG name in ``folder`` that are both unused: nothing there is replaced."""
+    Raises:
+        FileSystemError: ``path`` is a file (checked before anything is played).
+        FileConflictError: Every name is taken.
+    """
+    if path.exists() and not path.is_dir():
+        ensure_folder(path, "for the demo's results")  # says what is wrong with it
     for n in range(10_000):
-        base = stem if n == 0 else f"{stem}-{n}"
-        gif, png = folder / f"{base}.gif", folder / f"{base}.png"
-        if not gif.exists() and not png.exists():
-            return gif, png
+        candidate = path if n == 0 else path.with_name(f"{path.name}-{n}")
+        if not candidate.exists() or (candidate.is_dir() and not any(candidate.iterdir())):
+            return candidate
     raise FileConflictError(
-        f"Expected a free file name for {stem} in {folder}; found all 10000 taken. Delete some, or pass --out."
+        f"Expected a free folder name for {path}; found all 10000 taken. Delete some, or pass --out."
     )
 
 
 def run(args: argparse.Namespace) -> int:
-    """Play, print the scores, save the pictures."""
-    import io
+    """Evaluate both agents, print the table, write the comparison plot and the GIF."""
+    from retrokit.benchmark import plots
+    from retrokit.benchmark.definition import load_benchmark
+    from retrokit.benchmark.evaluation import Evaluation, evaluate, level_file_name
+    from retrokit.commands.evaluate import print_table
+    from retrokit.paths import atomic_write
 
-    import numpy as np
-    from PIL import Image
-    from tqdm import tqdm
+    benchmark = load_benchmark("dasher")
+    levels = benchmark.select(args.levels)
+    out = free_folder(args.out)
+    summaries = {}
+    for agent in AGENTS:
+        print(f"{agent} on the dasher benchmark ({len(levels)} levels):")
+        summaries[agent] = evaluate(Evaluation(
+            benchmark=benchmark, levels=levels, agent=agent, out=out / agent, budget=args.timesteps,
+            seed=args.seed, workers=args.workers, gif=agent == "jerk", progress=not args.no_progress,
+        ))
+    print_table(summaries)
+    jerk, rand = summaries["jerk"]["aggregate"], summaries["random"]["aggregate"]
+    if jerk is not None and rand:
+        print(f"JERK's aggregate is {jerk / rand:.2f}x random's.")
 
-    import retrokit
-    from retrokit.errors import InvalidArgumentError
-    from retrokit.paths import atomic_write, ensure_folder
-
-    if args.episodes < 1 or args.max_steps < 1:
-        raise InvalidArgumentError(
-            f"Expected --episodes and --max-steps of 1 or more, got {args.episodes} and {args.max_steps}."
-        )
-    ensure_folder(args.out, "for the GIF and PNG")  # before playing, so a bad --out costs nothing
-    state = retrokit.State.DEFAULT if args.state is None else args.state
-    env = retrokit.make(
-        args.game, state, frameskip=4, sticky_prob=0.25, max_episode_steps=args.max_steps,
-        action_type="all", render_mode="rgb_array",
-    )
-    rng = np.random.default_rng(args.seed)
-    agent = RunAndJump(env, rng)
-    results, best_frames, best_score = [], [], float("-inf")
-    with tqdm(total=args.episodes * args.max_steps, unit="step", desc=f"{args.game}") as bar:
-        for episode in range(args.episodes):
-            env.reset(seed=args.seed + episode)
-            frames, score, steps = [env.render()], 0.0, 0
-            while True:
-                _, reward, terminated, truncated, _info = env.step(agent.act())
-                score += reward
-                steps += 1
-                bar.update(1)
-                if steps % 2 == 0:
-                    frames.append(env.render())
-                if terminated or truncated:
-                    break
-            bar.update(args.max_steps - steps)  # an episode that ended early
-            frames.append(env.render())
-            results.append((episode + 1, score, steps, "done" if terminated else "time limit"))
-            if score > best_score:
-                best_score, best_frames = score, frames
-    env.close()
-
-    print(f"\n{'episode':>7}  {'score':>8}  {'steps':>5}  ended by")
-    for episode, score, steps, ended in results:
-        print(f"{episode:>7}  {score:>8.0f}  {steps:>5}  {ended}")
-    scores = [r[1] for r in results]
-    print(f"mean score {np.mean(scores):.1f}, best {max(scores):.0f}")
-
-    gif, png = free_names(args.out, args.game)
-    pictures = [Image.fromarray(f) for f in best_frames]
-    gif_bytes, png_bytes = io.BytesIO(), io.BytesIO()
-    pictures[0].save(gif_bytes, "GIF", save_all=True, append_images=pictures[1:], duration=2 * 4 * 1000 // 60, loop=0)
-    pictures[-1].save(png_bytes, "PNG")
-    try:
-        atomic_write(gif, gif_bytes.getvalue())
-        atomic_write(png, png_bytes.getvalue())
-    except FileExistsError:  # another demo took the name meanwhile
-        raise FileConflictError(f"Expected {gif} and {png} to be free; found one written meanwhile. Run again.") from None
-    print(f"saved {gif} ({len(pictures)} frames) and {png}")
+    names = [level.name for level in levels]
+    made = "report.md, summary.json, plots" if plots.have_matplotlib() else "report.md, summary.json"
+    written = [f"{out / agent}/ ({made})" for agent in AGENTS]
+    if not plots.have_matplotlib():
+        written.append(f"(no plots: matplotlib is not installed; pip install '{plots.PLOT_EXTRA}')")
+    else:
+        series = {agent: {lv: e["mean_score"] for lv, e in s["levels"].items()} for agent, s in summaries.items()}
+        atomic_write(out / "scores.png", plots.score_bars(series, names, "JERK against random on Dasher: level scores"))
+        written.append(str(out / "scores.png"))
+    best = max(summaries["jerk"]["levels"].items(), key=lambda item: item[1]["best"] or float("-inf"))[0]
+    gif = out / "jerk" / "gifs" / f"{level_file_name(best)}.gif"
+    if gif.is_file():
+        shutil.copyfile(gif, out / "jerk-best.gif")
+        written.append(f"{out / 'jerk-best.gif'} (JERK's best episode, on {best})")
+    print("wrote " + "\n      ".join(written))
     return 0

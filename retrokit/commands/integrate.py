@@ -1,4 +1,4 @@
-"""``retrokit integrate GAME [--state NAME]... [--force]``: make and check a game's save states."""
+"""``retrokit integrate [GAME] STATE``: make save states from recipes or movies, into the user's data folder."""
 
 from __future__ import annotations
 
@@ -9,28 +9,64 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``integrate`` command."""
     parser = subparsers.add_parser(
         "integrate",
-        help="make a game's save states from the recipes in its game.yaml, and check existing ones",
-        description="Play each state recipe of the game's game.yaml (under 'integrate') from power-on, "
-        "write the state it reaches as <name>.state in the game's folder, and check a state file that is "
-        "already there leads to the same RAM and screen. A state that differs is kept unless --force.",
+        help="make save states from the recipes in game.yaml, or from a movie, into your data folder",
+        description="Make save states. 'retrokit integrate Zone1.Act1' makes the state of that name of the one "
+        "known game that has it (else of the game.yaml in the current directory); 'retrokit integrate GAME "
+        "[STATE]' names the game (all its recipes without STATE). A recipe is played from power-on; with "
+        "--movie, the state is the one the movie reaches. States are written to your data folder "
+        "($RETROKIT_DATA/games/<Game>, else $XDG_DATA_HOME/retrokit/games/<Game>), which extends the shipped "
+        "game, or to --out; never into the installed package. A state already there that leads to the same "
+        "RAM and screen is left alone; one that differs is kept unless --force. Format: docs/integrate.md.",
     )
-    parser.add_argument("game", help="the game's name, e.g. Dasher-Genesis")
-    parser.add_argument("--state", action="append", metavar="NAME", help="only this state (repeatable)")
-    parser.add_argument("--force", action="store_true", help="replace states that differ from their recipe")
+    parser.add_argument("names", nargs="+", metavar="NAME",
+                        help="STATE, GAME, or GAME STATE (e.g. Zone1.Act1, Dasher-Genesis, Dasher-Genesis Zone1.Act1)")
+    parser.add_argument("--state", action="append", metavar="NAME", help="only this state (repeatable; with GAME)")
+    parser.add_argument("--movie", metavar="FILE.bk2", help="make the state the movie reaches instead of a recipe's")
+    parser.add_argument("--frame", type=int, metavar="N", help="with --movie: the state after N frames (default: all)")
+    parser.add_argument("--out", metavar="DIR", help="write the states into DIR instead of your data folder")
+    parser.add_argument("--force", action="store_true", help="replace states that differ from what was made")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    """Integrate the states; exit 1 if any differs from its recipe."""
-    from retrokit.data.games import find_game
-    from retrokit.data.integrate import integrate
+    """Integrate the states; exit 1 if any differs from what was made."""
+    from pathlib import Path
 
-    outcomes = integrate(find_game(args.game), args.state, force=args.force)
+    from retrokit.data.integrate import integrate, place_state, resolve, target_folder
+    from retrokit.errors import InvalidArgumentError
+    from retrokit.movie.playback import state_from_movie
+
+    if len(args.names) > 2:
+        raise InvalidArgumentError(
+            f"Expected STATE, GAME, or GAME STATE; found {len(args.names)} names: {' '.join(args.names)}."
+        )
+    if args.frame is not None and not args.movie:
+        raise InvalidArgumentError("Expected --frame only with --movie FILE.bk2; found it alone.")
+    out = Path(args.out) if args.out else None
+    if args.movie:
+        game, name = _movie_target(args.names, args.movie)
+        state = state_from_movie(game, args.movie, args.frame)
+        outcomes = [place_state(game, name, state, out or target_folder(game), force=args.force)]
+    else:
+        game, names = resolve(*args.names)
+        if args.state:
+            names = [*(names or []), *args.state]
+        outcomes = integrate(game, names, force=args.force, out=out)
     width = max(len(o.name) for o in outcomes)
     for outcome in outcomes:
         print(f"{outcome.name:<{width}}  {outcome.status:<10}  {outcome.path}")
     differs = [o.name for o in outcomes if o.status in ("differs", "damaged")]
     if differs:
-        print(f"{len(differs)} state(s) differ from their recipe or are damaged; rerun with --force to replace them.")
+        print(f"{len(differs)} state(s) differ from what was made or are damaged; rerun with --force to replace them.")
         return 1
     return 0
+
+
+def _movie_target(names: list[str], movie: str):  # -> (Game, state name)
+    """The game and state name of ``integrate [GAME] NAME --movie FILE``: the game defaults to the movie's."""
+    from retrokit.data.games import find_game
+    from retrokit.movie import read_bk2
+
+    if len(names) == 2:
+        return find_game(names[0]), names[1]
+    return find_game(read_bk2(movie).game), names[0]

@@ -81,8 +81,20 @@ class Game:
 
     @cached_property
     def info(self) -> GameInfo:
-        """The game's data file, parsed (read on first use): the first folder's that has one."""
-        return read_game_folder(next((f for f in self.folders if _is_game_folder(f)), self.folders[0]))
+        """The game's data file, parsed (read on first use): the first of its folders that has one.
+
+        Raises:
+            DataFileError: None of its folders has a data file (only a user's folder of states can lack one).
+        """
+        for folder in self.folders:
+            if _is_game_folder(folder):
+                return read_game_folder(folder)
+        raise data_error(
+            self.folders[0], f"a data file (game.yaml) for {self.name}, here or in a shipped game folder of that name",
+            "none: this folder of the user's data holds states or scenarios of a game that is not known",
+            "rename the folder to a known game's name (retrokit games lists them), or add a game.yaml",
+            did_you_mean(self.name, [name for name, folders in _index().items() if any(map(_is_game_folder, folders))]),
+        )
 
     @property
     def system(self) -> System:
@@ -159,7 +171,7 @@ class Game:
         if key in self.state_recipes:
             raise StateNotFoundError(
                 f"Expected the state file {key}{STATE_SUFFIX} in {where}; it has a recipe but has not been made. "
-                f"Make it with: retrokit integrate {self.name}"
+                f"Make it with: retrokit integrate {self.name} {key}"
             )
         raise StateNotFoundError(
             f"Expected a state of {self.name}: one of {', '.join(self.states) or '(none)'}; "
@@ -316,6 +328,7 @@ def _index() -> dict[str, tuple[Path, ...]]:
         return _index_cache[key]
     index: dict[str, list[Path]] = {}
     has_data: set[str] = set()
+    user = paths.user_games_dir()
     for directory in dirs:
         with os.scandir(directory) as entries:
             for entry in sorted(entries, key=lambda e: e.name):
@@ -323,6 +336,10 @@ def _index() -> dict[str, tuple[Path, ...]]:
                     continue
                 path, name = Path(entry.path), normalize_name(entry.name)
                 if _is_game_folder(path):
+                    has_data.add(name)
+                elif directory == user:
+                    # A user's folder may hold only states and scenarios for a shipped game; one that
+                    # matches no game is kept too, so that it fails loudly instead of being ignored.
                     has_data.add(name)
                 elif not _is_scenario_folder(path):
                     continue

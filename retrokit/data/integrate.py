@@ -12,9 +12,16 @@ has a recipe for, and checks the ones already there::
         until: {game_mode: 1}          # every field equal: arrived
         settle: 0                      # frames to run after arrival
 
-A made state is compared with a state file by the RAM and screen they lead
-to, never by their bytes: Genesis Plus GX's states hold host pointers that
-differ from one process to the next.
+States can also be made from a movie: the state a ``.bk2`` reaches at a
+frame (:func:`retrokit.movie.playback.state_from_movie`), placed with
+:func:`place_state`. The format and the commands are documented in
+``docs/integrate.md``.
+
+Made states go to the user's data folder (``<data>/games/<Game>/``, which
+extends the shipped game), never into the installed package. A made state is
+compared with a state file by the RAM and screen they lead to, never by their
+bytes: Genesis Plus GX's states hold host pointers that differ from one
+process to the next; a state that is already up to date is not rewritten.
 """
 
 from __future__ import annotations
@@ -27,10 +34,20 @@ from typing import Any
 
 import numpy as np
 
-from retrokit.data.games import Game, cached_rom_sha1
+from retrokit import paths
+from retrokit.data.games import Game, cached_rom_sha1, find_game, list_games, load_game, normalize_name
 from retrokit.data.statecheck import load_state
 from retrokit.data.states import StateRecord, write_state
-from retrokit.errors import DataFileError, InvalidArgumentError, StateError, StateNotFoundError, did_you_mean
+from retrokit.errors import (
+    DataFileError,
+    GameNotFoundError,
+    InvalidArgumentError,
+    RetrokitError,
+    StateError,
+    StateNotFoundError,
+    UnknownNameError,
+    did_you_mean,
+)
 from retrokit.host.emulator import Emulator
 from retrokit.host.memory import FieldReader
 
@@ -216,13 +233,16 @@ class Outcome:
     path: Path
 
 
-def integrate(game: Game, names: list[str] | None = None, *, force: bool = False) -> list[Outcome]:
+def integrate(
+    game: Game, names: list[str] | None = None, *, force: bool = False, out: Path | None = None,
+) -> list[Outcome]:
     """Make the game's states from their recipes, and check those already made.
 
     Args:
         game: The game.
         names: The states to integrate; all with a recipe when ``None``.
         force: Replace a state file that leads somewhere else than its recipe.
+        out: The folder to write into; by default :func:`target_folder`.
 
     Returns:
         One outcome per state. ``"differs"`` means the file was kept although
@@ -233,30 +253,102 @@ def integrate(game: Game, names: list[str] | None = None, *, force: bool = False
     if not known:
         raise StateNotFoundError(
             f"Expected state recipes under 'integrate' in {game.info.source}; found none. "
-            f"Add one per state (see retrokit/data/integrate.py)."
+            "Add one per state (the format is in docs/integrate.md), or make a state from a movie: "
+            f"retrokit integrate {game.name} NAME --movie FILE.bk2."
         )
     wanted = list(known) if names is None else names
-    outcomes = []
-    folder = game.folders[0]
     for name in wanted:
         if name not in known:
-            raise StateNotFoundError(f"Expected a state with a recipe ({', '.join(known)}), got {name!r}." + did_you_mean(name, known))
-        made = make_state(game, known[name])
-        record = StateRecord.of(game.name, cached_rom_sha1(game.require_rom(), game.system), made)
-        path = folder / f"{name}.state"
-        if not path.exists():
-            write_state(path, made, record=record)
-            outcomes.append(Outcome(name, "made", path))
-            continue
-        try:  # a damaged file is probed in a child first, so it cannot crash this process
-            existing = load_state(game, path)
-        except StateError:
-            existing = None
-        if existing is not None and fingerprint(game, existing) == fingerprint(game, made):
-            outcomes.append(Outcome(name, "up to date", path))
-        elif force:
-            write_state(path, made, overwrite=True, record=record)
-            outcomes.append(Outcome(name, "replaced", path))
-        else:
-            outcomes.append(Outcome(name, "differs" if existing is not None else "damaged", path))
-    return outcomes
+            raise StateNotFoundError(
+                f"Expected a state with a recipe in {game.info.source} ({', '.join(known)}); found {name!r}. "
+                "Add its recipe under 'integrate' (docs/integrate.md)." + did_you_mean(name, known)
+            )
+    folder = out if out is not None else target_folder(game)
+    return [place_state(game, name, make_state(game, known[name]), folder, force=force) for name in wanted]
+
+
+def place_state(game: Game, name: str, state: bytes, folder: Path, *, force: bool = False) -> Outcome:
+    """Write a made state as ``folder/<name>.state`` (with its record) unless an equivalent one is there.
+
+    Returns:
+        ``"made"`` (new file), ``"up to date"`` (an equivalent file is there and was left
+        alone), ``"replaced"`` (a different or damaged one was replaced: ``force``),
+        ``"differs"`` (a different one was kept) or ``"damaged"`` (one that cannot be
+        loaded was kept).
+    """
+    record = StateRecord.of(game.name, cached_rom_sha1(game.require_rom(), game.system), state)
+    path = folder / f"{name}.state"
+    if not path.exists():
+        write_state(path, state, record=record)
+        return Outcome(name, "made", path)
+    try:  # a damaged file is probed in a child first, so it cannot crash this process
+        existing = load_state(game, path)
+    except StateError:
+        existing = None
+    if existing is not None and fingerprint(game, existing) == fingerprint(game, state):
+        return Outcome(name, "up to date", path)
+    if force:
+        write_state(path, state, overwrite=True, record=record)
+        return Outcome(name, "replaced", path)
+    return Outcome(name, "differs" if existing is not None else "damaged", path)
+
+
+def target_folder(game: Game, data_dir: Path | None = None) -> Path:
+    """Where made states of ``game`` go: its folder among the user's, ``<data>/games/<Game>``.
+
+    A game whose only folder is outside every search folder (a game.yaml in the
+    current directory) is the user's own: its states go next to its game.yaml.
+    """
+    searched = [d.resolve() for d in paths.game_search_dirs()]
+    own = game.folders[0].resolve()
+    if len(game.folders) == 1 and own.parent not in searched:
+        return game.folders[0]
+    return paths.user_games_dir(data_dir) / game.name
+
+
+def resolve(first: str, second: str | None = None, *, cwd: Path | None = None) -> tuple[Game, list[str] | None]:
+    """Which game and states ``retrokit integrate FIRST [SECOND]`` means.
+
+    ``GAME STATE`` is that state of that game; ``GAME`` alone is all its recipes.
+    A lone ``STATE`` belongs to the one known game that has a state file or a
+    recipe of that name, else to the game.yaml in ``cwd``.
+
+    Raises:
+        UnknownNameError: Several games have that state, or none does and ``cwd`` has no game.yaml.
+    """
+    cwd = Path.cwd() if cwd is None else cwd
+    if second is not None:
+        return (load_game(cwd) if first == "." else find_game(first)), [second]
+    names = {g.name for g in list_games()}
+    if normalize_name(first) in names:
+        return find_game(first), None
+    owners = games_with_state(first)
+    if len(owners) == 1:
+        return find_game(owners[0]), [first]
+    if len(owners) > 1:
+        raise UnknownNameError(
+            f"Expected one game with a state or recipe named {first!r}; found {len(owners)}: {', '.join(owners)}. "
+            f"Name the game: retrokit integrate {owners[0]} {first}"
+        )
+    if (cwd / "game.yaml").is_file():
+        return load_game(cwd), [first]
+    raise GameNotFoundError(
+        f"Expected a game name, or a state or recipe that one known game has; found {first!r}, which no game "
+        f"has, and no game.yaml in {cwd} to make it for. Name the game: retrokit integrate GAME {first}"
+        + did_you_mean(first, names)
+    )
+
+
+def games_with_state(name: str) -> list[str]:
+    """The known games that have a state file or a recipe called ``name``."""
+    found = []
+    for game in list_games():
+        has = any((folder / f"{name}.state").is_file() for folder in game.folders)
+        if not has and any((folder / "game.yaml").is_file() for folder in game.folders):
+            try:
+                has = name in game.state_recipes
+            except RetrokitError:  # a broken data file is validate's business, not this search's
+                has = False
+        if has:
+            found.append(game.name)
+    return found

@@ -236,3 +236,31 @@ def _conflict(path: Path) -> FileConflictError:
         f"Expected no file at {str(path)!r} or the same state; found a different file. "
         "Pass overwrite=True to replace it, or choose another name."
     )
+
+
+# Genesis Plus GX (1.7.x) writes a 16-byte version string, then, for a Mega
+# Drive, the 68000's 64 KiB of work RAM as the core holds it (host-order
+# 16-bit words): so a state's fields can be read without the ROM or the core.
+_GPGX_SIGNATURE = b"GENPLUS-GX"
+_GPGX_RAM = slice(16, 16 + 0x10000)
+
+
+def state_ram(data: bytes, system: str) -> bytes | None:
+    """Return the system RAM inside a serialized core state, in the core's byte order, if its layout is known.
+
+    Known: Genesis states of Genesis Plus GX. For others, ``None``: only a
+    core can read them.
+
+    Args:
+        data: A serialized (uncompressed) core state.
+        system: The system's name, e.g. ``"Genesis"``.
+    """
+    if system == "Genesis" and data[: len(_GPGX_SIGNATURE)] == _GPGX_SIGNATURE and len(data) >= _GPGX_RAM.stop:
+        return bytes(data[_GPGX_RAM])
+    return None
+
+
+def state_format(data: bytes) -> str:
+    """Return the printable signature a core put at the start of a state (e.g. ``"GENPLUS-GX 1.7.5"``), or ``""``."""
+    head = data[:16].split(b"\0", 1)[0]
+    return head.decode("ascii") if head and all(32 <= b < 127 for b in head) else ""

@@ -43,7 +43,7 @@ class RetroEnv(gymnasium.Env):
     """A game as a Gymnasium environment.
 
     Args:
-        game: The game's name, e.g. ``"Airstriker-Genesis"``.
+        game: The game's name, e.g. ``"Airstriker-Genesis"``, or a loaded :class:`Game`.
         state: A state name, a ``.state`` path, or a :class:`State`.
         scenario: A scenario name of the game, a path to a ``.yaml`` or
             Gym Retro ``.json`` scenario, or ``None`` for the game's default.
@@ -68,7 +68,7 @@ class RetroEnv(gymnasium.Env):
 
     def __init__(
         self,
-        game: str,
+        game: str | Game,
         state: str | os.PathLike[str] | State | None = State.DEFAULT,
         scenario: str | os.PathLike[str] | Mapping[str, Any] | None = None,
         *,
@@ -84,7 +84,7 @@ class RetroEnv(gymnasium.Env):
         options: Mapping[str, str] | None = None,
         skip_video: bool = True,
     ) -> None:
-        self.game: Game = find_game(game)
+        self.game: Game = game if isinstance(game, Game) else find_game(game)
         _check_choice("obs_type", obs_type, OBS_TYPES)
         _check_choice("render_mode", render_mode, (None, *self.metadata["render_modes"]))
         if not isinstance(frameskip, int) or frameskip < 1:
@@ -308,7 +308,7 @@ def _check_choice(name: str, value: object, choices: tuple[object, ...]) -> None
 
 
 def make(
-    game: str,
+    game: str | Game,
     state: str | os.PathLike[str] | State | None = State.DEFAULT,
     scenario: str | os.PathLike[str] | Mapping[str, Any] | None = None,
     **options: Any,

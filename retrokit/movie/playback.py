@@ -7,6 +7,7 @@ import re
 import tempfile
 from collections.abc import Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from tqdm import tqdm
@@ -26,6 +27,9 @@ from retrokit.movie.bk2 import read_bk2
 from retrokit.movie.gif import GifWriter, gif_step
 from retrokit.movie.model import STATE_DIGEST, Movie
 from retrokit.paths import atomic_output, atomic_write, ensure_folder
+
+if TYPE_CHECKING:
+    from retrokit.data.games import Game
 
 FRAME_PATTERN = "frame_{:06d}.png"
 _SHA1 = re.compile(r"[0-9a-f]{40}")
@@ -268,3 +272,31 @@ def _place(out: Path, data: bytes, overwrite: bool) -> None:
         raise FileConflictError(
             f"Expected no file at {out}; found one. Choose another path, or pass overwrite (--overwrite)."
         ) from None
+
+
+def state_from_movie(game: Game, movie_path: str | os.PathLike[str], frame: int | None = None) -> bytes:
+    """Replay a movie of ``game`` for ``frame`` frames (all by default) and return the state it reaches.
+
+    Raises:
+        MovieError: The movie is malformed, of another game, or shorter than ``frame``.
+    """
+    movie = read_bk2(movie_path)
+    if movie.game != game.name:
+        raise MovieError(
+            f"Expected a movie of {game.name}; found one of {movie.game} in {movie_path}. "
+            f"Give its game instead: retrokit integrate {movie.game} NAME --movie {movie_path}"
+        )
+    length = len(movie.frames)
+    frame = length if frame is None else frame
+    if not 0 <= frame <= length:
+        raise MovieError(f"Expected a frame from 0 to {length} (the movie's length) for --frame; found {frame}.")
+    movie.frames = movie.frames[:frame]
+    with Emulator(game.system, game.require_rom(), ports=max(2, movie.players)) as emu:
+        for _ in play(movie, emulator=emu):
+            pass
+        if frame == 0:  # play() ran nothing: put the console at the movie's start
+            if movie.state is not None:
+                emu.set_state(movie.state)
+            else:
+                emu.reset()
+        return emu.get_state()

@@ -1,0 +1,92 @@
+"""Agents: how they are named on the command line, and the ``random`` baseline.
+
+An agent is a callable ``agent(env, budget, seed)``, called once per level. It
+plays the level's env (a Gymnasium env, wrapped in a
+:class:`~retrokit.benchmark.monitor.Monitor`) with ``reset`` and ``step`` until
+the budget is spent, when ``step`` raises
+:class:`~retrokit.benchmark.monitor.BudgetSpent`; the runner catches it. So any
+Gymnasium policy fits in a few lines (docs/evaluate.md has a Stable-Baselines3
+PPO). ``seed`` seeds the agent's own randomness; the env's first reset is
+already seeded by the runner.
+
+On the command line an agent is ``random``, ``jerk``, or ``MODULE:CALLABLE``
+where ``MODULE`` is an importable module or a ``.py`` file.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Protocol
+
+import gymnasium
+
+from retrokit.errors import UnknownNameError, did_you_mean
+
+BUILTINS = {
+    "random": "retrokit.benchmark.agents:random_agent",
+    "jerk": "retrokit.benchmark.jerk:jerk",
+}
+
+
+class Agent(Protocol):
+    """Plays one level's env until its budget is spent."""
+
+    def __call__(self, env: gymnasium.Env, budget: int, seed: int) -> None: ...
+
+
+def random_agent(env: gymnasium.Env, budget: int, seed: int) -> None:
+    """Sample every action uniformly from the action space (seeded by the runner)."""
+    env.reset()
+    while True:
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        if terminated or truncated:
+            env.reset()
+
+
+def resolve_agent(spec: str) -> Callable[..., None]:
+    """Return the agent named ``random``, ``jerk`` or ``MODULE:CALLABLE``.
+
+    Raises:
+        UnknownNameError: The name is none of those, or the module or callable cannot be found.
+    """
+    target = BUILTINS.get(spec, spec)
+    module_name, sep, attribute = target.partition(":")
+    if not sep or not module_name or not attribute:
+        raise UnknownNameError(
+            f"Expected an agent ({', '.join(BUILTINS)}, or MODULE:CALLABLE), got {spec!r}." + did_you_mean(spec, BUILTINS)
+        )
+    try:
+        module = _load_module(module_name)
+    except Exception as exc:  # noqa: BLE001 - any import failure of user code is the user's to see
+        raise UnknownNameError(
+            f"Expected the agent {spec!r} to name an importable module, but importing {module_name!r} failed: "
+            f"{type(exc).__name__}: {exc}. Check the name, or give a path to a .py file."
+        ) from None
+    agent = getattr(module, attribute, None)
+    if not callable(agent):
+        names = [n for n in vars(module) if not n.startswith("_") and callable(getattr(module, n))]
+        raise UnknownNameError(
+            f"Expected {module_name!r} to define a callable {attribute!r} (agent(env, budget, seed)), but it does not."
+            + did_you_mean(attribute, names)
+        )
+    return agent
+
+
+def _load_module(name: str):  # a module
+    if not name.endswith(".py"):
+        return importlib.import_module(name)
+    path = Path(name).expanduser().resolve()
+    if not path.is_file():
+        raise FileNotFoundError(f"no file {path}")
+    key = f"retrokit_agent_{abs(hash(str(path)))}"
+    if key in sys.modules:
+        return sys.modules[key]
+    spec = importlib.util.spec_from_file_location(key, path)
+    module = importlib.util.module_from_spec(spec)  # type: ignore[arg-type]
+    sys.modules[key] = module
+    spec.loader.exec_module(module)  # type: ignore[union-attr]
+    return module

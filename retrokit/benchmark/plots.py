@@ -1,0 +1,99 @@
+"""The PNG plots, drawn with matplotlib (the ``retrokit[plot]`` extra).
+
+The object API is used (no pyplot), so drawing changes no global state and
+needs no display.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from typing import Any
+
+PLOT_EXTRA = "retrokit[plot]"
+
+
+def have_matplotlib() -> bool:
+    """Whether matplotlib can be imported."""
+    import importlib.util
+
+    return importlib.util.find_spec("matplotlib") is not None
+
+
+def _figure(width: float, height: float):  # a matplotlib Figure
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    figure = Figure(figsize=(width, height), dpi=100, layout="constrained")
+    FigureCanvasAgg(figure)
+    return figure
+
+
+def _png(figure) -> bytes:  # a matplotlib Figure
+    out = io.BytesIO()
+    figure.savefig(out, format="png")
+    return out.getvalue()
+
+
+def _smooth(values: list[float], window: int) -> list[float]:
+    """The running mean of the last ``window`` values at each point."""
+    out, total = [], 0.0
+    for i, value in enumerate(values):
+        total += value
+        if i >= window:
+            total -= values[i - window]
+        out.append(total / min(i + 1, window))
+    return out
+
+
+def learning_curves(episodes: dict[str, list[dict[str, Any]]], budget: int, title: str) -> bytes:
+    """One panel per level: each episode's reward at the timestep it ended, and their running mean.
+
+    The paper's figures draw the same: episode reward against timesteps.
+    """
+    levels = list(episodes)
+    columns = min(3, max(1, len(levels)))
+    rows = max(1, math.ceil(len(levels) / columns))
+    figure = _figure(4.2 * columns, 3.0 * rows + 0.4)
+    figure.suptitle(title)
+    for i, level in enumerate(levels):
+        axes = figure.add_subplot(rows, columns, i + 1)
+        records = sorted(episodes[level], key=lambda e: e["episode"])
+        x = [e["timesteps"] for e in records]
+        y = [e["reward"] for e in records]
+        axes.scatter(x, y, s=6, alpha=0.35, color="tab:blue", label="episode")
+        if records:
+            axes.plot(x, _smooth(y, max(1, len(y) // 10)), color="tab:red", linewidth=1.5, label="running mean")
+        axes.set_title(level, fontsize=9)
+        axes.set_xlim(0, budget)
+        axes.set_xlabel("timesteps", fontsize=8)
+        axes.set_ylabel("episode reward", fontsize=8)
+        axes.tick_params(labelsize=7)
+        axes.grid(alpha=0.3)
+        if i == 0 and records:
+            axes.legend(fontsize=7, loc="lower right")
+    return _png(figure)
+
+
+def score_bars(series: dict[str, dict[str, float | None]], levels: list[str], title: str) -> bytes:
+    """Per-level scores as grouped horizontal bars, one colour per series (an agent, or the paper's)."""
+    height = 1.0 + 0.28 * len(levels) * max(1, len(series)) + 0.6
+    figure = _figure(8.0, max(3.0, height))
+    axes = figure.add_subplot(1, 1, 1)
+    band = 0.8 / max(1, len(series))
+    for k, (label, scores) in enumerate(series.items()):
+        ys = [i + (k - (len(series) - 1) / 2) * band for i in range(len(levels))]
+        values = [scores.get(level) for level in levels]
+        bars = axes.barh(ys, [v or 0.0 for v in values], height=band, label=label)
+        for bar, value in zip(bars, values, strict=True):
+            text = "–" if value is None else f"{value:,.0f}"
+            axes.annotate(text, (bar.get_width(), bar.get_y() + bar.get_height() / 2), xytext=(3, 0),
+                          textcoords="offset points", va="center", fontsize=7)
+    axes.set_yticks(range(len(levels)), levels, fontsize=8)
+    axes.invert_yaxis()
+    axes.set_xlabel("mean episode reward (score)")
+    axes.set_title(title)
+    axes.grid(axis="x", alpha=0.3)
+    axes.margins(x=0.12)
+    axes.legend(fontsize=8, loc="lower right")
+    return _png(figure)

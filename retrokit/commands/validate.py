@@ -1,0 +1,83 @@
+"""``retrokit validate [GAME ...] [--all] [--json FILE]``: check game integrations end to end."""
+
+from __future__ import annotations
+
+import argparse
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``validate`` command."""
+    parser = subparsers.add_parser(
+        "validate",
+        help="check games: data files, fields, states, scenarios (smoke runs) and solution movies",
+        description="Check each game's integration: game.yaml and scenarios against the JSON Schemas, fields "
+        "inside the system's RAM, every state (loaded in a child process, so a corrupt one cannot stop the run), "
+        "every scenario (compiled, tables covering the states, a deterministic smoke run on every state) and "
+        "the solution movies in movies/. Without a game's ROM, what needs it is skipped and the report says so. "
+        "Prints one table per game and a summary; exits with status 1 if any check failed.",
+    )
+    parser.add_argument("games", nargs="*", metavar="GAME",
+                        help="game names or game folders (default: the game.yaml folder in the current directory)")
+    parser.add_argument("--all", action="store_true", help="every game in the repository's and RETROKIT_GAMES' "
+                        "folders and the user's data folder (the wheel's own integrations only with GAME)")
+    parser.add_argument("--json", metavar="FILE", help="also write every result to this JSON file")
+    parser.add_argument("--frames", type=int, default=None, metavar="N",
+                        help="frames of scripted random play per state and scenario (default: 600)")
+    parser.add_argument("--quiet", "-q", action="store_true", help="print only failures, warnings and skips")
+    parser.set_defaults(run=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    """Check the games; print a table per game and a summary; exit 1 on any failure."""
+    from pathlib import Path
+
+    from tqdm import tqdm
+
+    from retrokit.errors import InvalidArgumentError
+    from retrokit.testing import STAGES, check_game
+    from retrokit.testing.report import PASS, GameReport, render, summary, write_json
+
+    if args.frames is not None and args.frames < 1:
+        raise InvalidArgumentError(f"Expected --frames of 1 or more, got {args.frames}.")
+    targets = list(args.games) + (own_games() if args.all else [])
+    if not targets:
+        if not Path("game.yaml").is_file():
+            raise InvalidArgumentError(
+                "Expected game names, --all, or a game.yaml in the current directory; found none. "
+                "Example: retrokit validate Dasher-Genesis"
+            )
+        targets = ["."]
+    reports: list[GameReport] = []
+    with tqdm(total=len(targets) * len(STAGES), unit="stage", leave=False) as bar:
+        for target in targets:
+            started = [0]  # stages of this game begun; the bar counts those finished
+
+            def step(stage: str, detail: str, name: str = str(target), started: list[int] = started) -> None:
+                bar.set_description(f"{name}: {detail or stage}")
+                if not detail:  # a stage starts (so the one before it is done); details only say where it is
+                    bar.update(1 if started[0] else 0)
+                    started[0] += 1
+
+            reports.append(check_game(target, frames=args.frames, progress=step))
+            bar.update(len(STAGES) - max(started[0] - 1, 0))  # the last stage, and any a broken game skipped
+    for report in reports:
+        if args.quiet:
+            shown = GameReport(report.game, [r for r in report.results if r.status != PASS])
+            print(render(shown) if shown.results else f"{report.game}: all {len(report.results)} checks passed")
+        else:
+            print(render(report))
+        print()
+    print(summary(reports))
+    if args.json:
+        write_json(args.json, reports)
+        print(f"wrote every result to {args.json}")
+    return 0 if all(r.passed for r in reports) else 1
+
+
+def own_games() -> list[str]:
+    """The games whose first folder is not the stable-retro wheel's: the ones this project and its users made."""
+    from retrokit import paths
+    from retrokit.data.games import list_games
+
+    wheel = paths.wheel_dir()
+    return [g.name for g in list_games() if wheel is None or not g.folders[0].is_relative_to(wheel)]

@@ -1,0 +1,135 @@
+"""Checking a game's reference movies: each replays to the outcome ``game.yaml`` expects.
+
+A game folder may hold solution movies, ``movies/<name>.bk2``, and its
+``game.yaml`` the outcome of each under the scenario it proves::
+
+    movies:
+      Zone1.Act1: {scenario: scenario, done_at: 615, reward: 2564, tolerance: 0.5}
+
+``done_at`` is the movie frame at which the scenario first says done (``null``:
+never), ``reward`` the total of every player's reward up to then. The movie
+is replayed from its own start state with the scenario evaluated after every
+frame.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from retrokit.data.games import Game
+from retrokit.errors import RetrokitError
+from retrokit.testing.report import FAIL, PASS, SKIP, WARN, GameReport
+
+__all__ = ["DEFAULT_TOLERANCE", "MOVIES_FOLDER", "MovieOutcome", "check_movies", "movie_files", "replay"]
+
+MOVIES_FOLDER = "movies"
+DEFAULT_TOLERANCE = 1e-3
+
+
+@dataclass(frozen=True)
+class MovieOutcome:
+    """What a scenario said along a movie.
+
+    Attributes:
+        frames: The movie's length in frames.
+        done_at: The first frame (1-based) at which done held, or ``None``.
+        reward: The total of every player's reward up to ``done_at`` (or the end).
+    """
+
+    frames: int
+    done_at: int | None
+    reward: float
+
+
+def movie_files(game: Game) -> dict[str, Path]:
+    """The game's solution movies by name (the file's stem), from every folder of the game."""
+    found: dict[str, Path] = {}
+    for folder in game.folders:
+        for path in sorted((folder / MOVIES_FOLDER).glob("*.bk2")):
+            found.setdefault(path.stem, path)
+    return found
+
+
+def replay(game: Game, movie_path: Path, scenario: str | None = None, rom: Path | None = None) -> MovieOutcome:
+    """Replay a movie with a scenario evaluated after every frame; return what it said.
+
+    Raises:
+        MovieError: The movie is malformed or is not of this game's system.
+        ScenarioError: The scenario does not compile, or fails while running.
+    """
+    from retrokit.dsl.scenario import load_scenario
+    from retrokit.host.emulator import Emulator
+    from retrokit.host.memory import FieldReader
+    from retrokit.movie import read_bk2
+
+    movie = read_bk2(movie_path)
+    path = game.scenario_path(scenario)
+    compiled = load_scenario(path, list(game.fields), game_dir=path.parent)
+    total, done_at = 0.0, None
+    with Emulator(game.system, rom or game.require_rom(), ports=max(2, movie.players)) as emu:
+        # As retrokit.movie.playback.play does, without converting screens nobody looks at.
+        emu.set_sticky(0.0, 0)
+        emu.forget_action()
+        if movie.state is not None:
+            emu.set_state(movie.state)
+        else:
+            emu.reset()
+        reader = FieldReader(game.fields, emu.space)
+        run = compiled.start()
+        run.reset(reader.read())  # as an env's reset: the scenario starts from the movie's state
+        for frame, buttons in enumerate(movie.frames, start=1):
+            emu.run(buttons, 1)
+            rewards, done = run.step(reader.read(), frame, frame)
+            total += sum(rewards)
+            if done:
+                done_at = frame
+                break
+    return MovieOutcome(len(movie.frames), done_at, total)
+
+
+def check_movies(game: Game, report: GameReport, rom: Path | None) -> None:
+    """Replay every solution movie and compare with its expected outcome; add the results to ``report``."""
+    files = movie_files(game)
+    expected = game.info.extra.get("movies") or {}
+    if not files and not expected:
+        return
+    for name in sorted(set(expected) - set(files)):
+        report.add("movie", FAIL, f"expected the movie {MOVIES_FOLDER}/{name}.bk2 that game.yaml's 'movies' names; "
+                   f"found no such file in {', '.join(str(f) for f in game.folders)}. Add it or remove the entry.",
+                   state=name)
+    for name, path in files.items():
+        if name not in expected:
+            report.add("movie", WARN, f"{path.name} has no expected outcome under 'movies' in game.yaml, so it "
+                       "proves nothing; add {done_at: F, reward: R}", state=name)
+            continue
+        if rom is None:
+            report.add("movie", SKIP, "no ROM to replay it with", state=name)
+            continue
+        _check_one(game, report, name, path, expected[name], rom)
+
+
+def _check_one(game: Game, report: GameReport, name: str, path: Path, want: Mapping[str, Any], rom: Path) -> None:
+    scenario = want.get("scenario")
+    label = scenario or game.default_scenario or ""
+    try:
+        outcome = replay(game, path, scenario, rom)
+    except RetrokitError as exc:
+        report.add("movie", FAIL, f"{path.name} could not be replayed: {exc}", state=name, scenario=label)
+        return
+    tolerance = float(want.get("tolerance", DEFAULT_TOLERANCE))
+    problems = []
+    if "done_at" in want and want["done_at"] != outcome.done_at:
+        found = f"frame {outcome.done_at}" if outcome.done_at else f"never, in its {outcome.frames} frames"
+        problems.append(f"done at frame {want['done_at']}, found done {found}")
+    if abs(outcome.reward - float(want["reward"])) > tolerance:
+        problems.append(f"a total reward of {want['reward']} (within {tolerance:g}), found {outcome.reward:g}")
+    if problems:
+        report.add("movie", FAIL, f"expected {'; and '.join(problems)}. If the scenario changed on purpose, "
+                   "update 'movies' in game.yaml; else the scenario's reward or done broke.",
+                   state=name, scenario=label)
+    else:
+        done = f"done at frame {outcome.done_at}" if outcome.done_at else "never done"
+        report.add("movie", PASS, f"{done}, total reward {outcome.reward:g}, as expected", state=name, scenario=label)

@@ -1,0 +1,390 @@
+"""Checking a game's save states: each loads, is the game's own, and its fields decode.
+
+States are loaded in a child process (``python -m retrokit.testing.states``),
+so that a corrupt state that crashes or hangs the core costs one result, not
+the run: the parent sees the child die or time out, blames the state it was
+on, and starts a new child for the rest.
+
+Without the ROM no core can load a state; the files are then parsed: the
+gzip stream, the core's signature and, where the layout is known
+(:func:`retrokit.data.states.state_ram`), the fields read from the RAM inside.
+
+A state is flagged as not the game's own when retrokit recorded it on another
+ROM (:class:`~retrokit.data.states.StateRecord`), when it is a copy of another
+game's state file, or when it does not reach what its recipe in ``game.yaml``
+(``integrate``) says it should: the recipe's ``set`` and ``until`` values.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import subprocess
+import sys
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from retrokit.data.games import Game, list_games
+from retrokit.data.states import read_state, state_format, state_ram
+from retrokit.errors import RetrokitError
+from retrokit.testing.report import FAIL, PASS, SKIP, WARN, GameReport
+
+if TYPE_CHECKING:
+    from retrokit.host.fields import FieldSpec
+    from retrokit.host.memory import AddressSpace
+
+__all__ = ["IDLE_FRAMES", "StateProbe", "check_states", "parse_states", "probe_states", "state_space"]
+
+IDLE_FRAMES = 60  # frames run after loading, so a state that breaks the core does so here
+CHILD_TIMEOUT = 30.0  # seconds a child may spend on one state
+CHILD_STARTUP = 120.0  # seconds a child may take to start (importing retrokit, loading the core) on a busy machine
+CHILD_MEMORY = 512 << 20  # bytes of address space a child may map: a gzip bomb fails there, the machine lives
+
+
+@dataclass
+class StateProbe:
+    """What loading (or parsing) one state showed.
+
+    Attributes:
+        name: The state's name.
+        path: Its file.
+        loaded: Whether a core loaded it (``False`` also when it was only parsed).
+        error: Why it could not be loaded or parsed, or ``""``.
+        start: Every field's value right after loading (or read from the file), by name.
+        after: Every field's value after :data:`IDLE_FRAMES` idle frames (empty when parsed).
+        parsed_only: No core was run: the values come from the file.
+        detail: A short description, e.g. the core's signature and the size.
+    """
+
+    name: str
+    path: str
+    loaded: bool = False
+    error: str = ""
+    start: dict[str, int] = field(default_factory=dict)
+    after: dict[str, int] = field(default_factory=dict)
+    parsed_only: bool = False
+    detail: str = ""
+
+
+# --- Parent side ---------------------------------------------------------------------------------
+
+
+def probe_states(game: Game, names: Sequence[str], rom: Path, *, frames: int = IDLE_FRAMES) -> dict[str, StateProbe]:
+    """Load each state in a child process with the game's ROM; return what each showed.
+
+    A child that dies or hangs marks the state it was loading as failed, and a
+    new child carries on with the states after it.
+    """
+    paths = {name: str(game.state_path(name)) for name in names}
+    fields = [{"name": f.name, "address": f.address, "type": f.type, "mask": f.mask} for f in game.fields.values()]
+    probes: dict[str, StateProbe] = {}
+    todo = list(names)
+    while todo:
+        request = {"system": game.system.name, "rom": str(rom), "fields": fields, "frames": frames,
+                   "states": [[n, paths[n]] for n in todo]}
+        done, current, failure = _run_child(request)
+        probes.update(done)
+        todo = [n for n in todo if n not in probes]
+        if current is not None and current in todo:  # the child died or hung on this one
+            probes[current] = StateProbe(current, paths[current], error=failure)
+            todo.remove(current)
+        elif todo:  # the child ended without starting the rest: report, do not loop
+            for name in todo:
+                probes[name] = StateProbe(name, paths[name], error=failure or "the state loader stopped early")
+            todo = []
+    return {name: probes[name] for name in names}
+
+
+def _run_child(request: Mapping[str, Any]) -> tuple[dict[str, StateProbe], str | None, str]:
+    """Run one child; return the probes it finished, the state it was on when it stopped, and why it stopped.
+
+    The child prints a line before and after each state; a state that prints
+    nothing for :data:`CHILD_TIMEOUT` seconds has hung the core, and the child
+    is killed. Its log goes to a file, so a chatty core cannot fill a pipe.
+    """
+    import selectors
+    import tempfile
+
+    probes: dict[str, StateProbe] = {}
+    current, failure = None, ""
+    with tempfile.TemporaryFile("w+") as log:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "retrokit.testing.states"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+            stderr=log, bufsize=0,
+        )
+        try:
+            proc.stdin.write(json.dumps(request).encode())  # type: ignore[union-attr]
+            proc.stdin.close()  # type: ignore[union-attr]
+        except BrokenPipeError:  # it died at once; its status says why
+            pass
+        # Raw reads, split here: a buffered reader could hold a line that select() then waits for.
+        fd = proc.stdout.fileno()  # type: ignore[union-attr]
+        pending = b""
+        with selectors.DefaultSelector() as selector:
+            selector.register(fd, selectors.EVENT_READ)
+            wait = CHILD_STARTUP
+            while True:
+                if not selector.select(timeout=wait):
+                    proc.kill()
+                    failure = (f"the core hung: loading the state and running {request['frames']} frames "
+                               f"took over {CHILD_TIMEOUT:g} s")
+                    break
+                chunk = os.read(fd, 1 << 16)
+                if not chunk:
+                    break
+                wait = CHILD_TIMEOUT
+                *lines, pending = (pending + chunk).split(b"\n")
+                for line in lines:
+                    try:
+                        message = json.loads(line)
+                    except json.JSONDecodeError:
+                        continue
+                    if "begin" in message:
+                        current = message["begin"]
+                    else:
+                        probes[message["name"]] = StateProbe(**message)
+                        current = None
+        proc.stdout.close()  # type: ignore[union-attr]
+        status = proc.wait()
+        if not failure and status != 0:
+            if status < 0:
+                failure = f"the core crashed (signal {-status}) while loading or running the state"
+            else:
+                log.seek(0)
+                last = log.read().strip().splitlines()[-1:] or ["no message"]
+                failure = f"the state loader exited with status {status}: {last[0]}"
+    return probes, current, failure
+
+
+def state_space(game: Game, data: bytes) -> AddressSpace | None:
+    """The console addresses of the RAM inside a serialized state, where its layout is known (else ``None``)."""
+    from retrokit.host.memory import AddressSpace, Region
+
+    ram = state_ram(data, game.system.name)
+    if ram is None:
+        return None
+    return AddressSpace([Region(game.system.ram_base, len(ram), memoryview(bytearray(ram)), game.system.ram_swap)])
+
+
+def parse_states(game: Game, names: Sequence[str]) -> dict[str, StateProbe]:
+    """Parse each state file without a core: gzip, signature, and the fields where the RAM layout is known."""
+    from retrokit.host.memory import FieldReader
+
+    probes = {}
+    for name in names:
+        path = game.state_path(name)
+        probe = StateProbe(name, str(path), parsed_only=True)
+        probes[name] = probe
+        try:
+            data = read_state(path)
+        except RetrokitError as exc:
+            probe.error = str(exc)
+            continue
+        probe.detail = f"{state_format(data) or 'no core signature'}, {len(data)} bytes"
+        space = state_space(game, data)
+        if space is None:
+            continue
+        mapped = [f for f in game.fields.values() if _inside(space, f)]
+        probe.start = FieldReader(mapped, space).read()
+    return probes
+
+
+def _inside(space: AddressSpace, spec: FieldSpec) -> bool:
+    try:
+        space.locate(spec.address, spec.field_type.width)
+    except RetrokitError:
+        return False
+    return True
+
+
+# --- Results -----------------------------------------------------------------------------------------
+
+
+def check_states(game: Game, report: GameReport, rom: Path | None) -> dict[str, StateProbe]:
+    """Check every state of the game; add the results to ``report``; return the probes of those that loaded."""
+    names = []
+    for name in game.states:
+        try:
+            game.state_path(name)
+            names.append(name)
+        except RetrokitError as exc:
+            report.add("state file", FAIL, str(exc), state=name)
+    if not names:
+        report.add("states", WARN if game.state_recipes else SKIP, "the game has no state files")
+        return {}
+    probes = probe_states(game, names, rom) if rom is not None else parse_states(game, names)
+    if rom is None:
+        report.add("state loads", SKIP, f"{len(names)} state{'s' * (len(names) != 1)} parsed, not loaded: "
+                   "no ROM to load them with (import it: retrokit import /path/to/roms)")
+    copies = _copies_elsewhere(game, names)
+    recipes = game.state_recipes
+    good = {}
+    for name, probe in probes.items():
+        if probe.error:
+            report.add("state loads" if rom is not None else "state parses", FAIL, probe.error, state=name)
+            continue
+        if rom is None:
+            report.add("state parses", PASS, probe.detail, state=name)
+        else:
+            report.add("state loads", PASS, f"loaded and ran {IDLE_FRAMES} frames in a child process", state=name)
+        foreign = _recorded_elsewhere(game, Path(probe.path))
+        if foreign:
+            report.add("state is the game's", FAIL, foreign, state=name)
+            continue
+        if name in copies:
+            report.add("state is the game's", FAIL,
+                       f"expected a state made with {game.name}'s ROM; found a copy of {copies[name]}. "
+                       "Replace the file with one made for this game (retrokit integrate, or retrokit play).",
+                       state=name)
+            continue
+        if name in recipes and probe.start:
+            mismatch = _recipe_mismatch(recipes[name], probe.start)
+            if mismatch:
+                report.add("state is the game's", FAIL,
+                           f"expected the values its recipe in game.yaml reaches ({mismatch[0]}); found {mismatch[1]}: "
+                           "the file is another state's, another game's, or made with another ROM. "
+                           f"Remake it: retrokit integrate {game.name} {name} (add --force to replace it).",
+                           state=name)
+                continue
+            report.add("state is the game's", PASS, f"reaches its recipe's {_recipe_text(recipes[name])}", state=name)
+        else:
+            report.add("state is the game's", PASS, "not a copy of another game's state (no recipe to compare with)",
+                       state=name)
+        if probe.start:
+            report.add("fields decode", PASS, f"{len(probe.start)} fields: " + _sample(probe.start), state=name)
+        elif game.fields:
+            report.add("fields decode", SKIP, "the RAM layout of this core's states is not known without the ROM",
+                       state=name)
+        good[name] = probe
+    return good
+
+
+def _recorded_elsewhere(game: Game, path: Path) -> str:
+    """Why a state retrokit wrote is another ROM's (from the record in its file), or ``""``."""
+    from retrokit.data.states import read_state_file
+
+    try:
+        record = read_state_file(path).record
+    except RetrokitError:
+        return ""  # an unreadable file already failed to load
+    if record is None or not game.sha1s or record.rom_sha1 in game.sha1s:
+        return ""
+    of = f" (a state of {record.game})" if record.game != game.name else ""
+    return (f"expected a state made with {game.name}'s ROM ({', '.join(game.sha1s)}); found one retrokit recorded "
+            f"on the ROM with SHA-1 {record.rom_sha1}{of}. Remake it with this game's ROM.")
+
+
+def _sample(values: Mapping[str, int], limit: int = 6) -> str:
+    shown = ", ".join(f"{k}={v}" for k, v in list(values.items())[:limit])
+    return shown + (", ..." if len(values) > limit else "")
+
+
+def _expected_values(recipe: Any) -> dict[str, int]:
+    if not isinstance(recipe, Mapping):
+        return {}
+    expected: dict[str, int] = {}
+    # After arrival a recipe may run more frames ('settle'): then only what it set must still hold.
+    parts = ("set", "until") if not recipe.get("settle") else ("set",)
+    for part in parts:
+        values = recipe.get(part)
+        if isinstance(values, Mapping):
+            expected.update({str(k): v for k, v in values.items() if isinstance(v, int)})
+    return expected
+
+
+def _recipe_text(recipe: Any) -> str:
+    """The values a recipe reaches, as ``zone=0, act=1, game_mode=1``."""
+    return ", ".join(f"{k}={v}" for k, v in _expected_values(recipe).items())
+
+
+def _recipe_mismatch(recipe: Any, values: Mapping[str, int]) -> tuple[str, str] | None:
+    expected = {k: v for k, v in _expected_values(recipe).items() if k in values}
+    wrong = {k: v for k, v in expected.items() if values[k] != v}
+    if not wrong:
+        return None
+    return (", ".join(f"{k}={v}" for k, v in wrong.items()), ", ".join(f"{k}={values[k]}" for k in wrong))
+
+
+_state_index: dict[tuple[str, ...], dict[int, list[tuple[str, Path]]]] = {}
+
+
+def _copies_elsewhere(game: Game, names: Sequence[str]) -> dict[str, str]:
+    """States of ``game`` whose file is byte for byte another game's state: name -> "Game's State"."""
+    games = list_games()
+    key = tuple(sorted(g.name for g in games))
+    if key not in _state_index:
+        by_size: dict[int, list[tuple[str, Path]]] = {}
+        for other in games:
+            for folder in other.folders:
+                try:
+                    entries = list(os.scandir(folder))
+                except OSError:
+                    continue
+                for entry in entries:
+                    if entry.name.endswith(".state") and entry.is_file():
+                        by_size.setdefault(entry.stat().st_size, []).append((other.name, Path(entry.path)))
+        _state_index.clear()
+        _state_index[key] = by_size
+    by_size = _state_index[key]
+    found = {}
+    for name in names:
+        path = game.state_path(name)
+        size = path.stat().st_size
+        others = [(g, p) for g, p in by_size.get(size, []) if g != game.name]
+        if not others:
+            continue
+        digest = _sha1(path)
+        for other, other_path in others:
+            if _sha1(other_path) == digest:
+                found[name] = f"{other}'s state {other_path.name[: -len('.state')]} ({other_path})"
+                break
+    return found
+
+
+def _sha1(path: Path) -> str:
+    return hashlib.sha1(path.read_bytes()).hexdigest()
+
+
+# --- Child side ------------------------------------------------------------------------------------
+
+
+def _child_main() -> int:
+    """Load the states a request names, one by one; print one JSON line per state (and one before each)."""
+    from retrokit.host.emulator import Emulator
+    from retrokit.host.fields import FieldSpec
+    from retrokit.host.memory import FieldReader
+
+    try:  # a gzip bomb or a core gone wild fails here with MemoryError, and the machine lives
+        import resource
+
+        resource.setrlimit(resource.RLIMIT_AS, (CHILD_MEMORY, CHILD_MEMORY))
+    except (ImportError, ValueError, OSError):  # not POSIX, or a lower hard limit already
+        pass
+    request = json.load(sys.stdin)
+    emu = Emulator(request["system"], request["rom"])
+    specs = [FieldSpec(f["name"], f["address"], f["type"], f["mask"]) for f in request["fields"]]
+    reader = FieldReader([s for s in specs if _inside(emu.space, s)], emu.space)
+    idle = [0] * emu.ports
+    for name, path in request["states"]:
+        print(json.dumps({"begin": name}), flush=True)
+        result: dict[str, Any] = {"name": name, "path": path}
+        try:
+            data = read_state(path)
+            emu.set_state(data)
+            result["start"] = reader.read()
+            emu.run(idle, request["frames"])
+            result["after"] = reader.read()
+            result["loaded"] = True
+            result["detail"] = f"{state_format(data) or 'no core signature'}, {len(data)} bytes"
+        except (RetrokitError, MemoryError) as exc:
+            result["error"] = str(exc) if not isinstance(exc, MemoryError) else "the state needs too much memory"
+        print(json.dumps(result), flush=True)
+    emu.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(_child_main())

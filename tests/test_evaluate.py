@@ -1,0 +1,345 @@
+"""``retrokit evaluate`` end to end on the Dasher benchmark: files, scores, determinism, resume, bad input."""
+
+from __future__ import annotations
+
+import json
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from PIL import Image
+
+from retrokit.cli import main
+
+TWO_LEVELS = "Zone2.Act2,Zone3.Act2"
+SMALL = ["--benchmark", "dasher", "--levels", TWO_LEVELS, "--timesteps", "600", "--no-progress"]
+
+
+def evaluate(out: Path, *args: str) -> int:
+    return main(["evaluate", *SMALL, "--out", str(out), *args])
+
+
+def summary(out: Path) -> bytes:
+    return (out / "summary.json").read_bytes()
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory) -> Path:
+    """JERK on two levels, 600 timesteps each, seed 0, one worker."""
+    out = tmp_path_factory.mktemp("reference") / "run"
+    assert evaluate(out, "--agent", "jerk", "--workers", "1") == 0
+    return out
+
+
+@pytest.fixture(scope="module")
+def jerk_and_random(tmp_path_factory) -> dict[str, Path]:
+    """Both agents on the same two levels with 1500 timesteps, on two workers; JERK saves GIFs."""
+    outs = {}
+    for agent in ("jerk", "random"):
+        outs[agent] = tmp_path_factory.mktemp(agent) / "run"
+        extra = ["--gif"] if agent == "jerk" else []
+        assert main(["evaluate", "--levels", TWO_LEVELS, "--timesteps", "1500", "--agent", agent, "--workers", "2",
+                     "--no-progress", "--out", str(outs[agent]), *extra]) == 0
+    return outs
+
+
+def test_dasher_writes_every_file(jerk_and_random) -> None:
+    out = jerk_and_random["jerk"]
+    episodes = [json.loads(line) for line in (out / "episodes.jsonl").read_text().splitlines()]
+    assert {e["level"] for e in episodes} == {"Dasher-Genesis/Zone2.Act2", "Dasher-Genesis/Zone3.Act2"}
+    assert set(episodes[0]) == {"level", "episode", "steps", "reward", "timesteps", "wall"}
+    data = json.loads((out / "summary.json").read_text())
+    for level, entry in data["levels"].items():
+        mine = [e for e in episodes if e["level"] == level]
+        assert entry["episodes"] == len(mine) > 3
+        assert entry["mean_score"] == pytest.approx(sum(e["reward"] for e in mine) / len(mine))
+        assert entry["timesteps"] == 1500 and max(e["timesteps"] for e in mine) <= 1500
+    assert data["aggregate"] == pytest.approx(sum(e["mean_score"] for e in data["levels"].values()) / 2)
+    rows = (out / "summary.csv").read_text().splitlines()
+    assert rows[0].startswith("level,mean_score") and len(rows) == 4 and rows[-1].startswith("aggregate,")
+    report = (out / "report.md").read_text()
+    assert "| Dasher-Genesis/Zone2.Act2 |" in report and "![learning-curves](learning-curves.png)" in report
+    for png in ("learning-curves.png", "scores.png"):
+        with Image.open(out / png) as image:
+            assert image.format == "PNG" and image.size[0] >= 600 and image.size[1] >= 250
+    for level in data["levels"]:
+        with Image.open(out / "gifs" / f"{level.replace('/', '_')}.gif") as gif:
+            assert gif.n_frames > 10 and gif.size == (320, 224)
+
+
+def test_jerk_beats_random_by_a_clear_margin(jerk_and_random) -> None:
+    jerk, rand = (json.loads((jerk_and_random[a] / "summary.json").read_text())["aggregate"] for a in ("jerk", "random"))
+    assert jerk > 1.5 * rand, (jerk, rand)
+
+
+def test_the_same_seed_gives_the_same_summary_twice_and_on_two_workers(reference, tmp_path) -> None:
+    assert evaluate(tmp_path / "again", "--agent", "jerk", "--workers", "1") == 0
+    assert evaluate(tmp_path / "two", "--agent", "jerk", "--workers", "2") == 0
+    assert summary(tmp_path / "again") == summary(reference) == summary(tmp_path / "two")
+    assert evaluate(tmp_path / "other", "--agent", "jerk", "--seed", "1") == 0
+    assert summary(tmp_path / "other") != summary(reference)
+
+
+def test_an_interrupted_run_resumes_to_the_uninterrupted_result(reference, agents_file, tmp_path, monkeypatch) -> None:
+    # The agent is JERK, which on the second level holds still at its 200th step until a flag file
+    # appears: the test interrupts it there, with the first level finished and the second half-played.
+    flag = tmp_path / "go-on"
+    monkeypatch.setenv("RETROKIT_TEST_FLAG", str(flag))
+    out = tmp_path / "run"
+    command = [sys.executable, "-m", "retrokit", "evaluate", *SMALL, "--agent", f"{agents_file}:jerk_pausing",
+               "--workers", "1", "--out", str(out)]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not (tmp_path / "waiting").exists() and process.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.05)
+    process.send_signal(signal.SIGINT)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130, err
+    assert "--resume" in err
+    assert list(json.loads((out / "run.json").read_text())["finished"]) == ["Dasher-Genesis/Zone2.Act2"]
+    played = (out / "episodes.jsonl").read_text()
+    assert "Dasher-Genesis/Zone3.Act2" in played  # some of its episodes, to be dropped on resume
+    interrupted = json.loads(summary(out))
+    assert not interrupted["complete"] and list(interrupted["levels"]) == ["Dasher-Genesis/Zone2.Act2"]
+    flag.touch()
+    assert evaluate(out, "--agent", f"{agents_file}:jerk_pausing", "--workers", "2", "--resume") == 0
+    resumed, uninterrupted = json.loads(summary(out)), json.loads(summary(reference))
+    assert (resumed["levels"], resumed["aggregate"]) == (uninterrupted["levels"], uninterrupted["aggregate"])
+    assert (out / "episodes.jsonl").read_text().count("\n") == sum(e["episodes"] for e in resumed["levels"].values())
+
+
+def test_a_half_written_episode_line_is_dropped_on_resume(reference, tmp_path) -> None:
+    import shutil
+
+    out = tmp_path / "run"
+    shutil.copytree(reference, out)
+    state = json.loads((out / "run.json").read_text())
+    del state["finished"]["Dasher-Genesis/Zone3.Act2"]  # as if killed while playing the second level
+    (out / "run.json").write_text(json.dumps(state))
+    with (out / "episodes.jsonl").open("a") as log:
+        log.write('{"level": "Dasher-Genesis/Zone3.Act2", "epis')
+    assert evaluate(out, "--agent", "jerk", "--resume") == 0
+    assert summary(out) == summary(reference)
+
+
+def test_resume_needs_the_same_settings(reference, tmp_path, capsys) -> None:
+    import shutil
+
+    out = tmp_path / "run"
+    shutil.copytree(reference, out)
+    assert evaluate(out, "--agent", "jerk", "--seed", "5", "--resume") == 2
+    assert "seed differ" in capsys.readouterr().err
+    assert evaluate(tmp_path / "none", "--agent", "jerk", "--resume") == 2
+    assert "drop --resume" in capsys.readouterr().err
+
+
+def test_an_earlier_evaluation_is_never_overwritten(reference, capsys) -> None:
+    before = summary(reference)
+    assert evaluate(reference, "--agent", "random") == 2
+    assert "already holds an evaluation" in capsys.readouterr().err
+    assert summary(reference) == before
+
+
+@pytest.mark.parametrize(
+    ("args", "expected"),
+    [
+        (["--levels", "Zone9.Act1"], "Expected a level of the dasher benchmark"),
+        (["--levels", "Zone1.Act3"], "Did you mean"),
+        (["--agent", "jerky"], "Did you mean 'jerk'?"),
+        (["--agent", "no_such_module:agent"], "importing 'no_such_module' failed"),
+        (["--agent", "retrokit.benchmark.agents:nothing"], "to define a callable 'nothing'"),
+        (["--benchmark", "dashr"], "Did you mean 'dasher'?"),
+        (["--workers", "0"], "--workers and --timesteps of 1 or more"),
+    ],
+    ids=["unknown-level", "level-typo", "agent-typo", "agent-module", "agent-callable", "benchmark-typo", "workers"],
+)
+def test_bad_names_fail_before_anything_is_written(tmp_path, capsys, args, expected) -> None:
+    out = tmp_path / "run"
+    assert main(["evaluate", "--timesteps", "100", "--no-progress", "--out", str(out), *args]) == 2
+    err = capsys.readouterr().err
+    assert expected in err and err.count("\n") == 1 and "Traceback" not in err
+    assert not out.exists()
+
+
+AGENTS = '''
+import numpy as np
+
+def fails_on_zone2(env, budget, seed):
+    """Plays right; raises at its 51st step on Zone2.Act2."""
+    right = env.unwrapped.actions.press(["RIGHT"])
+    env.reset()
+    for step in range(10**9):
+        if step == 50 and env.unwrapped.state_name == "Zone2.Act2":
+            raise ValueError("the agent's own bug")
+        _, _, terminated, truncated, _ = env.step(right)
+        if terminated or truncated:
+            env.reset()
+
+def wrong_shape(env, budget, seed):
+    env.reset()
+    env.step(np.zeros(5, dtype=np.int8))
+
+def out_of_range(env, budget, seed):
+    env.reset()
+    for _ in range(9):
+        env.step(np.zeros(12, dtype=np.int8))
+    env.step(np.full(12, 3, dtype=np.int8))
+
+def dies_in_a_worker(env, budget, seed):
+    """Kills its own process by a signal in a worker process; plays randomly in the command's own."""
+    import multiprocessing, os, pathlib, signal, time
+    flag = pathlib.Path(os.environ["RETROKIT_TEST_FLAG"])
+    if multiprocessing.parent_process() is not None:
+        flag.touch()
+        os.kill(os.getpid(), signal.SIGKILL)
+    deadline = time.monotonic() + 120
+    while not flag.exists() and time.monotonic() < deadline:  # let the worker take the other level
+        time.sleep(0.05)
+    env.reset()
+    while True:
+        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        if terminated or truncated:
+            env.reset()
+
+def jerk_pausing(env, budget, seed):
+    """JERK; on Zone3.Act2 its 200th step waits for a flag file (so a test can interrupt it there)."""
+    import os, pathlib, time
+    import gymnasium
+    from retrokit.benchmark.jerk import jerk
+
+    flag = pathlib.Path(os.environ["RETROKIT_TEST_FLAG"])
+
+    class Pause(gymnasium.Wrapper):
+        steps = 0
+
+        def step(self, action):
+            self.steps += 1
+            if self.steps == 200 and env.unwrapped.state_name == "Zone3.Act2":
+                (flag.parent / "waiting").touch()
+                while not flag.exists():
+                    time.sleep(0.05)
+            return self.env.step(action)
+
+    jerk(Pause(env), budget, seed)
+
+def no_reset(env, budget, seed):
+    env.step(np.zeros(12, dtype=np.int8))
+'''
+
+
+@pytest.fixture
+def agents_file(tmp_path) -> Path:
+    path = tmp_path / "my_agents.py"
+    path.write_text(AGENTS)
+    return path
+
+
+def test_an_agent_that_raises_names_level_and_step_and_keeps_the_rest(agents_file, tmp_path, capsys) -> None:
+    out = tmp_path / "run"
+    assert evaluate(out, "--agent", f"{agents_file}:fails_on_zone2", "--workers", "2") == 2
+    err = capsys.readouterr().err
+    assert "raised ValueError: the agent's own bug (level Dasher-Genesis/Zone2.Act2, step 51" in err
+    assert "--resume" in err and "Traceback" not in err
+    kept = json.loads(summary(out))
+    assert list(kept["levels"]) == ["Dasher-Genesis/Zone3.Act2"] and kept["levels"]["Dasher-Genesis/Zone3.Act2"]["episodes"]
+    assert "## Levels that failed" in (out / "report.md").read_text()
+
+
+@pytest.mark.parametrize(
+    ("agent", "expected"),
+    [
+        ("wrong_shape", "(level Dasher-Genesis/Zone2.Act2, step 1), got array [0,0,0,0,0] of shape (5,)"),
+        ("out_of_range", "Expected an action of MultiBinary(12) (level Dasher-Genesis/Zone2.Act2, step 10)"),
+        ("no_reset", "Expected reset() before step() at the start of an episode (level Dasher-Genesis/Zone2.Act2, step 1)"),
+    ],
+    ids=["shape", "range", "no-reset"],
+)
+def test_an_invalid_action_names_level_and_step(agents_file, tmp_path, capsys, agent, expected) -> None:
+    assert evaluate(tmp_path / "run", "--agent", f"{agents_file}:{agent}", "--levels", "Zone2.Act2") == 2
+    assert expected in capsys.readouterr().err
+
+
+def test_sonic_runs_up_to_the_missing_roms(tmp_path, monkeypatch, capsys) -> None:
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "empty"))
+    assert main(["evaluate", "--benchmark", "sonic", "--agent", "jerk", "--out", str(tmp_path / "run")]) == 2
+    err = capsys.readouterr().err
+    for game in ("SonicTheHedgehog-Genesis", "SonicTheHedgehog2-Genesis", "SonicAndKnuckles3-Genesis"):
+        assert game in err
+    assert "retrokit import" in err and not (tmp_path / "run").exists()
+
+
+def test_sonic_lists_the_papers_split(capsys) -> None:
+    assert main(["evaluate", "--benchmark", "sonic", "--list"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert sum(line.startswith("test ") for line in lines) == 11
+    assert sum(line.startswith("train") for line in lines) == 47
+
+
+def test_a_benchmark_file_runs(tmp_path) -> None:
+    path = tmp_path / "mine.yaml"
+    path.write_text("name: mine\nbudget: 200\nenv: {frameskip: 4, max_episode_steps: 100}\n"
+                    "levels:\n  test: [Dasher-Genesis/Zone1.Act1]\n")
+    out = tmp_path / "run"
+    assert main(["evaluate", "--benchmark", str(path), "--agent", "random", "--no-progress", "--out", str(out)]) == 0
+    data = json.loads(summary(out))
+    assert data["benchmark"] == "mine" and data["levels"]["Dasher-Genesis/Zone1.Act1"]["timesteps"] == 200
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("- a\n- b\n", "holds a list, not a mapping"),
+        ("budget: 0\nlevels: {test: [Dasher-Genesis/Zone1.Act1]}\n", "'budget' must be a whole number"),
+        ("budget: 10\nlevels: {test: [Zone1.Act1]}\n", "as 'Game-System/State'"),
+        ("budget: 10\nlevels: {train: [Dasher-Genesis/Zone1.Act1]}\n", "'levels' must map 'test'"),
+        ("budget: 10\nenv: {turbo: 1}\nlevels: {test: [Dasher-Genesis/Zone1.Act1]}\n", "'env' must map options"),
+        ("budget: 10\nlevelz: {}\n", "unknown keys ['levelz']"),
+        ("\x00\xff\xfe garbage: [", "cannot be read as YAML"),
+        ("a: " + "x" * (1 << 20), "more than a benchmark's"),
+    ],
+    ids=["list", "budget", "level-name", "no-test", "env-option", "unknown-key", "binary", "huge"],
+)
+def test_malformed_benchmark_files_are_refused(tmp_path, capsys, text, expected) -> None:
+    path = tmp_path / "bad.yaml"
+    path.write_bytes(text.encode("latin-1"))
+    assert main(["evaluate", "--benchmark", str(path), "--out", str(tmp_path / "run")]) == 2
+    assert expected in capsys.readouterr().err
+
+
+def test_a_missing_state_is_named(tmp_path, capsys) -> None:
+    path = tmp_path / "mine.yaml"
+    path.write_text("budget: 10\nlevels: {test: [Dasher-Genesis/Zone4.Act1]}\n")
+    assert main(["evaluate", "--benchmark", str(path), "--out", str(tmp_path / "run")]) == 2
+    assert "Dasher-Genesis/Zone4.Act1" in capsys.readouterr().err
+
+
+def test_without_matplotlib_the_report_says_how_to_get_plots(tmp_path, monkeypatch) -> None:
+    from retrokit.benchmark import plots
+
+    monkeypatch.setattr(plots, "have_matplotlib", lambda: False)
+    out = tmp_path / "run"
+    assert evaluate(out, "--agent", "random", "--levels", "Zone3.Act2", "--timesteps", "200") == 0
+    assert "pip install 'retrokit[plot]'" in (out / "report.md").read_text()
+    assert not (out / "scores.png").exists() and (out / "summary.json").is_file()
+
+
+def test_a_level_whose_env_cannot_start_fails_alone(tmp_path, capsys) -> None:
+    path = tmp_path / "mine.yaml"
+    path.write_text("budget: 100\nenv: {obs_type: pixels}\nlevels: {test: [Dasher-Genesis/Zone1.Act1]}\n")
+    out = tmp_path / "run"
+    assert main(["evaluate", "--benchmark", str(path), "--agent", "random", "--no-progress", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "Expected to start level Dasher-Genesis/Zone1.Act1 (step 0)" in err and "obs_type" in err
+    assert json.loads(summary(out))["levels"] == {}
+
+
+def test_a_worker_killed_by_a_signal_fails_its_level_only(agents_file, tmp_path, monkeypatch, capsys) -> None:
+    monkeypatch.setenv("RETROKIT_TEST_FLAG", str(tmp_path / "worker-started"))
+    out = tmp_path / "run"
+    assert evaluate(out, "--agent", f"{agents_file}:dies_in_a_worker", "--workers", "2") == 2
+    err = capsys.readouterr().err
+    assert "Dasher-Genesis/Zone3.Act2" in err and ("died (signal 9)" in err or "No worker is left" in err)
+    assert list(json.loads(summary(out))["levels"]) == ["Dasher-Genesis/Zone2.Act2"]

@@ -1,0 +1,281 @@
+"""``retrokit validate`` and ``retrokit.testing.check_game``: real games pass, planted faults fail.
+
+Every fault is planted in a copy of Dasher's folder; each must fail naming
+the check and the state, leave the other states passing, and never stop the run.
+"""
+
+from __future__ import annotations
+
+import gzip
+import json
+import random
+import shutil
+from pathlib import Path
+
+import pytest
+
+from retrokit.cli import main
+from retrokit.data.games import list_games
+from retrokit.paths import repo_games_dir
+from retrokit.testing import check_game
+from retrokit.testing.report import FAIL, PASS, SKIP, GameReport, render
+
+DASHER = repo_games_dir() / "Dasher-Genesis"
+FRAMES = 120  # smoke-run frames in these tests: enough to reach a division or a lookup, cheap on CPU
+
+
+def failed(report: GameReport) -> set[tuple[str, str]]:
+    """(check, state) of every failure."""
+    return {(r.check, r.state) for r in report.failures}
+
+
+@pytest.fixture
+def dasher_with_movies(tmp_path: Path) -> Path:
+    """A full copy of Dasher's folder (states, scenario, movies), as a game folder of its own."""
+    folder = tmp_path / "Dasher-Genesis"
+    shutil.copytree(DASHER, folder)
+    return folder
+
+
+@pytest.fixture
+def dasher(dasher_with_movies: Path) -> Path:
+    """The copy without its solution movies, whose replays the other faults need not pay for."""
+    shutil.rmtree(dasher_with_movies / "movies")
+    game_yaml = dasher_with_movies / "game.yaml"
+    text = game_yaml.read_text()
+    game_yaml.write_text(text[: text.index("\nmovies:")] + "\n")
+    return dasher_with_movies
+
+
+# --- Every game of the project passes ------------------------------------------------------------------
+
+
+SONICS = ("SonicTheHedgehog-Genesis", "SonicTheHedgehog2-Genesis", "SonicAndKnuckles3-Genesis")
+
+
+@pytest.mark.parametrize("name", sorted(p.name for p in repo_games_dir().iterdir() if p.is_dir()))
+def test_every_game_in_games_passes_check_game(name: str) -> None:
+    report = check_game(name, frames=FRAMES)
+    assert report.passed, render(report)
+    checks = {r.check for r in report.results if r.status == PASS}
+    assert {"data file", "scenario compiles"} <= checks
+    if name == "Dasher-Genesis":  # the ROM is here: everything ran
+        assert {"schema", "fields in RAM", "state loads", "smoke run", "deterministic", "movie"} <= checks
+        assert not report.find("smoke run", status=SKIP)
+    elif name in SONICS:  # without its ROM: what was checked, and what was skipped and why
+        assert {"schema", "fields in RAM", "state parses", "fields decode", "table coverage"} <= checks
+        skipped = {r.check: r.message for r in report.results if r.status == SKIP}
+        assert "no ROM" in skipped["smoke run"] and "not loaded" in skipped["state loads"]
+        assert "retrokit import" in skipped["ROM"]
+
+
+def test_dasher_movies_prove_the_completion_reward_and_done() -> None:
+    """Each act's solution movie is done when the act is cleared, paid its progress plus each player's bonus."""
+    from retrokit.data.games import find_game
+    from retrokit.testing.movies import movie_files, replay
+
+    game = find_game("Dasher-Genesis")
+    movies = movie_files(game)
+    assert sorted(movies) == ["Zone1.Act1", "Zone1.Act2", "Zone2.Act1", "Zone2.Act2", "Zone3.Act1", "Zone3.Act2"]
+    ends = {0: (1600, 2000), 1: (2400, 2640), 2: (2960, 3200)}
+    for name, path in movies.items():
+        zone, act = int(name[4]) - 1, int(name[-1]) - 1
+        outcome = replay(game, path)
+        assert outcome.done_at == outcome.frames, f"{name}: done must come with the clear, the movie's last frame"
+        progress = outcome.reward - 2 * 1000  # both players' rewards carry the clear bonus
+        assert 0 <= progress - (ends[zone][act] - 48) <= 3, f"{name}: paid {outcome.reward}"
+
+
+@pytest.mark.parametrize("game,state", [("Dasher-Genesis", "Zone2.Act1"), ("Airstriker-Genesis", "Level1")])
+def test_the_ram_read_from_a_state_file_is_the_ram_the_core_loads(game: str, state: str) -> None:
+    """The layout that lets validate read the fields of states whose ROM is missing (the Sonic games)."""
+    import numpy as np
+
+    from retrokit.data.games import find_game
+    from retrokit.data.states import read_state, state_ram
+    from retrokit.host.emulator import Emulator
+
+    found = find_game(game)
+    data = read_state(found.state_path(state))
+    with Emulator(found.system, found.require_rom()) as emu:
+        emu.set_state(data)
+        assert state_ram(data, "Genesis") == bytes(np.asarray(emu.ram))
+    assert state_ram(data, "Snes") is None and state_ram(b"GENPLUS-GX 1.7.5" + bytes(100), "Genesis") is None
+
+
+# --- Planted faults ----------------------------------------------------------------------------------------
+
+
+def test_division_by_zero_on_one_state_fails_that_state_only(dasher: Path) -> None:
+    (dasher / "broken.yaml").write_text("reward: 100 / (zone * 2 + act - 3)\ndone: level_done == 1\n")
+    report = check_game(dasher, frames=FRAMES)
+    bad = [r for r in report.failures if r.scenario == "broken"]
+    assert [(r.check, r.state) for r in bad] == [("smoke run", "Zone2.Act2")], render(report)
+    assert "division by zero" in bad[0].message
+    others = report.find("smoke run", status=PASS)
+    assert {r.state for r in others if r.scenario == "broken"} >= {"Zone1.Act1", "Zone2.Act1", "Zone3.Act2"}
+
+
+def test_a_table_missing_one_act_fails_coverage_for_that_state(dasher: Path) -> None:
+    values = "\n".join(f"      {z}, {a}: {1000 + z}" for z in range(3) for a in range(2) if (z, a) != (2, 1))
+    (dasher / "goal.yaml").write_text(
+        f"tables:\n  goal:\n    by: [zone, act]\n    values:\n{values}\n"
+        "reward: delta(p1_x) if p1_x < goal[zone, act] else 0\ndone: level_done == 1\n"
+    )
+    report = check_game(dasher, frames=FRAMES)
+    assert failed(report) == {("table coverage", "Zone3.Act2"), ("smoke run", "Zone3.Act2")}, render(report)
+    coverage = report.find("table coverage", state="Zone3.Act2")[0]
+    assert "zone=2, act=1" in coverage.message and "goal.yaml" in coverage.message
+
+
+@pytest.mark.parametrize("kind", ["truncated", "garbage"])
+def test_a_corrupt_state_fails_without_stopping_the_run(dasher: Path, kind: str) -> None:
+    path = dasher / "Zone2.Act1.state"
+    data = gzip.decompress(path.read_bytes())
+    if kind == "truncated":
+        path.write_bytes(path.read_bytes()[:300])
+    else:  # right size and signature, random inside (seed 1: the core dies of SIGSEGV on it, in the child)
+        garbage = bytearray(random.Random(1).randbytes(len(data)))
+        garbage[:16] = data[:16]
+        path.write_bytes(gzip.compress(bytes(garbage)))
+    report = check_game(dasher, frames=FRAMES)
+    assert failed(report) == {("state loads", "Zone2.Act1")}, render(report)
+    message = report.failures[0].message
+    assert ("truncated" in message) if kind == "truncated" else ("crashed (signal" in message)
+    # the states after it were still checked
+    assert report.find("state loads", state="Zone3.Act2", status=PASS)
+    assert report.find("smoke run", state="Zone3.Act2", status=PASS)
+
+
+def test_a_gzip_bomb_state_fails_without_stopping_the_run(dasher: Path) -> None:
+    member = gzip.compress(bytes(16 << 20), compresslevel=9, mtime=0)
+    (dasher / "Zone1.Act2.state").write_bytes(member * 48)  # 768 MiB once inflated (gzip members concatenate)
+    report = check_game(dasher, frames=FRAMES)
+    assert failed(report) == {("state loads", "Zone1.Act2")}, render(report)
+    assert "inflates past" in report.failures[0].message  # read_state's cap, in the child
+
+
+def test_a_state_that_hangs_the_core_fails_and_the_next_child_goes_on(monkeypatch: pytest.MonkeyPatch) -> None:
+    from retrokit.data.games import find_game
+    from retrokit.testing import states
+
+    monkeypatch.setattr(states, "CHILD_TIMEOUT", 0.001)  # 60 frames take longer: each state looks hung
+    game = find_game("Dasher-Genesis")
+    probes = states.probe_states(game, ["Zone1.Act1", "Zone1.Act2"], game.require_rom())
+    assert [p.error.startswith("the core hung") for p in probes.values()] == [True, True]
+
+
+def test_another_games_state_is_flagged(dasher: Path, airstriker_dir: Path) -> None:
+    shutil.copy(airstriker_dir / "Level1.state", dasher / "Zone2.Act2.state")
+    report = check_game(dasher, frames=FRAMES)
+    assert failed(report) == {("state is the game's", "Zone2.Act2")}, render(report)
+    assert "Airstriker-Genesis" in report.failures[0].message
+
+
+def test_a_state_recorded_on_another_rom_is_flagged(dasher: Path, airstriker_dir: Path) -> None:
+    from retrokit.data.states import StateRecord, read_state, write_state
+
+    data = read_state(airstriker_dir / "Level1.state")
+    record = StateRecord.of("Airstriker-Genesis", "0" * 40, data)  # as retrokit writes a state, on another ROM
+    (dasher / "Zone1.Act2.state").unlink()
+    write_state(dasher / "Zone1.Act2.state", data, record=record)
+    report = check_game(dasher, frames=FRAMES)
+    assert failed(report) == {("state is the game's", "Zone1.Act2")}, render(report)
+    assert "recorded on the ROM with SHA-1 0000" in report.failures[0].message
+
+
+def test_a_state_made_for_another_level_is_flagged_by_its_recipe(dasher: Path) -> None:
+    shutil.copy(dasher / "Zone1.Act1.state", dasher / "Zone3.Act1.state")
+    report = check_game(dasher, frames=FRAMES)
+    assert failed(report) == {("state is the game's", "Zone3.Act1")}, render(report)
+    assert "zone=2" in report.failures[0].message and "found zone=0" in report.failures[0].message
+
+
+def test_a_movie_with_the_wrong_expected_reward_fails(dasher_with_movies: Path) -> None:
+    text = (dasher_with_movies / "game.yaml").read_text()
+    (dasher_with_movies / "game.yaml").write_text(text.replace("reward: 3952", "reward: 3900"))
+    report = check_game(dasher_with_movies, frames=FRAMES)
+    assert failed(report) == {("movie", "Zone1.Act2")}, render(report)
+    assert "a total reward of 3900" in report.failures[0].message and "found 3952" in report.failures[0].message
+
+
+def test_movies_without_an_outcome_warn_and_missing_or_broken_ones_fail(dasher: Path) -> None:
+    (dasher / "movies").mkdir()
+    shutil.copy(DASHER / "movies" / "Zone1.Act1.bk2", dasher / "movies" / "Loose.bk2")
+    (dasher / "movies" / "Broken.bk2").write_bytes(b"PK\x03\x04 not really a zip")
+    with (dasher / "game.yaml").open("a") as f:
+        f.write("movies:\n  Gone: {reward: 1}\n  Broken: {reward: 1}\n")
+    report = check_game(dasher, frames=FRAMES)
+    assert failed(report) == {("movie", "Gone"), ("movie", "Broken")}, render(report)
+    assert report.find("movie", state="Loose")[0].status == "warn"
+    assert "could not be replayed" in report.find("movie", state="Broken")[0].message
+
+
+def test_a_misspelled_key_in_game_yaml_fails_with_its_line(dasher: Path) -> None:
+    text = (dasher / "game.yaml").read_text()
+    (dasher / "game.yaml").write_text(text.replace("\nintegrate:", "\nintgrate:"))
+    line = text[: text.index("\nintegrate:")].count("\n") + 2
+    report = check_game(dasher, frames=FRAMES)
+    assert {check for check, _ in failed(report)} == {"schema", "data file"}, render(report)
+    schema = report.find("schema", status=FAIL)[0].message
+    assert f"game.yaml:{line}:1:" in schema and "Did you mean 'integrate'?" in schema
+    assert "Did you mean 'integrate'?" in report.find("data file")[0].message  # loading the game refuses it too
+
+
+def test_a_field_outside_ram_fails_and_overlaps_warn(dasher: Path) -> None:
+    text = (dasher / "game.yaml").read_text()
+    text = text.replace('end_x:       {address: 0xFF000A', 'end_x:       {address: 0xFE0000')
+    text = text.replace('start_x:     {address: 0xFF000C', 'start_x:     {address: 0xFF000D')
+    (dasher / "game.yaml").write_text(text)
+    report = check_game(dasher, frames=FRAMES)
+    outside = report.find("fields in RAM", status=FAIL)
+    assert len(outside) == 1 and "'end_x'" in outside[0].message
+    overlap = report.find("field overlap")
+    assert [r.status for r in overlap] == ["warn"]
+    assert "start_x (0xff000d-0xff000e) and camera_x (0xff000e-0xff000f)" in overlap[0].message
+
+
+# --- The command -------------------------------------------------------------------------------------------
+
+
+def test_validate_command_passes_on_the_free_games(capsys, tmp_path: Path) -> None:
+    out_json = tmp_path / "results.json"
+    status = main(["validate", "Dasher-Genesis", "Airstriker-Genesis", "--frames", str(FRAMES),
+                   "--json", str(out_json)])
+    out = capsys.readouterr().out
+    assert status == 0, out
+    assert "check" in out and "result" in out and "smoke run" in out  # the tables
+    assert "2 of 2 games passed" in out
+    doc = json.loads(out_json.read_text())
+    assert doc["passed"] and [g["game"] for g in doc["games"]] == ["Dasher-Genesis", "Airstriker-Genesis"]
+
+
+def test_validate_command_exits_1_on_a_failure(capsys, dasher: Path) -> None:
+    (dasher / "Zone1.Act1.state").write_bytes(b"not a state")
+    status = main(["validate", str(dasher), "--frames", str(FRAMES), "-q"])
+    out = capsys.readouterr().out
+    assert status == 1
+    assert "state loads" in out and "Zone1.Act1" in out and "FAIL" in out and "0 of 1 game passed" in out
+
+
+def test_validate_without_names_checks_the_game_yaml_here(capsys, dasher: Path, monkeypatch) -> None:
+    monkeypatch.chdir(dasher)
+    assert main(["validate", "--frames", str(FRAMES), "-q"]) == 0
+    assert "Dasher-Genesis: all" in capsys.readouterr().out
+    monkeypatch.chdir(dasher.parent)
+    assert main(["validate"]) == 2
+    assert "Expected game names, --all, or a game.yaml" in capsys.readouterr().err
+
+
+def test_validate_an_unknown_game_is_a_one_line_error(capsys) -> None:
+    assert main(["validate", "Dashr-Genesis"]) == 2
+    err = capsys.readouterr().err
+    assert "Did you mean 'Dasher-Genesis'?" in err and "Traceback" not in err
+
+
+def test_games_are_listed_for_validate_all() -> None:
+    from retrokit.commands.validate import own_games
+
+    own = own_games()
+    assert "Dasher-Genesis" in own and "Airstriker-Genesis" not in own
+    assert set(own) <= {g.name for g in list_games()}

@@ -75,7 +75,7 @@ def __dir__() -> list[str]:
 
 def _register() -> None:
     # Gymnasium ids must exist as soon as retrokit is imported, since
-    # ``gymnasium.make("retrokit/<Game>")`` is how many users reach us; this
+    # ``gymnasium.make("retrokit/<Game>-v0")`` is how many users reach us; this
     # costs Gymnasium's import and a scan of the game folders, not the envs'.
     from retrokit.envs.registration import register_envs
 

@@ -25,6 +25,12 @@ def did_you_mean(name: str, choices: Iterable[str], *, n: int = 1) -> str:
     return " Did you mean one of: " + ", ".join(repr(c) for c in close) + "?"
 
 
+def shown(value: object, limit: int = 60) -> str:
+    """``repr(value)`` for a message, cut to ``limit`` characters so a huge argument cannot flood it."""
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
 class RetrokitError(Exception):
     """The root of every error retrokit raises on purpose."""
 

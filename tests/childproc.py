@@ -1,7 +1,7 @@
 """Running a hostile input in a child process, so a regression fails a test instead of killing or hanging the suite.
 
 The child runs a snippet of Python under a wall-clock timeout and an address
-space limit; it prints its peak resident memory (``ru_maxrss``) on its last
+space limit; it prints its peak resident memory (``VmHWM``) on its last
 line, so a test can hold it to the 500 MB every input must stay under.
 """
 
@@ -20,6 +20,14 @@ REPO = Path(__file__).resolve().parent.parent
 MAX_RSS_MB = 500
 ADDRESS_SPACE = 3 * 2**30  # far above what Python, numpy and a core map, far below what a blow-up wants
 _MARK = "childproc-peak-rss-kb:"
+# The child's own peak: VmHWM belongs to its address space, which exec made anew. (ru_maxrss is
+# not: Linux carries it across fork and exec, so a child of a big pytest process would report
+# the parent's peak.) Elsewhere, ru_maxrss is the best there is.
+_PEAK_KB = (
+    "next((int(l.split()[1]) for l in open('/proc/self/status') if l.startswith('VmHWM:')), 0) "
+    "if __import__('os').path.exists('/proc/self/status') "
+    "else __import__('resource').getrusage(__import__('resource').RUSAGE_SELF).ru_maxrss"
+)
 
 
 @dataclass
@@ -52,8 +60,7 @@ def run_child(code: str, *, timeout: float = 60, env: dict[str, str] | None = No
     A child still running after ``timeout`` seconds is killed, and the test
     fails with a clear message rather than hanging.
     """
-    script = textwrap.dedent(code) + (
-        f"\nimport resource as _r\nprint({_MARK!r}, _r.getrusage(_r.RUSAGE_SELF).ru_maxrss, flush=True)\n"
+    script = textwrap.dedent(code) + f"\nprint({_MARK!r}, {_PEAK_KB}, flush=True)\n" + (
         "raise SystemExit(globals().get('exit_status', 0))\n"
     )
     try:

@@ -152,7 +152,7 @@ def test_every_frame_scenario_sums_the_frames_rewards() -> None:
 
 
 def test_gymnasium_make_finds_registered_games() -> None:
-    env = gymnasium.make("retrokit/Airstriker-Genesis", frameskip=4, max_episode_steps=3)
+    env = gymnasium.make("retrokit/Airstriker-Genesis-v0", frameskip=4, max_episode_steps=3)
     env.reset(seed=0)
     for _ in range(3):
         *_, truncated, _ = env.step(env.action_space.sample())

@@ -126,7 +126,7 @@ def test_vector_takes_actions_as_a_list_too() -> None:
 
 @pytest.mark.parametrize("mode, kind", [(None, ThreadedVectorEnv), ("sync", gymnasium.vector.SyncVectorEnv)], ids=["default", "sync"])
 def test_gymnasium_make_vec_gives_the_threaded_vector_by_default(mode: str | None, kind: type) -> None:
-    vec = gymnasium.make_vec("retrokit/Airstriker-Genesis", num_envs=2, vectorization_mode=mode, frameskip=4, max_episode_steps=3)
+    vec = gymnasium.make_vec("retrokit/Airstriker-Genesis-v0", num_envs=2, vectorization_mode=mode, frameskip=4, max_episode_steps=3)
     assert isinstance(vec, kind) and vec.num_envs == 2
     vec.reset(seed=0)
     for _ in range(3):

@@ -91,6 +91,7 @@ class Analysis:
     defines: dict[str, n.Node]
     rewards: list[n.Node]
     done: n.Node | None
+    dones: list[n.Node] = field(default_factory=list)
     fields: list[str] = field(default_factory=list)
     slots: dict[str, Slot] = field(default_factory=dict)
     types: dict[str, str] = field(default_factory=dict)
@@ -133,7 +134,8 @@ class Checker:
         defines = {name: self._parse(snippet) for name, snippet in spec.defines.items()}
         rewards = [self._parse(snippet) for snippet in spec.rewards]
         done = self._parse(spec.done) if spec.done is not None else None
-        analysis = Analysis(spec, defines, rewards, done)
+        dones = [self._parse(snippet) for snippet in spec.dones]
+        analysis = Analysis(spec, defines, rewards, done, dones)
         analysis.fields = list(self._used_fields)
         analysis.slots = self.slots
         return analysis

@@ -1,8 +1,10 @@
 """Generate the Python source of a checked scenario.
 
-The output is one function, ``_bind(s)``, that closes over a Run's state list
-``s`` and returns two step functions, ``_first`` (reset) and ``_next`` (every
-later step), each ``(v, frame, step) -> ((reward, ...), done)``. Their bodies
+The output is one function, ``_bind(s, d)``, that closes over a Run's state
+list ``s`` and its list of per-player dones ``d`` (written each step when the
+scenario has ``dones``), and returns two step functions, ``_first`` (reset)
+and ``_next`` (every later step), each ``(v, frame, step) -> ((reward, ...),
+done)``. Their bodies
 are straight-line code: read the fields the scenario uses from ``v``, compute
 the definitions and memory arguments in dependency order, then the outputs,
 then store the slots. No user text reaches the code except numbers: fields are
@@ -11,7 +13,10 @@ read by their ``repr``, everything else has a generated name.
 Run-time failures are checked inline where they can happen, so the message can
 name the expression: a division tests its divisor (``_divzero(site)``) unless
 it is a constant (never zero: the checker refuses that), and a table lookup
-tests for a missing key (``_nokey(site, key)``).
+tests for a missing key (``_nokey(site, key)``). A reward that is not a finite
+number (an overflow to inf, a NaN) is refused (``_nonfinite(player, value)``).
+Python's compiler refuses code nested 200 brackets deep, so an expression whose
+code would nest deeper than :data:`MAX_NESTING` is refused at compile time.
 """
 
 from __future__ import annotations
@@ -22,6 +27,22 @@ from retrokit.dsl import nodes as n
 from retrokit.dsl.check import COUNTERS, MEMORY, Analysis, constant
 from retrokit.dsl.graph import FIRST, NEXT, Graph
 from retrokit.dsl.source import Snippet
+from retrokit.errors import ScenarioCompileError
+
+#: CPython refuses code nesting 200 brackets deep; generated code stays below this.
+MAX_NESTING = 180
+
+
+def nesting(code: str) -> int:
+    """How deep brackets nest in generated code (it holds no strings, so every bracket counts)."""
+    depth = deepest = 0
+    for ch in code:
+        if ch in "([{":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif ch in ")]}":
+            depth -= 1
+    return deepest
 
 
 @dataclass(frozen=True)
@@ -46,7 +67,7 @@ class CodeGen:
 
     def module(self) -> str:
         """Return the source text of ``_bind``."""
-        lines = ["def _bind(s):"]
+        lines = ["def _bind(s, d):"]
         for name, mode in (("_first", FIRST), ("_next", NEXT)):
             lines += ["    " + line for line in self.function(name, mode)]
         lines.append("    return _first, _next")
@@ -61,11 +82,11 @@ class CodeGen:
         for kind, key in self.graph.order(mode):
             if kind == "def":
                 snippet = self.a.spec.defines[key]  # type: ignore[index]
-                body.append(f"{self.defs[key]} = {self.expr(self.a.defines[key], mode, snippet)}")  # type: ignore[index]
+                body.append(f"{self.defs[key]} = {self.whole(self.a.defines[key], mode, snippet)}")  # type: ignore[index]
                 continue
             slot = slots[key]  # type: ignore[index]
             i = slot.index
-            body.append(f"_m{i} = {self.expr(slot.arg, mode, slot.snippet)}")
+            body.append(f"_m{i} = {self.whole(slot.arg, mode, slot.snippet)}")
             if mode == NEXT and slot.kind == "peak":
                 body.append(f"_p{i} = _m{i} if _m{i} > s[{i}] else s[{i}]")
                 writes.append(f"s[{i}] = _p{i}")
@@ -73,15 +94,24 @@ class CodeGen:
                 writes.append(f"s[{i}] = _m{i}")
         rewards = []
         for i, (root, snippet) in enumerate(zip(self.a.rewards, self.a.spec.rewards)):
-            body.append(f"_r{i} = _float({self.expr(root, mode, snippet)})")
+            body.append(f"_r{i} = _float({self.whole(root, mode, snippet)})")
+            # x - x is 0.0 for a finite x, NaN (true) for inf or NaN: one subtraction a step.
+            body.append(f"if _r{i} - _r{i}: _nonfinite({i}, _r{i})")
             rewards.append(f"_r{i}")
         if not rewards:  # no reward given: 0 for the one player
             rewards.append("0.0")
+        players = []
+        for i, (root, snippet) in enumerate(zip(self.a.dones, self.a.spec.dones)):
+            body.append(f"_pd{i} = {self.whole(root, mode, snippet)}")
+            writes.append(f"d[{i}] = _pd{i}")
+            players.append(f"_pd{i}")
+        everyone_out = " and ".join(players)  # the episode also ends once every player is out
         if self.a.done is not None:
             assert self.a.spec.done is not None
-            body.append(f"_done = {self.expr(self.a.done, mode, self.a.spec.done)}")
+            done = self.whole(self.a.done, mode, self.a.spec.done)
+            body.append(f"_done = {done} or ({everyone_out})" if players else f"_done = {done}")
         else:
-            body.append("_done = False")
+            body.append(f"_done = {everyone_out}" if players else "_done = False")
         loads = [f"{local} = v[{field!r}]" for field, local in self._fields.items()]
         out = [f"def {name}(v, frame, step):", "    try:"]
         out += ["        " + line for line in loads + body + writes]
@@ -111,6 +141,18 @@ class CodeGen:
         if name not in self._fields:
             self._fields[name] = f"_f{len(self._fields)}"
         return self._fields[name]
+
+    def whole(self, node: n.Node, mode: str, sn: Snippet) -> str:
+        """A whole expression's code for one statement, refused if Python could not compile it."""
+        code = self.expr(node, mode, sn)
+        depth = nesting(code)
+        if depth > MAX_NESTING:
+            raise sn.error(
+                ScenarioCompileError, node.start, node.end,
+                f"expected an expression Python can compile (at most {MAX_NESTING} brackets deep once generated), "
+                f"got one generating {depth}; split it into definitions under 'define:'",
+            )
+        return code
 
     def expr(self, node: n.Node, mode: str, sn: Snippet) -> str:
         """The Python expression computing ``node`` in ``mode``."""

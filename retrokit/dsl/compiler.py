@@ -44,10 +44,12 @@ class Program:
         self.source = gen.module()
         self._sites = gen.sites
         self._tables = spec.tables
+        self._rewards = spec.rewards
         namespace = {
             "__builtins__": {},
             "_abs": abs, "_min": min, "_max": max, "_float": float,
-            "_divzero": self._divzero, "_nokey": self._nokey, "_missing": self._missing, "_fail": self._fail,
+            "_divzero": self._divzero, "_nonfinite": self._nonfinite, "_nokey": self._nokey,
+            "_missing": self._missing, "_fail": self._fail,
             "_RuntimeError": ScenarioRuntimeError, "_KeyError": KeyError,
             "_Errors": (ArithmeticError, TypeError, ValueError),
         }
@@ -56,9 +58,9 @@ class Program:
         exec(compile(self.source, f"<scenario {self.name!r}>", "exec"), namespace)  # noqa: S102 - our own generated code
         self._bind = namespace["_bind"]
 
-    def bind(self, state: list) -> tuple[StepFunction, StepFunction]:
-        """Return ``(first, next)`` step functions working on ``state``."""
-        return self._bind(state)
+    def bind(self, state: list, dones: list) -> tuple[StepFunction, StepFunction]:
+        """Return ``(first, next)`` step functions working on ``state``, writing players' dones into ``dones``."""
+        return self._bind(state, dones)
 
     # --- run-time errors -------------------------------------------------------------
 
@@ -69,6 +71,14 @@ class Program:
         raise site.snippet.error(
             ScenarioRuntimeError, node.start, node.end,
             f"scenario {self.name!r}: division by zero: the divisor {divisor} is 0",
+        )
+
+    def _nonfinite(self, player: int, value: float) -> None:
+        snippet = self._rewards[player]
+        raise snippet.error(
+            ScenarioRuntimeError, 0, len(snippet.text),
+            f"scenario {self.name!r}: expected the {snippet.role} to be a finite number, got {value}: a value "
+            f"overflowed past 1.8e308, or a division or product met NaN; bound the expression, e.g. with clip()",
         )
 
     def _nokey(self, index: int, key: object) -> None:

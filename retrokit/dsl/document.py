@@ -15,27 +15,39 @@ in it points into the file. The format is documented in ``docs/scenarios.md``::
       progress: clip(x - initial(x), 0, end_x) / end_x
     reward: delta(progress, 0) * 9000
     done: lives < prev(lives) or progress >= 1
+    # or, per player: rewards: [...], dones: [p1_lives == 0, p2_lives == 0]
 """
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
+import numpy as np
 import yaml
 
 from retrokit.dsl.check import constant
-from retrokit.dsl.parser import parse
+from retrokit.dsl.parser import MAX_INT, parse
 from retrokit.dsl.source import Snippet, SourceText, align, located, read_source
 from retrokit.dsl.spec import Scalar, ScenarioSpec, Table
-from retrokit.errors import ScenarioError, did_you_mean
+from retrokit.errors import ScenarioError, did_you_mean, shown
 
-TOP_KEYS = ("name", "description", "include", "tables", "define", "reward", "rewards", "done", "actions", "crop")
+TOP_KEYS = (
+    "name", "description", "include", "tables", "define", "reward", "rewards", "done", "dones", "actions", "crop",
+)
 INCLUDE_KEYS = ("description", "include", "tables", "define")
 TABLE_KEYS = ("by", "default", "values", "description")
 
+#: The most values a scenario file may hold, aliases expanded: the Sonic level tables hold a few hundred.
+MAX_VALUES = 100_000
+
 _INT_TAG = "tag:yaml.org,2002:int"
 _FLOAT_TAG = "tag:yaml.org,2002:float"
+#: The tags YAML gives plain values by itself; any other was written on purpose (``!!python/...``).
+_PLAIN_TAGS = frozenset(
+    f"tag:yaml.org,2002:{name}" for name in ("str", "int", "float", "bool", "null", "seq", "map", "timestamp", "merge")
+)
 
 
 class _Reader:
@@ -54,9 +66,42 @@ class _Reader:
             mark = exc.problem_mark or exc.context_mark
             index = mark.index if mark is not None else 0
             raise located(ScenarioError, self.source, index, index + 1, f"this is not valid YAML: {exc.problem or exc}") from None
+        except yaml.reader.ReaderError as exc:  # a control character such as NUL
+            raise located(
+                ScenarioError, self.source, exc.position, exc.position + 1,
+                f"expected printable text, got the control character {chr(exc.character)!r}; remove it",
+            ) from None
+        except (yaml.YAMLError, RecursionError) as exc:  # RecursionError: collections nested thousands deep
+            raise located(ScenarioError, self.source, 0, 1, f"this is not valid YAML: {exc}") from None
         if root is not None and not isinstance(root, yaml.MappingNode):
             raise self.error(root, "a scenario file holds a mapping (key: value lines) at its top")
+        if root is not None:
+            self._check_tags(root)
         return root
+
+    def _check_tags(self, root: yaml.Node) -> None:
+        """Refuse explicit tags (``!!python/...``, ``!!binary``, ``!foo``): a scenario is plain YAML.
+
+        Aliases are followed, so the walk also counts the values the file
+        holds once they are expanded: a few lines of nested aliases can stand
+        for billions, and reading them would never end.
+        """
+        stack = [root]
+        count = 0
+        while stack:
+            node = stack.pop()
+            count += 1
+            if count > MAX_VALUES:
+                raise self.error(
+                    root, f"expected a scenario of at most {MAX_VALUES} YAML values, aliases expanded, got more; "
+                    f"write out what the aliases (*name) repeat, or drop them",
+                )
+            if node.tag not in _PLAIN_TAGS:
+                raise self.error(node, f"expected plain YAML values, got one tagged {node.tag!r}; remove the tag")
+            if isinstance(node, yaml.SequenceNode):
+                stack.extend(node.value)
+            elif isinstance(node, yaml.MappingNode):
+                stack.extend(part for pair in node.value for part in pair)
 
     def mapping(self, node: yaml.Node, what: str, allowed: tuple[str, ...] | None = None) -> dict[str, tuple[yaml.Node, yaml.Node]]:
         """The entries of a mapping node, checking for duplicate and unknown keys."""
@@ -85,18 +130,30 @@ class _Reader:
 
     def plain(self, node: yaml.Node) -> object:
         """The Python value of a node (lists, numbers, strings)."""
-        return yaml.constructor.SafeConstructor().construct_document(node)
+        try:
+            return yaml.constructor.SafeConstructor().construct_document(node)
+        except (yaml.YAMLError, ValueError, OverflowError) as exc:  # e.g. an integer of over 4300 digits, a bad date
+            raise self.error(node, f"this value cannot be read: {exc}") from None
 
     def number(self, node: yaml.Node, role: str) -> Scalar:
         """A number: a YAML int or float, or a constant expression such as ``0x3080 + 0x1049``."""
+        value: object = None
         if isinstance(node, yaml.ScalarNode) and node.tag in (_INT_TAG, _FLOAT_TAG):
             value = self.plain(node)
-            if not isinstance(value, bool):
-                return value  # type: ignore[return-value]
-        snippet = self.snippet(node, role)
-        value = constant(parse(snippet))
+        if value is None or isinstance(value, bool):
+            value = constant(parse(self.snippet(node, role)))
         if value is None:
             raise self.error(node, f"{role} must be a number or a constant arithmetic expression")
+        return self._checked(node, role, value)  # type: ignore[arg-type]
+
+    def _checked(self, node: yaml.Node, role: str, value: Scalar) -> Scalar:
+        """Refuse what the scenario's code could not hold: inf, NaN, integers over 64 bits."""
+        if isinstance(value, float) and not math.isfinite(value):
+            raise self.error(node, f"expected {role} to be a finite number, got {value}")
+        if isinstance(value, int) and abs(value) > MAX_INT:
+            raise self.error(
+                node, f"expected {role} to fit in 64 bits (at most {MAX_INT}), got a {value.bit_length()}-bit number"
+            )
         return value
 
     def table(self, key: yaml.Node, node: yaml.Node) -> Table:
@@ -128,14 +185,18 @@ class _Reader:
 
     def _key_part(self, node: yaml.Node, part: str) -> Scalar:
         text = part.strip().replace("_", "")
-        try:
-            return int(text, 0)
-        except ValueError:
-            pass
-        try:
-            return float(text)
-        except ValueError:
-            raise self.error(node, f"a table key is one or more numbers separated by commas, e.g. '0, 1'; got {node.value!r}") from None
+        if len(text) <= 40:  # longer is no 64-bit number, and int() refuses over 4300 digits
+            try:
+                return self._checked(node, "a table key", int(text, 0))
+            except ValueError:
+                pass
+            try:
+                return self._checked(node, "a table key", float(text))
+            except ValueError:
+                pass
+        raise self.error(
+            node, f"a table key is one or more numbers separated by commas, e.g. '0, 1'; got {node.value[:40]!r}"
+        )
 
     def name_snippet(self, key: yaml.Node, role: str) -> Snippet:
         start = key.start_mark.index
@@ -156,12 +217,15 @@ class DocumentLoader:
         if resolved in self._seen:
             raise ScenarioError(f"{path}: included more than once (includes must not loop)")
         self._seen.append(resolved)
-        text = read_source(path)
-        self.load_text(text, str(path), path.parent, top=top)
+        self.load_source(read_source(path), path.parent, top=top)
 
     def load_text(self, text: str, name: str, base: Path | None, *, top: bool = True) -> None:
         """Read scenario YAML ``text``; ``name`` labels it in messages, ``base`` resolves includes."""
-        reader = _Reader(SourceText(name, text))
+        self.load_source(SourceText(name, text), base, top=top)
+
+    def load_source(self, source: SourceText, base: Path | None, *, top: bool = True) -> None:
+        """Read scenario YAML from ``source``; ``base`` resolves includes."""
+        reader = _Reader(source)
         root = reader.compose()
         if root is None:
             return
@@ -172,7 +236,11 @@ class DocumentLoader:
                 if base is None:
                     raise reader.error(entries["include"][1], "include needs a folder to look in: pass game_dir")
                 target = base / str(reader.plain(item))
-                if not target.is_file():
+                try:
+                    found = target.is_file()
+                except (OSError, ValueError):  # a name too long for the file system, or holding NUL
+                    found = False
+                if not found:
                     raise reader.error(item, f"no file {str(reader.plain(item))!r} to include (looked for {target})")
                 self.load_file(target, top=False)
         if "name" in entries:
@@ -197,6 +265,15 @@ class DocumentLoader:
             spec.rewards = [reader.snippet(item, f"reward of player {i + 1}") for i, item in enumerate(items)]
         if "done" in entries:
             spec.done = reader.snippet(entries["done"][1], "done")
+        if "dones" in entries:
+            items = self._list(reader, entries["dones"][1], "dones")
+            players = max(1, len(spec.rewards))
+            if len(items) != players:
+                raise reader.error(
+                    entries["dones"][1],
+                    f"expected one done condition per player ({players}, as many as the rewards), got {len(items)}",
+                )
+            spec.dones = [reader.snippet(item, f"done of player {i + 1}") for i, item in enumerate(items)]
         if "actions" in entries:
             spec.actions = self._actions(reader, entries["actions"][1])
         if "crop" in entries:
@@ -246,7 +323,14 @@ def document_from_dict(data: dict, *, name: str | None = None, game_dir: str | o
     ``<scenario NAME>``, so its errors point at lines of that text.
     """
     label = name or str(data.get("name", "scenario"))
-    text = yaml.safe_dump(_plain_keys(data), sort_keys=False, default_flow_style=False, width=10_000)
+    try:
+        text = yaml.safe_dump(_plain_keys(data), sort_keys=False, default_flow_style=False, width=10_000)
+    except yaml.YAMLError as exc:  # RepresenterError: an object YAML cannot write
+        found = exc.args[1] if len(exc.args) > 1 else exc
+        raise ScenarioError(
+            f"scenario {label!r}: expected plain values (text, numbers, lists, dicts), got {shown(found)} "
+            f"({type(found).__name__}); pass expressions as text"
+        ) from None
     loader = DocumentLoader(label)
     loader.load_text(text, f"<scenario {label!r}>", Path(game_dir) if game_dir is not None else None)
     if name:
@@ -255,9 +339,11 @@ def document_from_dict(data: dict, *, name: str | None = None, game_dir: str | o
 
 
 def _plain_keys(value: object) -> object:
-    """Make a dict dumpable: tuple keys ``(0, 1)`` become ``"0, 1"``."""
+    """Make a dict dumpable: tuple keys ``(0, 1)`` become ``"0, 1"``, numpy values Python ones."""
     if isinstance(value, dict):
         return {(", ".join(str(p) for p in k) if isinstance(k, tuple) else k): _plain_keys(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
         return [_plain_keys(v) for v in value]
+    if isinstance(value, (np.generic, np.ndarray)):  # np.int64(3), np.array([0, 0, 320, 224])
+        return _plain_keys(value.tolist())
     return value

@@ -17,6 +17,8 @@ is an error.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from retrokit.dsl import nodes as n
 from retrokit.dsl.check import MEMORY, Analysis, Slot
 from retrokit.errors import ScenarioCompileError
@@ -84,30 +86,14 @@ class Graph:
         return self.a.defines[key] if kind == "def" else self._slots[key].arg  # type: ignore[index]
 
     def roots(self) -> list[n.Node]:
-        """The outputs: rewards, then done."""
-        return [*self.a.rewards, *([self.a.done] if self.a.done is not None else [])]
+        """The outputs: rewards, done, then the players' dones."""
+        return [*self.a.rewards, *([self.a.done] if self.a.done is not None else []), *self.a.dones]
 
     def check_cycles(self) -> None:
         """Raise ScenarioCompileError if something needs itself at reset."""
         items: list[Item] = [("def", name) for name in self.a.defines]
         items += [("slot", index) for index in self._slots]
-        state: dict[Item, int] = {}
-        path: list[Item] = []
-
-        def visit(item: Item) -> None:
-            state[item] = 1
-            path.append(item)
-            for dep in sorted(deps(self.expression(item), FIRST, self.a), key=repr):
-                if state.get(dep) == 1:
-                    self._cycle_error(path[path.index(dep):] + [dep])
-                if dep not in state:
-                    visit(dep)
-            path.pop()
-            state[item] = 2
-
-        for item in items:
-            if item not in state:
-                visit(item)
+        self._postorder(items, FIRST, on_cycle=self._cycle_error)
 
     def order(self, mode: str) -> list[Item]:
         """The items to compute in ``mode``, each after the items it reads."""
@@ -118,19 +104,44 @@ class Graph:
             if item not in live:
                 live.add(item)
                 stack.extend(needs(self.expression(item), mode, self.a))
+        return self._postorder(sorted(live, key=repr), mode)
+
+    def definition_order(self) -> list[str]:
+        """Every definition, each after the definitions it reads at reset (no cycles: see check_cycles)."""
+        items: list[Item] = [("def", name) for name in self.a.defines]
+        return [key for kind, key in self._postorder(items, FIRST) if kind == "def"]  # type: ignore[misc]
+
+    def _postorder(
+        self, items: list[Item], mode: str, on_cycle: Callable[[list[Item]], None] | None = None
+    ) -> list[Item]:
+        """Depth-first post-order from ``items`` over what each reads in ``mode``.
+
+        Iterative, so a chain of thousands of definitions needs no deep Python
+        stack. ``on_cycle`` gets the path of any item met again while it is
+        still being visited (a cycle), ending with that item.
+        """
         ordered: list[Item] = []
-        seen: set[Item] = set()
-
-        def visit(item: Item) -> None:
-            seen.add(item)
-            for dep in sorted(deps(self.expression(item), mode, self.a), key=repr):
-                if dep not in seen:
-                    visit(dep)
-            ordered.append(item)
-
-        for item in sorted(live, key=repr):
-            if item not in seen:
-                visit(item)
+        state: dict[Item, int] = {}  # 1: on the path, 2: done
+        for root in items:
+            if root in state:
+                continue
+            state[root] = 1
+            path = [root]
+            pending = [iter(sorted(deps(self.expression(root), mode, self.a), key=repr))]
+            while pending:
+                dep = next(pending[-1], None)
+                if dep is None:
+                    pending.pop()
+                    done = path.pop()
+                    state[done] = 2
+                    ordered.append(done)
+                elif state.get(dep) == 1:
+                    if on_cycle is not None:
+                        on_cycle(path[path.index(dep):] + [dep])
+                elif dep not in state:
+                    state[dep] = 1
+                    path.append(dep)
+                    pending.append(iter(sorted(deps(self.expression(dep), mode, self.a), key=repr)))
         return ordered
 
     def _label(self, item: Item) -> str:

@@ -23,6 +23,7 @@ name (``docs/scenarios.md``).
 from __future__ import annotations
 
 import json
+import math
 import os
 import re
 from collections.abc import Mapping, Sequence
@@ -158,9 +159,22 @@ class _Converter:
             out["crop"] = list(data["crop"])
         return out
 
+    def check_numbers(self, spec: Mapping, path: list[str]) -> None:
+        """Refuse a variable's reward or penalty that is no finite number, or a reference that is no integer."""
+        for key in ("reward", "penalty", "reference"):
+            value = spec.get(key)
+            if value is None:
+                continue
+            whole = key == "reference"
+            number = isinstance(value, int if whole else (int, float)) and not isinstance(value, bool)
+            if not number or not math.isfinite(value):
+                wanted = "an integer" if whole else "a finite number"
+                raise self.error([*path, key], f"expected {key} to be {wanted}, got {value!r}")
+
     def measure(self, name: str, spec: Mapping, path: list[str], default: str) -> tuple[str, str, int]:
         """The DSL text of a variable's measure, its op, and its reference."""
         spec = self.check_keys(spec, VARIABLE_KEYS, path)
+        self.check_numbers(spec, path)
         if self.fields is not None and name not in self.fields:
             raise self.error(path, f"unknown variable {name!r}: the game has no such field." + did_you_mean(name, self.fields), ScenarioCompileError)
         measurement = spec.get("measurement", default)
@@ -179,6 +193,7 @@ class _Converter:
             terms.append(_reward_term(m, op, reference, var))
         if "time" in spec:  # the rule applied to the constant 1, each frame
             time = self.check_keys(spec["time"], VARIABLE_KEYS, [*path, "time"])
+            self.check_numbers(time, [*path, "time"])
             op = time.get("op", "")
             if op not in OPS:
                 raise self.error([*path, "time", "op"], f"unknown op {op!r}." + did_you_mean(str(op), OPS[1:]))
@@ -221,12 +236,13 @@ def _find_key(text: str, path: Sequence[str]) -> int:
 
 
 def _read_json(path: Path) -> tuple[dict, SourceText]:
-    text = read_source(path)
-    source = SourceText(str(path), text)
+    source = read_source(path)
     try:
-        data = json.loads(text)
+        data = json.loads(source.text)
     except json.JSONDecodeError as exc:
         raise located(ScenarioError, source, exc.pos, exc.pos + 1, f"this is not valid JSON: {exc.msg}") from None
+    except (ValueError, RecursionError) as exc:  # an integer of over 4300 digits; arrays nested thousands deep
+        raise located(ScenarioError, source, 0, 1, f"this JSON cannot be read: {exc}") from None
     if not isinstance(data, dict):
         raise located(ScenarioError, source, 0, 1, "a scenario.json file holds an object ({...})")
     return data, source

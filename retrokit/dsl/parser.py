@@ -5,14 +5,20 @@ aliased alternatives map one-to-one onto the methods of :class:`ToAst`. Syntax
 errors become :class:`~retrokit.errors.ScenarioSyntaxError` pointing at the
 offending character, with what was expected; errors raised while building the
 tree (lark wraps them in ``VisitError``) are unwrapped.
+
+Every later pass walks the tree recursively, and the generated Python nests as
+the expression does, so an expression may nest at most :data:`MAX_DEPTH`
+operations deep; deeper ones are refused before the tree is built. Number
+literals must be finite and fit in 64 bits: the console's values do.
 """
 
 from __future__ import annotations
 
 import functools
+import math
 from pathlib import Path
 
-from lark import Lark, Token, Transformer, v_args
+from lark import Lark, Token, Transformer, Tree, v_args
 from lark.exceptions import UnexpectedCharacters, UnexpectedEOF, UnexpectedInput, UnexpectedToken, VisitError
 
 from retrokit.dsl import nodes as n
@@ -20,6 +26,14 @@ from retrokit.dsl.source import Snippet
 from retrokit.errors import ScenarioError, ScenarioSyntaxError
 
 _GRAMMAR = Path(__file__).with_name("grammar.lark")
+
+#: How many operations (operators, calls, lookups) may enclose one another in an
+#: expression: a sum of 101 terms, or 101 nested calls, is refused. Longer
+#: formulas are split into definitions (``define:``), which have no such limit.
+MAX_DEPTH = 100
+
+#: The largest integer literal: the console's values are at most 64 bits wide.
+MAX_INT = 2**64 - 1
 
 #: How lark's terminal names read in a message.
 _TERMINALS = {
@@ -67,6 +81,14 @@ class ToAst(Transformer):
 
     def int_literal(self, meta, children):
         text = _literal(children[0])
+        # Checked by length first: int() refuses over 4300 digits, and 64 bits need at most 20.
+        digits = text[2:] if text[1:2] in "xX" else text
+        if len(digits.lstrip("0")) > 20 or int(text, 16 if digits is not text else 10) > MAX_INT:
+            shown = text if len(text) <= 24 else f"{text[:10]}...{text[-4:]} ({len(text)} digits)"
+            raise self._snippet.error(
+                ScenarioSyntaxError, meta.start_pos, meta.end_pos,
+                f"expected an integer of at most 64 bits (up to {MAX_INT}), got {shown}; use a smaller number",
+            )
         if len(text) > 1 and text[0] == "0" and text[1] not in "xX":
             raise self._snippet.error(
                 ScenarioSyntaxError, meta.start_pos, meta.end_pos,
@@ -75,7 +97,13 @@ class ToAst(Transformer):
         return n.Number(start=meta.start_pos, end=meta.end_pos, value=int(text, 0))
 
     def float_literal(self, meta, children):
-        return n.Number(start=meta.start_pos, end=meta.end_pos, value=float(_literal(children[0])))
+        value = float(_literal(children[0]))
+        if not math.isfinite(value):  # e.g. 1e999: the generated code could not even name it
+            raise self._snippet.error(
+                ScenarioSyntaxError, meta.start_pos, meta.end_pos,
+                f"expected a finite decimal number (at most about 1.8e308), got {children[0]!s}; use a smaller number",
+            )
+        return n.Number(start=meta.start_pos, end=meta.end_pos, value=value)
 
     def true(self, meta, children):
         return n.Bool(start=meta.start_pos, end=meta.end_pos, value=True)
@@ -145,12 +173,34 @@ def parse(snippet: Snippet) -> n.Node:
         tree = _lark().parse(snippet.text)
     except UnexpectedInput as exc:
         raise _syntax_error(snippet, exc) from None
+    _check_depth(snippet, tree)
     try:
         return ToAst(snippet).transform(tree)
     except VisitError as exc:
         if isinstance(exc.orig_exc, ScenarioError):
             raise exc.orig_exc from None
         raise
+
+
+def _check_depth(snippet: Snippet, tree: Tree) -> None:
+    """Refuse a tree nesting more than MAX_DEPTH operations, walking it without recursion.
+
+    Lark's ``arguments`` node is no operation of its own: a call and its
+    arguments count as one level.
+    """
+    stack: list[tuple[Tree, int]] = [(tree, 1)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            meta = node.meta
+            raise snippet.error(
+                ScenarioSyntaxError, meta.start_pos, meta.end_pos,
+                f"expected an expression nesting at most {MAX_DEPTH} operations (operators, calls, lookups), "
+                f"got more; split it into definitions under 'define:' (a long sum: add parts defined separately)",
+            )
+        for child in node.children:
+            if isinstance(child, Tree):
+                stack.append((child, depth if child.data == "arguments" else depth + 1))
 
 
 def _syntax_error(snippet: Snippet, exc: UnexpectedInput) -> ScenarioSyntaxError:

@@ -23,7 +23,7 @@ from retrokit.dsl.compiler import Program
 from retrokit.dsl.document import document_from_dict, load_document
 from retrokit.dsl.gymretro import is_gym_retro, spec_from_json, spec_from_json_dict
 from retrokit.dsl.spec import ScenarioSpec
-from retrokit.errors import ScenarioError
+from retrokit.errors import InvalidArgumentError, ScenarioError, shown
 
 __all__ = ["Run", "Scenario", "load_scenario"]
 
@@ -65,13 +65,17 @@ class Run:
     """One stream of episodes of a scenario: its memory (``prev``, ``initial``, ...).
 
     ``reset`` starts an episode. ``step`` returns ``(rewards, done)``: a tuple of
-    ``players`` floats, and a bool. Stepping without a reset treats the first
-    step as the reset point (``initial(x)`` is then the first step's value).
+    ``players`` floats, and a bool; :attr:`dones` then holds each player's own
+    done condition (a scenario's ``dones:``), which ``done`` includes once all
+    hold. Stepping without a reset treats the first step as the reset point
+    (``initial(x)`` is then the first step's value).
     """
 
     def __init__(self, program: Program) -> None:
         self._state: list = [None] * program.slot_count
-        self._first, self._next = program.bind(self._state)
+        #: Each player's done condition after the last step (``dones:``); all False without one.
+        self.dones: list[bool] = [False] * program.players
+        self._first, self._next = program.bind(self._state, self.dones)
         # The hot path: after reset, ``run.step`` is the generated function itself.
         self.step = self._step_before_reset  # type: ignore[method-assign]
 
@@ -132,6 +136,7 @@ def load_scenario(
         ScenarioCompileError: An unknown name, a wrong argument count, a type
             error or a division by a constant zero.
         ScenarioError: The file is malformed or cannot be read.
+        InvalidArgumentError: ``source`` is neither a path nor a dict.
     """
     if isinstance(source, Mapping):
         data = dict(source)
@@ -140,6 +145,10 @@ def load_scenario(
         else:
             spec = document_from_dict(data, name=name, game_dir=game_dir)
         return Scenario(spec, fields)
+    if not isinstance(source, (str, os.PathLike)):
+        raise InvalidArgumentError(
+            f"Expected a scenario file's path or a scenario dict, got {shown(source)} ({type(source).__name__})."
+        )
     path = Path(source)
     suffix = path.suffix.lower()
     if suffix == ".json":

@@ -19,23 +19,6 @@ from pathlib import Path
 from retrokit.errors import RetrokitError, ScenarioError
 
 
-def read_source(path: Path) -> str:
-    """Return a scenario file's text.
-
-    Raises:
-        ScenarioError: The file cannot be read, or is not UTF-8 text.
-    """
-    try:
-        return path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ScenarioError(f"cannot read scenario file {str(path)!r}: {exc.strerror or exc}") from None
-    except UnicodeDecodeError as exc:
-        raise ScenarioError(
-            f"{path}: expected a UTF-8 text file; found a byte that is not UTF-8 at offset {exc.start}. "
-            "Save the scenario as UTF-8 text."
-        ) from None
-
-
 @dataclass(frozen=True)
 class SourceText:
     """The full text of one source (a file, or a lone expression), for locating."""
@@ -153,3 +136,38 @@ def located(cls: type[RetrokitError], source: SourceText, start: int, end: int, 
     err.file, err.line, err.column = source.name, line, col  # type: ignore[attr-defined]
     return err
 
+
+
+#: The largest scenario file read: the shipped ones are a few kilobytes, and YAML
+#: takes tens of times a file's size in memory.
+MAX_SOURCE_BYTES = 4 * 2**20
+
+
+def read_source(path: Path) -> SourceText:
+    """Read a scenario file as UTF-8 text (a leading byte-order mark is allowed).
+
+    Raises:
+        ScenarioError: The file cannot be read, or is not UTF-8; the error
+            points at the first byte that is not.
+    """
+    try:
+        with path.open("rb") as file:
+            data = file.read(MAX_SOURCE_BYTES + 1)  # never more: a scenario is a few kilobytes
+    except OSError as exc:
+        raise ScenarioError(f"cannot read scenario file {str(path)!r}: {exc.strerror or exc}") from None
+    if len(data) > MAX_SOURCE_BYTES:
+        raise ScenarioError(
+            f"{path}: expected a scenario file of at most {MAX_SOURCE_BYTES // 2**20} MiB, got a larger one; "
+            f"is it the right file?"
+        )
+    try:
+        return SourceText(str(path), data.decode("utf-8-sig"))
+    except UnicodeDecodeError as exc:
+        # Locate the bad byte in the text as far as it decodes, so the message shows its line.
+        bom = 3 if data.startswith(b"\xef\xbb\xbf") else 0
+        good = data[bom : exc.start].decode("utf-8")
+        shown = SourceText(str(path), good + data[exc.start :].decode("utf-8", errors="replace"))
+        raise located(
+            ScenarioError, shown, len(good), len(good) + 1,
+            f"expected UTF-8 text, got the byte 0x{data[exc.start]:02x}; save the file as UTF-8",
+        ) from None

@@ -48,6 +48,9 @@ class ScenarioSpec:
         define_names: For each definition, a snippet pointing at its name.
         rewards: One reward expression per player.
         done: The done condition; ``None`` means never done.
+        dones: One done condition per player, if given: a player whose
+            condition holds is out of the game; the episode ends when
+            ``done`` holds or every player is out.
         actions: Gym Retro-style button combinations, if given.
         crop: ``(x, y, width, height)`` of the screen to keep, if given.
     """
@@ -58,5 +61,6 @@ class ScenarioSpec:
     define_names: dict[str, Snippet] = field(default_factory=dict)
     rewards: list[Snippet] = field(default_factory=list)
     done: Snippet | None = None
+    dones: list[Snippet] = field(default_factory=list)
     actions: list | None = None
     crop: tuple[int, int, int, int] | None = None

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from retrokit.dsl import nodes as n
 from retrokit.dsl.check import BOOL, COUNTERS, FLOAT, INT, NUMBERS, Analysis, table_type
+from retrokit.dsl.graph import Graph
 from retrokit.dsl.source import Snippet
 from retrokit.errors import ScenarioCompileError
 
@@ -43,10 +44,13 @@ class TypeChecker:
     def run(self) -> None:
         """Check all expressions; store definition and reward types in the analysis."""
         a = self.a
+        # In dependency order, each definition finds the ones it reads typed
+        # already, so inference recurses only as deep as one expression.
+        order = Graph(a).definition_order()
         for _ in range(8):
             before = dict(self.types)
             self._settled.clear()
-            for name in a.defines:
+            for name in order:
                 self.define_type(name)
             if self.types == before:
                 break
@@ -62,6 +66,12 @@ class TypeChecker:
                 raise a.spec.done.error(
                     ScenarioCompileError, a.done.start, a.done.end,
                     f"done must be a condition (boolean), and this is a number; {_TEST_HINT}",
+                )
+        for root, snippet in zip(a.dones, a.spec.dones):
+            if self.type_of(root, snippet) != BOOL:
+                raise snippet.error(
+                    ScenarioCompileError, root.start, root.end,
+                    f"a player's done must be a condition (boolean), and this is a number; {_TEST_HINT}",
                 )
         a.types = dict(self.types)
 

@@ -5,6 +5,8 @@
 - ``vector``: many envs stepped in one native call.
 - ``multiplayer``: PettingZoo envs for two-player games.
 - ``sonic``: the Sonic benchmark preset.
+- ``options``: checking what ``make`` is given; ``compat``: stable-retro's
+  conveniences on :class:`RetroEnv`.
 - ``actions``, ``buffers``, ``viewer``, ``registration``: action spaces, reusable
   arrays, the ``human`` window, Gymnasium ids.
 """

@@ -17,12 +17,13 @@ Groups come from the scenario's ``actions`` or, failing that, the system's.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 
 import numpy as np
 from gymnasium import spaces
 
-from retrokit.errors import InvalidArgumentError, did_you_mean
+from retrokit.errors import InvalidArgumentError, did_you_mean, shown
 from retrokit.host.primitives import pack_buttons
 from retrokit.host.systems import System
 
@@ -102,8 +103,20 @@ class ActionMap:
             raise InvalidArgumentError(f"Expected {self.players} actions, one per player, got {len(per_player)}.")
         if self.action_type == "discrete":
             size = math.prod(len(c) for c in self.combos)
-            return sum(int(a) * size**p for p, a in enumerate(per_player))  # type: ignore[call-overload]
-        return np.concatenate([np.asarray(a).ravel() for a in per_player]).astype(self.space.dtype)
+            # Each index is checked against one player's choices: past them it would pick another player's.
+            return sum(self._discrete_index(a, size) * size**p for p, a in enumerate(per_player))
+        parts = [np.asarray(a).ravel() for a in per_player]
+        width = len(self.combos) if self.action_type == "multi_discrete" else self.num_buttons
+        for p, part in enumerate(parts):
+            if part.size != width:
+                raise InvalidArgumentError(
+                    f"Expected player {p + 1}'s action to have {width} items, got {part.size}; "
+                    f"pass one like its action_space(agent).sample()."
+                )
+        joint = np.concatenate(parts)
+        if self.action_type == "multi_discrete":
+            self._check_choices(joint)  # before the cast, which would turn 1.5 into 1
+        return joint.astype(self.space.dtype)
 
     def _make_filter_table(self) -> np.ndarray:
         """What :meth:`filter` makes of every possible mask, for the native packer."""
@@ -138,10 +151,46 @@ class ActionMap:
             return
         out[: self.players] = self.to_masks(action)
 
+    def _discrete_index(self, action: object, n: int | None = None) -> int:
+        """A Discrete action as an int, refused unless it is a whole number below ``n`` (the space's size)."""
+        n = self.space.n if n is None else n  # type: ignore[attr-defined]
+        if isinstance(action, np.ndarray) and action.size == 1:
+            action = action.reshape(()).item()
+        if isinstance(action, (bool, np.bool_)) or not isinstance(action, numbers.Integral):
+            raise InvalidArgumentError(
+                f"Expected a discrete action, a whole number from 0 to {n - 1}, got {shown(action)} "
+                f"({type(action).__name__}); pass e.g. env.action_space.sample()."
+            )
+        index = int(action)
+        if not 0 <= index < n:
+            raise InvalidArgumentError(
+                f"Expected a discrete action from 0 to {n - 1}, got {index}; "
+                f"other values would press other buttons."
+            )
+        return index
+
+    def _check_choices(self, flat: np.ndarray) -> None:
+        """Refuse a multi-discrete action of the wrong length, or choosing past a group's combinations."""
+        nvec = self.space.nvec  # type: ignore[attr-defined]
+        values = flat.tolist()
+        whole = all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in values)
+        if flat.size != nvec.size or not whole:
+            raise InvalidArgumentError(
+                f"Expected a multi-discrete action of {nvec.size} whole numbers (one per button group and player), "
+                f"got {shown(values)}; pass an array like env.action_space.sample()."
+            )
+        bad = [(i, int(v), int(n)) for i, (v, n) in enumerate(zip(values, nvec.tolist())) if not 0 <= v < n]
+        if bad:
+            i, value, n = bad[0]
+            raise InvalidArgumentError(
+                f"Expected choice {i} of the multi-discrete action from 0 to {n - 1}, got {value}; "
+                f"the space is {self.space}."
+            )
+
     def to_masks(self, action: object) -> list[int]:
         """Return one RetroPad mask per player for an action of this map's type."""
         if self.action_type == "discrete":
-            index = int(action)  # type: ignore[call-overload]
+            index = self._discrete_index(action)
             per_player = math.prod(len(c) for c in self.combos)
             masks = []
             for _ in range(self.players):
@@ -155,6 +204,7 @@ class ActionMap:
         flat = np.asarray(action).ravel()
         if self.action_type == "multi_discrete":
             n = len(self.combos)
+            self._check_choices(flat)
             return [
                 int(np.bitwise_or.reduce([combos[int(i)] for combos, i in zip(self.combos, flat[p * n : (p + 1) * n])]))
                 for p in range(self.players)

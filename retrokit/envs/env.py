@@ -23,6 +23,8 @@ from retrokit.data.games import Game, find_game
 from retrokit.data.statecheck import load_state
 from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
+from retrokit.envs.compat import StableRetroCompat
+from retrokit.envs.options import check_crop, make_arguments
 from retrokit.envs.stepper import Stepper, drive
 from retrokit.errors import InvalidArgumentError, did_you_mean
 from retrokit.host.emulator import Emulator
@@ -39,7 +41,7 @@ class State(enum.Enum):
     NONE = "none"  #: power on, no state
 
 
-class RetroEnv(gymnasium.Env):
+class RetroEnv(StableRetroCompat, gymnasium.Env):
     """A game as a Gymnasium environment.
 
     Args:
@@ -118,6 +120,7 @@ class RetroEnv(gymnasium.Env):
         )
         self._crop = getattr(self.scenario, "crop", None)
         self._screen_shape = self.emulator.system.screen or self._first_frame_shape()
+        check_crop(self._crop, self._screen_shape)
         self.observation_space = self._make_observation_space()
         self._buffers = BufferPool(self.observation_space.shape)
         self.record_dir = Path(record) if record is not None else None
@@ -251,6 +254,7 @@ class RetroEnv(gymnasium.Env):
         truncated = self.max_episode_steps is not None and stepper.steps >= self.max_episode_steps and not done
         if self.players > 1:
             values["rewards"] = rewards
+            values["dones"] = stepper.dones
         if (done or truncated) and self.movies is not None:
             self.movies.end()
         if self.render_mode == "human":
@@ -314,4 +318,4 @@ def make(
     **options: Any,
 ) -> RetroEnv:
     """Make the Gymnasium environment of a game: see :class:`RetroEnv` for the options."""
-    return RetroEnv(game, state, scenario, **options)
+    return RetroEnv(**make_arguments(game, state, scenario, options))

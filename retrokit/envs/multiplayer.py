@@ -3,7 +3,10 @@
 :class:`RetroParallelEnv` is written once, over a :class:`retrokit.envs.env.RetroEnv`
 with every player; the AEC form comes from PettingZoo's conversion wrapper.
 Every agent sees the whole screen (or RAM) and gets its own reward from the
-scenario's per-player rewards.
+scenario's per-player rewards. A scenario's per-player done conditions
+(``dones:``) take a player out for good: its agent is terminated and leaves
+``agents``, as PettingZoo's rules ask, and presses nothing from then on; the
+others play on until the scenario's ``done``, or until every player is out.
 """
 
 from __future__ import annotations
@@ -81,19 +84,21 @@ class RetroParallelEnv(ParallelEnv):
         if missing:
             raise InvalidArgumentError(f"Expected an action for every live agent; missing {missing}.")
         idle = self._act_space.sample() * 0 if not isinstance(self._act_space, spaces.Discrete) else 0
-        joint = self._env.actions.combine([actions.get(a, idle) for a in self.possible_agents])
+        # A player out of the game presses nothing, whatever is passed for it.
+        joint = self._env.actions.combine([actions[a] if a in self.agents else idle for a in self.possible_agents])
         obs, _, terminated, truncated, info = self._env.step(joint)
-        rewards = info.pop("rewards")
+        rewards, dones = info.pop("rewards"), info.pop("dones")
         agents = self.agents
+        index = {a: self.possible_agents.index(a) for a in agents}
+        out = {a: bool(terminated or dones[index[a]]) for a in agents}
         result = (
             {a: obs.copy() for a in agents},
-            {a: float(rewards[self.possible_agents.index(a)]) for a in agents},
-            {a: bool(terminated) for a in agents},
-            {a: bool(truncated) for a in agents},
+            {a: float(rewards[index[a]]) for a in agents},
+            out,
+            {a: bool(truncated) and not out[a] for a in agents},
             {a: dict(info) for a in agents},
         )
-        if terminated or truncated:
-            self.agents = []
+        self.agents = [] if terminated or truncated else [a for a in agents if not out[a]]
         return result
 
     def render(self) -> Any:

@@ -19,17 +19,16 @@ import numpy as np
 from gymnasium import spaces
 
 from retrokit.data.games import find_game
+from retrokit.data.sonic_levels import (  # noqa: F401 - named here too, where users look: retrokit.sonic.levels()
+    GAMES,
+    TEST_LEVELS,
+    levels,
+    test_levels,
+    train_levels,
+)
 from retrokit.envs.env import RetroEnv
+from retrokit.envs.options import check_options
 from retrokit.errors import InvalidArgumentError, StateNotFoundError, did_you_mean
-
-GAMES = ("SonicTheHedgehog-Genesis", "SonicTheHedgehog2-Genesis", "SonicAndKnuckles3-Genesis")
-
-#: The paper's test levels; every other state of the three games is a training level.
-TEST_LEVELS = {
-    "SonicTheHedgehog-Genesis": ("SpringYardZone.Act1", "GreenHillZone.Act2", "StarLightZone.Act3", "ScrapBrainZone.Act1"),
-    "SonicTheHedgehog2-Genesis": ("MetropolisZone.Act3", "HillTopZone.Act2", "CasinoNightZone.Act2"),
-    "SonicAndKnuckles3-Genesis": ("LavaReefZone.Act1", "FlyingBatteryZone.Act2", "HydrocityZone.Act1", "AngelIslandZone.Act2"),
-}
 
 #: The baselines' 7 button combinations.
 ACTIONS = (("LEFT",), ("RIGHT",), ("LEFT", "DOWN"), ("RIGHT", "DOWN"), ("DOWN",), ("DOWN", "B"), ("B",))
@@ -39,22 +38,6 @@ ACTIONS_WITH_NOOP = ((),) + ACTIONS
 FRAMESKIP = 4
 STICKY_PROB = 0.25
 MAX_EPISODE_STEPS = 4500
-
-
-def levels() -> list[tuple[str, str]]:
-    """Return every benchmark level as ``(game, state)``, in a stable order."""
-    return [(game, state) for game in GAMES for state in sorted(find_game(game).states)]
-
-
-def test_levels() -> list[tuple[str, str]]:
-    """Return the paper's 11 test levels."""
-    return [(game, state) for game, states in TEST_LEVELS.items() for state in states]
-
-
-def train_levels() -> list[tuple[str, str]]:
-    """Return the paper's 47 training levels."""
-    test = set(test_levels())
-    return [level for level in levels() if level not in test]
 
 
 class Discretizer(gymnasium.ActionWrapper):
@@ -136,7 +119,7 @@ def make(
         **options,
         "action_type": "all",
     }
-    env: gymnasium.Env = RetroEnv(game, state, scenario, **settings)
+    env: gymnasium.Env = RetroEnv(game, state, scenario, **check_options(settings))
     env = Discretizer(env, ACTIONS_WITH_NOOP if noop else ACTIONS)
     if allow_backtracking:
         env = AllowBacktracking(env)

@@ -74,6 +74,11 @@ class Stepper:
         self._run: Any = None  # the scenario's state for this episode
         self._before: tuple[int, ...] = ()
 
+    @property
+    def dones(self) -> tuple[bool, ...]:
+        """Each player's own done condition after the last step (a scenario's ``dones:``), all False without."""
+        return tuple(self._run.dones[: self.players]) if self._run is not None else (False,) * self.players
+
     def use_masks(self, row: np.ndarray) -> None:
         """Write the buttons into ``row`` from now on: a vector env's shared array, read by its runner."""
         row[:] = self.masks

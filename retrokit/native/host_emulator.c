@@ -8,6 +8,7 @@
  */
 #include "host.h"
 
+#include <limits.h>
 #include <string.h>
 
 #include "video.h"
@@ -190,7 +191,8 @@ static PyObject *emulator_run(EmulatorObject *self, PyObject *const *args, Py_ss
         return PyErr_Format(PyExc_TypeError, "run() takes (actions, frames[, screen]), got %zd arguments", nargs);
     long frames = PyLong_AsLong(args[1]);
     if (frames == -1 && PyErr_Occurred()) return NULL;
-    if (frames < 0) return PyErr_Format(InvalidArgumentError, "frames must be 0 or more, got %ld", frames);
+    if (frames < 0 || frames > INT_MAX) /* the core loop counts in an int: never wrap to 0 or a few frames */
+        return PyErr_Format(InvalidArgumentError, "frames must be 0 or more and at most %d, got %ld", INT_MAX, frames);
     Py_buffer buf, screen = {0};
     if (PyObject_GetBuffer(args[0], &buf, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0) return NULL;
     const char *f = buf.format ? buf.format : "B";

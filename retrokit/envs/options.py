@@ -1,0 +1,193 @@
+"""Checking what ``retrokit.make`` is given, before anything is built.
+
+:func:`make_arguments` checks the game, state and scenario and every keyword
+option of :class:`~retrokit.envs.env.RetroEnv`, and normalises them: numpy
+integers and floats become Python ones, numbers that the native host cannot
+hold are refused, a misspelled keyword gets a did-you-mean. Every refusal is
+an :class:`~retrokit.errors.InvalidArgumentError` (or, for an unknown keyword,
+an :class:`~retrokit.errors.UnknownNameError`) saying what was expected,
+what was found and how to fix it, never a raw ``TypeError``.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+import numbers
+import os
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+
+from retrokit.data.games import Game
+from retrokit.envs.actions import ACTION_TYPES
+from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean, shown
+
+#: The native host counts frames in a C int.
+MAX_FRAMESKIP = 2**31 - 1
+#: Steps are counted in 64 bits.
+MAX_STEPS = 2**63 - 1
+
+OBS_TYPES = ("rgb", "ram")
+RENDER_MODES = ("rgb_array", "human")
+
+
+def _integer(name: str, value: object, low: int, high: int) -> int:
+    """A whole number (Python or numpy, never a bool) in [low, high]."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+        raise InvalidArgumentError(
+            f"Expected {name} to be a whole number, got {shown(value)} ({type(value).__name__}); "
+            f"pass e.g. {name}={low}."
+        )
+    number = int(value)
+    if not low <= number <= high:
+        raise InvalidArgumentError(f"Expected {name} from {low} to {high}, got {number}; pass a value in that range.")
+    return number
+
+
+def _frameskip(value: object) -> int:
+    return _integer("frameskip", value, 1, MAX_FRAMESKIP)
+
+
+def _players(value: object) -> int:
+    return _integer("players", value, 1, 2**16)
+
+
+def _max_episode_steps(value: object) -> int | None:
+    return None if value is None else _integer("max_episode_steps", value, 1, MAX_STEPS)
+
+
+def _sticky_prob(value: object) -> float:
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise InvalidArgumentError(
+            f"Expected sticky_prob to be a number in [0, 1], got {shown(value)} ({type(value).__name__}); "
+            f"pass e.g. sticky_prob=0.25."
+        )
+    prob = float(value)
+    if not (math.isfinite(prob) and 0.0 <= prob <= 1.0):
+        raise InvalidArgumentError(f"Expected sticky_prob in [0, 1], got {prob}; pass a probability, e.g. 0.25.")
+    return prob
+
+
+def _choice(name: str, choices: tuple[str, ...], optional: bool = False) -> Callable[[object], str | None]:
+    def check(value: object) -> str | None:
+        if value is None and optional:
+            return None
+        if isinstance(value, str) and value in choices:
+            return value
+        hint = did_you_mean(value, choices) if isinstance(value, str) else ""
+        allowed = ", ".join(repr(c) for c in choices) + (" or None" if optional else "")
+        raise InvalidArgumentError(f"Expected {name} to be one of {allowed}, got {shown(value)}.{hint}")
+
+    return check
+
+
+def _record(value: object) -> str | os.PathLike[str] | None:
+    if value is None or (isinstance(value, (str, os.PathLike)) and str(value)):
+        return value  # type: ignore[return-value]
+    raise InvalidArgumentError(
+        f"Expected record to be a folder path (str or os.PathLike) or None, got {shown(value)}; "
+        f"pass e.g. record='movies'."
+    )
+
+
+def _flag(name: str) -> Callable[[object], bool]:
+    def check(value: object) -> bool:
+        if isinstance(value, (bool, np.bool_)):
+            return bool(value)
+        raise InvalidArgumentError(f"Expected {name} to be True or False, got {shown(value)}.")
+
+    return check
+
+
+def _core_options(value: object) -> dict[str, str] | None:
+    if value is None:
+        return None
+    if isinstance(value, Mapping) and all(isinstance(k, str) and isinstance(v, str) for k, v in value.items()):
+        return dict(value)
+    raise InvalidArgumentError(
+        f"Expected options to map core option names to values, both str, got {shown(value)}; "
+        f"pass e.g. options={{'genesis_plus_gx_region_detect': 'ntsc-u'}}."
+    )
+
+
+#: Every keyword option of RetroEnv, and how it is checked (tests check this matches RetroEnv).
+OPTIONS: dict[str, Callable[[Any], Any]] = {
+    "obs_type": _choice("obs_type", OBS_TYPES),
+    "action_type": _choice("action_type", ACTION_TYPES),
+    "frameskip": _frameskip,
+    "sticky_prob": _sticky_prob,
+    "max_episode_steps": _max_episode_steps,
+    "players": _players,
+    "render_mode": _choice("render_mode", RENDER_MODES, optional=True),
+    "record": _record,
+    "scenario_every_frame": _flag("scenario_every_frame"),
+    "skip_video": _flag("skip_video"),
+    "options": _core_options,
+}
+
+
+def check_options(options: Mapping[str, Any]) -> dict[str, Any]:
+    """Check and normalise RetroEnv's keyword options.
+
+    Raises:
+        UnknownNameError: A keyword is not an option (with the closest one).
+        InvalidArgumentError: A value has the wrong type or range.
+    """
+    checked = {}
+    for name, value in options.items():
+        check = OPTIONS.get(name)
+        if check is None:
+            raise UnknownNameError(
+                f"Expected a keyword option of retrokit.make ({', '.join(OPTIONS)}), got {name!r}."
+                + did_you_mean(name, OPTIONS)
+            )
+        checked[name] = check(value)
+    return checked
+
+
+def make_arguments(game: object, state: object, scenario: object, options: Mapping[str, Any]) -> dict[str, Any]:
+    """Check everything ``retrokit.make`` was given; return RetroEnv's keyword arguments.
+
+    Args:
+        game: The game's name, or a :class:`~retrokit.data.games.Game`.
+        state: A state name or ``.state`` path, a :class:`~retrokit.envs.env.State`, or ``None``.
+        scenario: A scenario name or path, a scenario dict, or ``None``.
+        options: The keyword options.
+
+    Raises:
+        UnknownNameError: A keyword is not an option.
+        InvalidArgumentError: An argument has the wrong type or range.
+    """
+    if not (isinstance(game, Game) or (isinstance(game, str) and game)):
+        raise InvalidArgumentError(
+            f"Expected game to be a game's name (str) or a Game, got {shown(game)}; pass e.g. 'Airstriker-Genesis' "
+            f"(`retrokit games` lists them)."
+        )
+    if not (state is None or isinstance(state, (str, os.PathLike, enum.Enum))):
+        raise InvalidArgumentError(
+            f"Expected state to be a state's name, a .state path, retrokit.State or None, got {shown(state)}."
+        )
+    if not (scenario is None or isinstance(scenario, (str, os.PathLike, Mapping))):
+        raise InvalidArgumentError(
+            f"Expected scenario to be a scenario's name, a .yaml or .json path, a dict or None, got {shown(scenario)}."
+        )
+    return {"game": game, "state": state, "scenario": scenario, **check_options(options)}
+
+
+def check_crop(crop: tuple[int, int, int, int] | None, screen: tuple[int, int]) -> None:
+    """Refuse a scenario's crop ``(x, y, width, height)`` that leaves nothing of a ``(height, width)`` screen.
+
+    A width or height of 0 reaches the screen's edge, as in Gym Retro, so only
+    a corner past the screen's right or bottom edge leaves nothing.
+    """
+    if crop is None:
+        return
+    x, y, _, _ = crop
+    height, width = screen
+    if x >= width or y >= height:
+        raise InvalidArgumentError(
+            f"Expected the scenario's crop [x, y, width, height] to keep part of the {width}x{height} screen, "
+            f"got {list(crop)}; fix 'crop' in the scenario (x below {width}, y below {height})."
+        )

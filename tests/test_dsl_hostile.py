@@ -1,0 +1,261 @@
+"""Hostile scenario inputs end as located retrokit errors, never as Python's own.
+
+Issue 13, faults 8 to 11: expressions too deep or too long for Python's
+compiler or stack, literals the generated code cannot hold (``1e999``, a
+5000-digit integer), files that are not UTF-8 or hold NUL bytes or YAML tags,
+and rewards that overflow to inf or NaN while running.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from retrokit.dsl.codegen import MAX_NESTING
+from retrokit.dsl.parser import MAX_DEPTH
+from retrokit.dsl.scenario import load_scenario
+from retrokit.errors import (
+    InvalidArgumentError,
+    ScenarioCompileError,
+    ScenarioError,
+    ScenarioRuntimeError,
+    ScenarioSyntaxError,
+)
+
+FIELDS = ["x", "lives"]
+
+
+def _nested(template: str, times: int, inner: str = "x") -> str:
+    for _ in range(times):
+        inner = template.format(inner)
+    return inner
+
+
+def _load(tmp_path: Path, data: bytes | str):
+    path = tmp_path / "s.yaml"
+    path.write_bytes(data if isinstance(data, bytes) else data.encode())
+    return path, load_scenario(path, FIELDS)
+
+
+def _step(scenario, x: int = 2) -> float:
+    run = scenario.start()
+    run.reset({"x": 1, "lives": 3})
+    return run.step({"x": x, "lives": 3}, 1, 1)[0][0]
+
+
+# --- fault 8: deep or long expressions ------------------------------------------------------
+
+TOO_DEEP = [
+    pytest.param(" + ".join(["x"] * 201), ScenarioSyntaxError, "nesting at most 100", id="sum_of_201_terms"),
+    pytest.param(_nested("abs({})", 300), ScenarioSyntaxError, "nesting at most 100", id="300_nested_abs"),
+    pytest.param("-" * 300 + "x", ScenarioSyntaxError, "nesting at most 100", id="300_unary_minus"),
+    pytest.param(_nested("clip(x, 0, {})", 99), ScenarioCompileError, "brackets deep", id="99_nested_clip"),
+    pytest.param(_nested("t[{}]", 99), ScenarioCompileError, "brackets deep", id="99_nested_lookups"),
+    pytest.param(_nested("min(x, {})", 10_000), ScenarioSyntaxError, "nesting at most 100", id="10000_nested_min"),
+]
+
+
+@pytest.mark.parametrize("expression,error,message", TOO_DEEP)
+def test_too_deep_expression_is_a_located_error(tmp_path, expression: str, error: type, message: str) -> None:
+    text = f"tables:\n  t: {{values: {{1: 2}}}}\nreward: {expression}\n"
+    with pytest.raises(error, match=message) as info:
+        _load(tmp_path, text)
+    assert info.value.file == str(tmp_path / "s.yaml") and info.value.line == 3  # type: ignore[attr-defined]
+    assert "define:" in str(info.value)  # says how to fix it
+
+
+@pytest.mark.parametrize(
+    "expression,value",
+    [
+        pytest.param(" + ".join(["x"] * MAX_DEPTH), 2.0 * MAX_DEPTH, id="sum_at_the_limit"),
+        pytest.param(_nested("abs({})", MAX_DEPTH - 1), 2.0, id="nested_abs_at_the_limit"),
+        pytest.param("(" * 150 + "x" + ")" * 150, 2.0, id="150_redundant_parentheses"),
+        pytest.param(_nested("(x if {} > 0 else 0)", 40), 2.0, id="40_nested_ifs"),
+    ],
+)
+def test_deep_expressions_within_the_limits_compile_and_run(tmp_path, expression: str, value: float) -> None:
+    _, scenario = _load(tmp_path, f"reward: {expression}\n")
+    assert _step(scenario) == value
+    assert MAX_NESTING < 200  # CPython's own limit on brackets
+
+
+@pytest.mark.parametrize("count", [200, 1000, 3000], ids=lambda c: f"{c}_definitions")
+@pytest.mark.parametrize("order", ["in_order", "reversed"])
+def test_long_chains_of_definitions_compile(tmp_path, count: int, order: str) -> None:
+    chain = ["  d0: x"] + [f"  d{i}: d{i - 1} + 1" for i in range(1, count)]
+    if order == "reversed":
+        chain.reverse()
+    _, scenario = _load(tmp_path, "define:\n" + "\n".join(chain) + f"\nreward: d{count - 1}\n")
+    assert _step(scenario) == 2 + count - 1
+
+
+def test_deep_analysis_leaves_the_recursion_limit_alone(tmp_path) -> None:
+    limit = sys.getrecursionlimit()
+    _load(tmp_path, f"reward: {_nested('abs({})', MAX_DEPTH - 1)}\n")
+    assert sys.getrecursionlimit() == limit
+
+
+# --- faults 9 and 10: literals and files the code cannot hold --------------------------------
+
+BAD_FILES = [
+    pytest.param(b"reward: 1e999 * x\n", ScenarioSyntaxError, (1, 9), "finite decimal", id="literal_1e999"),
+    pytest.param(b"reward: x + " + b"9" * 5000 + b"\n", ScenarioSyntaxError, (1, 13), "at most 64 bits", id="5000_digit_integer"),
+    pytest.param(b"reward: x + 0x1" + b"0" * 16 + b"\n", ScenarioSyntaxError, (1, 13), "at most 64 bits", id="65_bit_hex"),
+    pytest.param(b"reward: x\x00 + 1\n", ScenarioError, (1, 10), "control character", id="nul_byte"),
+    pytest.param(b"rew\x00ard: x\n", ScenarioError, (1, 4), "control character", id="nul_byte_in_key"),
+    pytest.param("reward: x  # café\n".encode("latin-1"), ScenarioError, (1, 17), "expected UTF-8", id="latin1_file"),
+    pytest.param("reward: x\n".encode("utf-16"), ScenarioError, (1, 1), "expected UTF-8", id="utf16_file"),
+    pytest.param(b"name: !!python/object:os.system x\nreward: x\n", ScenarioError, (1, 7), "tagged", id="python_tag"),
+    pytest.param(b"name: !!binary 'zz'\nreward: x\n", ScenarioError, (1, 7), "tagged", id="binary_tag"),
+    pytest.param(b"reward: !expr x\n", ScenarioError, (1, 9), "tagged", id="local_tag"),
+    pytest.param(b"crop: [" + b"9" * 5000 + b", 0, 1, 1]\nreward: x\n", ScenarioError, (1, 7), "cannot be read", id="5000_digit_crop"),
+    pytest.param(b"tables:\n  t:\n    values: {1: " + b"9" * 5000 + b"}\nreward: t[x]\n", ScenarioError, (3, 17), "cannot be read", id="5000_digit_table_value"),
+    pytest.param(b"tables:\n  t:\n    values: {1: 2}\n    default: .inf\nreward: t[x]\n", ScenarioError, (4, 14), "finite", id="infinite_table_default"),
+    pytest.param(b"tables:\n  t:\n    values: {1: .nan}\nreward: t[x]\n", ScenarioError, (3, 17), "finite", id="nan_table_value"),
+    pytest.param(b"tables:\n  t:\n    values: {1: 1e308 * 10}\nreward: t[x]\n", ScenarioError, (3, 17), "finite", id="overflowing_constant"),
+    pytest.param(b"tables:\n  t:\n    values: {1: 0x1_0000_0000_0000_0000}\nreward: t[x]\n", ScenarioError, (3, 17), "64 bits", id="65_bit_table_value"),
+    pytest.param(b"reward: " + b"[" * 5000 + b"\n", ScenarioError, (1, 1), "not valid YAML", id="5000_open_brackets"),
+]
+
+
+@pytest.mark.parametrize("data,error,place,message", BAD_FILES)
+def test_bad_file_is_a_located_scenario_error(tmp_path, data: bytes, error: type, place: tuple[int, int], message: str) -> None:
+    with pytest.raises(error, match=message) as info:
+        _load(tmp_path, data)
+    err = info.value
+    assert (err.file, err.line, err.column) == (str(tmp_path / "s.yaml"), *place)  # type: ignore[attr-defined]
+
+
+def _alias_bomb(key: str) -> str:
+    """Ten lines standing for 10**9 values: each list holds the one above it ten times."""
+    lines = ["      a0: &a0 [x, x, x, x, x, x, x, x, x, x]"]
+    lines += [f"      a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 10)}]" for i in range(1, 9)]
+    return "tables:\n  t:\n    values: {1: 2}\n    description:\n" + "\n".join(lines) + f"\n{key}: *a8\nreward: x\n"
+
+
+@pytest.mark.timeout(20)
+@pytest.mark.parametrize("key", ["actions", "crop", "rewards"])
+def test_an_alias_bomb_is_refused_quickly(tmp_path, key: str) -> None:
+    with pytest.raises(ScenarioError, match="at most 100000 YAML values"):
+        _load(tmp_path, _alias_bomb(key))
+
+
+def test_aliases_that_repeat_a_little_are_fine(tmp_path) -> None:
+    _, scenario = _load(tmp_path, "rewards:\n  - &r delta(x)\n  - *r\n")
+    assert scenario.players == 2
+
+
+@pytest.mark.parametrize("suffix", [".yaml", ".json"])
+def test_a_huge_scenario_file_is_refused_before_it_is_read(tmp_path, suffix: str) -> None:
+    path = tmp_path / f"huge{suffix}"
+    with path.open("wb") as file:
+        file.truncate(64 * 2**20)  # 64 MiB of NULs, sparse
+    with pytest.raises(ScenarioError, match="at most 4 MiB"):
+        load_scenario(path, FIELDS)
+
+
+def test_an_included_file_that_is_not_utf8_is_located(tmp_path) -> None:
+    (tmp_path / "inc.yaml").write_bytes("define:\n  a: x  # é\n".encode("latin-1"))
+    with pytest.raises(ScenarioError, match="expected UTF-8") as info:
+        _load(tmp_path, "include: [inc.yaml]\nreward: a\n")
+    assert info.value.file == str(tmp_path / "inc.yaml") and info.value.line == 2  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize(
+    "data,message",
+    [
+        pytest.param("{\"reward\": {}} \xe9".encode("latin-1"), "expected UTF-8", id="latin1_json"),
+        pytest.param(b'{"reward": ' + b"9" * 5000 + b"}", "cannot be read", id="5000_digit_json"),
+    ],
+)
+def test_bad_json_scenario_is_a_scenario_error(tmp_path, data: bytes, message: str) -> None:
+    path = tmp_path / "scenario.json"
+    path.write_bytes(data)
+    with pytest.raises(ScenarioError, match=message):
+        load_scenario(path, FIELDS)
+
+
+# --- fault 11: rewards that are not finite numbers ---------------------------------------------
+
+NON_FINITE = [
+    pytest.param("x * 1e308 * 1e308", "got inf", id="overflow_to_inf"),
+    pytest.param("-x * 1e308 * 1e308", "got -inf", id="overflow_to_minus_inf"),
+    pytest.param("x / (x * 1e308 * 1e308 - x * 1e308 * 1e308)", "got nan", id="nan_divisor"),
+]
+
+
+@pytest.mark.parametrize("expression,message", NON_FINITE)
+def test_non_finite_reward_is_a_located_runtime_error(tmp_path, expression: str, message: str) -> None:
+    _, scenario = _load(tmp_path, f"rewards:\n  - x\n  - {expression}\n")
+    with pytest.raises(ScenarioRuntimeError, match=message) as info:
+        _step(scenario)
+    err = info.value
+    assert (err.line, err.column) == (3, 5)  # type: ignore[attr-defined]
+    assert "reward of player 2" in str(err) and "^^^" in str(err)
+
+
+def test_non_finite_check_also_guards_the_first_step(tmp_path) -> None:
+    _, scenario = _load(tmp_path, "reward: x * 1e308 * 1e308\n")
+    with pytest.raises(ScenarioRuntimeError, match="finite"):
+        scenario.start().reset({"x": 1, "lives": 3})
+
+
+def test_large_finite_rewards_pass(tmp_path) -> None:
+    _, scenario = _load(tmp_path, "reward: x * 1e307\n")
+    assert _step(scenario) == 2e307
+
+
+@pytest.mark.parametrize(
+    "variable,message",
+    [
+        pytest.param({"reward": "abc"}, "reward to be a finite number, got 'abc'", id="string_reward"),
+        pytest.param({"penalty": [1]}, "penalty to be a finite number", id="list_penalty"),
+        pytest.param({"reward": 1, "op": "equal", "reference": "x"}, "reference to be an integer", id="string_reference"),
+        pytest.param({"reward": True}, "finite number, got True", id="bool_reward"),
+    ],
+)
+def test_json_variable_with_a_wrong_number_is_located(tmp_path, variable: dict, message: str) -> None:
+    path = tmp_path / "scenario.json"
+    path.write_text(json.dumps({"reward": {"variables": {"x": variable}}}, indent=2))
+    with pytest.raises(ScenarioError, match=message) as info:
+        load_scenario(path, FIELDS)
+    assert info.value.file == str(path)  # type: ignore[attr-defined]
+
+
+def test_json_time_reward_that_is_no_number_is_refused() -> None:
+    with pytest.raises(ScenarioError, match="reward to be a finite number"):
+        load_scenario({"reward": {"time": {"reward": "z"}}}, FIELDS)
+
+
+@pytest.mark.parametrize(
+    "data,message",
+    [
+        pytest.param({"reward": object()}, "expected plain values", id="object"),
+        pytest.param({"reward": {1, 2}}, "tagged", id="set"),
+        pytest.param({"reward": b"x"}, "tagged", id="bytes"),
+    ],
+)
+def test_a_dict_scenario_with_values_yaml_cannot_hold_is_a_scenario_error(data: dict, message: str) -> None:
+    with pytest.raises(ScenarioError, match=message):
+        load_scenario(data, FIELDS)
+
+
+@pytest.mark.parametrize("source", [5, None, ["reward: x"]], ids=["int", "none", "list"])
+def test_a_scenario_source_that_is_no_path_or_dict_is_refused(source: object) -> None:
+    with pytest.raises(InvalidArgumentError, match="Expected a scenario file's path or a scenario dict"):
+        load_scenario(source, FIELDS)  # type: ignore[arg-type]
+
+
+def test_a_dict_scenario_takes_numpy_values() -> None:
+    scenario = load_scenario({"reward": "x", "crop": np.array([0, 0, 32, 16]), "tables": {"t": {"values": {1: np.int64(2)}}}}, FIELDS)
+    assert scenario.crop == (0, 0, 32, 16)
+
+
+def test_json_scenario_written_as_dict_with_nan_multiplier_is_refused() -> None:
+    data = {"reward": {"variables": {"x": {"reward": float("nan")}}}}
+    with pytest.raises(ScenarioError):
+        load_scenario(json.loads(json.dumps(data)), FIELDS)

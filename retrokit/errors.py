@@ -178,3 +178,14 @@ class AgentError(RetrokitError, RuntimeError):
 
 class BackendUnavailableError(RetrokitError, ImportError):
     """An evaluation backend (Ray) is not installed, or its cluster cannot be reached."""
+
+
+# --- RAM search ----------------------------------------------------------------------------------
+
+
+class RamSearchError(RetrokitError, ValueError):
+    """A RAM search was asked for something its snapshots or history cannot give."""
+
+
+class SessionError(RamSearchError):
+    """A RAM search session file is missing, corrupt, not a session, or from another game."""

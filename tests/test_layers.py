@@ -11,7 +11,7 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parent.parent / "retrokit"
 # Each layer may import itself and the layers after it, never one before it.
-LAYERS = ["commands", "testing", "envs", "movie", "dsl", "data", "host"]
+LAYERS = ["commands", "testing", "ramsearch", "envs", "movie", "dsl", "data", "host"]
 
 
 def imported_modules(path: Path) -> set[str]:

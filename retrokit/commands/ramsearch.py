@@ -1,0 +1,351 @@
+"""``retrokit ramsearch``: find a game's variables in RAM, one command a process, and save them to its game.yaml.
+
+A search lives in a session file (``ramsearch.session`` in the current
+folder unless ``--session`` names another): each subcommand reads it, does one
+thing and writes it back. See ``docs/ramsearch.md``::
+
+    retrokit ramsearch new GAME [--state STATE] [--session FILE]
+    retrokit ramsearch run [--press BUTTON ...] [--frames N] [--movie FILE.bk2 [--until FRAME]] [--session FILE]
+    retrokit ramsearch filter OP [VALUE] [--than previous|first] [--session FILE]
+    retrokit ramsearch show [--limit N] [--json] [--session FILE]
+    retrokit ramsearch undo | redo [--session FILE]
+    retrokit ramsearch poke ADDRESS VALUE [--type TYPE] [--session FILE]
+    retrokit ramsearch screenshot FILE.png [--session FILE]
+    retrokit ramsearch save NAME ADDRESS TYPE [--game-file PATH] [--session FILE]
+    retrokit ramsearch shell [--session FILE]       # the others typed at a prompt, one a line
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import TYPE_CHECKING
+
+from retrokit.errors import InvalidArgumentError
+
+if TYPE_CHECKING:
+    from retrokit.ramsearch import Candidate, RamSearch
+
+_SESSION_HELP = "the session file (default: ramsearch.session in the current folder)"
+_VALUES_SHOWN = 8  # snapshots whose values `show` prints; older ones are elided
+MAX_LISTED = 100_000  # `show` lists no more: each row is decoded at every snapshot in Python
+
+
+def register(subparsers: argparse._SubParsersAction) -> None:
+    """Add the ``ramsearch`` command and its subcommands."""
+    from retrokit.ramsearch.filters import OPS
+
+    parser = subparsers.add_parser(
+        "ramsearch",
+        help="find a game's variables in RAM (snapshots, filters, undo) and save them into its game.yaml",
+        description="A RAM search in the spirit of BizHawk's RAM Search and Gym Retro's integration tool. Start "
+        "with 'new', move the game with 'run', narrow the candidates with 'filter', look with 'show', and write "
+        "a find into the game's game.yaml with 'save'. The search is kept in a session file between commands.",
+    )
+    commands = parser.add_subparsers(title="subcommands", metavar="SUBCOMMAND")
+
+    def sub(name: str, help_text: str, run) -> argparse.ArgumentParser:
+        p = commands.add_parser(name, help=help_text, description=help_text[0].upper() + help_text[1:] + ".")
+        p.add_argument("--session", metavar="FILE", default=None, help=_SESSION_HELP)
+        p.set_defaults(run=run)
+        return p
+
+    p = sub("new", "start a search from a save state: the first snapshot, every type at every address", _new)
+    p.add_argument("game", metavar="GAME", help="the game, e.g. Dasher-Genesis")
+    p.add_argument("--state", help="the save state to start from (default: the game's default state)")
+    p.add_argument(
+        "--types", metavar="CODES", help="comma-separated type codes to search (default: every type Gym Retro infers)"
+    )
+    p.add_argument("--force", action="store_true", help="replace an existing session file")
+
+    p = sub("run", "move the game on (hold buttons, or play a movie), then take a snapshot", _run)
+    p.add_argument(
+        "--press",
+        nargs="+",
+        default=[],
+        metavar="BUTTON",
+        help="buttons to hold, by the game's names (RIGHT, B; 2:START for port 2)",
+    )
+    p.add_argument("--frames", metavar="N", help="frames to run (default: 1)")
+    p.add_argument("--movie", metavar="FILE.bk2", help="play this movie from its start instead")
+    p.add_argument("--until", metavar="FRAME", help="stop the movie after this many frames (default: its end)")
+    p.add_argument("--state", help="load this save state first")
+
+    p = sub("filter", "keep the candidates whose newest value passes a comparison", _filter)
+    p.add_argument("op", metavar="OP", help=", ".join(OPS))
+    p.add_argument(
+        "value", nargs="?", metavar="VALUE", help="the number to compare with (for changed-by: the difference)"
+    )
+    p.add_argument(
+        "--than",
+        metavar="previous|first",
+        help="compare with the previous (default) or first snapshot, the value at an ADDRESS, or, with 'changes', the change count with VALUE",
+    )
+
+    p = sub("show", "list the candidates: address, type, scale, change count, value at each snapshot", _show)
+    p.add_argument("--limit", default="20", metavar="N", help="list at most N (default: 20; 0: all)")
+    p.add_argument("--json", action="store_true", help='print a JSON list of {"address", "type", "values"}')
+
+    sub("undo", "undo the last filter", _undo)
+    sub("redo", "apply the last undone filter again", _redo)
+    sub("shell", "read subcommands from a prompt (or standard input), one a line, until 'quit'", _shell)
+
+    p = sub("poke", "write a value into RAM, to test a guess", _poke)
+    p.add_argument("address", metavar="ADDRESS", help="the console address, e.g. 0xFF002B")
+    p.add_argument("value", metavar="VALUE", help="the value")
+    p.add_argument("--type", default="|u1", help="its type code (default: |u1)")
+
+    p = sub("screenshot", "save the screen (the next frame, so pokes show) as a PNG", _screenshot)
+    p.add_argument("file", metavar="FILE.png")
+    p.add_argument("--overwrite", action="store_true", help="replace an existing file")
+
+    p = sub("save", "write a field into the game's game.yaml, keeping its comments and layout", _save)
+    p.add_argument("name", metavar="NAME", help="the field's name, e.g. lives")
+    p.add_argument("address", metavar="ADDRESS", help="its console address, e.g. 0xFF002B")
+    p.add_argument("type", metavar="TYPE", help="its type code, e.g. '|u1'")
+    p.add_argument("--game-file", metavar="PATH", help="the game.yaml to write (default: the game's own)")
+    p.add_argument("--force", action="store_true", help="replace a field of the same name")
+    parser.set_defaults(run=run)
+
+
+SUBCOMMANDS = ("new", "run", "filter", "show", "undo", "redo", "poke", "screenshot", "save", "shell")
+
+
+def run(args: argparse.Namespace) -> int:
+    """``retrokit ramsearch`` without a subcommand: say which there are."""
+    raise InvalidArgumentError(
+        f"Expected a subcommand of ramsearch: {', '.join(SUBCOMMANDS)}; got none. See: retrokit ramsearch --help"
+    )
+
+
+# --- helpers --------------------------------------------------------------------------------------
+
+
+def _number(text: str | None, what: str) -> int | None:
+    if text is None:
+        return None
+    try:
+        return int(text, 0)
+    except ValueError:
+        raise InvalidArgumentError(
+            f"Expected {what} as a whole number (decimal, or hex as 0xFF002B), got {text!r}."
+        ) from None
+
+
+def _session(args: argparse.Namespace) -> str:
+    from retrokit.ramsearch import DEFAULT_SESSION
+
+    return args.session or DEFAULT_SESSION
+
+
+def _open(args: argparse.Namespace) -> RamSearch:
+    from retrokit.ramsearch import RamSearch
+
+    return RamSearch.load(_session(args))
+
+
+# --- subcommands ----------------------------------------------------------------------------------
+
+
+def _new(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from retrokit.data.games import find_game
+    from retrokit.errors import FileConflictError, SessionError
+    from retrokit.ramsearch import RamSearch
+    from retrokit.ramsearch.session import read_session
+
+    path = Path(_session(args))
+    game = find_game(args.game)
+    if path.exists() and not args.force:
+        try:
+            old = read_session(path)
+        except SessionError:
+            raise FileConflictError(
+                f"Expected no file at {path}; found one that is not a session. Pass --session OTHER, or --force to replace it."
+            ) from None
+        if old.game != game.name:
+            raise SessionError(
+                f"Expected {path} to be free or a session of {game.name}; found a session of another game, {old.game}. "
+                f"Pass --session OTHER for {game.name}, or --force to replace it."
+            )
+        raise FileConflictError(
+            f"Expected no session at {path}; found one of {old.game} with {len(old.labels)} snapshot(s). "
+            "Pass --force to start over, or --session OTHER."
+        )
+    with RamSearch(game, args.state, types=args.types) as search:
+        search.save(path, overwrite=args.force)
+        print(
+            f"New search of {game.name} from {search.state or 'power-on'}: {search.count:,} candidates "
+            f"({len(search.types)} types at every address of {search.layout.describe()}). Session: {path}"
+        )
+    return 0
+
+
+def _run(args: argparse.Namespace) -> int:
+    frames, until = _number(args.frames, "--frames"), _number(args.until, "--until")
+    if args.movie is None and until is not None:
+        raise InvalidArgumentError("Expected --until with --movie FILE.bk2; got --until alone.")
+    if args.movie is not None and (args.press or frames is not None or args.state):
+        raise InvalidArgumentError("Expected either --movie (with --until) or --press/--frames/--state, not both.")
+    with _open(args) as search:
+        if args.movie is not None:
+            index = search.play(args.movie, until)
+        else:
+            index = search.run(args.press, 1 if frames is None else frames, state=args.state)
+        search.save(_session(args))
+        print(f"Snapshot {index + 1}: {search.labels[index]}.")
+    return 0
+
+
+def _filter(args: argparse.Namespace) -> int:
+    than = args.than
+    if than is not None and than not in ("previous", "first", "changes"):
+        try:
+            than = int(than, 0)
+        except ValueError:
+            pass  # the engine names what --than takes, and the closest one
+    with _open(args) as search:
+        before = search.count
+        after = search.filter(args.op, _number(args.value, "VALUE"), than)
+        search.save(_session(args))
+        print(f"{search.history[-1]}: {before:,} -> {after:,} candidates.")
+    return 0
+
+
+def _rows(search: RamSearch, groups: list[list[Candidate]]) -> list[list[str]]:
+    """One row per group of candidates that read the same bytes the same way (the narrowest type first)."""
+    first = max(0, len(search.labels) - _VALUES_SHOWN)
+    rows = []
+    for group in groups:
+        head = group[0]
+        shown = ("... " if first else "") + " ".join(str(v) for v in head.values[first:])
+        others = [
+            c.type if c.address == head.address else f"{c.type}@{search.layout.format(c.address)}" for c in group[1:]
+        ]
+        also = f"  (also {' '.join(others)})" if others else ""
+        rows.append([search.layout.format(head.address), head.type, head.scale or "-", str(head.changes), shown + also])
+    return rows
+
+
+def _show(args: argparse.Namespace) -> int:
+    from retrokit.ramsearch import group_candidates
+
+    limit = _number(args.limit, "--limit")
+    if limit is None or limit < 0:
+        raise InvalidArgumentError(f"Expected --limit of 0 (all) or more, got {args.limit!r}.")
+    with _open(args) as search:
+        if (not limit or limit > MAX_LISTED) and search.count > MAX_LISTED:
+            raise InvalidArgumentError(
+                f"Expected at most {MAX_LISTED:,} candidates to list; found {search.count:,}. "
+                "Filter them first, or pass --limit N."
+            )
+        if args.json:
+            candidates = search.candidates(limit or None)
+            print(json.dumps([{"address": c.address, "type": c.type, "values": list(c.values)} for c in candidates]))
+            return 0
+        total = search.count
+        # A group holds at most one candidate per type and start address around its low byte.
+        fetched = search.candidates(limit * len(search.types) * 8 if limit else None)
+        groups = group_candidates(fetched)
+        if limit and len(fetched) < total:
+            groups = groups[:limit]  # the last groups may be cut short, and are not listed
+        shown = groups[:limit] if limit else groups
+        complete = len(fetched) == total
+        print(
+            f"{total:,} candidate{'s' * (total != 1)}"
+            + (
+                f" in {len(groups):,} group{'s' * (len(groups) != 1)} (types reading the same bytes alike)"
+                if complete
+                else ""
+            )
+            + (f"; the first {len(shown)} by address:" if len(shown) < len(groups) or not complete else ":")
+        )
+        if not shown:
+            return 0
+        first = max(0, len(search.labels) - _VALUES_SHOWN)
+        header = ["address", "type", "scale", "changes", f"values at snapshots {first + 1}-{len(search.labels)}"]
+        rows = [header, *_rows(search, shown)]
+        widths = [max(len(r[i]) for r in rows) for i in range(4)]
+        for row in rows:
+            print("  ".join(cell.ljust(width) for cell, width in zip(row[:4], widths)) + "  " + row[4])
+        print("snapshots: " + "; ".join(f"{i + 1} {label}" for i, label in enumerate(search.labels) if i >= first))
+    return 0
+
+
+def _undo(args: argparse.Namespace) -> int:
+    return _step_history(args, redo=False)
+
+
+def _redo(args: argparse.Namespace) -> int:
+    return _step_history(args, redo=True)
+
+
+def _step_history(args: argparse.Namespace, *, redo: bool) -> int:
+    with _open(args) as search:
+        before = search.count
+        label = search.redo() if redo else search.undo()
+        search.save(_session(args))
+        print(f"{'Redid' if redo else 'Undid'} {label}: {before:,} -> {search.count:,} candidates.")
+    return 0
+
+
+def _poke(args: argparse.Namespace) -> int:
+    address, value = _number(args.address, "ADDRESS"), _number(args.value, "VALUE")
+    with _open(args) as search:
+        search.poke(address, value, args.type)
+        search.save(_session(args))
+        print(f"Wrote {value} as {args.type} at {search.layout.format(address)}; the next run starts from it.")
+    return 0
+
+
+def _screenshot(args: argparse.Namespace) -> int:
+    with _open(args) as search:
+        path = search.screenshot(args.file, overwrite=args.overwrite)
+        height, width = search.emulator.screen_shape()
+        print(f"Saved the screen ({width}x{height}) to {path}.")
+    return 0
+
+
+def _shell(args: argparse.Namespace) -> int:
+    """Run subcommands typed one a line (``filter equal 3``), each as its own command, on one session."""
+    import shlex
+    import sys
+
+    from retrokit.cli import build_parser
+    from retrokit.errors import RetrokitError
+
+    parser, interactive = build_parser(), sys.stdin.isatty()
+    session = ["--session", args.session] if args.session else []
+    while True:
+        try:
+            line = input("ramsearch> " if interactive else "")
+        except EOFError:
+            return 0
+        try:
+            words = shlex.split(line)
+        except ValueError as exc:
+            print(f"retrokit: error: Expected a line of words, as a shell splits them; found {exc}.", file=sys.stderr)
+            continue
+        if not words or words[0].startswith("#"):
+            continue
+        if words[0] in ("quit", "exit"):
+            return 0
+        if words[0] == "shell":
+            print("retrokit: error: Expected a subcommand other than shell inside the shell.", file=sys.stderr)
+            continue
+        try:
+            parsed = parser.parse_args(["ramsearch", *words, *session])
+            parsed.run(parsed)
+        except SystemExit:  # argparse printed its usage error or help
+            continue
+        except RetrokitError as exc:
+            print(f"retrokit: error: {exc}", file=sys.stderr)
+
+
+def _save(args: argparse.Namespace) -> int:
+    address = _number(args.address, "ADDRESS")
+    with _open(args) as search:
+        path = search.save_field(args.name, address, args.type, game_file=args.game_file, force=args.force)
+        print(f"Wrote field {args.name} ({search.layout.format(address)}, {args.type}) into {path}.")
+    return 0

@@ -1,0 +1,109 @@
+"""Filters: what a RAM search compares each candidate with, and how.
+
+Filters follow BizHawk's RAM Search: compare each candidate's value in the
+newest snapshot with a number, with its value in the previous or the first
+snapshot, or with the value at another address, by ``equal``,
+``not-equal``, ``less``, ``greater``, ``less-equal``, ``greater-equal``,
+``changed-by N``, ``increased``, ``decreased``, ``changed`` or
+``unchanged``; or compare its change count (snapshots at which its value
+differed from the one before) with a number. :func:`check_filter` checks the
+parts fit together; :mod:`retrokit.ramsearch.engine` runs them.
+"""
+
+from __future__ import annotations
+
+import operator
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from retrokit.errors import InvalidArgumentError, did_you_mean
+from retrokit.ramsearch.ram import RamLayout
+
+COMPARISONS: dict[str, Callable[[np.ndarray, object], np.ndarray]] = {
+    "equal": operator.eq,
+    "not-equal": operator.ne,
+    "less": operator.lt,
+    "greater": operator.gt,
+    "less-equal": operator.le,
+    "greater-equal": operator.ge,
+}
+#: The operations that compare with a snapshot, and the comparison each is.
+CHANGES = {"increased": "greater", "decreased": "less", "changed": "not-equal", "unchanged": "equal"}
+OPS = (*COMPARISONS, "changed-by", *CHANGES)
+REFERENCES = ("previous", "first", "changes")
+
+
+@dataclass(frozen=True)
+class Filter:
+    """One filter: an operation, an optional number, and what to compare with.
+
+    Attributes:
+        op: One of :data:`OPS`.
+        value: The number compared with (for ``changed-by``, the difference).
+        than: ``"previous"``, ``"first"``, ``"changes"`` or a console address;
+            ``None`` with a number means the number itself.
+    """
+
+    op: str
+    value: int | None = None
+    than: str | int | None = None
+
+    def describe(self, layout: RamLayout | None = None) -> str:
+        """The filter as the command line writes it."""
+        words = [self.op] + ([] if self.value is None else [str(self.value)])
+        if self.than is not None:
+            than = layout.format(self.than) if layout is not None and isinstance(self.than, int) else str(self.than)
+            words.append(f"--than {than}")
+        return " ".join(words)
+
+
+def _is_int(value: object) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+
+
+def check_filter(op: str, value: int | None = None, than: str | int | None = None) -> Filter:
+    """Check a filter's parts fit together and fill in the default reference.
+
+    Raises:
+        InvalidArgumentError: Unknown operation or reference, or a missing or extra number.
+    """
+    for what, number in (("number", value), ("address", than)):
+        if number is not None and not isinstance(number, str) and not _is_int(number):
+            raise InvalidArgumentError(f"Expected a whole number as the filter's {what}, got {number!r}.")
+    value = None if value is None else int(value)  # numpy integers become plain ones
+    than = int(than) if _is_int(than) else than
+    if op not in OPS:
+        raise InvalidArgumentError(
+            f"Expected a filter operation ({', '.join(OPS)}), got {op!r}." + did_you_mean(op, OPS)
+        )
+    if isinstance(than, str) and than not in REFERENCES:
+        raise InvalidArgumentError(
+            f"Expected --than previous, first, changes or a console address, got {than!r}."
+            + did_you_mean(than, REFERENCES)
+        )
+    if op in CHANGES:
+        if value is not None:
+            raise InvalidArgumentError(
+                f"Expected no number after {op!r}, got {value}. For a difference, use: changed-by N."
+            )
+        if than == "changes":
+            raise InvalidArgumentError(f"Expected --than previous, first or an address for {op!r}, got 'changes'.")
+        return Filter(op, None, "previous" if than is None else than)
+    if op == "changed-by":
+        if value is None:
+            raise InvalidArgumentError("Expected a number after 'changed-by' (the difference, e.g. -1), got none.")
+        if than == "changes":
+            raise InvalidArgumentError("Expected --than previous, first or an address for 'changed-by', got 'changes'.")
+        return Filter(op, value, "previous" if than is None else than)
+    if value is None:
+        if than == "changes":
+            raise InvalidArgumentError(f"Expected a number to compare change counts with: {op} N --than changes.")
+        return Filter(op, None, "previous" if than is None else than)
+    if than is not None and than != "changes":
+        raise InvalidArgumentError(
+            f"Expected a number or --than {than}, not both: '{op} {value}' compares with the number, "
+            f"'{op} --than {than}' with the snapshot. For a difference, use: changed-by {value} --than {than}."
+        )
+    return Filter(op, value, than)

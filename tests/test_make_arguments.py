@@ -232,3 +232,23 @@ def test_sonic_level_id_reaches_the_preset() -> None:
     # No Sonic ROM on test machines: the preset's own message about importing it shows the id was resolved.
     with pytest.raises(RomNotFoundError, match="SonicTheHedgehog-Genesis"):
         gymnasium.make("retrokit/SonicTheHedgehog-GreenHillZone.Act1-v0")
+
+
+@pytest.mark.parametrize(
+    ("keyword", "value"),
+    [("frameskip", 2**31), ("sticky_prob", float("nan")), ("obs_type", "rbg"), ("scenario_every_frame", "yes")],
+    ids=["frameskip-too-big", "sticky-nan", "obs-type-typo", "flag-not-bool"],
+)
+def test_a_retroenv_made_directly_follows_makes_rules(keyword: str, value: object) -> None:
+    from retrokit.envs.env import RetroEnv
+
+    with pytest.raises(InvalidArgumentError, match=keyword):
+        RetroEnv(AIRSTRIKER, **{keyword: value})
+
+
+def test_a_retroenv_made_directly_takes_numpy_integers() -> None:
+    from retrokit.envs.env import RetroEnv
+
+    env = RetroEnv(AIRSTRIKER, frameskip=np.int64(4))
+    assert env.frameskip == 4 and type(env.frameskip) is int
+    env.close()

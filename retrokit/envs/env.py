@@ -24,14 +24,12 @@ from retrokit.data.statecheck import load_state
 from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
 from retrokit.envs.compat import StableRetroCompat
-from retrokit.envs.options import check_crop, make_arguments
+from retrokit.envs.options import check_crop, check_options, make_arguments
 from retrokit.envs.stepper import Stepper, drive
-from retrokit.errors import InvalidArgumentError, did_you_mean
+from retrokit.errors import InvalidArgumentError
 from retrokit.host.emulator import Emulator
 from retrokit.host.memory import FieldReader
 from retrokit.movie.recorder import EpisodeMovies
-
-OBS_TYPES = ("rgb", "ram")
 
 
 class State(enum.Enum):
@@ -86,16 +84,19 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
         options: Mapping[str, str] | None = None,
         skip_video: bool = True,
     ) -> None:
+        checked = check_options(
+            {
+                "obs_type": obs_type, "action_type": action_type, "frameskip": frameskip, "sticky_prob": sticky_prob,
+                "max_episode_steps": max_episode_steps, "players": players, "render_mode": render_mode,
+                "record": record, "scenario_every_frame": scenario_every_frame, "options": options,
+                "skip_video": skip_video,
+            }
+        )  # the same rules as retrokit.make's, whichever way the env is made
+        frameskip, sticky_prob, players = checked["frameskip"], checked["sticky_prob"], checked["players"]
+        max_episode_steps, scenario_every_frame = checked["max_episode_steps"], checked["scenario_every_frame"]
+        skip_video, options = checked["skip_video"], checked["options"]
         self.game: Game = game if isinstance(game, Game) else find_game(game)
-        _check_choice("obs_type", obs_type, OBS_TYPES)
-        _check_choice("render_mode", render_mode, (None, *self.metadata["render_modes"]))
-        if not isinstance(frameskip, int) or frameskip < 1:
-            raise InvalidArgumentError(f"Expected frameskip to be a whole number of 1 or more, got {frameskip!r}.")
-        if not 0.0 <= sticky_prob <= 1.0:
-            raise InvalidArgumentError(f"Expected sticky_prob in [0, 1], got {sticky_prob!r}.")
-        if max_episode_steps is not None and max_episode_steps < 1:
-            raise InvalidArgumentError(f"Expected max_episode_steps of 1 or more (or None), got {max_episode_steps!r}.")
-        if not 1 <= players <= max(self.game.players, 1):
+        if players > max(self.game.players, 1):
             raise InvalidArgumentError(
                 f"Expected 1 to {self.game.players} players for {self.game.name}, got {players}."
             )
@@ -301,14 +302,6 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
             self._viewer = None
         if hasattr(self, "emulator"):
             self.emulator.close()
-
-
-def _check_choice(name: str, value: object, choices: tuple[object, ...]) -> None:
-    if value not in choices:
-        raise InvalidArgumentError(
-            f"Expected {name} to be one of {choices}, got {value!r}."
-            + (did_you_mean(value, [c for c in choices if isinstance(c, str)]) if isinstance(value, str) else "")
-        )
 
 
 def make(

@@ -135,20 +135,29 @@ def check_options(options: Mapping[str, Any]) -> dict[str, Any]:
         UnknownNameError: A keyword is not an option (with the closest one).
         InvalidArgumentError: A value has the wrong type or range.
     """
-    checked = {}
-    for name, value in options.items():
-        check = OPTIONS.get(name)
-        if check is None:
+    check_names(options)
+    return {name: OPTIONS[name](value) for name, value in options.items()}
+
+
+def check_names(options: Mapping[str, Any]) -> None:
+    """Refuse a keyword that is no option of RetroEnv, with the closest one.
+
+    Raises:
+        UnknownNameError: A keyword is not an option.
+    """
+    for name in options:
+        if name not in OPTIONS:
             raise UnknownNameError(
                 f"Expected a keyword option of retrokit.make ({', '.join(OPTIONS)}), got {name!r}."
                 + did_you_mean(name, OPTIONS)
             )
-        checked[name] = check(value)
-    return checked
 
 
 def make_arguments(game: object, state: object, scenario: object, options: Mapping[str, Any]) -> dict[str, Any]:
-    """Check everything ``retrokit.make`` was given; return RetroEnv's keyword arguments.
+    """Check what ``retrokit.make`` was given before RetroEnv takes it; return RetroEnv's keyword arguments.
+
+    The options' values are checked by RetroEnv itself (:func:`check_options`),
+    so that an env made directly follows the same rules; here only their names.
 
     Args:
         game: The game's name, or a :class:`~retrokit.data.games.Game`.
@@ -173,7 +182,8 @@ def make_arguments(game: object, state: object, scenario: object, options: Mappi
         raise InvalidArgumentError(
             f"Expected scenario to be a scenario's name, a .yaml or .json path, a dict or None, got {shown(scenario)}."
         )
-    return {"game": game, "state": state, "scenario": scenario, **check_options(options)}
+    check_names(options)
+    return {"game": game, "state": state, "scenario": scenario, **options}
 
 
 def check_crop(crop: tuple[int, int, int, int] | None, screen: tuple[int, int]) -> None:

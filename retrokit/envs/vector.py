@@ -4,10 +4,12 @@ For retrokit's own envs a step is one native call: one native thread per CPU
 (the calling one included) takes the emulators one at a time, runs their
 frames and converts each screen straight into the batch, with the GIL
 released throughout; Python only reads the fields and evaluates the
-scenarios around it. More envs than CPUs share the threads, so they never
-crowd the machine. Other envs (wrapped ones, or ones that evaluate their
-scenario every frame) are stepped on as many Python threads, which also
-overlap because the host releases the GIL while frames run.
+scenarios around it; envs that evaluate their scenario every frame take one
+such call per frame (``envs/stepper.py``'s ``drive`` is the loop). More envs
+than CPUs share the threads, so they never crowd the machine. Other envs
+(wrapped ones, or plain ones with different frame skips) are stepped on
+Python threads, which also overlap because the host releases the GIL while
+frames run.
 
 It follows ``gymnasium.vector.VectorEnv`` with next-step autoreset, like
 Gymnasium's own vector envs: the step after an episode ends resets that env

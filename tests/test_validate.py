@@ -92,13 +92,14 @@ def test_the_ram_read_from_a_state_file_is_the_ram_the_core_loads(game: str, sta
     import numpy as np
 
     from retrokit.data.games import find_game
+    from retrokit.data.statecheck import vet_state
     from retrokit.data.states import read_state, state_ram
     from retrokit.host.emulator import Emulator
 
     found = find_game(game)
     data = read_state(found.state_path(state))
     with Emulator(found.system, found.require_rom()) as emu:
-        emu.set_state(data)
+        emu.set_state(vet_state(data, found.system, found.require_rom(), shipped=found.state_path(state)))
         assert state_ram(data, "Genesis") == bytes(np.asarray(emu.ram))
     assert state_ram(data, "Snes") is None and state_ram(b"GENPLUS-GX 1.7.5" + bytes(100), "Genesis") is None
 

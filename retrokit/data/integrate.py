@@ -36,7 +36,7 @@ import numpy as np
 
 from retrokit import paths
 from retrokit.data.games import Game, cached_rom_sha1, find_game, list_games, load_game, normalize_name
-from retrokit.data.statecheck import load_state
+from retrokit.data.statecheck import check_state, load_state, remember_written
 from retrokit.data.states import StateRecord, write_state
 from retrokit.errors import (
     DataFileError,
@@ -48,7 +48,7 @@ from retrokit.errors import (
     UnknownNameError,
     did_you_mean,
 )
-from retrokit.host.emulator import Emulator
+from retrokit.host.emulator import Emulator, VettedState
 from retrokit.host.memory import FieldReader
 
 HOLD_FRAMES = 2  # a press is held this long, then released as long, until arrival
@@ -187,7 +187,7 @@ def _count(where: str, key: str, value: Any, least: int) -> int:
     return number
 
 
-def make_state(game: Game, recipe: Recipe) -> bytes:
+def make_state(game: Game, recipe: Recipe) -> VettedState:
     """Play a recipe from power-on and return the state it reaches.
 
     Raises:
@@ -216,7 +216,7 @@ def make_state(game: Game, recipe: Recipe) -> bytes:
         )
 
 
-def fingerprint(game: Game, state: bytes) -> str:
+def fingerprint(game: Game, state: VettedState) -> str:
     """A digest of where a state leads: RAM and screen after some idle frames."""
     with Emulator(game.system, game.require_rom()) as emu:
         emu.set_state(state)
@@ -276,7 +276,10 @@ def place_state(game: Game, name: str, state: bytes, folder: Path, *, force: boo
         ``"differs"`` (a different one was kept) or ``"damaged"`` (one that cannot be
         loaded was kept).
     """
+    if not isinstance(state, VettedState):  # bytes from elsewhere are checked as any state
+        state = check_state(game, state, source=f"the state {name} to place")
     record = StateRecord.of(game.name, cached_rom_sha1(game.require_rom(), game.system), state)
+    remember_written(game, state)  # this machine wrote it: reading it back needs no probe
     path = folder / f"{name}.state"
     if not path.exists():
         write_state(path, state, record=record)

@@ -42,6 +42,11 @@ def run(args: argparse.Namespace) -> int:
         )
     if args.frame is not None and not args.movie:
         raise InvalidArgumentError("Expected --frame only with --movie FILE.bk2; found it alone.")
+    if args.state and args.movie:
+        raise InvalidArgumentError(
+            f"Expected --state or --movie, not both; found --state {args.state[0]} with --movie {args.movie}. "
+            f"To make a state from the movie, name it: retrokit integrate [GAME] NAME --movie {args.movie}"
+        )
     out = Path(args.out) if args.out else None
     if args.movie:
         game, name = _movie_target(args.names, args.movie)
@@ -65,8 +70,10 @@ def run(args: argparse.Namespace) -> int:
 def _movie_target(names: list[str], movie: str):  # -> (Game, state name)
     """The game and state name of ``integrate [GAME] NAME --movie FILE``: the game defaults to the movie's."""
     from retrokit.data.games import find_game
+    from retrokit.data.names import check_state_name
     from retrokit.movie import read_bk2
 
+    check_state_name(names[-1])  # before the movie is replayed: the name becomes a file name
     if len(names) == 2:
         return find_game(names[0]), names[1]
     return find_game(read_bk2(movie).game), names[0]

@@ -36,6 +36,7 @@ import numpy as np
 
 from retrokit import paths
 from retrokit.data.games import Game, cached_rom_sha1, find_game, list_games, load_game, normalize_name
+from retrokit.data.names import check_state_name
 from retrokit.data.statecheck import check_state, load_state, remember_written
 from retrokit.data.states import StateRecord, write_state
 from retrokit.errors import (
@@ -43,6 +44,7 @@ from retrokit.errors import (
     GameNotFoundError,
     InvalidArgumentError,
     RetrokitError,
+    RomNotFoundError,
     StateError,
     StateNotFoundError,
     UnknownNameError,
@@ -249,7 +251,16 @@ def integrate(
         it does not match its recipe, ``"damaged"`` that it was kept although it
         is not a state the core can load (rerun with ``force`` to replace either).
     """
+    for name in names or []:
+        check_state_name(name)
     known = recipes(game)
+    shipped = [n for n in names or [] if n not in known and n in game.states]
+    if shipped and game.rom_path() is None:  # nothing to make: the state is there, the ROM is what is missing
+        raise RomNotFoundError(
+            f"Expected {game.name}'s ROM to integrate {', '.join(shipped)}; found the state shipped with the game "
+            f"({game.state_path(shipped[0])}) but no ROM. Import the ROM, then the state plays as it is: "
+            "retrokit import /path/to/your/roms"
+        )
     if not known:
         raise StateNotFoundError(
             f"Expected state recipes under 'integrate' in {game.info.source}; found none. "
@@ -276,6 +287,7 @@ def place_state(game: Game, name: str, state: bytes, folder: Path, *, force: boo
         ``"differs"`` (a different one was kept) or ``"damaged"`` (one that cannot be
         loaded was kept).
     """
+    check_state_name(name)  # the name becomes a file name in the game's folder: no '..', '/' or control characters
     if not isinstance(state, VettedState):  # bytes from elsewhere are checked as any state
         state = check_state(game, state, source=f"the state {name} to place")
     record = StateRecord.of(game.name, cached_rom_sha1(game.require_rom(), game.system), state)

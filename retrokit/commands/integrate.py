@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -30,9 +31,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Integrate the states; exit 1 if any differs from what was made."""
-    from pathlib import Path
-
-    from retrokit.data.integrate import integrate, place_state, resolve, target_folder
+    from retrokit.data.integrate import integrate, place_state, target_folder
     from retrokit.errors import InvalidArgumentError
     from retrokit.movie.playback import state_from_movie
 
@@ -77,3 +76,40 @@ def _movie_target(names: list[str], movie: str):  # -> (Game, state name)
     if len(names) == 2:
         return find_game(names[0]), names[1]
     return find_game(read_bk2(movie).game), names[0]
+
+
+def resolve(first: str, second: str | None = None, *, cwd: Path | None = None):  # -> (Game, list[str] | None)
+    """Which game and states ``retrokit integrate FIRST [SECOND]`` means.
+
+    ``GAME STATE`` is that state of that game; ``GAME`` alone is all its recipes.
+    A lone ``STATE`` belongs to the one known game that has a state file or a
+    recipe of that name, else to the game.yaml in ``cwd``.
+
+    Raises:
+        UnknownNameError: Several games have that state, or none does and ``cwd`` has no game.yaml.
+    """
+    from retrokit.data.games import find_game, list_games, normalize_name
+    from retrokit.data.integrate import games_with_state
+    from retrokit.errors import GameNotFoundError, UnknownNameError, did_you_mean
+
+    cwd = Path.cwd() if cwd is None else cwd
+    if second is not None:
+        return find_game(cwd if first == "." else first), [second]
+    names = {g.name for g in list_games()}
+    if normalize_name(first) in names:
+        return find_game(first), None
+    owners = games_with_state(first)
+    if len(owners) == 1:
+        return find_game(owners[0]), [first]
+    if len(owners) > 1:
+        raise UnknownNameError(
+            f"Expected one game with a state or recipe named {first!r}; found {len(owners)}: {', '.join(owners)}. "
+            f"Name the game: retrokit integrate {owners[0]} {first}"
+        )
+    if (cwd / "game.yaml").is_file():
+        return find_game(cwd), [first]
+    raise GameNotFoundError(
+        f"Expected a game name, or a state or recipe that one known game has; found {first!r}, which no game "
+        f"has, and no game.yaml in {cwd} to make it for. Name the game: retrokit integrate GAME {first}"
+        + did_you_mean(first, names)
+    )

@@ -35,19 +35,17 @@ from typing import Any
 import numpy as np
 
 from retrokit import paths
-from retrokit.data.games import Game, cached_rom_sha1, find_game, list_games, load_game, normalize_name
+from retrokit.data.games import Game, cached_rom_sha1, list_games
 from retrokit.data.names import check_state_name
 from retrokit.data.statecheck import check_state, load_state, remember_written
 from retrokit.data.states import StateRecord, write_state
 from retrokit.errors import (
     DataFileError,
-    GameNotFoundError,
     InvalidArgumentError,
     RetrokitError,
     RomNotFoundError,
     StateError,
     StateNotFoundError,
-    UnknownNameError,
     did_you_mean,
 )
 from retrokit.host.emulator import Emulator, VettedState
@@ -319,39 +317,6 @@ def target_folder(game: Game, data_dir: Path | None = None) -> Path:
     if len(game.folders) == 1 and own.parent not in searched:
         return game.folders[0]
     return paths.user_games_dir(data_dir) / game.name
-
-
-def resolve(first: str, second: str | None = None, *, cwd: Path | None = None) -> tuple[Game, list[str] | None]:
-    """Which game and states ``retrokit integrate FIRST [SECOND]`` means.
-
-    ``GAME STATE`` is that state of that game; ``GAME`` alone is all its recipes.
-    A lone ``STATE`` belongs to the one known game that has a state file or a
-    recipe of that name, else to the game.yaml in ``cwd``.
-
-    Raises:
-        UnknownNameError: Several games have that state, or none does and ``cwd`` has no game.yaml.
-    """
-    cwd = Path.cwd() if cwd is None else cwd
-    if second is not None:
-        return (load_game(cwd) if first == "." else find_game(first)), [second]
-    names = {g.name for g in list_games()}
-    if normalize_name(first) in names:
-        return find_game(first), None
-    owners = games_with_state(first)
-    if len(owners) == 1:
-        return find_game(owners[0]), [first]
-    if len(owners) > 1:
-        raise UnknownNameError(
-            f"Expected one game with a state or recipe named {first!r}; found {len(owners)}: {', '.join(owners)}. "
-            f"Name the game: retrokit integrate {owners[0]} {first}"
-        )
-    if (cwd / "game.yaml").is_file():
-        return load_game(cwd), [first]
-    raise GameNotFoundError(
-        f"Expected a game name, or a state or recipe that one known game has; found {first!r}, which no game "
-        f"has, and no game.yaml in {cwd} to make it for. Name the game: retrokit integrate GAME {first}"
-        + did_you_mean(first, names)
-    )
 
 
 def games_with_state(name: str) -> list[str]:

@@ -1,7 +1,7 @@
-"""120 corrupt states behind a real state's valid header: none kills the process that loads it.
+"""Corrupt states behind a real state's valid header: none kills the process that loads it.
 
-Each state is Dasher's Zone1.Act1 with its header kept and its body damaged
-(all random, a random window, or scattered bytes). Each goes through the
+Each state is Dasher's Zone1.Act1 with its header kept and a random body
+(the fuzz of issue 24, where 3 of 120 passed the first probe). Each goes through the
 public API: ``retrokit.make(game, path)``, then 3,000 frames with random
 input and a reset every 500. The probe (:mod:`retrokit.data.probe`) must
 refuse every state that would crash the core; the ones it passes must play.
@@ -10,7 +10,8 @@ The probes run first, two at a time, each in its own child, through
 the play runs in one child process, so a state the probe missed fails this
 test instead of killing the suite.
 
-Set ``RETROKIT_FUZZ_STATES`` to run more (or fewer) than 120.
+24 states run always (about a quarter of them pass the probe and play);
+the issue's full 120 with ``RETROKIT_FUZZ_STATES=120``.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ from childproc import MAX_RSS_MB, REPO, run_child
 from retrokit.data.states import compress_state, read_state
 
 DASHER = REPO / "games" / "Dasher-Genesis"
-COUNT = int(os.environ.get("RETROKIT_FUZZ_STATES", "120"))
+COUNT = int(os.environ.get("RETROKIT_FUZZ_STATES", "24"))
 HEADER = 16  # "GENPLUS-GX 1.7.5": the core's signature, checked by the core on load
 
 PLAY = """
@@ -55,21 +56,9 @@ print(json.dumps({"played": played, "refused": refused}))
 
 
 def corrupt_states(good: bytes, count: int) -> list[bytes]:
-    """Damaged copies of ``good``: a third random bodies, a third a random 4 KiB window, a third 64 scattered bytes."""
+    """Copies of ``good`` with its header and a random body."""
     rng = random.Random(2024)
-    states = []
-    for i in range(count):
-        body = bytearray(good)
-        if i % 3 == 0:
-            body[HEADER:] = rng.randbytes(len(good) - HEADER)
-        elif i % 3 == 1:
-            at = rng.randrange(HEADER, len(good) - 4096)
-            body[at : at + 4096] = rng.randbytes(4096)
-        else:
-            for _ in range(64):
-                body[rng.randrange(HEADER, len(good))] = rng.randrange(256)
-        states.append(bytes(body))
-    return states
+    return [good[:HEADER] + rng.randbytes(len(good) - HEADER) for _ in range(count)]
 
 
 def test_corrupt_states_never_kill_the_process(tmp_path: Path, monkeypatch) -> None:

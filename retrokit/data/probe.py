@@ -14,7 +14,7 @@ one when:
   (``<data>/state-probes/``) under the SHA-256 of the system, the ROM's SHA-1
   and the state;
 - otherwise, once it has passed the probe: loaded into a fresh emulator in a
-  child process, run, loaded again, and run under random input. The child
+  child process, run, loaded again, and run 3,000 frames under random input. The child
   dying by a signal, running out of memory, or hanging marks it unsafe.
 
 Nothing inside the file (retrokit's ``RK`` record, a movie's header) makes a
@@ -52,7 +52,10 @@ from retrokit.host.systems import System, get_system
 _mint = claim_mint()
 
 PROBE_FRAMES = 300
-"""Frames run from a probed state, idle, then again under random input after loading it a second time."""
+"""Idle frames run from a probed state after its first load."""
+PROBE_INPUT_FRAMES = 3000
+"""Frames of random input run after the second load: a corrupt body may crash the core only thousands of frames
+in (where depends on the process's memory layout), so the probe plays as long as a short episode."""
 PROBE_TIMEOUT = 60.0
 """Seconds a child may run one state before the state counts as one that hangs the core."""
 CHILD_STARTUP = 120.0
@@ -108,7 +111,7 @@ def _child_limits() -> None:
 
 def run_child(
     system: str, rom: str | os.PathLike[str], states: Sequence[tuple[str, str]], *, frames: int,
-    fields: Sequence[Mapping[str, Any]] = (), timeout: float = PROBE_TIMEOUT,
+    input_frames: int, fields: Sequence[Mapping[str, Any]] = (), timeout: float = PROBE_TIMEOUT,
 ) -> tuple[dict[str, ChildResult], str | None, str]:
     """Run one child over ``states``; return the results it finished, the state it was on when it stopped, and why.
 
@@ -120,11 +123,13 @@ def run_child(
         system: The system's name.
         rom: The ROM to load the states on.
         states: ``(name, path)`` of each state file, in order.
-        frames: Frames to run after each load.
+        frames: Idle frames to run after the first load of each state.
+        input_frames: Frames of random input to run after loading it again.
         fields: RAM fields (``name``, ``address``, ``type``, ``mask``) to read after loading.
         timeout: Seconds one state may take.
     """
-    request = {"system": system, "rom": os.fspath(rom), "frames": frames, "fields": list(fields),
+    request = {"system": system, "rom": os.fspath(rom), "frames": frames, "input_frames": input_frames,
+               "fields": list(fields),
                "states": [list(s) for s in states]}
     results: dict[str, ChildResult] = {}
     current, failure = None, ""
@@ -169,7 +174,7 @@ def run_child(
         if not failure and status != 0:
             if status < 0:
                 name = signal.Signals(-status).name if -status in signal.valid_signals() else f"signal {-status}"
-                failure = f"the emulator crashed ({name}) within {2 * frames} frames of loading it"
+                failure = f"the emulator crashed ({name}) within {frames + input_frames} frames of loading it"
             else:
                 log.seek(0)
                 last = log.read().strip().splitlines()[-1:] or ["no message"]
@@ -204,7 +209,7 @@ def probe_key(state: bytes, system: str, rom_sha1: str) -> str:
 
 def probe_state(
     state: bytes, system: str | System, rom: str | os.PathLike[str], *, frames: int = PROBE_FRAMES,
-    timeout: float = PROBE_TIMEOUT,
+    input_frames: int = PROBE_INPUT_FRAMES, timeout: float = PROBE_TIMEOUT,
 ) -> ProbeVerdict:
     """Load ``state`` on ``rom`` in a child process, run, load again, run under input; report how it ended.
 
@@ -214,7 +219,8 @@ def probe_state(
         state: The serialized state (uncompressed).
         system: The system (a name or descriptor).
         rom: The ROM to load it on.
-        frames: Frames to run after each of the two loads.
+        frames: Idle frames to run after the first load.
+        input_frames: Frames of random input to run after the second.
         timeout: Seconds before the child counts as hung, and is killed.
     """
     from retrokit.data.states import compress_state
@@ -223,7 +229,9 @@ def probe_state(
     with tempfile.NamedTemporaryFile(prefix="retrokit-probe-", suffix=".state") as tmp:
         tmp.write(compress_state(state))
         tmp.flush()
-        results, _, failure = run_child(system, rom, [("state", tmp.name)], frames=frames, timeout=timeout)
+        results, _, failure = run_child(
+            system, rom, [("state", tmp.name)], frames=frames, input_frames=input_frames, timeout=timeout
+        )
     result = results.get("state")
     if result is None:
         return ProbeVerdict(False, failure or "the probe stopped before it loaded the state")
@@ -328,7 +336,7 @@ def _child_main() -> int:
 
     _child_limits()
     request = json.load(sys.stdin)
-    frames = int(request["frames"])
+    frames, input_frames = int(request["frames"]), int(request["input_frames"])
     emu = Emulator(request["system"], request["rom"])
     specs = [FieldSpec(f["name"], f["address"], f["type"], f["mask"]) for f in request["fields"]]
     reader = FieldReader([s for s in specs if _inside(emu, s)], emu.space)
@@ -345,7 +353,7 @@ def _child_main() -> int:
             emu.run(idle, frames)
             result["after"] = reader.read()
             emu.set_state(state)  # every reset() loads the state again: some crash only then
-            for _ in range(0, frames, 10):  # and some only under input
+            for _ in range(0, input_frames, 10):  # and some only under input
                 emu.run([rng.getrandbits(12) for _ in range(emu.ports)], 10)
             emu.get_state()
             result["loaded"] = True

@@ -36,6 +36,7 @@ if TYPE_CHECKING:
 __all__ = ["IDLE_FRAMES", "StateProbe", "check_states", "parse_states", "probe_states", "state_space"]
 
 IDLE_FRAMES = 60  # frames run after loading, so a state that breaks the core does so here
+INPUT_FRAMES = 300  # then, loaded again, frames of random input: some states crash only then
 CHILD_TIMEOUT = 30.0  # seconds a child may spend on one state
 
 
@@ -83,7 +84,8 @@ def probe_states(game: Game, names: Sequence[str], rom: Path, *, frames: int = I
     todo = list(names)
     while todo:
         done, current, failure = run_child(
-            game.system.name, rom, [(n, paths[n]) for n in todo], frames=frames, fields=fields, timeout=CHILD_TIMEOUT
+            game.system.name, rom, [(n, paths[n]) for n in todo], frames=frames, input_frames=INPUT_FRAMES,
+            fields=fields, timeout=CHILD_TIMEOUT,
         )
         probes.update({name: StateProbe(**vars(result)) for name, result in done.items()})
         todo = [n for n in todo if n not in probes]

@@ -142,7 +142,7 @@ def test_a_corrupt_state_fails_without_stopping_the_run(dasher: Path, kind: str)
     report = check_game(dasher, frames=FRAMES)
     assert failed(report) == {("state loads", "Zone2.Act1")}, render(report)
     message = report.failures[0].message
-    assert ("truncated" in message) if kind == "truncated" else ("crashed (signal" in message)
+    assert ("truncated" in message) if kind == "truncated" else ("the emulator crashed (SIG" in message)
     # the states after it were still checked
     assert report.find("state loads", state="Zone3.Act2", status=PASS)
     assert report.find("smoke run", state="Zone3.Act2", status=PASS)
@@ -163,7 +163,7 @@ def test_a_state_that_hangs_the_core_fails_and_the_next_child_goes_on(monkeypatc
     monkeypatch.setattr(states, "CHILD_TIMEOUT", 0.001)  # 60 frames take longer: each state looks hung
     game = find_game("Dasher-Genesis")
     probes = states.probe_states(game, ["Zone1.Act1", "Zone1.Act2"], game.require_rom())
-    assert [p.error.startswith("the core hung") for p in probes.values()] == [True, True]
+    assert ["hangs the core" in p.error for p in probes.values()] == [True, True]
 
 
 def test_another_games_state_is_flagged(dasher: Path, airstriker_dir: Path) -> None:

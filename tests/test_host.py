@@ -493,3 +493,14 @@ def test_libc_rand_in_the_process_does_not_reach_the_cores(airstriker_rom: Path)
     libc = ctypes.CDLL(None)
     untouched = reset_after(None)
     assert [reset_after(seed) for seed in (42, 4242, 12345)] == [untouched] * 3
+
+
+def test_a_packed_state_unpacks_checked_and_cannot_be_made_directly(airstriker: Emulator) -> None:
+    from retrokit.host.emulator import PackedState
+
+    state = airstriker.get_state()
+    packed = state.pack()
+    assert len(packed) < len(state) and packed.unpack() == state
+    airstriker.set_state(packed.unpack())
+    with pytest.raises(StateError, match="made directly as PackedState"):
+        PackedState(b"x", "Genesis")

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import os
+import zlib
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Self
@@ -63,6 +64,32 @@ class VettedState(bytes):
 
     def __reduce__(self) -> tuple[type[bytes], tuple[bytes]]:
         return bytes, (bytes(self),)  # what is read back from a pickle is unchecked bytes
+
+    def pack(self) -> PackedState:
+        """This state zlib-compressed (fast), to keep many in memory; :meth:`PackedState.unpack` gives it back checked."""
+        return PackedState(zlib.compress(self, 1), self.system, seal=_SEAL)
+
+
+class PackedState:
+    """A :class:`VettedState`, compressed (a search keeps thousands); made only by :meth:`VettedState.pack`.
+
+    Attributes:
+        system: The system whose core the state is for.
+    """
+
+    __slots__ = ("_blob", "system")
+
+    def __init__(self, blob: bytes, system: str, *, seal: object = None) -> None:
+        if seal is not _SEAL:
+            raise StateError("Expected a state packed by VettedState.pack(); found one made directly as PackedState(...).")
+        self._blob, self.system = bytes(blob), system
+
+    def unpack(self) -> VettedState:
+        """The state again, as checked as it was when packed."""
+        return VettedState(zlib.decompress(self._blob), self.system, seal=_SEAL)
+
+    def __len__(self) -> int:
+        return len(self._blob)
 
 
 _SEAL = object()

@@ -292,9 +292,10 @@ def vet_state(
     if isinstance(state, VettedState) and state.system == system:
         return state
     state = bytes(state)
-    if shipped is not None and _ships(Path(shipped), state):
-        return _mint(state, system)
     key = probe_key(state, system, rom_sha1)
+    if shipped is not None and _ships(Path(shipped), state):
+        _remember(key, ProbeVerdict(True))  # a movie that starts from it (Core.bin) is then known too
+        return _mint(state, system)
     verdict = _cached(key)
     if verdict is None:
         verdict = probe_state(state, system, rom)

@@ -294,7 +294,8 @@ def vet_state(
     state = bytes(state)
     key = probe_key(state, system, rom_sha1)
     if shipped is not None and _ships(Path(shipped), state):
-        _remember(key, ProbeVerdict(True))  # a movie that starts from it (Core.bin) is then known too
+        if _cached(key) is None:  # a movie that starts from it (Core.bin) is then known too
+            _remember(key, ProbeVerdict(True))
         return _mint(state, system)
     verdict = _cached(key)
     if verdict is None:

@@ -252,3 +252,31 @@ def test_integrate_a_shipped_state_without_its_rom_says_the_rom_is_missing(tmp_p
     err = capsys.readouterr().err
     assert status == 2 and err.count("\n") == 1, err
     assert "found the state shipped with the game" in err and "retrokit import" in err and "recipe" not in err, err
+
+
+# --- resolved once ------------------------------------------------------------------------------------
+
+
+def test_an_env_takes_the_game_state_and_scenario_resolved_once(tmp_path: Path) -> None:
+    from retrokit.data.resolve import State, resolve
+    from retrokit.envs.env import RetroEnv
+    from retrokit.host.emulator import VettedState
+
+    game = find_game("Dasher-Genesis")
+    setup = resolve("Dasher-Genesis", "Zone1.Act2")
+    assert (setup.game.name, setup.rom, setup.start.name) == (game.name, game.require_rom(), "Zone1.Act2")
+    assert isinstance(setup.start.state, VettedState) and setup.scenario == game.scenario_path()
+    assert resolve(game, State.NONE, {"reward": "0"}).start.state is None
+    env = RetroEnv(setup, obs_type="ram")
+    try:
+        env.reset(seed=0)
+        assert env.state_name == "Zone1.Act2" and env.scenario is not None
+    finally:
+        env.close()
+
+
+def test_find_game_is_the_one_resolver_of_names_and_folders(dasher_copy: Path, monkeypatch) -> None:
+    monkeypatch.chdir(dasher_copy)
+    by_name = find_game("Dasher-Genesis-v0")
+    assert by_name.name == "Dasher-Genesis" and find_game(by_name) is by_name
+    assert find_game(".").folders == (Path("."),) and find_game(str(dasher_copy)).name == "Dasher-Genesis"

@@ -32,7 +32,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import BinaryIO
 
-from retrokit.errors import FileSystemError
+from retrokit.errors import FileSystemError, UnknownNameError, did_you_mean, shown
 
 GAMES_ENV = "RETROKIT_GAMES"
 DATA_ENV = "RETROKIT_DATA"
@@ -85,6 +85,41 @@ def repo_games_dir() -> Path | None:
         if path.is_dir():
             return path
     return None
+
+
+BUNDLED_DOCS = "_docs"
+"""The package folder an installed retrokit keeps ``docs/*.md`` in (``setup.py`` copies them there)."""
+
+
+def docs_dir() -> Path | None:
+    """Return the user guides: ``docs/`` of a checkout, or the copy inside an installed package."""
+    package = Path(__file__).resolve().parent
+    for path in (package / BUNDLED_DOCS, package.parent / "docs"):
+        if path.is_dir():
+            return path
+    return None
+
+
+def doc_topics() -> list[str]:
+    """Return the names of the guides ``retrokit docs TOPIC`` prints (``integrate`` for ``docs/integrate.md``)."""
+    folder = docs_dir()
+    return sorted(path.stem for path in folder.glob("*.md")) if folder is not None else []
+
+
+def doc_path(topic: str) -> Path:
+    """Return the guide named ``topic`` (``integrate``, ``integrate.md`` or ``docs/integrate.md``).
+
+    Raises:
+        UnknownNameError: No guide has that name (with a did-you-mean), or this install has no guides.
+    """
+    topics = doc_topics()
+    name = topic.removeprefix("docs/").removesuffix(".md")
+    if name not in topics:
+        raise UnknownNameError(
+            f"Expected one of retrokit's guides ({', '.join(topics) or 'none found in this install'}); "
+            f"got {shown(topic)}. `retrokit docs` lists them." + did_you_mean(name, topics)
+        )
+    return docs_dir() / f"{name}.md"  # type: ignore[operator]
 
 
 def env_games_dirs() -> list[Path]:

@@ -12,7 +12,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="replay a .bk2 movie into PNG frames, a GIF or an MP4",
         description="Replay a .bk2 movie (recorded by retrokit or stable-retro) on its game's ROM, "
         "and write the screens: into a folder as frame_000000.png, ... (numbered by movie frame), "
-        "or into OUT.gif (30 frames a second at most), or OUT.mp4 (needs: pip install 'retrokit[video]'). "
+        "or into OUT.gif (30 frames a second at most), or OUT.mp4 (needs: pip install 'retrokit-rl[video]'). "
         "A progress bar shows on standard error.",
     )
     parser.add_argument("movie", metavar="MOVIE.bk2", help="the movie to replay")

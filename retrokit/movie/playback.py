@@ -21,6 +21,7 @@ from retrokit.errors import (
     InvalidArgumentError,
     MovieError,
     RomError,
+    install_extra,
 )
 from retrokit.host.emulator import Emulator
 from retrokit.movie.bk2 import read_bk2
@@ -210,7 +211,7 @@ def _require_imageio(out: Path):  # the imageio.v2 module
     except ImportError:
         raise InvalidArgumentError(
             f"Expected imageio with its ffmpeg plugin to write {out}; found them not installed. "
-            "Export to a .gif or to a folder of PNG frames instead, or: pip install 'retrokit[video]'"
+            f"Export to a .gif or to a folder of PNG frames instead, or: {install_extra('video')}"
         ) from None
     return imageio
 

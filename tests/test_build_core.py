@@ -212,6 +212,19 @@ def test_pip_failing_otherwise_names_the_command_to_rerun(monkeypatch, tmp_path,
                           "--sdist FILE")
 
 
+def test_a_python_without_pip_says_how_to_get_it(monkeypatch, tmp_path, capsys) -> None:
+    """A venv made without pip (as uv makes them): the message names ensurepip and --sdist."""
+    import subprocess
+    import sys
+
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(tmp_path / "bare")], check=True)
+    bare = tmp_path / "bare" / "bin" / "python"
+    monkeypatch.setattr(build.sys, "executable", str(bare))
+    monkeypatch.setenv("PATH", f"{tools(tmp_path)}{os.pathsep}{os.environ['PATH']}")
+    status, _, err = run_cli(capsys, "--stable-retro", "1.0.1")
+    assert_one_line_error(status, err, f"Expected pip in {bare}", "-m ensurepip", "--sdist FILE")
+
+
 def test_a_patch_against_a_modified_source(monkeypatch, tmp_path, capsys) -> None:
     monkeypatch.setenv("PATH", str(tools(tmp_path)))
     source = original_source().replace(b"system_frame_gen(0);", b"system_frame_gen(frameskip);")

@@ -65,7 +65,7 @@ def _install(tmp_path: Path, damage: Callable[[bytes], bytes]) -> dict[str, str]
     cores.mkdir()
     tmp.mkdir()
     (cores / core_filename("genesis_plus_gx")).write_bytes(damage(CORE.read_bytes()))
-    return {"RETROKIT_CORES": str(cores), "TMPDIR": str(tmp)}
+    return {"RETROKIT_CORES": str(cores), "TMPDIR": str(tmp), "RETROKIT_DATA": str(tmp_path / "data")}  # verdicts kept there
 
 
 @pytest.mark.parametrize("case", list(REFUSED), ids=list(REFUSED))
@@ -122,8 +122,7 @@ PROBED = {
 
 @pytest.mark.parametrize("case", list(PROBED), ids=list(PROBED))
 def test_a_core_damaged_inside_is_probed_and_refused_in_one_line(tmp_path: Path, case: str) -> None:
-    env = {**_install(tmp_path, PROBED[case]), "RETROKIT_DATA": str(tmp_path / "data")}
-    child = run_child(OPEN, env=env, timeout=120)
+    child = run_child(OPEN, env=_install(tmp_path, PROBED[case]), timeout=120)
     assert child.returncode == 0 and child.signal is None, child.describe()
     (line,) = child.stdout.splitlines()
     assert line.startswith("refused: ") and "is not a core retrokit can load" in line, line

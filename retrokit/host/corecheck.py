@@ -29,6 +29,7 @@ from __future__ import annotations
 import base64
 import functools
 import hashlib
+import importlib
 import importlib.metadata
 import json
 import os
@@ -229,13 +230,18 @@ def _remember(digest: str, verdict: ProbeVerdict) -> None:
         pass  # a read-only data folder: the core is probed again next time, which is only slower
 
 
+def mark_probing(core: Path) -> None:
+    """Let this process load ``core`` unvetted: only the probe's child does, since it is the probe."""
+    _vetted.add(_stat_key(core))
+
+
 def _child(argv: list[str]) -> int:
     """The probe: open the emulator with the core, run the frames; exit 0, or _REFUSED on retrokit's error."""
-    from retrokit.host import corecheck  # the module the emulator calls: run with -m, this one is __main__
     from retrokit.host.emulator import Emulator
 
     system, rom, core = argv
-    corecheck._vetted.add(_stat_key(Path(core)))  # noqa: SLF001 - this process is the probe: it loads the core as it is
+    # Run with -m, this file is __main__: mark the core in the module the emulator calls, not in this copy.
+    importlib.import_module(__spec__.name).mark_probing(Path(core))
     try:
         with Emulator(system, rom, core_path=core) as emulator:
             emulator.run(0, PROBE_FRAMES)

@@ -140,7 +140,7 @@ def fetch_sdist(
         BuildToolError: This Python has no pip.
         SourceFetchError: The index could not be reached.
         SourceNotFoundError: The index has no sdist of that version.
-        CoreBuildError: pip failed otherwise (the message names its last line and the command to rerun).
+        CoreBuildError: pip failed otherwise (the message quotes its error and the command to rerun).
     """
     what = [sys.executable, "-m", "pip", "download", "--no-deps", "--no-binary", "stable-retro",
             f"stable-retro=={version}", *(["--index-url", index_url] if index_url is not None else [])]  # fmt: skip

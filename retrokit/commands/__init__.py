@@ -2,6 +2,11 @@
 
 Each module in this package is a command. It defines::
 
+    EXAMPLES = [  # full command lines, shown at the end of --help; a test parses each
+        "retrokit name ARG --option VALUE      # what this does (optional comment)",
+        "retrokit name sub ARG                  # one at least for every subcommand too",
+    ]
+
     def register(subparsers: argparse._SubParsersAction) -> None:
         parser = subparsers.add_parser("name", help="one line", description="...")
         parser.add_argument(...)

@@ -5,6 +5,12 @@ from __future__ import annotations
 import argparse
 import sys
 
+EXAMPLES = [
+    "retrokit build-core genesis_plus_gx                 # fetch stable-retro's source with pip, build, install",
+    "retrokit build-core genesis_plus_gx --sdist stable_retro-1.0.1.tar.gz   # from a downloaded sdist, offline",
+    "retrokit build-core genesis_plus_gx --index-url https://pypi.example.org/simple --force",
+]
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``build-core`` command."""

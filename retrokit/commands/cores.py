@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import argparse
 
+EXAMPLES = [
+    "retrokit cores                     # each system's core, and where it was found",
+]
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``cores`` command."""
@@ -24,8 +28,9 @@ def run(args: argparse.Namespace) -> int:
     from retrokit.host.systems import all_systems
 
     systems = all_systems()
-    width = max(len(name) for name in systems)
-    core_width = max(len(s.core) for s in systems.values())
+    width = max(len("SYSTEM"), *(len(name) for name in systems))
+    core_width = max(len("CORE"), *(len(s.core) for s in systems.values()))
+    print(f"{'SYSTEM':<{width}}  {'CORE':<{core_width}}  {'FOUND IN':<14}  PATH")
     for name, system in systems.items():
         try:
             found = locate_core(system.core)

@@ -22,6 +22,12 @@ from retrokit.paths import ensure_folder
 AGENTS = ("jerk", "random")
 
 
+EXAMPLES = [
+    "retrokit demo                                   # the whole demo, into ./retrokit-demo",
+    "retrokit demo --levels Zone1.Act1 --timesteps 2000 --out quick-demo",
+]
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``demo`` command."""
     parser = subparsers.add_parser(

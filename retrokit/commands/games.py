@@ -11,6 +11,13 @@ if TYPE_CHECKING:
     from retrokit.data.games import Game
 
 
+EXAMPLES = [
+    "retrokit games                     # every known game",
+    "retrokit games 'Sonic*'            # only the games whose name matches",
+    "retrokit games --imported          # only those whose ROM is here",
+]
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``games`` command."""
     parser = subparsers.add_parser(

@@ -9,6 +9,13 @@ from retrokit.commands._common import add_data_dir_option, rom_status
 SHOWN = 10
 
 
+EXAMPLES = [
+    "retrokit import ~/roms                              # search a folder (and the .zip files in it)",
+    "retrokit import Sonic.zip Airstriker.md -v",
+    "retrokit import --game SonicTheHedgehog-Genesis     # which ROM that game expects",
+]
+
+
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``import`` command."""
     parser = subparsers.add_parser(

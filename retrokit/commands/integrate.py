@@ -4,6 +4,12 @@ from __future__ import annotations
 
 import argparse
 
+EXAMPLES = [
+    "retrokit integrate Dasher-Genesis                   # every state recipe of the game",
+    "retrokit integrate Dasher-Genesis Zone1.Act1 --force",
+    "retrokit integrate Dasher-Genesis Mine --movie Mine-000000.bk2 --frame 600",
+]
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``integrate`` command."""

@@ -4,6 +4,11 @@ from __future__ import annotations
 
 import argparse
 
+EXAMPLES = [
+    "retrokit play Dasher-Genesis                        # F5 saves a state, F9 records a movie",
+    "retrokit play Airstriker-Genesis --state Level1 --name Mine --scale 3",
+]
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``play`` command."""

@@ -4,6 +4,11 @@ from __future__ import annotations
 
 import argparse
 
+EXAMPLES = [
+    "retrokit playback Mine-000000.bk2 mine.gif          # an animated GIF",
+    "retrokit playback Mine-000000.bk2 frames --every 4  # one PNG in 4 into the folder frames",
+]
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``playback`` command."""

@@ -4,6 +4,12 @@ from __future__ import annotations
 
 import argparse
 
+EXAMPLES = [
+    "retrokit validate Dasher-Genesis                    # one game, by name",
+    "retrokit validate games/MyGame-Genesis --json report.json",
+    "retrokit validate --all --quiet                     # every game, failures only",
+]
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``validate`` command."""

@@ -25,7 +25,6 @@ import shutil
 import subprocess
 import sys
 import tarfile
-import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -41,9 +40,17 @@ from retrokit.errors import (
 )
 from retrokit.host.cores import build_record_path, built_cores_dir, core_filename, read_build_record
 from retrokit.host.patching import apply_patch
-from retrokit.paths import atomic_write
+from retrokit.host.workdirs import work_folder
+from retrokit.paths import atomic_write, require_regular_file
 
 PATCHES_DIR = Path(__file__).resolve().parent.parent / "native" / "patches"
+
+MIB = 2**20
+# Bounds on the core's folder extracted from an sdist: stable-retro 1.0.1's cores/genesis holds 558 files,
+# 16 MiB in all, the biggest 3.4 MiB; these leave room for growth and none for a bomb.
+MAX_MEMBER_BYTES = 32 * MIB
+MAX_SOURCE_BYTES = 128 * MIB
+MAX_SOURCE_FILES = 10_000
 
 # What stable-retro's CMakeLists.txt passes to every core's makefile with GCC
 # (add_core): warnings off, C17, the C++ runtime linked in.
@@ -115,7 +122,13 @@ def check_tools(env: dict[str, str] | None = None) -> tuple[str, str]:
     env = dict(os.environ if env is None else env)
     path = env.get("PATH", "")
     cc = env.get("CC") or "cc"
-    words = shlex.split(cc) or ["cc"]  # CC may carry a wrapper or flags: "ccache gcc"
+    try:
+        words = shlex.split(cc) or ["cc"]  # CC may carry a wrapper or flags: "ccache gcc"
+    except ValueError as exc:  # an unclosed quote or a trailing backslash
+        raise BuildToolError(
+            f"Expected CC to be a command line, as a shell splits it (e.g. 'gcc' or 'ccache gcc'); found {cc!r}, "
+            f"which does not split ({exc}). Fix its quoting, or unset CC to use cc."
+        ) from None
     found_cc, found_make = shutil.which(words[0], path=path), shutil.which("make", path=path)
     for name, found, what in ((words[0], found_cc, "a C compiler"), ("make", found_make, "make")):
         if found is None:
@@ -182,16 +195,23 @@ def _shorten(text: str, limit: int = 200) -> str:
 def unpack_core_source(sdist: Path, folder: str, dest: Path, *, progress: Progress = _no_progress) -> Path:
     """Extract only ``folder`` (e.g. ``cores/genesis``) of the sdist into ``dest``; return where it is.
 
+    What is extracted is bounded (:data:`MAX_MEMBER_BYTES` a file, :data:`MAX_SOURCE_BYTES` and
+    :data:`MAX_SOURCE_FILES` in all), by the sizes the archive declares, before a byte is written.
+
     Raises:
-        CoreBuildError: The sdist is unreadable or has no such folder.
+        FileSystemError: ``sdist`` is missing, or not a regular file (a FIFO would block forever).
+        CoreBuildError: The sdist is unreadable, has no such folder, or its folder is over the bounds.
     """
+    require_regular_file(sdist, "a stable-retro sdist (.tar.gz)")
     try:
         with tarfile.open(sdist, "r:gz") as tar:
-            members = []
+            members, total = [], 0
             for member in tar:
                 rest = member.name.partition("/")[2]
                 if rest == folder or rest.startswith(folder + "/"):
                     members.append(member)
+                    total += member.size
+                    _check_bounds(sdist, member, len(members), total)
             if not members:
                 raise CoreBuildError(f"Expected {folder}/ in {sdist.name}; found no such folder. Is it stable-retro's sdist?")
             for i, member in enumerate(members, 1):
@@ -200,6 +220,24 @@ def unpack_core_source(sdist: Path, folder: str, dest: Path, *, progress: Progre
     except (tarfile.TarError, OSError, EOFError) as exc:
         raise CoreBuildError(f"Expected a readable .tar.gz at {sdist}; reading it failed: {exc}.") from None
     return dest / members[0].name.partition("/")[0] / folder
+
+
+def _check_bounds(sdist: Path, member: tarfile.TarInfo, count: int, total: int) -> None:
+    """Refuse a core folder bigger than any real one (an archive bomb fills the disk, not the source tree)."""
+    over = (
+        f"{member.name} of {member.size / MIB:,.0f} MiB (at most {MAX_MEMBER_BYTES // MIB} MiB a file)"
+        if member.size > MAX_MEMBER_BYTES
+        else f"{total / MIB:,.0f} MiB in all (at most {MAX_SOURCE_BYTES // MIB} MiB)"
+        if total > MAX_SOURCE_BYTES
+        else f"more than {MAX_SOURCE_FILES:,} files"
+        if count > MAX_SOURCE_FILES
+        else None
+    )
+    if over is not None:
+        raise CoreBuildError(
+            f"Expected a core's source in {sdist.name}, as in stable-retro's sdist (16 MiB, 558 files for "
+            f"genesis_plus_gx); found {over}, so nothing was extracted past it. Use stable-retro's own sdist."
+        )
 
 
 def patch_text(recipe: Recipe) -> str:
@@ -333,8 +371,7 @@ def build_core(
         return current
     check_target(recipe, data, force=force)
     cc, _ = check_tools()
-    with tempfile.TemporaryDirectory(prefix="retrokit-build-") as tmp:
-        work = Path(tmp)
+    with work_folder() as work:  # removes the folders of builds that were killed, too
         if sdist is None:
             step(f"Fetching stable-retro {version}'s source from {index_url or 'the package index'} (about 150 MB)")
             sdist = fetch_sdist(version, work / "sdist", index_url=index_url, progress=progress)

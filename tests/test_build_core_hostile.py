@@ -8,20 +8,30 @@ from __future__ import annotations
 
 import os
 import signal
+import socket
 import subprocess
 import sys
 import tarfile
 import tempfile
+import threading
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 from bombs import MIB, tar_gz_of_zeros
 from childproc import MAX_RSS_MB, run_cli
-from test_build_core import RECIPE, assert_one_line_error, fake_sdist, original_source, tools
+from test_build_core import (
+    RECIPE,
+    assert_one_line_error,
+    fake_sdist,
+    original_source,
+    pip_without_config,  # noqa: F401 (a fixture the index tests use)
+    tools,
+)
 
 from retrokit.cli import main
-from retrokit.errors import CoreBuildError
+from retrokit.errors import CoreBuildError, InvalidArgumentError, SourceFetchError
 from retrokit.host import build, workdirs
 from retrokit.host.cores import CORES_ENV
 
@@ -137,3 +147,63 @@ def test_a_killed_build_leaves_a_named_folder_the_next_build_removes(tmp_path, c
     status, err = build_cli(capsys, "--sdist", str(sdist))  # the next build, with a make that works
     assert status == 0, err
     assert list((tmp_path / "tmp").iterdir()) == []
+
+
+# --- indexes that do not answer, or cannot be reached ------------------------------------------
+
+
+@pytest.fixture
+def black_hole() -> Iterator[str]:
+    """The URL of an index on 127.0.0.1 that accepts every connection and never answers."""
+    server = socket.create_server(("127.0.0.1", 0))
+    server.settimeout(0.1)  # so the thread sees the end of the test
+    held: list[socket.socket] = []
+    done = threading.Event()
+
+    def accept() -> None:
+        while not done.is_set():
+            try:
+                held.append(server.accept()[0])
+            except TimeoutError:
+                continue
+
+    thread = threading.Thread(target=accept, daemon=True)
+    thread.start()
+    yield f"http://127.0.0.1:{server.getsockname()[1]}/simple"
+    done.set()
+    thread.join(timeout=10)
+    server.close()
+    for connection in held:
+        connection.close()
+
+
+@pytest.mark.usefixtures("pip_without_config")
+def test_an_index_that_never_answers_times_out(black_hole) -> None:
+    start = time.monotonic()
+    with pytest.raises(SourceFetchError, match="accepted the connection") as caught:
+        build.build_core("genesis_plus_gx", index_url=black_hole, version="1.0.1", timeout=1, deadline=120)
+    assert black_hole in str(caught.value) and "did not answer within 1 s" in str(caught.value)
+    assert time.monotonic() - start < 60  # pip's answer timeout of 1 s, three tries: not 300 s
+
+
+@pytest.mark.usefixtures("pip_without_config")
+def test_a_download_past_its_deadline_is_stopped(black_hole) -> None:
+    start = time.monotonic()
+    with pytest.raises(SourceFetchError, match="within 2 s; it was not done by then") as caught:
+        build.build_core("genesis_plus_gx", index_url=black_hole, version="1.0.1", timeout=600, deadline=2)
+    assert "--sdist FILE" in str(caught.value)
+    assert time.monotonic() - start < 30
+
+
+@pytest.mark.parametrize("url", ["not a url", "nonexistent.invalid/simple", "ftp://host/simple", "http:///simple"])
+def test_an_index_url_that_is_not_a_url_is_refused_first(url: str, capsys) -> None:
+    with pytest.raises(InvalidArgumentError, match="Expected --index-url to be an http"):
+        build.check_index_url(url)
+    assert_one_line_error(*build_cli(capsys, "--index-url", url), f"found {url!r}")
+
+
+@pytest.mark.usefixtures("pip_without_config")
+def test_a_plain_http_index_elsewhere_is_said_to_be_unread(capsys) -> None:
+    status, err = build_cli(capsys, "--index-url", "http://nonexistent.invalid/simple", "--stable-retro", "1.0.1")
+    assert_one_line_error(status, err, "pip did not read it", "PIP_TRUSTED_HOST=nonexistent.invalid")
+    assert "versions there" not in err

@@ -16,23 +16,28 @@ prefers it to the wheel's, with a record of what it was built from.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
 import re
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
 import tarfile
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from urllib.parse import urlsplit
 
 from retrokit.errors import (
     BuildToolError,
     CoreBuildError,
     FileConflictError,
+    InvalidArgumentError,
     SourceFetchError,
     SourceNotFoundError,
     UnknownNameError,
@@ -61,8 +66,13 @@ WHEEL_MAKE_ENV = {"CFLAGS": "-w -std=gnu17", "CXXFLAGS": "-w", "LDFLAGS": "-w -s
 _NETWORK_FAILURES = (
     "NewConnectionError", "Failed to establish a new connection", "Connection refused", "Network is unreachable",
     "Temporary failure in name resolution", "Name or service not known", "ConnectTimeout", "Read timed out",
-    "Max retries exceeded", "ProxyError", "SSLError", "Could not fetch URL",
+    "Max retries exceeded", "ProxyError", "SSLError", "Could not fetch URL", "ReadTimeoutError",
+    "ConnectTimeoutError", "is either a non-existing path or lacks a specific scheme",
 )  # fmt: skip
+# How long pip waits for any one answer of the index, and for the whole download (150 MB): an index
+# that accepts connections and never answers is given up on, not waited for forever.
+PIP_TIMEOUT = 15.0
+FETCH_DEADLINE = 1800.0
 
 
 @dataclass(frozen=True)
@@ -139,36 +149,117 @@ def check_tools(env: dict[str, str] | None = None) -> tuple[str, str]:
     return shlex.join([found_cc, *words[1:]]), found_make  # type: ignore[list-item,return-value]
 
 
+def check_index_url(url: str) -> str:
+    """Return ``url`` if pip can take it as an index: ``http(s)://host/...`` or ``file:///folder``.
+
+    Raises:
+        InvalidArgumentError: It is not such a URL (pip would ignore it and report no versions at all).
+    """
+    parts = urlsplit(url)
+    if (parts.scheme in ("http", "https") and parts.netloc) or (parts.scheme == "file" and parts.path):
+        return url
+    raise InvalidArgumentError(
+        f"Expected --index-url to be an http(s) or file URL, e.g. https://pypi.org/simple; found {url!r}. "
+        "Pass the index's full URL, or leave --index-url out to use pip's."
+    )
+
+
+@contextlib.contextmanager
+def _killed_after(proc: subprocess.Popen, seconds: float) -> Iterator[threading.Event]:
+    """Kill ``proc``'s process group if it still runs after ``seconds``, or when the block is left early.
+
+    ``proc`` must lead its own session (``start_new_session=True``), so that
+    what it started (pip's build backend, which holds its output open) goes
+    with it. The event yielded is set if the time ran out.
+    """
+    expired = threading.Event()
+
+    def kill() -> None:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+
+    def expire() -> None:
+        expired.set()
+        kill()
+
+    timer = threading.Timer(seconds, expire)
+    timer.daemon = True
+    timer.start()
+    try:
+        yield expired
+    finally:
+        timer.cancel()
+        if proc.poll() is None:  # left early (Ctrl-C, an error): pip must not run on alone
+            kill()
+            proc.wait()
+
+
 def fetch_sdist(
-    version: str, dest: Path, *, index_url: str | None = None, progress: Progress = _no_progress
+    version: str,
+    dest: Path,
+    *,
+    index_url: str | None = None,
+    progress: Progress = _no_progress,
+    timeout: float = PIP_TIMEOUT,
+    deadline: float = FETCH_DEADLINE,
 ) -> Path:
     """Download stable-retro's sdist of ``version`` into ``dest`` with pip; return its path.
 
+    Args:
+        version: The stable-retro version.
+        dest: The folder to download into.
+        index_url: The index; by default pip's configuration.
+        progress: Called as the download advances.
+        timeout: Seconds pip waits for any one answer of the index (pip's ``--timeout``).
+        deadline: Seconds the whole download may take; pip is killed past them.
+
     Raises:
-        SourceFetchError: The index could not be reached.
+        SourceFetchError: The index could not be reached, or did not answer in time.
         SourceNotFoundError: The index has no sdist of that version.
     """
     command = [sys.executable, "-m", "pip", "download", "--no-deps", "--no-binary", "stable-retro",
-               f"stable-retro=={version}", "-d", str(dest), "--progress-bar", "raw", "--retries", "2"]  # fmt: skip
+               f"stable-retro=={version}", "-d", str(dest), "--progress-bar", "raw", "--retries", "2",
+               "--timeout", f"{timeout:g}"]  # fmt: skip
     if index_url is not None:
         command += ["--index-url", index_url]
     where = index_url or "the package index"
     lines: list[str] = []
     try:
-        proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                start_new_session=True)  # fmt: skip
     except OSError as exc:
         raise BuildToolError(f"Expected to run pip ({sys.executable} -m pip); it failed: {exc}.") from None
     assert proc.stdout is not None
-    for line in proc.stdout:
-        lines.append(line.rstrip())
-        match = re.match(r"Progress (\d+) of (\d+)", line)
-        if match:
-            progress("download", int(match.group(1)), int(match.group(2)))
-    proc.wait()
+    with _killed_after(proc, deadline) as expired:
+        for line in proc.stdout:
+            lines.append(line.rstrip())
+            match = re.match(r"Progress (\d+) of (\d+)", line)
+            if match:
+                progress("download", int(match.group(1)), int(match.group(2)))
+        proc.wait()
+    if expired.is_set():
+        raise SourceFetchError(
+            f"Expected to download stable-retro {version}'s source from {where} within {deadline:g} s; it was not "
+            f"done by then (the index answers too slowly, or not at all), so pip was stopped. Check the network "
+            f"connection (or --index-url), or download the sdist yourself and pass --sdist FILE."
+        )
     found = sorted(dest.glob("stable_retro-*.tar.gz")) + sorted(dest.glob("stable-retro-*.tar.gz"))
     if proc.returncode == 0 and found:
         return found[0]
     text = "\n".join(lines)
+    if "ReadTimeoutError" in text or "Read timed out" in text:
+        raise SourceFetchError(
+            f"Expected to download stable-retro {version}'s source from {where}; it accepted the connection but did "
+            f"not answer within {timeout:g} s, three times. Check that the URL is a package index (or "
+            f"--index-url), or download the sdist yourself and pass --sdist FILE."
+        )
+    untrusted = re.search(r"The repository located at (\S+) is not a trusted or secure host", text)
+    if untrusted:
+        raise SourceFetchError(
+            f"Expected to download stable-retro {version}'s source from {where}; pip did not read it, as it reads "
+            f"a plain-http index only on this machine or on a host it is told to trust. Use https, or trust the "
+            f"host: PIP_TRUSTED_HOST={untrusted.group(1)} retrokit build-core ..."
+        )
     if any(marker in text for marker in _NETWORK_FAILURES):
         reason = next(line for line in lines if any(m in line for m in _NETWORK_FAILURES))
         raise SourceFetchError(
@@ -338,6 +429,7 @@ def build_core(
     force: bool = False,
     progress: Progress = _no_progress,
     step: Callable[[str], None] = lambda message: None,
+    **fetch_limits: float,
 ) -> Path:
     """Fetch, patch, build and install a core; return the installed library.
 
@@ -351,6 +443,7 @@ def build_core(
             core in the way that ``build-core`` did not make.
         progress: Called as steps advance: ``(what, done, total)``.
         step: Called with a line saying what happens next.
+        fetch_limits: ``timeout`` and ``deadline`` of :func:`fetch_sdist`, in seconds.
 
     Raises:
         CoreBuildError: A tool is missing, the index is unreachable or has no
@@ -359,6 +452,8 @@ def build_core(
     from retrokit.host.cores import stable_retro_version
 
     recipe = recipe_for(core)
+    if index_url is not None and sdist is None:
+        check_index_url(index_url)
     version = version or stable_retro_version()
     if version is None:
         raise SourceNotFoundError(
@@ -374,7 +469,7 @@ def build_core(
     with work_folder() as work:  # removes the folders of builds that were killed, too
         if sdist is None:
             step(f"Fetching stable-retro {version}'s source from {index_url or 'the package index'} (about 150 MB)")
-            sdist = fetch_sdist(version, work / "sdist", index_url=index_url, progress=progress)
+            sdist = fetch_sdist(version, work / "sdist", index_url=index_url, progress=progress, **fetch_limits)
         step(f"Unpacking {recipe.folder}/ from {sdist.name}")
         source = unpack_core_source(sdist, recipe.folder, work / "src", progress=progress)
         step(f"Applying {recipe.patch}")

@@ -8,9 +8,11 @@ resort, is a file-system error that escaped them.
 Every command's ``--help`` ends with examples: each command module lists full
 command lines in ``EXAMPLES``, and :func:`build_parser` shows each one at the
 end of the help of the (sub)command it runs, and of that command's parent (so
-``retrokit ramsearch --help`` shows its subcommands' examples too). A test
-walks every (sub)command and fails if one has no example, or if an example
-does not parse.
+``retrokit ramsearch --help`` shows its subcommands' examples too). A module
+whose parser shows them in its own epilog may give that text as ``EXAMPLES``
+instead: its lines that start with ``retrokit`` are the examples. A test
+(tests/test_cli_teaches.py) walks every (sub)command and fails if one has no
+example, or if an example does not parse.
 """
 
 from __future__ import annotations
@@ -56,11 +58,15 @@ class CommandParser(argparse.ArgumentParser):
         return action
 
     def format_help(self) -> str:
-        """The help, ending with the examples (argparse's epilog would wrap them into one paragraph)."""
+        """The help, ending with the examples (argparse's epilog would wrap them into one paragraph).
+
+        Examples the parser's own epilog already shows are not shown twice.
+        """
         text = super().format_help()
-        if not self.examples:
+        shown = [example for example in self.examples if example not in (self.epilog or "")]
+        if not shown:
             return text
-        return text + "\nexamples:\n" + "".join(f"  {example}\n" for example in self.examples)
+        return text + "\nexamples:\n" + "".join(f"  {example}\n" for example in shown)
 
 
 def example_words(example: str) -> list[str]:
@@ -69,8 +75,14 @@ def example_words(example: str) -> list[str]:
     return words[1:] if words[:1] == ["retrokit"] else words
 
 
-def add_examples(root: CommandParser, examples: Iterable[str]) -> None:
-    """Show each example in the help of the command it runs and of that command's parent (but the top level's)."""
+def add_examples(root: CommandParser, examples: Iterable[str] | str) -> None:
+    """Show each example in the help of the command it runs and of that command's parent (but the top level's).
+
+    ``examples`` is a list of command lines, or the text of an epilog in which
+    they are the lines that start with ``retrokit``.
+    """
+    if isinstance(examples, str):
+        examples = [line.strip() for line in examples.splitlines() if line.strip().startswith("retrokit ")]
     for example in examples:
         chain = [root]
         for word in example_words(example):

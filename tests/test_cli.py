@@ -135,30 +135,3 @@ def test_a_closed_pipe_ends_the_command_quietly(command: list[str]) -> None:
     stderr = process.stderr.read().decode()
     process.wait(timeout=120)
     assert "Traceback" not in stderr and "BrokenPipeError" not in stderr
-
-
-def test_cores_prints_a_header_row_over_aligned_columns(capsys):
-    status, out, _ = run(capsys, "cores")
-    assert status == 0
-    header, first = out.splitlines()[:2]
-    assert header.split() == ["SYSTEM", "CORE", "FOUND", "IN", "PATH"]
-    assert first.index(first.split()[1]) == header.index("CORE")  # the columns line up under their names
-
-
-def test_convert_names_its_positionals_as_its_text_does(capsys):
-    status, out, _ = run(capsys, "convert", "--help")
-    text = " ".join(out.split())  # argparse wraps lines where the terminal width says
-    assert status == 0
-    assert "SCENARIO.json [OUT.yaml]" in text and "Without OUT.yaml" in text
-
-
-@pytest.mark.parametrize(
-    ("game", "expected"),
-    [("SonicTheHedgehog-Genesis", "Expected the ROM of SonicTheHedgehog-Genesis"), ("Dasher-Genesis", "Expected pygame")],
-    ids=["rom-missing-is-said-first", "then-pygame"],
-)
-def test_play_without_pygame_checks_the_rom_first(capsys, monkeypatch, game, expected):
-    monkeypatch.setitem(sys.modules, "pygame", None)  # `import pygame` raises ImportError
-    status, out, err = run(capsys, "play", game)
-    assert status == 2 and out == ""
-    assert err.startswith(f"retrokit: error: {expected}") and "Traceback" not in err

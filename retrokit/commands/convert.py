@@ -1,14 +1,9 @@
-"""``retrokit convert SCENARIO.json [OUT.yaml]``: a Gym Retro scenario as retrokit scenario YAML."""
+"""``retrokit convert SCENARIO.json [OUT]``: a Gym Retro scenario as retrokit scenario YAML."""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
-
-EXAMPLES = [
-    "retrokit convert scenario.json scenario.yaml      # a Gym Retro scenario as retrokit YAML",
-    "retrokit convert scenario.json                    # print the YAML instead",
-]
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -17,12 +12,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "convert",
         help="convert a Gym Retro scenario.json to retrokit scenario YAML",
         description="Write a Gym Retro scenario.json as retrokit scenario YAML, with the same rewards and done "
-        "condition (Lua scripts cannot be converted). Without OUT.yaml, the YAML goes to standard output. "
-        "An existing OUT.yaml is never replaced unless --overwrite.",
+        "condition (Lua scripts cannot be converted). Without OUT, the YAML goes to standard output. "
+        "An existing OUT is never replaced unless --overwrite.",
     )
     parser.add_argument("source", type=Path, metavar="SCENARIO.json", help="the Gym Retro scenario to convert")
-    parser.add_argument("out", type=Path, nargs="?", metavar="OUT.yaml", help="the YAML file to write")
-    parser.add_argument("--overwrite", action="store_true", help="replace OUT.yaml if it exists")
+    parser.add_argument("out", type=Path, nargs="?", metavar="OUT", help="the .yaml to write")
+    parser.add_argument("--overwrite", action="store_true", help="replace OUT if it exists")
     parser.set_defaults(run=run)
 
 
@@ -47,3 +42,10 @@ def run(args: argparse.Namespace) -> int:
         ) from None
     print(f"wrote {args.out}")
     return 0
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit convert scenario.json scenario.yaml      # a Gym Retro scenario as retrokit YAML",
+    "retrokit convert scenario.json                    # print the YAML instead",
+]

@@ -4,10 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-EXAMPLES = [
-    "retrokit cores                     # each system's core, and where it was found",
-]
-
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``cores`` command."""
@@ -42,3 +38,9 @@ def run(args: argparse.Namespace) -> int:
     print(f"Cores retrokit can build, to skip drawing the frames an env does not show: {buildable} "
           "(retrokit build-core CORE).")
     return 0
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit cores                     # each system's core, and where it was found",
+]

@@ -11,13 +11,6 @@ if TYPE_CHECKING:
     from retrokit.data.games import Game
 
 
-EXAMPLES = [
-    "retrokit games                     # every known game",
-    "retrokit games 'Sonic*'            # only the games whose name matches",
-    "retrokit games --imported          # only those whose ROM is here",
-]
-
-
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``games`` command."""
     parser = subparsers.add_parser(
@@ -87,3 +80,11 @@ def scenarios_refused(game: Game) -> list[str]:
         except RetrokitError:
             refused.append(name)
     return refused
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit games                     # every known game",
+    "retrokit games 'Sonic*'            # only the games whose name matches",
+    "retrokit games --imported          # only those whose ROM is here",
+]

@@ -48,17 +48,10 @@ class PlaySession:
         scale: Window pixels per console pixel.
 
     Raises:
-        RomNotFoundError: The game's ROM is missing (checked before pygame).
-        StateNotFoundError: The game has no such state (checked before pygame).
         EnvError: pygame is missing or no display can be opened.
     """
 
     def __init__(self, game: Game, state: str | None, folder: Path, *, name: str = "Play", scale: int = 2) -> None:
-        # The ROM and the state first: a user without pygame should not install it only to learn that the
-        # ROM is missing.
-        rom = game.require_rom()
-        start = state or game.default_state
-        start_path = game.state_path(start) if start is not None else None
         try:
             import pygame
         except ImportError:
@@ -69,9 +62,10 @@ class PlaySession:
         except pygame.error as exc:
             raise EnvError(f"Expected a display for retrokit play; found none ({exc}).") from None
         self.game, self.folder, self.name, self.scale = game, Path(folder), name, scale
-        self.emulator = Emulator(game.system, rom)
-        if start_path is not None:
-            self.emulator.set_state(read_state(start_path))
+        self.emulator = Emulator(game.system, game.require_rom())
+        start = state or game.default_state
+        if start is not None:
+            self.emulator.set_state(read_state(game.state_path(start)))
         self.held: set[int] = set()
         self.recorder: MovieRecorder | None = None
         self.saved: list[Path] = []

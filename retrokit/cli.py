@@ -35,6 +35,7 @@ EXAMPLES = [
     "retrokit games                     # the known games, their states, and whether their ROM is here",
     "retrokit import ~/roms             # copy the ROMs of known games from a folder or .zip",
     "retrokit evaluate --benchmark dasher --agent random --out runs/random",
+    "retrokit docs                      # the guides (docs/*.md); print one with retrokit docs TOPIC",
 ]
 
 

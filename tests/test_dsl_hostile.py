@@ -140,7 +140,7 @@ def _alias_bomb(key: str) -> str:
 @pytest.mark.timeout(20)
 @pytest.mark.parametrize("key", ["actions", "crop", "rewards"])
 def test_an_alias_bomb_is_refused_quickly(tmp_path, key: str) -> None:
-    with pytest.raises(ScenarioError, match="at most 100000 YAML values"):
+    with pytest.raises(ScenarioError, match="to add at most 100000 YAML values"):
         _load(tmp_path, _alias_bomb(key))
 
 

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from retrokit.data.yamlfile import MAX_VALUES, TooManyValuesError, iter_nodes
 from retrokit.dsl.check import constant
 from retrokit.dsl.parser import MAX_INT, parse
 from retrokit.dsl.source import Snippet, SourceText, align, located, read_source
@@ -38,9 +39,6 @@ TOP_KEYS = (
 )
 INCLUDE_KEYS = ("description", "include", "tables", "define")
 TABLE_KEYS = ("by", "default", "values", "description")
-
-#: The most values a scenario file may hold, aliases expanded: the Sonic level tables hold a few hundred.
-MAX_VALUES = 100_000
 
 _INT_TAG = "tag:yaml.org,2002:int"
 _FLOAT_TAG = "tag:yaml.org,2002:float"
@@ -86,22 +84,15 @@ class _Reader:
         holds once they are expanded: a few lines of nested aliases can stand
         for billions, and reading them would never end.
         """
-        stack = [root]
-        count = 0
-        while stack:
-            node = stack.pop()
-            count += 1
-            if count > MAX_VALUES:
-                raise self.error(
-                    root, f"expected a scenario of at most {MAX_VALUES} YAML values, aliases expanded, got more; "
-                    f"write out what the aliases (*name) repeat, or drop them",
-                )
-            if node.tag not in _PLAIN_TAGS:
-                raise self.error(node, f"expected plain YAML values, got one tagged {node.tag!r}; remove the tag")
-            if isinstance(node, yaml.SequenceNode):
-                stack.extend(node.value)
-            elif isinstance(node, yaml.MappingNode):
-                stack.extend(part for pair in node.value for part in pair)
+        try:
+            for node in iter_nodes(root):
+                if node.tag not in _PLAIN_TAGS:
+                    raise self.error(node, f"expected plain YAML values, got one tagged {node.tag!r}; remove the tag")
+        except TooManyValuesError:
+            raise self.error(
+                root, f"expected aliases (*name) to add at most {MAX_VALUES} YAML values to a scenario once "
+                f"expanded, got more; write out what the aliases repeat, or drop them",
+            ) from None
 
     def mapping(self, node: yaml.Node, what: str, allowed: tuple[str, ...] | None = None) -> dict[str, tuple[yaml.Node, yaml.Node]]:
         """The entries of a mapping node, checking for duplicate and unknown keys."""
@@ -213,11 +204,12 @@ class DocumentLoader:
 
     def load_file(self, path: Path, *, top: bool = True) -> None:
         """Read ``path`` (a scenario, or an included file when ``top`` is false)."""
+        source = read_source(path)  # first: a symlink loop is its error, before resolve() raises a raw one
         resolved = path.resolve()
         if resolved in self._seen:
             raise ScenarioError(f"{path}: included more than once (includes must not loop)")
         self._seen.append(resolved)
-        self.load_source(read_source(path), path.parent, top=top)
+        self.load_source(source, path.parent, top=top)
 
     def load_text(self, text: str, name: str, base: Path | None, *, top: bool = True) -> None:
         """Read scenario YAML ``text``; ``name`` labels it in messages, ``base`` resolves includes."""

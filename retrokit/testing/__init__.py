@@ -118,7 +118,8 @@ def _resolve(game: Game | str | os.PathLike[str]) -> Game:
     if normalize_name(text) in known:
         return known[normalize_name(text)]
     folder = Path(text)
-    if folder.is_dir() and any((folder / m).is_file() for m in ("game.yaml", "data.json", "rom.sha")):
+    # lexists: a data file that cannot be read (a FIFO, a loop) fails the data check, with the reason
+    if folder.is_dir() and any(os.path.lexists(folder / m) for m in ("game.yaml", "data.json", "rom.sha")):
         return Game(normalize_name(folder.resolve().name), (folder,))
     from retrokit.data.games import find_game
 

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
@@ -316,7 +317,7 @@ def document_from_dict(data: dict, *, name: str | None = None, game_dir: str | o
     """
     label = name or str(data.get("name", "scenario"))
     try:
-        text = yaml.safe_dump(_plain_keys(data), sort_keys=False, default_flow_style=False, width=10_000)
+        text = yaml.safe_dump(plain_scenario_dict(data, label), sort_keys=False, default_flow_style=False, width=10_000)
     except yaml.YAMLError as exc:  # RepresenterError: an object YAML cannot write
         found = exc.args[1] if len(exc.args) > 1 else exc
         raise ScenarioError(
@@ -330,12 +331,44 @@ def document_from_dict(data: dict, *, name: str | None = None, game_dir: str | o
     return loader.spec
 
 
-def _plain_keys(value: object) -> object:
-    """Make a dict dumpable: tuple keys ``(0, 1)`` become ``"0, 1"``, numpy values Python ones."""
-    if isinstance(value, dict):
-        return {(", ".join(str(p) for p in k) if isinstance(k, tuple) else k): _plain_keys(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain_keys(v) for v in value]
+#: How deep a scenario given as a dict may nest: the deepest shipped one nests 5 levels.
+MAX_DICT_DEPTH = 100
+
+
+def plain_scenario_dict(data: Mapping, label: str = "scenario") -> dict:
+    """Copy a scenario given as a dict into plain values YAML can write, checking its shape.
+
+    Tuple keys ``(0, 1)`` become ``"0, 1"``, numpy values Python ones.
+
+    Raises:
+        ScenarioError: The dict contains itself, or nests deeper than :data:`MAX_DICT_DEPTH`
+            (either would exhaust Python's stack while it is read).
+    """
+    return _plain_keys(data, label, 0, set())  # type: ignore[return-value]
+
+
+def _plain_keys(value: object, label: str, depth: int, path: set[int]) -> object:
+    if isinstance(value, (Mapping, list, tuple)):
+        if id(value) in path:
+            raise ScenarioError(
+                f"scenario {label!r}: expected a tree of plain values; found a dict or list that contains itself. "
+                "Pass a copy without the loop"
+            )
+        if depth >= MAX_DICT_DEPTH:
+            raise ScenarioError(
+                f"scenario {label!r}: expected dicts and lists nested at most {MAX_DICT_DEPTH} deep; found deeper "
+                "ones. A scenario nests a few levels: check what was passed"
+            )
+        path.add(id(value))
+        try:
+            if isinstance(value, Mapping):
+                return {
+                    (", ".join(str(p) for p in k) if isinstance(k, tuple) else k): _plain_keys(v, label, depth + 1, path)
+                    for k, v in value.items()
+                }
+            return [_plain_keys(v, label, depth + 1, path) for v in value]
+        finally:
+            path.discard(id(value))
     if isinstance(value, (np.generic, np.ndarray)):  # np.int64(3), np.array([0, 0, 320, 224])
-        return _plain_keys(value.tolist())
+        return _plain_keys(value.tolist(), label, depth, path)
     return value

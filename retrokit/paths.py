@@ -244,18 +244,44 @@ def ensure_folder(folder: Path | str, purpose: str = "written") -> Path:
             should be, or the folder cannot be created.
     """
     folder = Path(folder)
+    if "\0" in str(folder):  # os refuses it with a ValueError, not an OSError
+        raise FileSystemError(f"Expected a folder path {purpose}; found {str(folder)!r}, which holds a NUL byte. Remove it.")
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:  # mkdir says FileExistsError for a file in the way: not a conflict, a wrong path
-        if folder.exists():
+        if os.path.exists(folder):  # os.path's: False, not an error, for a name too long
             reason = "a file, not a folder"
         elif isinstance(exc, (FileExistsError, NotADirectoryError)):
             reason = "a file where one of its parent folders should be"
         else:
-            reason = exc.strerror or str(exc)
+            reason = f"it cannot be made: {exc.strerror or exc}"
         raise FileSystemError(
             f"Expected a folder at {str(folder)!r} {purpose}; found {reason}. Choose another place, or move the file."
         ) from None
+    return folder
+
+
+def writable_folder(folder: Path | str, purpose: str) -> Path:
+    """Make ``folder`` if needed and prove it can take a new file now; return it.
+
+    For a folder used later (``make(record=...)`` records at each ``reset()``):
+    the check is made up front, by creating and deleting a file in it, so that
+    a file in the way, a name too long, or a folder under ``/proc`` is an
+    error where the folder was given.
+
+    Args:
+        folder: The folder.
+        purpose: What it is for, in the error message (``"to record movies into"``).
+
+    Raises:
+        FileSystemError: The folder cannot be made, or cannot be written.
+    """
+    folder = ensure_folder(folder, purpose)
+    try:
+        with tempfile.TemporaryFile(dir=folder, prefix=".retrokit-probe."):
+            pass
+    except OSError as exc:
+        raise _cannot(folder, purpose, exc) from None
     return folder
 
 

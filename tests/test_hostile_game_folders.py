@@ -80,6 +80,18 @@ def test_an_unreadable_file_in_a_game_folder_is_a_failed_check(tmp_path: Path, f
 
 
 @pytest.mark.parametrize("special", list(SPECIAL), ids=list(SPECIAL))
+def test_an_unreadable_solution_movie_is_a_failed_check(tmp_path: Path, special: str) -> None:
+    folder = dasher_copy(tmp_path / "games")
+    (folder / "movies").mkdir()
+    (folder / "game.yaml").write_text(GAME_YAML + "movies:\n  Zone1.Act1: {done_at: 621, reward: 3552}\n")
+    SPECIAL[special](folder / "movies" / "Zone1.Act1.bk2")
+    results, child = _validate(folder, tmp_path)
+    movie = [r for r in results if r["check"] == "movie"]
+    assert [r["status"] for r in movie] == ["fail"], child.describe()
+    assert FOUND[special] in movie[0]["message"] and "Zone1.Act1.bk2" in movie[0]["message"], child.describe()
+
+
+@pytest.mark.parametrize("special", list(SPECIAL), ids=list(SPECIAL))
 def test_an_unreadable_game_yaml_fails_the_data_check(tmp_path: Path, special: str) -> None:
     folder = dasher_copy(tmp_path / "games")
     SPECIAL[special](folder / "game.yaml")

@@ -213,7 +213,7 @@ def read_benchmark(path: str | os.PathLike[str]) -> Benchmark:
     path = Path(path)
 
     def fail(problem: str) -> BenchmarkFileError:
-        return BenchmarkFileError(f"Expected a benchmark file, but {path}: {problem}. See docs/evaluate.md for its shape.")
+        return BenchmarkFileError(f"Expected a benchmark file, but {path}: {problem}. See retrokit docs evaluate for its shape.")
 
     try:
         # The guarded reader and the YAML reader of every retrokit file: no FIFO, device or alias bomb.

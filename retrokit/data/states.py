@@ -23,7 +23,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from retrokit.errors import FileConflictError, FileSystemError, StateError
-from retrokit.paths import atomic_write, read_regular_file
+from retrokit.paths import REPLACE_HINT, atomic_write, read_regular_file
 
 GZIP_MAGIC = b"\x1f\x8b"
 MAX_STATE_SIZE = 16 * 2**20
@@ -213,17 +213,13 @@ def write_state(
         if same:
             return path
         raise _conflict(path)
-    try:
-        atomic_write(path, compress_state(data, record), overwrite=overwrite)
-    except FileExistsError:
-        raise _conflict(path) from None
+    atomic_write(path, compress_state(data, record), overwrite=overwrite)
     return path
 
 
 def _conflict(path: Path) -> FileConflictError:
     return FileConflictError(
-        f"Expected no file at {str(path)!r} or the same state; found a different file. "
-        "Pass overwrite=True to replace it, or choose another name."
+        f"Expected no file at {str(path)!r} or the same state; found a different file. {REPLACE_HINT}"
     )
 
 

@@ -99,5 +99,5 @@ def own_games() -> list[str]:
 EXAMPLES = [
     "retrokit validate Dasher-Genesis                    # one game, by name",
     "retrokit validate games/MyGame-Genesis --json report.json",
-    "retrokit validate --all --quiet                     # every game, failures only",
+    "retrokit validate --all --quiet                     # every game not from the wheel, failures only",
 ]

@@ -1,14 +1,25 @@
 """retrokit: emulated console games as reinforcement-learning environments.
 
-``retrokit.make(game, state, scenario, **options)`` makes a Gymnasium env;
-``retrokit.make_vec`` steps several on threads; ``retrokit.multiplayer`` has
-the PettingZoo envs of two-player games; ``retrokit.sonic`` is the Sonic
-benchmark preset; ``retrokit.movie`` reads, writes and plays ``.bk2`` movies.
+The public names, each imported on first use (PEP 562), so that ``import
+retrokit`` and ``retrokit --help`` stay fast:
 
-The package is layered (``docs/architecture.md``): ``host`` (the native
-emulator's Python face), ``data`` (games, states, ROMs), ``dsl`` (scenarios),
-``envs`` (Gymnasium and PettingZoo), ``movie``, and ``commands`` (the CLI).
-Names are imported on first use (PEP 562), so ``retrokit --help`` stays fast.
+- ``make(game, state, scenario, **options)``: a Gymnasium env
+  (:class:`RetroEnv`); ``make_vec``: several stepped together on native
+  threads (:class:`ThreadedVectorEnv`); ``State``: where an env starts.
+- ``multiplayer``: the PettingZoo envs of two-player games; ``sonic``: the
+  Sonic benchmark preset; ``register_envs``: the Gymnasium ids
+  (``gymnasium.make("retrokit/Dasher-Genesis-v0")``), registered at import.
+- ``movie``: ``.bk2`` movies, read, written, recorded and played back.
+- ``testing``: ``check_game``, behind ``retrokit validate``.
+- ``Emulator``: one console running one game, below the envs.
+
+The package is layered (``docs/architecture.md``), each layer importing only
+those below it: ``host`` (the emulator's Python face, over the C host in
+``native``), ``data`` (games, their files, states and ROMs), ``dsl`` (the
+scenario language), ``envs``, ``movie``, ``ramsearch``, ``testing``,
+``benchmark`` (``retrokit evaluate``), this package's public names, and
+``commands`` with ``cli`` (the ``retrokit`` command). ``errors`` and ``paths``
+serve every layer.
 """
 
 from __future__ import annotations

@@ -22,6 +22,7 @@ The stable-retro wheel is located without importing its Python code.
 from __future__ import annotations
 
 import contextlib
+import errno
 import functools
 import importlib.metadata
 import importlib.util
@@ -291,18 +292,44 @@ def ensure_folder(folder: Path | str, purpose: str = "written") -> Path:
             should be, or the folder cannot be created.
     """
     folder = Path(folder)
+    if "\0" in str(folder):  # os refuses it with a ValueError, not an OSError
+        raise FileSystemError(f"Expected a folder path {purpose}; found {str(folder)!r}, which holds a NUL byte. Remove it.")
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:  # mkdir says FileExistsError for a file in the way: not a conflict, a wrong path
-        if folder.exists():
+        if os.path.exists(folder):  # os.path's: False, not an error, for a name too long
             reason = "a file, not a folder"
         elif isinstance(exc, (FileExistsError, NotADirectoryError)):
             reason = "a file where one of its parent folders should be"
         else:
-            reason = exc.strerror or str(exc)
+            reason = f"it cannot be made: {exc.strerror or exc}"
         raise FileSystemError(
             f"Expected a folder at {str(folder)!r} {purpose}; found {reason}. Choose another place, or move the file."
         ) from None
+    return folder
+
+
+def writable_folder(folder: Path | str, purpose: str) -> Path:
+    """Make ``folder`` if needed and prove it can take a new file now; return it.
+
+    For a folder used later (``make(record=...)`` records at each ``reset()``):
+    the check is made up front, by creating and deleting a file in it, so that
+    a file in the way, a name too long, or a folder under ``/proc`` is an
+    error where the folder was given.
+
+    Args:
+        folder: The folder.
+        purpose: What it is for, in the error message (``"to record movies into"``).
+
+    Raises:
+        FileSystemError: The folder cannot be made, or cannot be written.
+    """
+    folder = ensure_folder(folder, purpose)
+    try:
+        with tempfile.TemporaryFile(dir=folder, prefix=".retrokit-probe."):
+            pass
+    except OSError as exc:
+        raise _cannot(folder, purpose, exc) from None
     return folder
 
 
@@ -325,6 +352,68 @@ def require_regular_file(path: Path | str, what: str) -> Path:
     except OSError as exc:
         raise FileSystemError(f"Expected {what} at {str(path)!r}; found {exc.strerror or exc}.") from None
     if not stat.S_ISREG(mode):
-        kind = "a folder" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode) else "a device or socket"
-        raise FileSystemError(f"Expected {what} at {str(path)!r}; found {kind}, which is not a file retrokit reads.")
+        raise _not_regular(path, what, mode)
     return path
+
+
+def _not_regular(path: Path, what: str, mode: int) -> FileSystemError:
+    """The error for a path that is not a regular file (``mode`` from its stat)."""
+    kind = "a folder" if stat.S_ISDIR(mode) else "a FIFO" if stat.S_ISFIFO(mode) else "a device or socket"
+    return FileSystemError(
+        f"Expected {what} at {str(path)!r}; found {kind}, which is not a file retrokit reads. "
+        "Replace it with a regular file, or remove it."
+    )
+
+
+def read_regular_file(path: Path | str, what: str, limit: int) -> bytes:
+    """Read a data file whole: the one guarded way retrokit reads a game's files.
+
+    The file is opened with ``O_NONBLOCK``, so a FIFO cannot block the open,
+    then checked on the open descriptor (no race with a rename): only a
+    regular file is read, and never more than ``limit`` bytes, so a link to
+    ``/dev/zero`` or a huge file cannot fill memory.
+
+    Args:
+        path: The file (symlinks followed; a loop is an error).
+        what: What it should be, for the error (``"a game.yaml data file"``).
+        limit: The most bytes a file of this kind may hold.
+
+    Raises:
+        FileSystemError: ``path`` is missing, unreadable, a symlink loop, a folder,
+            a device, a FIFO or a socket, or larger than ``limit``.
+    """
+    path = Path(path)
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    except OSError as exc:
+        found = "a symlink loop" if exc.errno == errno.ELOOP else exc.strerror or str(exc)
+        raise FileSystemError(f"Expected {what} at {str(path)!r}; found {found}. Fix or remove it.") from None
+    try:
+        mode = os.fstat(fd).st_mode
+        chunks = []
+        size = 0
+        while stat.S_ISREG(mode) and size <= limit:
+            chunk = os.read(fd, min(1 << 20, limit + 1 - size))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            size += len(chunk)
+    except OSError as exc:  # EIO on a failing disk
+        raise FileSystemError(f"Expected {what} at {str(path)!r}; found it cannot be read: {exc.strerror or exc}.") from None
+    finally:
+        os.close(fd)
+    if not stat.S_ISREG(mode):
+        raise _not_regular(path, what, mode)
+    if size > limit:
+        raise FileSystemError(
+            f"Expected {what} at {str(path)!r} of at most {_size(limit)}; found a larger file. Is it the right file?"
+        )
+    return b"".join(chunks)
+
+
+def _size(count: int) -> str:
+    """A byte count as people write it: ``4 MiB``, ``1 KiB``, or bytes."""
+    for unit, scale in (("GiB", 2**30), ("MiB", 2**20), ("KiB", 2**10)):
+        if count >= scale and count % scale == 0:
+            return f"{count // scale} {unit}"
+    return f"{count} bytes"

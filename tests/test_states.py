@@ -68,7 +68,7 @@ def test_bad_state_files(tmp_path, kind, message):
 
 
 def test_missing_state_file(tmp_path):
-    with pytest.raises(StateError, match="Expected a readable save state at .*Nope.state"):
+    with pytest.raises(StateError, match="Expected a save state file at .*Nope.state"):
         read_state(tmp_path / "Nope.state")
 
 

@@ -280,3 +280,21 @@ def test_games_are_listed_for_validate_all() -> None:
     own = own_games()
     assert "Dasher-Genesis" in own and "Airstriker-Genesis" not in own
     assert set(own) <= {g.name for g in list_games()}
+
+
+def test_validate_all_says_which_games_it_means(capsys, monkeypatch) -> None:
+    """Issue 20: --all is the games not from the stable-retro wheel; the help and the run's first line say so."""
+    from retrokit.commands import validate
+
+    assert main(["validate", "--help"]) == 0
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert "each game `retrokit games` lists whose first folder is not the stable-retro wheel's" in help_text
+    own = validate.own_games()
+    wheel = [g.name for g in list_games() if g.name not in own]
+    assert "Airstriker-Genesis" in wheel and "Dasher-Genesis" in own
+    monkeypatch.setattr(validate, "own_games", lambda: ["Dasher-Genesis"])  # one game: the line, not the hour
+    assert main(["validate", "--all", "--frames", str(FRAMES), "-q"]) == 0
+    first, *rest = capsys.readouterr().out.splitlines()
+    assert first == (f"--all: 1 of the {len(list_games())} games retrokit games lists, those not from the "
+                     "stable-retro wheel (name one of the others to check it): Dasher-Genesis")
+    assert any(line.startswith("Dasher-Genesis: all") for line in rest)

@@ -24,7 +24,9 @@ from typing import Any
 
 import yaml
 
+from retrokit.data.yamlfile import load_yaml
 from retrokit.errors import BenchmarkFileError, RomNotFoundError, StateNotFoundError, UnknownNameError, did_you_mean
+from retrokit.paths import read_regular_file
 
 BUILTIN_FILES = {"dasher": Path(__file__).with_name("dasher.yaml")}
 BUILTINS = ("dasher", "sonic")
@@ -214,9 +216,8 @@ def read_benchmark(path: str | os.PathLike[str]) -> Benchmark:
         return BenchmarkFileError(f"Expected a benchmark file, but {path}: {problem}. See retrokit docs evaluate for its shape.")
 
     try:
-        if path.stat().st_size > MAX_FILE_BYTES:
-            raise fail(f"is {path.stat().st_size} bytes, more than a benchmark's {MAX_FILE_BYTES}")
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        # The guarded reader and the YAML reader of every retrokit file: no FIFO, device or alias bomb.
+        data = load_yaml(read_regular_file(path, "a benchmark file", MAX_FILE_BYTES).decode("utf-8-sig"))
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
         raise fail(f"cannot be read as YAML ({str(exc).splitlines()[0]})") from None
     if not isinstance(data, dict):

@@ -22,7 +22,8 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
-from retrokit.errors import DataFileError, FieldTypeError, did_you_mean
+from retrokit.errors import DataFileError, FieldTypeError, FileSystemError, did_you_mean
+from retrokit.paths import read_regular_file
 
 if TYPE_CHECKING:
     from retrokit.host.fields import FieldSpec
@@ -169,11 +170,11 @@ def read_game_yaml(path: str | os.PathLike[str]) -> GameInfo:
     """
     import yaml
 
-    from retrokit.data.yamlfile import DuplicateKeyError, load_yaml
+    from retrokit.data.yamlfile import DuplicateKeyError, load_yaml, read_yaml_text
 
     source = Path(path)
     try:
-        doc = load_yaml(source.read_text(encoding="utf-8"))
+        doc = load_yaml(read_yaml_text(source, "a game.yaml data file"))
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         at = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
@@ -181,6 +182,8 @@ def read_game_yaml(path: str | os.PathLike[str]) -> GameInfo:
         if isinstance(exc, DuplicateKeyError):
             raise data_error(source, "each key once in a mapping", f"{problem}{at}", "remove or rename one") from exc
         raise data_error(source, "valid YAML", f"a syntax error{at}: {problem}", "fix the YAML syntax") from exc
+    except FileSystemError:
+        raise
     except (OSError, UnicodeDecodeError) as exc:
         raise data_error(source, "a readable UTF-8 file", str(exc), "check the file") from exc
     doc = _expect(source, "the file", doc, dict, "a mapping (system, roms, fields, states, players)")
@@ -224,18 +227,24 @@ def _positive(source: Path, players: int) -> int:
     return players
 
 
+#: The largest Gym Retro data file read (data.json, metadata.json, rom.sha): the wheel's are a few kilobytes.
+MAX_JSON_BYTES = 4 * 2**20
+
+
 def _read_json(path: Path, required: bool) -> dict[str, Any]:
-    if not path.is_file() and not required:
+    if not os.path.lexists(path) and not required:
         return {}
     try:
         # Duplicate keys are kept as json keeps them (the last wins): the wheel's own data files have some.
-        doc = json.loads(path.read_text(encoding="utf-8"))
+        doc = json.loads(read_regular_file(path, f"a Gym Retro {path.name}", MAX_JSON_BYTES).decode("utf-8"))
     except json.JSONDecodeError as exc:
         raise data_error(
             path, "valid JSON", f"a syntax error at line {exc.lineno}, column {exc.colno}: {exc.msg}",
             "fix the JSON syntax",
         ) from exc
-    except (OSError, UnicodeDecodeError) as exc:
+    except RecursionError:
+        raise data_error(path, "JSON nested at most a few hundred deep", "deeper nesting", "fix the file") from None
+    except UnicodeDecodeError as exc:
         raise data_error(path, "a readable UTF-8 JSON file", str(exc), "check the file") from exc
     return _expect(path, "the file", doc, dict, "a JSON object")
 
@@ -253,8 +262,9 @@ def read_gym_retro_folder(folder: str | os.PathLike[str]) -> GameInfo:
     _check_keys(data_path, "the file", data, ("info",))
     meta = _read_json(meta_path, required=False)
     sha1s: tuple[str, ...] = ()
-    if sha_path.is_file():
-        lines = [line.strip() for line in sha_path.read_text(encoding="utf-8", errors="replace").splitlines()]
+    if os.path.lexists(sha_path):
+        text = read_regular_file(sha_path, "a Gym Retro rom.sha", MAX_JSON_BYTES).decode("utf-8", errors="replace")
+        lines = [line.strip() for line in text.splitlines()]
         sha1s = tuple(_sha1(sha_path, f"line {i + 1}", line) for i, line in enumerate(lines) if line)
     per_player = _names(meta_path, "'default_player_state'", meta.get("default_player_state", []))
     players = _expect(meta_path, "'players'", meta.get("players", max(1, len(per_player))), int, "an integer")
@@ -277,6 +287,6 @@ def read_gym_retro_folder(folder: str | os.PathLike[str]) -> GameInfo:
 def read_game_folder(folder: str | os.PathLike[str]) -> GameInfo:
     """Read a game folder's data file: ``game.yaml`` if there is one, else Gym Retro's files."""
     folder = Path(folder)
-    if (folder / "game.yaml").is_file():
+    if os.path.lexists(folder / "game.yaml"):  # a FIFO, a folder or a loop there is an error, not Gym Retro's files
         return read_game_yaml(folder / "game.yaml")
     return read_gym_retro_folder(folder)

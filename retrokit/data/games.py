@@ -312,7 +312,17 @@ _index_cache: dict[tuple[tuple[str, int], ...], dict[str, tuple[Path, ...]]] = {
 
 
 def _is_game_folder(path: Path) -> bool:
-    return any((path / marker).is_file() for marker in ("game.yaml", "rom.sha", "data.json"))
+    # lexists, not is_file: a data file that is a FIFO, a folder or a symlink loop makes its folder the game's,
+    # so reading it fails with the reason instead of the next folder's data file being used without a word.
+    return any(os.path.lexists(path / marker) for marker in ("game.yaml", "rom.sha", "data.json"))
+
+
+def _is_folder(entry: os.DirEntry[str]) -> bool:
+    """Whether a search folder's entry is a folder; a symlink loop is not (it cannot be read as one)."""
+    try:
+        return entry.is_dir()
+    except OSError:  # ELOOP: a link to itself must not break every command
+        return False
 
 
 def _is_scenario_folder(path: Path) -> bool:
@@ -332,7 +342,7 @@ def _index() -> dict[str, tuple[Path, ...]]:
     for directory in dirs:
         with os.scandir(directory) as entries:
             for entry in sorted(entries, key=lambda e: e.name):
-                if entry.name[:1] in "._" or not entry.is_dir():
+                if entry.name[:1] in "._" or not _is_folder(entry):
                     continue
                 path, name = Path(entry.path), normalize_name(entry.name)
                 if _is_game_folder(path):

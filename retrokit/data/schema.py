@@ -24,7 +24,8 @@ from typing import Any
 
 import yaml
 
-from retrokit.errors import DataFileError, did_you_mean
+from retrokit.data.yamlfile import compose_yaml, read_yaml_text
+from retrokit.errors import DataFileError, FileSystemError, did_you_mean
 
 __all__ = ["SCHEMAS", "SCHEMA_DIR", "SchemaIssue", "check_file", "check_text", "schema_path"]
 
@@ -82,8 +83,10 @@ def check_file(path: str | os.PathLike[str], kind: str) -> list[SchemaIssue]:
     """Return every problem of a YAML data file against its kind's schema (empty: it conforms)."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
+        text = read_yaml_text(path, f"a YAML {kind} file")
+    except FileSystemError as exc:
+        return [SchemaIssue(str(path), 1, 1, str(exc))]
+    except UnicodeDecodeError as exc:
         return [SchemaIssue(str(path), 1, 1, f"expected a readable UTF-8 file; found an error: {exc}")]
     return check_text(text, kind, str(path))
 
@@ -91,7 +94,7 @@ def check_file(path: str | os.PathLike[str], kind: str) -> list[SchemaIssue]:
 def check_text(text: str, kind: str, name: str = "<text>") -> list[SchemaIssue]:
     """Return every problem of YAML ``text`` against the schema of ``kind``; ``name`` labels it."""
     try:
-        root = yaml.compose(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+        root = compose_yaml(text)  # counted with aliases expanded: the checks below walk every value
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         line, column = (mark.line + 1, mark.column + 1) if mark is not None else (1, 1)

@@ -18,13 +18,12 @@ import hashlib
 import io
 import json
 import os
-import stat
 import zlib
 from dataclasses import dataclass
 from pathlib import Path
 
-from retrokit.errors import FileConflictError, StateError
-from retrokit.paths import REPLACE_HINT, atomic_write
+from retrokit.errors import FileConflictError, FileSystemError, StateError
+from retrokit.paths import REPLACE_HINT, atomic_write, read_regular_file
 
 GZIP_MAGIC = b"\x1f\x8b"
 MAX_STATE_SIZE = 16 * 2**20
@@ -101,20 +100,10 @@ def read_state_file(path: str | os.PathLike[str]) -> StateFile:
         StateError: The file is missing, empty, not gzip, truncated or corrupt.
     """
     path = Path(path)
-    try:
-        if not stat.S_ISREG(path.stat().st_mode):  # a FIFO would block, a device never end
-            raise StateError(f"Expected a save state file at {str(path)!r}; found a folder, device or FIFO.")
-        with open(path, "rb") as f:
-            blob = f.read(MAX_STATE_FILE_SIZE + 1)
-    except OSError as exc:
-        raise StateError(
-            f"Expected a readable save state at {str(path)!r}; found an error: {exc.strerror or exc}."
-        ) from exc
-    if len(blob) > MAX_STATE_FILE_SIZE:
-        raise StateError(
-            f"{path}: expected a save state file of at most {MAX_STATE_FILE_SIZE} bytes; found a larger one. "
-            "It is not a save state."
-        )
+    try:  # a FIFO would block, a device never end, a loop never resolve
+        blob = read_regular_file(path, "a save state file", MAX_STATE_FILE_SIZE)
+    except FileSystemError as exc:
+        raise StateError(f"{exc} It is not a save state.") from None
     return StateFile(decompress_state(blob, source=str(path)), state_record(blob))
 
 

@@ -15,6 +15,12 @@ name the expression: a division tests its divisor (``_divzero(site)``) unless
 it is a constant (never zero: the checker refuses that), and a table lookup
 tests for a missing key (``_nokey(site, key)``). A reward that is not a finite
 number (an overflow to inf, a NaN) is refused (``_nonfinite(player, value)``).
+Integers are 64-bit: each definition's and memory's value is tested against
+:data:`INT_MIN` and :data:`INT_MAX` (``_overflow(site, value)``), and a shift
+by a count that is not a constant from 0 to 63 tests it first
+(``_shift(site, count)``), so no value grows from step to step without bound
+and no step builds a huge number. Within one expression an intermediate may
+be wider (an expression is a few operations: its size bounds it).
 Python's compiler refuses code nested 200 brackets deep, so an expression whose
 code would nest deeper than :data:`MAX_NESTING` is refused at compile time.
 """
@@ -31,6 +37,9 @@ from retrokit.errors import ScenarioCompileError
 
 #: CPython refuses code nesting 200 brackets deep; generated code stays below this.
 MAX_NESTING = 180
+#: The integers a scenario computes with: 64 bits, signed or unsigned, as fields and literals are.
+INT_MIN = -(2**63)
+INT_MAX = 2**64 - 1
 
 
 def nesting(code: str) -> int:
@@ -43,6 +52,39 @@ def nesting(code: str) -> int:
         elif ch in ")]}":
             depth -= 1
     return deepest
+
+
+#: Operators whose result can leave 64 bits when their operands are inside: (2**64 - 1) * 2, -(2**64 - 1), ...
+_WIDENING = frozenset({"+", "-", "*", "<<", "|", "^", "//", "%", "~"})
+
+
+def may_overflow(node: n.Node) -> bool:
+    """Whether ``node`` can give an integer outside 64 bits when every name it reads is inside.
+
+    Fields and literals are 64-bit; definitions and memories are tested where
+    they are computed; so only arithmetic can leave the range, and a choice
+    (``if``, ``min``, ``clip``, a table) only if one of its choices can.
+    """
+    value = constant(node)
+    if value is not None:
+        return isinstance(value, int) and not INT_MIN <= value <= INT_MAX
+    if isinstance(node, n.Unary):
+        return node.op != "+" or may_overflow(node.operand)
+    if isinstance(node, n.Binary):
+        if node.op == "/":
+            return False  # a float
+        return node.op in _WIDENING or may_overflow(node.left) or may_overflow(node.right)
+    if isinstance(node, n.IfElse):
+        return may_overflow(node.then) or may_overflow(node.other)
+    if isinstance(node, n.Call):
+        if node.func == "delta":
+            return True
+        if node.func == "prev":  # at reset, prev(x, default) is the default
+            return len(node.args) > 1 and may_overflow(node.args[1])
+        if node.func in ("initial", "peak", "sign"):
+            return False
+        return any(may_overflow(arg) for arg in node.args)  # abs, min, max, clip: one of their arguments
+    return False  # names, numbers, conditions, table values
 
 
 @dataclass(frozen=True)
@@ -82,11 +124,15 @@ class CodeGen:
         for kind, key in self.graph.order(mode):
             if kind == "def":
                 snippet = self.a.spec.defines[key]  # type: ignore[index]
-                body.append(f"{self.defs[key]} = {self.whole(self.a.defines[key], mode, snippet)}")  # type: ignore[index]
+                root = self.a.defines[key]  # type: ignore[index]
+                local = self.defs[key]  # type: ignore[index]
+                body.append(f"{local} = {self.whole(root, mode, snippet)}")
+                body += self.bounded(local, snippet, root)
                 continue
             slot = slots[key]  # type: ignore[index]
             i = slot.index
             body.append(f"_m{i} = {self.whole(slot.arg, mode, slot.snippet)}")
+            body += self.bounded(f"_m{i}", slot.snippet, slot.arg)
             if mode == NEXT and slot.kind == "peak":
                 body.append(f"_p{i} = _m{i} if _m{i} > s[{i}] else s[{i}]")
                 writes.append(f"s[{i}] = _p{i}")
@@ -125,6 +171,18 @@ class CodeGen:
             "        raise _fail(exc) from None",
         ]
         return out
+
+    def bounded(self, local: str, snippet: Snippet, node: n.Node) -> list[str]:
+        """The statement refusing an integer outside 64 bits in ``local`` (a definition's or a memory's value).
+
+        One chained comparison, and only where ``node`` can leave the range
+        (:func:`may_overflow`): copies, choices and conditions need none, so
+        a step of Sonic's contest scenario makes one test. Floats and booleans
+        pass it too (a float out of range goes to ``_overflow``, which lets it through).
+        """
+        if not may_overflow(node):
+            return []
+        return [f"if not {INT_MIN} <= {local} <= {INT_MAX}: _overflow({self.site(snippet, node)}, {local})"]
 
     def temp(self, prefix: str) -> str:
         """A fresh local name."""
@@ -173,6 +231,11 @@ class CodeGen:
             if node.op in ("/", "//", "%") and constant(node.right) is None:
                 z = self.temp("_z")
                 return f"({left} {node.op} {z} if ({z} := {right}) else _divzero({self.site(sn, node)}))"
+            count = constant(node.right)
+            if node.op == "<<" and not (isinstance(count, int) and 0 <= count < 64):
+                # Tested before shifting: 1 << (frame * 10**8) would build a number of 12.5 MB a step.
+                z = self.temp("_z")
+                return f"({left} << {z} if 0 <= ({z} := {right}) < 64 else _shift({self.site(sn, node)}, {z}))"
             return f"({left} {node.op} {right})"
         if isinstance(node, n.Compare):
             parts = [self.expr(node.operands[0], mode, sn)]

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 
 from retrokit.dsl.check import Checker
-from retrokit.dsl.codegen import CodeGen, Site
+from retrokit.dsl.codegen import INT_MAX, INT_MIN, CodeGen, Site
 from retrokit.dsl.graph import Graph
 from retrokit.dsl.spec import ScenarioSpec, Table
 from retrokit.dsl.typecheck import TypeChecker
@@ -49,6 +49,7 @@ class Program:
             "__builtins__": {},
             "_abs": abs, "_min": min, "_max": max, "_float": float,
             "_divzero": self._divzero, "_nonfinite": self._nonfinite, "_nokey": self._nokey,
+            "_overflow": self._overflow, "_shift": self._shift,
             "_missing": self._missing, "_fail": self._fail,
             "_RuntimeError": ScenarioRuntimeError, "_KeyError": KeyError,
             "_Errors": (ArithmeticError, TypeError, ValueError),
@@ -71,6 +72,26 @@ class Program:
         raise site.snippet.error(
             ScenarioRuntimeError, node.start, node.end,
             f"scenario {self.name!r}: division by zero: the divisor {divisor} is 0",
+        )
+
+    def _overflow(self, index: int, value: object) -> None:
+        if not isinstance(value, int):  # a float beyond 2**64 is a float: only integers are 64-bit
+            return
+        site: Site = self._sites[index]
+        raise site.snippet.error(
+            ScenarioRuntimeError, site.node.start, site.node.end,
+            f"scenario {self.name!r}: expected an integer of 64 bits ({INT_MIN} to {INT_MAX}), got a "
+            f"{value.bit_length()}-bit one: scenario integers are 64-bit, and this one overflowed; bound the "
+            f"expression, e.g. with clip(), or make it a decimal number with / 1",
+        )
+
+    def _shift(self, index: int, count: int) -> None:
+        site: Site = self._sites[index]
+        node = site.node
+        raise site.snippet.error(
+            ScenarioRuntimeError, node.start, node.end,
+            f"scenario {self.name!r}: expected a shift count from 0 to 63 (integers are 64-bit), got {count}; "
+            f"bound the count, e.g. with clip()",
         )
 
     def _nonfinite(self, player: int, value: float) -> None:

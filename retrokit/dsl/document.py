@@ -22,11 +22,13 @@ from __future__ import annotations
 
 import math
 import os
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 import yaml
 
+from retrokit.data.yamlfile import MAX_VALUES, TooManyValuesError, iter_nodes
 from retrokit.dsl.check import constant
 from retrokit.dsl.parser import MAX_INT, parse
 from retrokit.dsl.source import Snippet, SourceText, align, located, read_source
@@ -38,9 +40,6 @@ TOP_KEYS = (
 )
 INCLUDE_KEYS = ("description", "include", "tables", "define")
 TABLE_KEYS = ("by", "default", "values", "description")
-
-#: The most values a scenario file may hold, aliases expanded: the Sonic level tables hold a few hundred.
-MAX_VALUES = 100_000
 
 _INT_TAG = "tag:yaml.org,2002:int"
 _FLOAT_TAG = "tag:yaml.org,2002:float"
@@ -86,22 +85,15 @@ class _Reader:
         holds once they are expanded: a few lines of nested aliases can stand
         for billions, and reading them would never end.
         """
-        stack = [root]
-        count = 0
-        while stack:
-            node = stack.pop()
-            count += 1
-            if count > MAX_VALUES:
-                raise self.error(
-                    root, f"expected a scenario of at most {MAX_VALUES} YAML values, aliases expanded, got more; "
-                    f"write out what the aliases (*name) repeat, or drop them",
-                )
-            if node.tag not in _PLAIN_TAGS:
-                raise self.error(node, f"expected plain YAML values, got one tagged {node.tag!r}; remove the tag")
-            if isinstance(node, yaml.SequenceNode):
-                stack.extend(node.value)
-            elif isinstance(node, yaml.MappingNode):
-                stack.extend(part for pair in node.value for part in pair)
+        try:
+            for node in iter_nodes(root):
+                if node.tag not in _PLAIN_TAGS:
+                    raise self.error(node, f"expected plain YAML values, got one tagged {node.tag!r}; remove the tag")
+        except TooManyValuesError:
+            raise self.error(
+                root, f"expected aliases (*name) to add at most {MAX_VALUES} YAML values to a scenario once "
+                f"expanded, got more; write out what the aliases repeat, or drop them",
+            ) from None
 
     def mapping(self, node: yaml.Node, what: str, allowed: tuple[str, ...] | None = None) -> dict[str, tuple[yaml.Node, yaml.Node]]:
         """The entries of a mapping node, checking for duplicate and unknown keys."""
@@ -213,11 +205,12 @@ class DocumentLoader:
 
     def load_file(self, path: Path, *, top: bool = True) -> None:
         """Read ``path`` (a scenario, or an included file when ``top`` is false)."""
+        source = read_source(path)  # first: a symlink loop is its error, before resolve() raises a raw one
         resolved = path.resolve()
         if resolved in self._seen:
             raise ScenarioError(f"{path}: included more than once (includes must not loop)")
         self._seen.append(resolved)
-        self.load_source(read_source(path), path.parent, top=top)
+        self.load_source(source, path.parent, top=top)
 
     def load_text(self, text: str, name: str, base: Path | None, *, top: bool = True) -> None:
         """Read scenario YAML ``text``; ``name`` labels it in messages, ``base`` resolves includes."""
@@ -324,7 +317,7 @@ def document_from_dict(data: dict, *, name: str | None = None, game_dir: str | o
     """
     label = name or str(data.get("name", "scenario"))
     try:
-        text = yaml.safe_dump(_plain_keys(data), sort_keys=False, default_flow_style=False, width=10_000)
+        text = yaml.safe_dump(plain_scenario_dict(data, label), sort_keys=False, default_flow_style=False, width=10_000)
     except yaml.YAMLError as exc:  # RepresenterError: an object YAML cannot write
         found = exc.args[1] if len(exc.args) > 1 else exc
         raise ScenarioError(
@@ -338,12 +331,44 @@ def document_from_dict(data: dict, *, name: str | None = None, game_dir: str | o
     return loader.spec
 
 
-def _plain_keys(value: object) -> object:
-    """Make a dict dumpable: tuple keys ``(0, 1)`` become ``"0, 1"``, numpy values Python ones."""
-    if isinstance(value, dict):
-        return {(", ".join(str(p) for p in k) if isinstance(k, tuple) else k): _plain_keys(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_plain_keys(v) for v in value]
+#: How deep a scenario given as a dict may nest: the deepest shipped one nests 5 levels.
+MAX_DICT_DEPTH = 100
+
+
+def plain_scenario_dict(data: Mapping, label: str = "scenario") -> dict:
+    """Copy a scenario given as a dict into plain values YAML can write, checking its shape.
+
+    Tuple keys ``(0, 1)`` become ``"0, 1"``, numpy values Python ones.
+
+    Raises:
+        ScenarioError: The dict contains itself, or nests deeper than :data:`MAX_DICT_DEPTH`
+            (either would exhaust Python's stack while it is read).
+    """
+    return _plain_keys(data, label, 0, set())  # type: ignore[return-value]
+
+
+def _plain_keys(value: object, label: str, depth: int, path: set[int]) -> object:
+    if isinstance(value, (Mapping, list, tuple)):
+        if id(value) in path:
+            raise ScenarioError(
+                f"scenario {label!r}: expected a tree of plain values; found a dict or list that contains itself. "
+                "Pass a copy without the loop"
+            )
+        if depth >= MAX_DICT_DEPTH:
+            raise ScenarioError(
+                f"scenario {label!r}: expected dicts and lists nested at most {MAX_DICT_DEPTH} deep; found deeper "
+                "ones. A scenario nests a few levels: check what was passed"
+            )
+        path.add(id(value))
+        try:
+            if isinstance(value, Mapping):
+                return {
+                    (", ".join(str(p) for p in k) if isinstance(k, tuple) else k): _plain_keys(v, label, depth + 1, path)
+                    for k, v in value.items()
+                }
+            return [_plain_keys(v, label, depth + 1, path) for v in value]
+        finally:
+            path.discard(id(value))
     if isinstance(value, (np.generic, np.ndarray)):  # np.int64(3), np.array([0, 0, 320, 224])
-        return _plain_keys(value.tolist())
+        return _plain_keys(value.tolist(), label, depth, path)
     return value

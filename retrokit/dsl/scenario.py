@@ -20,7 +20,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from retrokit.dsl.compiler import Program
-from retrokit.dsl.document import document_from_dict, load_document
+from retrokit.dsl.document import document_from_dict, load_document, plain_scenario_dict
 from retrokit.dsl.gymretro import is_gym_retro, spec_from_json, spec_from_json_dict
 from retrokit.dsl.spec import ScenarioSpec
 from retrokit.errors import InvalidArgumentError, ScenarioError, shown
@@ -139,7 +139,7 @@ def load_scenario(
         InvalidArgumentError: ``source`` is neither a path nor a dict.
     """
     if isinstance(source, Mapping):
-        data = dict(source)
+        data = plain_scenario_dict(source, name or "scenario")  # first: a dict containing itself stops here
         if is_gym_retro(data):
             spec = spec_from_json_dict(data, fields, name=name or "scenario")
         else:

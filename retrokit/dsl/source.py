@@ -16,7 +16,7 @@ import bisect
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from retrokit.errors import RetrokitError, ScenarioError
+from retrokit.errors import FileSystemError, RetrokitError, ScenarioError
 
 
 @dataclass(frozen=True)
@@ -138,28 +138,23 @@ def located(cls: type[RetrokitError], source: SourceText, start: int, end: int, 
 
 
 
-#: The largest scenario file read: the shipped ones are a few kilobytes, and YAML
-#: takes tens of times a file's size in memory.
-MAX_SOURCE_BYTES = 4 * 2**20
-
-
 def read_source(path: Path) -> SourceText:
     """Read a scenario file as UTF-8 text (a leading byte-order mark is allowed).
 
+    The file is read by :func:`retrokit.paths.read_regular_file`, with the size
+    cap of every YAML file: a FIFO, a device or a symlink loop is an error.
+
     Raises:
-        ScenarioError: The file cannot be read, or is not UTF-8; the error
-            points at the first byte that is not.
+        ScenarioError: The file cannot be read, is not a regular file, is too
+            large, or is not UTF-8; the error points at the first byte that is not.
     """
+    from retrokit.data.yamlfile import MAX_YAML_BYTES
+    from retrokit.paths import read_regular_file
+
     try:
-        with path.open("rb") as file:
-            data = file.read(MAX_SOURCE_BYTES + 1)  # never more: a scenario is a few kilobytes
-    except OSError as exc:
-        raise ScenarioError(f"cannot read scenario file {str(path)!r}: {exc.strerror or exc}") from None
-    if len(data) > MAX_SOURCE_BYTES:
-        raise ScenarioError(
-            f"{path}: expected a scenario file of at most {MAX_SOURCE_BYTES // 2**20} MiB, got a larger one; "
-            f"is it the right file?"
-        )
+        data = read_regular_file(path, "a scenario file", MAX_YAML_BYTES)
+    except FileSystemError as exc:
+        raise ScenarioError(str(exc)) from None
     try:
         return SourceText(str(path), data.decode("utf-8-sig"))
     except UnicodeDecodeError as exc:

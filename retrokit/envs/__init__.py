@@ -1,12 +1,19 @@
-"""The env layer: games as Gymnasium and PettingZoo environments.
+"""The env layer: games as Gymnasium and PettingZoo environments, and the window to play them by hand.
 
-- ``env``: :class:`RetroEnv` and ``make``, one game as a Gymnasium env.
-- ``stepper``: one episode's steps, shared by the env and the vector env.
-- ``vector``: many envs stepped in one native call.
-- ``multiplayer``: PettingZoo envs for two-player games.
-- ``sonic``: the Sonic benchmark preset.
-- ``options``: checking what ``make`` is given; ``compat``: stable-retro's
-  conveniences on :class:`RetroEnv`.
-- ``actions``, ``buffers``, ``viewer``, ``registration``: action spaces, reusable
-  arrays, the ``human`` window, Gymnasium ids.
+On the host, data and scenario layers; the movie, testing, benchmark and
+command layers build on it. One module a concern:
+
+- ``env``: :class:`~retrokit.envs.env.RetroEnv` and ``make``, one game as a
+  Gymnasium env; ``options``: checking every keyword ``make`` takes before
+  anything is built; ``compat``: stable-retro's conveniences, for ported code.
+- ``stepper``: one episode's steps (buttons, frames, fields, scenario), shared
+  by the env and the vector env, with observers (movie recording).
+- ``vector``: many envs stepped in one native call (``make_vec``).
+- ``multiplayer``: PettingZoo parallel and AEC envs for two-player games.
+- ``sonic``: the Sonic benchmark preset; ``registration``: the Gymnasium ids
+  of every game and Sonic level.
+- ``actions``: action spaces to button masks; ``buffers``: reusable
+  observation arrays; ``viewer``: the ``human`` render window.
+- ``play``: ``retrokit play``, a game played by hand, saving states and
+  recording movies.
 """

@@ -23,6 +23,7 @@ import numpy as np
 from retrokit.data.games import Game
 from retrokit.envs.actions import ACTION_TYPES
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean, shown
+from retrokit.paths import writable_folder
 
 #: The native host counts frames in a C int.
 MAX_FRAMESKIP = 2**31 - 1
@@ -93,8 +94,13 @@ def _choice(name: str, choices: tuple[str, ...], optional: bool = False) -> Call
 
 
 def _record(value: object) -> str | os.PathLike[str] | None:
-    if value is None or (isinstance(value, (str, os.PathLike)) and str(value)):
-        return value  # type: ignore[return-value]
+    if value is None:
+        return None
+    if isinstance(value, (str, os.PathLike)) and os.fspath(value):
+        # Made and tried now, not at the first reset(): a file in the way, a name too long, a NUL byte or a
+        # folder that cannot be written is an error where the folder was given.
+        writable_folder(os.fspath(value), "to record movies into (make()'s record=)")
+        return value
     raise InvalidArgumentError(
         f"Expected record to be a folder path (str or os.PathLike) or None, got {shown(value)}; "
         f"pass e.g. record='movies'."

@@ -28,6 +28,7 @@ movie retrokit accepts plays the same in both.
 from __future__ import annotations
 
 import datetime
+import errno
 import io
 import os
 import re
@@ -82,6 +83,9 @@ def read_bk2(path: str | os.PathLike[str]) -> Movie:
         raise MovieError(f"Expected a .bk2 movie at {path}; found no such file.") from None
     except IsADirectoryError:
         raise MovieError(f"Expected a .bk2 movie at {path}; found a folder.") from None
+    except OSError as exc:  # a symlink loop, no permission, a failing disk
+        found = "a symlink loop" if exc.errno == errno.ELOOP else f"it cannot be read: {exc.strerror or exc}"
+        raise MovieError(f"Expected a .bk2 movie at {path}; found {found}.") from None
     except (zipfile.BadZipFile, zlib.error, EOFError) as exc:
         raise MovieError(
             f"{path}: expected a .bk2 movie, which is a zip file; found a file that is not a complete zip "

@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import os
+import sys
 import threading
+import time
+import weakref
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Self
@@ -13,6 +16,7 @@ from retrokit.data.states import StateRecord
 from retrokit.errors import FileConflictError, FileSystemError, MovieError, RetrokitError
 from retrokit.movie.bk2 import write_bk2
 from retrokit.movie.model import STATE_DIGEST, Movie, layout
+from retrokit.paths import ensure_folder
 
 _claims: dict[tuple[Path, str], int] = {}
 _reserved: set[Path] = set()
@@ -78,6 +82,45 @@ def state_header(game: str, state: bytes) -> dict[str, str]:
     return {"SHA1": record.rom_sha1, STATE_DIGEST: record.sha256}
 
 
+#: How often, in seconds of wall-clock time, a recording movie is written out whole while it records.
+FLUSH_SECONDS = 1.0
+#: Frames between two looks at the clock (one look a frame would cost more than the check is worth).
+_CLOCK_EVERY = 64
+
+
+class _MovieFile:
+    """Where a recording movie goes, and what was written of it: shared with the recorder's finalizer.
+
+    Kept apart from :class:`MovieRecorder` so that the finalizer which writes
+    the movie at exit, or when a recorder is dropped unclosed, holds no
+    reference to the recorder itself.
+    """
+
+    def __init__(self, path: Path, movie: Movie, overwrite: bool) -> None:
+        self.path = path
+        self.movie = movie
+        self.overwrite = overwrite
+        self.written: int | None = None  # frames in the file; None: nothing written yet
+        self.pid = os.getpid()  # a forked child must not write its parent's movie
+
+    def write(self) -> None:
+        """Write the movie whole, as it is now, replacing what this recorder wrote before (atomically)."""
+        reserved = _is_reservation(self.path)
+        write_bk2(self.path, self.movie, overwrite=self.overwrite or reserved or self.written is not None)
+        if reserved:
+            _reserved.discard(self.path.resolve())
+        self.written = len(self.movie.frames)
+
+    def write_at_exit(self) -> None:
+        """The finalizer: complete the movie of a script that exits, or drops its recorder, without close()."""
+        if os.getpid() != self.pid:
+            return
+        try:
+            self.write()
+        except (RetrokitError, OSError) as exc:  # at exit there is no caller to raise to: say it once
+            print(f"retrokit: the movie {self.path} could not be written at exit: {exc}", file=sys.stderr)
+
+
 class MovieRecorder:
     """Collects the buttons of every emulated frame, and writes the movie on :meth:`close`.
 
@@ -85,6 +128,13 @@ class MovieRecorder:
     (after sticky actions), starting from ``start_state``; then the movie replays
     exactly. stable-retro's own recordings begin with the frame its ``reset``
     runs with no buttons pressed.
+
+    Nothing recorded is lost to a process that ends badly: while it records,
+    the movie is written out whole (atomically, so the file is always a
+    playable movie) every :data:`FLUSH_SECONDS`, so a process killed with
+    SIGKILL leaves a movie of all but its last second; and a script that exits,
+    or drops the recorder, without :meth:`close` gets its movie written whole
+    by a finalizer.
 
     Args:
         path: The ``.bk2`` file to write.
@@ -109,10 +159,10 @@ class MovieRecorder:
         *,
         overwrite: bool = False,
     ) -> None:
-        self.path = Path(path)
-        if not overwrite and self.path.exists() and not _is_reservation(self.path):  # fail before the episode
+        path = Path(path)
+        if not overwrite and path.exists() and not _is_reservation(path):  # fail before the episode
             raise FileConflictError(
-                f"Expected no file at {self.path} to record a movie into; found one. "
+                f"Expected no file at {path} to record a movie into; found one. "
                 "Delete it, choose another name, or pass overwrite=True to replace it."
             )
         self.movie = Movie(game, system, players, start_state)
@@ -120,8 +170,20 @@ class MovieRecorder:
             self.movie.header.update(state_header(self.movie.game, start_state))
         self._layout = layout(self.movie.system)
         self._players = self.movie.players
-        self._overwrite = overwrite
+        self._file = _MovieFile(path, self.movie, overwrite)
+        self._finalizer = weakref.finalize(self, self._file.write_at_exit)
+        self._next_flush = time.monotonic() + FLUSH_SECONDS
         self._closed = False
+
+    @property
+    def path(self) -> Path:
+        """The ``.bk2`` file the movie goes to."""
+        return self._file.path
+
+    @path.setter
+    def path(self, path: Path) -> None:
+        self._file.path = Path(path)
+        self._file.written = None  # nothing of this recording is at the new path yet
 
     def record(self, masks: Sequence[int]) -> None:
         """Append one frame: one RetroPad bit mask per port.
@@ -136,14 +198,27 @@ class MovieRecorder:
         if self._closed:
             raise MovieError(f"Expected an open recorder; found it closed after writing {self.path}. Make a new one.")
         frame = tuple(int(m) for m in masks[: self._players])
-        where = f"{self.path} frame {len(self.movie.frames)}"
+        frames = self.movie.frames
         if len(frame) < self._players or any(int(m) for m in masks[self._players :]):
             raise MovieError(
-                f"{where}: expected {self._players} mask(s), one per player, then only zeros; found {list(masks)!r}."
+                f"{self.path} frame {len(frames)}: expected {self._players} mask(s), one per player, then only "
+                f"zeros; found {list(masks)!r}."
             )
         if any(m < 0 or m & ~self._layout.allowed for m in frame):
-            self._layout.check_frame(frame, self._players, where)  # raises, naming the button
-        self.movie.frames.append(frame)
+            self._layout.check_frame(frame, self._players, f"{self.path} frame {len(frames)}")  # raises, naming it
+        frames.append(frame)
+        if len(frames) % _CLOCK_EVERY == 0 and time.monotonic() >= self._next_flush:
+            self.flush()
+
+    def flush(self) -> None:
+        """Write the movie recorded so far (a playable movie, replaced atomically by later writes and by close).
+
+        Raises:
+            FileConflictError: A different file appeared at the path meanwhile.
+        """
+        if not self._closed and len(self.movie.frames) != self._file.written:
+            self._file.write()
+        self._next_flush = time.monotonic() + FLUSH_SECONDS
 
     def __len__(self) -> int:
         """How many frames have been recorded."""
@@ -161,10 +236,8 @@ class MovieRecorder:
             FileConflictError: A different file appeared at the path meanwhile.
         """
         if not self._closed:
-            reserved = _is_reservation(self.path)
-            write_bk2(self.path, self.movie, overwrite=self._overwrite or reserved)
-            if reserved:
-                _reserved.discard(self.path.resolve())
+            self._file.write()
+            self._finalizer.detach()
             self._closed = True
         return self.path
 
@@ -206,7 +279,7 @@ class EpisodeMovies:
     def start(self) -> None:
         """Begin an episode's movie, ending the last one if it is still open."""
         self.end()
-        self.folder.mkdir(parents=True, exist_ok=True)
+        ensure_folder(self.folder, "to record movies into")
         self.recorder = MovieRecorder(claim_movie_path(self.folder, self.stem), *self._movie)
 
     def frames(self, first: tuple[int, ...], applied: tuple[int, ...], count: int) -> None:

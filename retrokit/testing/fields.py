@@ -55,24 +55,43 @@ def check_fields(game: Game, report: GameReport, space: AddressSpace | None, whe
                    f"(fields {', '.join(names)}); check the byte order and width")
     else:
         report.add("type codes", PASS, f"{len(fields)} fields with valid type codes")
-    pairs = overlaps(fields)
-    for a, b in pairs:
-        report.add("field overlap", WARN, f"{_span(a)} and {_span(b)} share bytes; if not meant, fix an address")
-    if not pairs:
+    groups = overlaps(fields)
+    for group in groups:
+        shown = [_span(spec) for spec in group[:MAX_NAMED]]
+        more = f" and {len(group) - MAX_NAMED} more fields" if len(group) > MAX_NAMED else ""
+        names = f"{', '.join(shown[:-1])} and {shown[-1]}" if not more else f"{', '.join(shown)}{more}"
+        report.add("field overlap", WARN, f"{names} share bytes; if not meant, fix an address")
+    if not groups:
         report.add("field overlap", PASS, "no two fields share a byte")
 
 
-def overlaps(fields: Mapping[str, FieldSpec]) -> list[tuple[FieldSpec, FieldSpec]]:
-    """Return the pairs of fields whose bytes overlap, in address order."""
+#: The most fields one overlap warning names; the rest are counted.
+MAX_NAMED = 8
+
+
+def overlaps(fields: Mapping[str, FieldSpec]) -> list[list[FieldSpec]]:
+    """Return the groups of fields whose bytes overlap, in address order.
+
+    A group is a run of fields, sorted by address, each starting before an
+    earlier one of the run ends: one sweep, so that many fields at one address
+    cost one group, not a pair for every two of them.
+    """
     specs = sorted(fields.values(), key=lambda f: (f.address, f.name))
-    found = []
-    for i, a in enumerate(specs):
-        end = a.address + a.field_type.width
-        for b in specs[i + 1 :]:
-            if b.address >= end:
-                break
-            found.append((a, b))
-    return found
+    groups: list[list[FieldSpec]] = []
+    run: list[FieldSpec] = []
+    end = -1
+    for spec in specs:
+        stop = spec.address + spec.field_type.width
+        if run and spec.address < end:
+            run.append(spec)
+            end = max(end, stop)
+        else:
+            if len(run) > 1:
+                groups.append(run)
+            run, end = [spec], stop
+    if len(run) > 1:
+        groups.append(run)
+    return groups
 
 
 def _span(spec: FieldSpec) -> str:

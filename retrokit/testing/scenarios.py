@@ -164,14 +164,14 @@ def smoke_run(game: Game, state: str, scenario: Path, *, frames: int = SMOKE_FRA
 
     The run stops at done, and at the first error (recorded, not raised).
     """
-    import retrokit
+    from retrokit.envs.env import make  # the env layer's make, not the root package's: testing sits below it
 
     run = SmokeRun()
     env = None
     step = 0
     try:
-        env = retrokit.make(game, state, str(scenario), obs_type="ram", frameskip=SMOKE_FRAMESKIP,
-                            sticky_prob=0.25, players=game.players, action_type="all")
+        env = make(game, state, str(scenario), obs_type="ram", frameskip=SMOKE_FRAMESKIP,
+                   sticky_prob=0.25, players=game.players, action_type="all")
         env.action_space.seed(seed)
         obs, _ = env.reset(seed=seed)
         action = env.action_space.sample()

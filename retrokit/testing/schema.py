@@ -8,6 +8,7 @@ schema here: their loader checks them.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from retrokit.data.games import Game
@@ -20,7 +21,8 @@ __all__ = ["check_schemas"]
 def check_schemas(game: Game, report: GameReport) -> bool:
     """Check the game's YAML files against their schemas; add the results; return whether its game.yaml files conform."""
     ok = True
-    data_files = [folder / "game.yaml" for folder in game.folders if (folder / "game.yaml").is_file()]
+    # lexists, not is_file: an overlay game.yaml that is a FIFO, a folder or a loop fails here, not silently skipped
+    data_files = [folder / "game.yaml" for folder in game.folders if os.path.lexists(folder / "game.yaml")]
     for path in data_files:
         ok = _check(report, path, "game", "") and ok
     if not data_files:
@@ -56,11 +58,14 @@ def _includes(path: Path) -> list[Path]:
     """The files a scenario includes (directly), as far as it can be read."""
     import yaml
 
+    from retrokit.data.yamlfile import load_yaml, read_yaml_text
+
     try:
-        doc = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, yaml.YAMLError):
+        doc = load_yaml(read_yaml_text(path, "a scenario file"))
+    except (OSError, UnicodeDecodeError, yaml.YAMLError):  # the scenario's own check reports it
         return []
     names = doc.get("include") if isinstance(doc, dict) else None
     if not isinstance(names, list):
         return []
-    return [path.parent / str(n) for n in names if (path.parent / str(n)).is_file()]
+    # lexists: an include that is a FIFO or a loop is checked, and fails, instead of being skipped
+    return [path.parent / str(n) for n in names if os.path.lexists(path.parent / str(n))]

@@ -264,7 +264,7 @@ def _copies_elsewhere(game: Game, names: Sequence[str]) -> dict[str, str]:
                 except OSError:
                     continue
                 for entry in entries:
-                    if entry.name.endswith(".state") and entry.is_file():
+                    if entry.name.endswith(".state") and _is_file(entry):
                         by_size.setdefault(entry.stat().st_size, []).append((other.name, Path(entry.path)))
         _state_index.clear()
         _state_index[key] = by_size
@@ -272,6 +272,8 @@ def _copies_elsewhere(game: Game, names: Sequence[str]) -> dict[str, str]:
     found = {}
     for name in names:
         path = game.state_path(name)
+        if not path.is_file():  # a FIFO, a device or a loop: its own check says so
+            continue
         size = path.stat().st_size
         others = [(g, p) for g, p in by_size.get(size, []) if g != game.name]
         if not others:
@@ -284,7 +286,17 @@ def _copies_elsewhere(game: Game, names: Sequence[str]) -> dict[str, str]:
     return found
 
 
+def _is_file(entry: os.DirEntry[str]) -> bool:
+    try:
+        return entry.is_file()
+    except OSError:  # a symlink loop is no state file
+        return False
+
+
 def _sha1(path: Path) -> str:
-    return hashlib.sha1(path.read_bytes()).hexdigest()
+    from retrokit.data.states import MAX_STATE_FILE_SIZE
+    from retrokit.paths import read_regular_file
+
+    return hashlib.sha1(read_regular_file(path, "a save state file", MAX_STATE_FILE_SIZE)).hexdigest()
 
 

@@ -1,0 +1,215 @@
+"""Hostile game folders through ``validate``, ``make`` and ``import retrokit``: a failed check or one line of error.
+
+Each case builds a copy of Dasher's folder with one file made hostile (an alias
+bomb, a FIFO, a link to /dev/zero, a symlink loop, 100,000 fields at one
+address), and runs the tool in a child process under a timeout and an address
+space limit, so a regression fails the test instead of hanging the suite. The
+child's peak memory is held to the 500 MB every input must stay under.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+from childproc import MAX_RSS_MB, run_child, run_cli
+
+DASHER = Path(__file__).resolve().parent.parent / "games" / "Dasher-Genesis"
+GAME_YAML = (DASHER / "game.yaml").read_text().partition("\nmovies:")[0] + "\n"  # no movies: quick to check
+
+
+def _alias_bomb(key: str = "x-bomb") -> str:
+    """Ten lines of YAML standing for 10**9 values: each list holds the one above it ten times."""
+    lines = [f"{key}:", "  a0: &a0 [x, x, x, x, x, x, x, x, x, x]"]
+    lines += [f"  a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 10)}]" for i in range(1, 9)]
+    return "\n".join(lines) + "\n"
+
+
+def dasher_copy(root: Path, name: str = "Dasher-Genesis") -> Path:
+    """A copy of Dasher's folder (game.yaml without movies, the default scenario, one state, the ROM)."""
+    folder = root / name
+    folder.mkdir(parents=True)
+    (folder / "game.yaml").write_text(GAME_YAML.replace("states:\n  default: Zone1.Act1\n  by_players: "
+                                                        "[Zone1.Act1, Zone1.Act1.2P]", "states:\n  default: Zone1.Act1"))
+    for file in ("scenario.yaml", "Zone1.Act1.state", "rom.md"):
+        shutil.copy(DASHER / file, folder / file)
+    return folder
+
+
+def _validate(folder: Path, tmp_path: Path) -> tuple[list[dict], object]:
+    out = tmp_path / "report.json"
+    child = run_cli(["validate", str(folder), "--frames", "5", "-q", "--json", str(out)], timeout=120, cwd=tmp_path)
+    assert child.signal is None and child.peak_rss_mb < MAX_RSS_MB, child.describe()
+    assert out.is_file(), f"validate wrote no report:\n{child.describe()}"
+    assert "Traceback" not in child.stderr, child.describe()
+    return json.loads(out.read_text())["games"][0]["results"], child
+
+
+def _fifo(path: Path) -> None:
+    path.unlink(missing_ok=True)
+    os.mkfifo(path)
+
+
+def _dev_zero(path: Path) -> None:
+    path.unlink(missing_ok=True)
+    path.symlink_to("/dev/zero")
+
+
+def _loop(path: Path) -> None:
+    path.unlink(missing_ok=True)
+    path.symlink_to(path.name)  # relative: the link names itself
+
+
+SPECIAL: dict[str, Callable[[Path], None]] = {"fifo": _fifo, "link-to-dev-zero": _dev_zero, "symlink-loop": _loop}
+#: What the report names for each special file.
+FOUND = {"fifo": "found a FIFO", "link-to-dev-zero": "found a device", "symlink-loop": "found a symlink loop"}
+
+
+@pytest.mark.parametrize("special", list(SPECIAL), ids=list(SPECIAL))
+@pytest.mark.parametrize("file", ["scenario.yaml", "extra.yaml", "Zone1.Act1.state"])
+def test_an_unreadable_file_in_a_game_folder_is_a_failed_check(tmp_path: Path, file: str, special: str) -> None:
+    folder = dasher_copy(tmp_path / "games")
+    SPECIAL[special](folder / file)
+    results, child = _validate(folder, tmp_path)
+    failed = [r for r in results if r["status"] == "fail"]
+    assert any(FOUND[special] in r["message"] and file in r["message"] for r in failed), child.describe()
+
+
+@pytest.mark.parametrize("special", list(SPECIAL), ids=list(SPECIAL))
+def test_an_unreadable_solution_movie_is_a_failed_check(tmp_path: Path, special: str) -> None:
+    folder = dasher_copy(tmp_path / "games")
+    (folder / "movies").mkdir()
+    (folder / "game.yaml").write_text(GAME_YAML + "movies:\n  Zone1.Act1: {done_at: 621, reward: 3552}\n")
+    SPECIAL[special](folder / "movies" / "Zone1.Act1.bk2")
+    results, child = _validate(folder, tmp_path)
+    movie = [r for r in results if r["check"] == "movie"]
+    assert [r["status"] for r in movie] == ["fail"], child.describe()
+    assert FOUND[special] in movie[0]["message"] and "Zone1.Act1.bk2" in movie[0]["message"], child.describe()
+
+
+@pytest.mark.parametrize("special", list(SPECIAL), ids=list(SPECIAL))
+def test_an_unreadable_game_yaml_fails_the_data_check(tmp_path: Path, special: str) -> None:
+    folder = dasher_copy(tmp_path / "games")
+    SPECIAL[special](folder / "game.yaml")
+    results, child = _validate(folder, tmp_path)
+    data = [r for r in results if r["check"] == "data file"]
+    assert data and data[0]["status"] == "fail" and FOUND[special] in data[0]["message"], child.describe()
+
+
+OVERLAYS = {"fifo": _fifo, "folder": lambda p: p.mkdir(), "symlink-loop": _loop}
+
+
+@pytest.mark.parametrize("overlay", list(OVERLAYS), ids=list(OVERLAYS))
+def test_an_overlay_game_yaml_that_cannot_be_read_is_said_not_skipped(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, overlay: str
+) -> None:
+    """A game.yaml in a folder searched first is the game's data file: one that is no file is an error."""
+    overlay_folder = tmp_path / "first" / "Dasher-Genesis"
+    overlay_folder.mkdir(parents=True)
+    OVERLAYS[overlay](overlay_folder / "game.yaml")
+    monkeypatch.setenv("RETROKIT_GAMES", str(tmp_path / "first"))
+    results, child = _validate(Path("Dasher-Genesis"), tmp_path)
+    data = [r for r in results if r["check"] == "data file"]
+    assert data and data[0]["status"] == "fail", child.describe()
+    assert str(overlay_folder / "game.yaml") in data[0]["message"], child.describe()
+    child = run_child("import retrokit\nretrokit.make('Dasher-Genesis')", timeout=60)
+    last = child.stderr.strip().splitlines()[-1]
+    assert child.returncode != 0 and str(overlay_folder / "game.yaml") in last, child.describe()
+
+
+def test_a_game_folder_linking_to_itself_breaks_no_command(tmp_path: Path) -> None:
+    games = tmp_path / "games"
+    games.mkdir()
+    (games / "Loop-Genesis").symlink_to("Loop-Genesis")
+    child = run_cli(["games"], env={"RETROKIT_GAMES": str(games)}, timeout=60)
+    assert child.returncode == 0 and "Dasher-Genesis" in child.stdout, child.describe()
+
+
+def test_an_alias_bomb_in_game_yaml_is_refused_quickly(tmp_path: Path) -> None:
+    folder = dasher_copy(tmp_path / "games")
+    (folder / "game.yaml").write_text(GAME_YAML + _alias_bomb())
+    assert (folder / "game.yaml").stat().st_size - len(GAME_YAML) < 1024
+    results, child = _validate(folder, tmp_path)
+    failed = [r for r in results if r["status"] == "fail"]
+    assert any("aliases (*name) to add at most" in r["message"] for r in failed), child.describe()
+    child = run_child(f"import retrokit\nretrokit.make({str(folder)!r})", timeout=60)
+    last = child.stderr.strip().splitlines()[-1]
+    assert "DataFileError" in last and "aliases (*name) to add at most" in last, child.describe()
+
+
+def test_a_hundred_thousand_fields_at_one_address_give_one_warning() -> None:
+    """The overlap check sweeps once: 100,000 fields at one address are one group, not 5 billion pairs.
+
+    (A game.yaml of 100,000 fields is near the 4 MiB a YAML file may hold, and
+    takes a minute to parse on a loaded machine, so the check is run on the
+    fields directly.)
+    """
+    child = run_child(
+        """
+        from types import SimpleNamespace
+        from retrokit.data.games import find_game
+        from retrokit.host.fields import FieldSpec
+        from retrokit.testing.fields import check_fields
+        from retrokit.testing.report import GameReport
+
+        fields = {f"f{i}": FieldSpec(f"f{i}", 0xFF0000, "|u1") for i in range(100_000)}
+        game = SimpleNamespace(fields=fields, system=find_game("Dasher-Genesis").system)
+        report = GameReport("many")
+        check_fields(game, report, None)
+        for result in report.find("field overlap"):
+            print(result.status, result.message)
+        """,
+        timeout=120,
+    )
+    assert child.returncode == 0 and child.peak_rss_mb < MAX_RSS_MB, child.describe()
+    lines = child.stdout.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("warn f0 (0xff0000), f1 (0xff0000), f10 (0xff0000)"), child.describe()
+    assert lines[0].endswith("and 99992 more fields share bytes; if not meant, fix an address"), child.describe()
+
+
+MOVIE_ENTRIES = {
+    "without-reward": ("{done_at: 621}", "to have a 'reward'"),
+    "reward-is-a-word": ("{done_at: 621, reward: abc}", "a finite number as 'reward'"),
+    "entry-is-a-list": ("[621, 3552]", "to have the form {done_at: F, reward: R}"),
+    "tolerance-is-nan": ("{done_at: 621, reward: 1, tolerance: .nan}", "a finite number as 'tolerance'"),
+    "done-at-is-a-word": ("{done_at: soon, reward: 1}", "a frame number (1 or more) or null"),
+}
+
+
+@pytest.mark.parametrize("case", list(MOVIE_ENTRIES), ids=list(MOVIE_ENTRIES))
+def test_a_malformed_movies_entry_is_a_failed_check(tmp_path: Path, case: str) -> None:
+    entry, message = MOVIE_ENTRIES[case]
+    folder = dasher_copy(tmp_path / "games")
+    (folder / "movies").mkdir()
+    shutil.copy(DASHER / "movies" / "Zone1.Act1.bk2", folder / "movies" / "Zone1.Act1.bk2")
+    (folder / "game.yaml").write_text(GAME_YAML + f"movies:\n  Zone1.Act1: {entry}\n")
+    results, child = _validate(folder, tmp_path)
+    movie = [r for r in results if r["check"] == "movie"]
+    assert [r["status"] for r in movie] == ["fail"] and message in movie[0]["message"], child.describe()
+
+
+def test_a_nan_tolerance_no_longer_passes_a_wrong_reward(tmp_path: Path) -> None:
+    """The control: a finite tolerance and a wrong reward fail, as NaN's must too (above)."""
+    folder = dasher_copy(tmp_path / "games")
+    (folder / "movies").mkdir()
+    shutil.copy(DASHER / "movies" / "Zone1.Act1.bk2", folder / "movies" / "Zone1.Act1.bk2")
+    (folder / "game.yaml").write_text(GAME_YAML + "movies:\n  Zone1.Act1: {done_at: 621, reward: 1}\n")
+    results, child = _validate(folder, tmp_path)
+    movie = [r for r in results if r["check"] == "movie"]
+    assert [r["status"] for r in movie] == ["fail"] and "a total reward of 1" in movie[0]["message"], child.describe()
+
+
+def test_a_scenario_whose_integers_grow_fails_its_smoke_run_quickly(tmp_path: Path) -> None:
+    """prev(t, 3) * prev(t, 3) made each step 3 times slower than the last: now step 5 fails, and says why."""
+    folder = dasher_copy(tmp_path / "games")
+    (folder / "growing.yaml").write_text("define:\n  t: prev(t, 3) * prev(t, 3)\nreward: t / 1\n")
+    out = tmp_path / "report.json"
+    child = run_cli(["validate", str(folder), "--frames", "600", "-q", "--json", str(out)], timeout=120, cwd=tmp_path)
+    assert child.signal is None and child.peak_rss_mb < MAX_RSS_MB and out.is_file(), child.describe()
+    smoke = [r for r in json.loads(out.read_text())["games"][0]["results"]
+             if r["check"] == "smoke run" and r["scenario"] == "growing"]
+    assert smoke and all(r["status"] == "fail" and "integers are 64-bit" in r["message"] for r in smoke), child.describe()

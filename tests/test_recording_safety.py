@@ -1,0 +1,147 @@
+"""make(record=...): the folder is checked at make(), and a movie survives a kill or a script that never closes.
+
+Issue 19 section 5. The folder is made and tried when the env is made, so a
+file in the way, a name too long, a NUL byte or a folder under /proc is a
+retrokit error there, not a raw OSError at the first reset(). A recording
+movie is written whole every ``FLUSH_SECONDS``, so a process killed with
+SIGKILL leaves a movie that plays up to about a second before the kill; and a
+finalizer writes the movie of a script that exits without ``env.close()``.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+from childproc import REPO
+
+import retrokit
+from retrokit.errors import FileSystemError, InvalidArgumentError
+from retrokit.movie import play, read_bk2
+from retrokit.movie.recorder import FLUSH_SECONDS, MovieRecorder
+
+BAD_FOLDERS = {
+    "an-existing-file": (lambda tmp: tmp / "afile", FileSystemError, "found a file, not a folder"),
+    "under-a-file": (lambda tmp: tmp / "afile" / "movies", FileSystemError, "parent folders should be"),
+    "a-300-character-name": (lambda tmp: tmp / ("m" * 300), FileSystemError, "File name too long"),
+    "a-folder-under-proc": (lambda tmp: Path("/proc/movies"), FileSystemError, "cannot be made"),
+    "proc-itself": (lambda tmp: Path("/proc"), FileSystemError, "cannot be written"),
+    "a-nul-byte": (lambda tmp: f"{tmp}/mo\0vies", FileSystemError, "holds a NUL byte"),
+    "an-empty-string": (lambda tmp: "", InvalidArgumentError, "Expected record to be a folder path"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_FOLDERS), ids=list(BAD_FOLDERS))
+def test_a_record_folder_that_cannot_take_movies_is_refused_at_make(tmp_path: Path, case: str) -> None:
+    (tmp_path / "afile").write_text("not a folder")
+    folder, error, message = BAD_FOLDERS[case]
+    with pytest.raises(error, match=message) as info:
+        retrokit.make("Dasher-Genesis", record=folder(tmp_path))
+    assert "\n" not in str(info.value)
+    assert (tmp_path / "afile").read_text() == "not a folder"  # the file in the way is left alone
+
+
+def test_the_record_folder_is_made_at_make(tmp_path: Path) -> None:
+    folder = tmp_path / "new" / "movies"
+    env = retrokit.make("Dasher-Genesis", record=folder)
+    try:
+        assert folder.is_dir() and list(folder.iterdir()) == []  # made and tried; the probe file is gone
+    finally:
+        env.close()
+
+
+RECORDING = """
+import sys, time
+import retrokit
+env = retrokit.make("Dasher-Genesis", record={folder!r})
+env.reset(seed=0)
+env.action_space.seed(0)
+recorder = env.unwrapped.movies.recorder
+while True:
+    env.step(env.action_space.sample())
+    print(len(recorder), time.monotonic(), flush=True)
+"""
+
+
+def test_a_movie_survives_sigkill_up_to_about_a_second_before(tmp_path: Path) -> None:
+    folder = tmp_path / "movies"
+    child = subprocess.Popen(
+        [sys.executable, "-c", textwrap.dedent(RECORDING.format(folder=str(folder)))],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO,
+    )
+    reports: list[tuple[int, float]] = []
+    try:
+        assert child.stdout is not None
+        started = None
+        for line in child.stdout:
+            frames, at = line.split()
+            reports.append((int(frames), float(at)))
+            started = started or float(at)
+            if float(at) - started > 3 * FLUSH_SECONDS + 1:  # a few flushes in
+                break
+        killed_at = time.monotonic()
+        child.send_signal(signal.SIGKILL)
+    finally:
+        child.kill()
+        child.wait(timeout=30)
+    assert child.returncode == -signal.SIGKILL, child.stderr.read() if child.stderr else ""
+    movies = sorted(folder.glob("*.bk2"))
+    assert len(movies) == 1 and movies[0].stat().st_size > 0, movies
+    movie = read_bk2(movies[0])
+    # Every frame recorded more than a flush (and a second's slack for a loaded machine) before the kill is there.
+    settled = max((frames for frames, at in reports if at < killed_at - FLUSH_SECONDS - 1), default=0)
+    assert settled > 0 and settled <= len(movie.frames) <= reports[-1][0], (settled, len(movie.frames), reports[-1])
+    assert sum(1 for _ in play(movie)) == len(movie.frames)  # and it plays back, frame for frame
+    assert not [p for p in folder.iterdir() if p.suffix != ".bk2"]  # no temporary file left
+
+
+EXITING = """
+import retrokit
+env = retrokit.make("Dasher-Genesis", record={folder!r})
+env.reset(seed=0)
+env.action_space.seed(0)
+for _ in range(50):
+    env.step(env.action_space.sample())
+print(len(env.unwrapped.movies.recorder))
+{ending}
+"""
+
+
+@pytest.mark.parametrize(
+    "ending",
+    ["", "raise SystemExit(3)", "del env; import gc; gc.collect(); print('dropped')"],
+    ids=["script-ends", "system-exit", "env-dropped"],
+)
+def test_a_script_that_never_closes_its_env_leaves_a_complete_movie(tmp_path: Path, ending: str) -> None:
+    folder = tmp_path / "movies"
+    done = subprocess.run(
+        [sys.executable, "-c", textwrap.dedent(EXITING.format(folder=str(folder), ending=ending))],
+        capture_output=True, text=True, timeout=120, cwd=REPO, check=False,
+    )
+    assert done.returncode in (0, 3) and "Traceback" not in done.stderr, done.stderr
+    recorded = int(done.stdout.split()[0])
+    movies = sorted(folder.glob("*.bk2"))
+    assert len(movies) == 1, movies
+    movie = read_bk2(movies[0])
+    assert recorded >= 50 and len(movie.frames) == recorded  # every frame, not only those of the last flush
+    assert sum(1 for _ in play(movie)) == recorded
+
+
+def test_a_forked_child_does_not_write_its_parents_movie(tmp_path: Path) -> None:
+    recorder = MovieRecorder(tmp_path / "m.bk2", "Dasher-Genesis", "Genesis", 1)
+    recorder.record([0])
+    pid = os.fork()
+    if pid == 0:  # the child exits at once, running its finalizers only if they are its own
+        import atexit
+
+        atexit._run_exitfuncs()
+        os._exit(0)
+    os.waitpid(pid, 0)
+    assert not (tmp_path / "m.bk2").exists()
+    assert recorder.close() == tmp_path / "m.bk2" and len(read_bk2(tmp_path / "m.bk2").frames) == 1

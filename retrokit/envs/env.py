@@ -25,6 +25,7 @@ from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
 from retrokit.envs.compat import StableRetroCompat
 from retrokit.envs.options import check_crop, check_options, make_arguments
+from retrokit.envs.pickling import PicklesAsArguments
 from retrokit.envs.stepper import Stepper, drive
 from retrokit.errors import InvalidArgumentError
 from retrokit.host.emulator import Emulator
@@ -39,7 +40,7 @@ class State(enum.Enum):
     NONE = "none"  #: power on, no state
 
 
-class RetroEnv(StableRetroCompat, gymnasium.Env):
+class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
     """A game as a Gymnasium environment.
 
     Args:
@@ -62,6 +63,10 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
         skip_video: Tell the core that only a step's last frame is seen (none
             with RAM observations and no render mode), so a core that asks
             skips drawing the rest (``retrokit build-core``); False draws all.
+
+    The env pickles as these arguments (see :mod:`retrokit.envs.pickling`):
+    unpickled, it is a fresh env made from them, not yet reset; the
+    emulator's current state and the episode are not carried over.
     """
 
     metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 60}
@@ -84,6 +89,11 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
         options: Mapping[str, str] | None = None,
         skip_video: bool = True,
     ) -> None:
+        PicklesAsArguments.__init__(
+            self, game, state, scenario, obs_type=obs_type, action_type=action_type, frameskip=frameskip,
+            sticky_prob=sticky_prob, max_episode_steps=max_episode_steps, players=players, render_mode=render_mode,
+            record=record, scenario_every_frame=scenario_every_frame, options=options, skip_video=skip_video,
+        )
         checked = check_options(
             {
                 "obs_type": obs_type, "action_type": action_type, "frameskip": frameskip, "sticky_prob": sticky_prob,

@@ -18,6 +18,7 @@ and returns its first observation with reward 0.
 
 from __future__ import annotations
 
+import functools
 import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -29,13 +30,19 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, concatenate, create_empty_array, iterate
 
 from retrokit.envs.buffers import BufferPool, Pool, StepArrays
+from retrokit.envs.pickling import PicklesAsArguments
 from retrokit.envs.stepper import drive
 from retrokit.errors import InvalidArgumentError
 from retrokit.host.runner import Runner
 
 
-class ThreadedVectorEnv(VectorEnv):
+class ThreadedVectorEnv(PicklesAsArguments, VectorEnv):
     """Steps several envs at once, one thread each.
+
+    It pickles as its arguments (see :mod:`retrokit.envs.pickling`), so its
+    ``env_fns`` must pickle for it to: functions of a module, or
+    ``functools.partial`` of them (as :func:`make_vec` gives), not lambdas.
+    Unpickled, it is a fresh vector env made by calling them again.
 
     Args:
         env_fns: Functions that each make one env; all must have the same spaces.
@@ -47,6 +54,7 @@ class ThreadedVectorEnv(VectorEnv):
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP}
 
     def __init__(self, env_fns: Sequence[Callable[[], gymnasium.Env]], threads: int | None = None) -> None:
+        PicklesAsArguments.__init__(self, env_fns, threads)
         if not env_fns:
             raise InvalidArgumentError("Expected at least one env function, got none.")
         if threads is not None and (not isinstance(threads, int) or threads < 1):
@@ -221,10 +229,15 @@ def available_cpus() -> int:
 def make_vec(
     game: str, num_envs: int, state: Any = None, scenario: Any = None, *, threads: int | None = None, **options: Any
 ) -> ThreadedVectorEnv:
-    """Make ``num_envs`` copies of a game's env stepped on threads (one per CPU unless ``threads`` says)."""
+    """Make ``num_envs`` copies of a game's env stepped on threads (one per CPU unless ``threads`` says).
+
+    The vector env pickles as these arguments: unpickled, it is a fresh one
+    made from them (no emulator state or episode carried over).
+    """
     from retrokit.envs.env import State, make
 
     if num_envs < 1:
         raise InvalidArgumentError(f"Expected num_envs of 1 or more, got {num_envs}.")
     start = State.DEFAULT if state is None else state
-    return ThreadedVectorEnv([lambda: make(game, start, scenario, **options) for _ in range(num_envs)], threads)
+    # partials, not lambdas: the vector env pickles as its env functions
+    return ThreadedVectorEnv([functools.partial(make, game, start, scenario, **options)] * num_envs, threads)

@@ -24,9 +24,10 @@ from retrokit.data.statecheck import load_state
 from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
 from retrokit.envs.compat import StableRetroCompat
-from retrokit.envs.options import check_crop, check_options, make_arguments
+from retrokit.envs.options import check_crop, check_options, check_seed, make_arguments
 from retrokit.envs.pickling import PicklesAsArguments
 from retrokit.envs.stepper import Stepper, drive
+from retrokit.envs.viewer import render_modes
 from retrokit.errors import InvalidArgumentError
 from retrokit.host.emulator import Emulator
 from retrokit.host.memory import FieldReader
@@ -69,7 +70,8 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
     emulator's current state and the episode are not carried over.
     """
 
-    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 60}
+    # Each env sets its own: render_fps is its console's frame rate over its frame skip.
+    metadata = {"render_modes": render_modes(), "render_fps": 60}
 
     def __init__(
         self,
@@ -118,6 +120,8 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         self.scenario = self._load_scenario(scenario)
         self.emulator = Emulator(self.game.system, self.game.require_rom(), options=options, ports=max(players, 2))
         self.reader = FieldReader(self.game.fields, self.emulator.space)
+        rate = self.emulator.system.frame_rate(self.emulator.av_info()["fps"])  # the core says NTSC or PAL
+        self.metadata = {"render_modes": render_modes(), "render_fps": rate / frameskip}
         self.actions = ActionMap(self.emulator.system, action_type, getattr(self.scenario, "actions", None), players)
         self.action_space = self.actions.space
         self.stepper = Stepper(
@@ -225,7 +229,7 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
     # --- the Gymnasium API -----------------------------------------------------------------------
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
-        super().reset(seed=seed)
+        super().reset(seed=check_seed(seed))
         self._start()
         self.emulator.forget_action()
         self.emulator.set_sticky(self.sticky_prob, int(self.np_random.integers(0, 2**63)))

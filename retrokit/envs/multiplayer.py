@@ -26,6 +26,7 @@ from pettingzoo.utils.wrappers import OrderEnforcingWrapper
 from retrokit.data.games import find_game
 from retrokit.envs.env import RetroEnv, State
 from retrokit.envs.pickling import PicklesAsArguments
+from retrokit.envs.viewer import render_modes
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean
 
 
@@ -40,7 +41,7 @@ class RetroParallelEnv(PicklesAsArguments, ParallelEnv):
         **options: Other :class:`retrokit.envs.env.RetroEnv` options, except ``players``.
     """
 
-    metadata = {"render_modes": ["rgb_array", "human"], "name": "retrokit_v0", "is_parallelizable": True}
+    metadata = {"render_modes": render_modes(), "name": "retrokit_v0", "is_parallelizable": True}
 
     def __init__(self, game: str, state: Any = State.DEFAULT, scenario: Any = None, **options: Any) -> None:
         PicklesAsArguments.__init__(self, game, state, scenario, **options)
@@ -62,6 +63,7 @@ class RetroParallelEnv(PicklesAsArguments, ParallelEnv):
         self.possible_agents = [f"player_{i + 1}" for i in range(players)]
         self.agents: list[str] = []
         self.render_mode = self._env.render_mode
+        self.metadata = {**self.metadata, **self._env.metadata}  # its frame rate, over its frame skip
         self._obs_space = self._env.observation_space
         self._act_space = self._env.actions.single_player_space()
 

@@ -30,6 +30,7 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, concatenate, create_empty_array, iterate
 
 from retrokit.envs.buffers import BufferPool, Pool, StepArrays
+from retrokit.envs.options import check_seed
 from retrokit.envs.pickling import PicklesAsArguments
 from retrokit.envs.stepper import drive
 from retrokit.errors import InvalidArgumentError
@@ -118,9 +119,16 @@ class ThreadedVectorEnv(PicklesAsArguments, VectorEnv):
         return [done[i] if i in done else futures[i].result() for i in range(self.num_envs)]
 
     def reset(self, *, seed: int | Sequence[int | None] | None = None, options: dict[str, Any] | None = None):
-        seeds = [None if seed is None else seed + i for i in range(self.num_envs)] if not isinstance(seed, Sequence) else list(seed)
-        if len(seeds) != self.num_envs:
-            raise InvalidArgumentError(f"Expected {self.num_envs} seeds, got {len(seeds)}.")
+        if isinstance(seed, (Sequence, np.ndarray)) and not isinstance(seed, str):
+            seeds = [check_seed(s) for s in seed]  # one per env, as Gymnasium's vector envs take them
+            if len(seeds) != self.num_envs:
+                raise InvalidArgumentError(
+                    f"Expected {self.num_envs} seeds (one per env), got {len(seeds)}; pass one int, or a list of "
+                    f"{self.num_envs}."
+                )
+        else:
+            first = check_seed(seed)
+            seeds = [None if first is None else first + i for i in range(self.num_envs)]
         results = self._each(lambda i: self.envs[i].reset(seed=seeds[i], options=options))
         infos: dict[str, Any] = {}
         for i, (_, info) in enumerate(results):

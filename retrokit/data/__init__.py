@@ -7,3 +7,9 @@
 - ``importer``: ``retrokit import``, ROMs found by SHA-1.
 - ``integrate``: making and checking save states from recipes.
 """
+
+from __future__ import annotations
+
+from retrokit.lazy import lazy_names
+
+__getattr__ = lazy_names(__name__)  # its submodules, on first use: retrokit.data.<module>

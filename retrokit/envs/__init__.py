@@ -10,3 +10,9 @@
 - ``actions``, ``buffers``, ``viewer``, ``registration``: action spaces, reusable
   arrays, the ``human`` window, Gymnasium ids.
 """
+
+from __future__ import annotations
+
+from retrokit.lazy import lazy_names
+
+__getattr__ = lazy_names(__name__)  # its submodules, on first use: retrokit.envs.<module>

@@ -8,3 +8,9 @@
 - ``systems`` (with ``systems.yaml``): buttons, RAM layout and core options per console.
 - ``cores``: where each system's libretro core is found.
 """
+
+from __future__ import annotations
+
+from retrokit.lazy import lazy_names
+
+__getattr__ = lazy_names(__name__)  # its submodules, on first use: retrokit.host.<module>

@@ -6,6 +6,7 @@ What users pickle envs for: Gymnasium's AsyncVectorEnv and SuperSuit's
 
 from __future__ import annotations
 
+import copy
 import functools
 import pickle
 
@@ -67,6 +68,15 @@ def test_the_copy_starts_fresh_not_where_the_original_was() -> None:
     assert np.array_equal(obs, first)  # the episode's start, not the original's frame 120
     env.close()
     copy.close()
+
+
+def test_deepcopy_makes_a_fresh_env_too() -> None:
+    # SuperSuit's concat_vec_envs_v1 without num_cpus deep-copies the env it is given.
+    env = retrokit.make(GAME, **RAM)
+    twin = copy.deepcopy(env)
+    assert twin.emulator is not env.emulator and play(twin) == play(env)
+    env.close()
+    twin.close()
 
 
 def test_a_game_object_and_a_scenario_dict_as_arguments_pickle() -> None:

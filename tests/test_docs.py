@@ -164,3 +164,10 @@ def test_the_sb3_agent_file_plays_through_retrokit_evaluate(folders, monkeypatch
 def test_tiny_cuts_only_the_marked_budgets() -> None:
     code = "STEPS = 100_000  # tests: 64\nOTHER = 5\n    ITERATIONS = 10  #tests: 1\n"
     assert tiny(code) == "STEPS = 64\nOTHER = 5\n    ITERATIONS = 1\n"
+
+
+def test_a_recipe_whose_packages_are_missing_says_which_and_how_to_install() -> None:
+    code = "# requires numpy, no_such_package_here: pip install no-such-package\nimport no_such_package_here\n"
+    assert _missing(code) == "needs no_such_package_here: pip install no-such-package"
+    assert _missing("# requires numpy: pip install numpy\nimport numpy\n") is None
+    assert _requires("# requires numpy: pip install numpy; this is agent.py\n")["file"] == "agent.py"

@@ -13,10 +13,7 @@ import importlib.util
 
 import numpy as np
 
-from retrokit.errors import EnvError, MissingExtraError
-
-#: How to install what ``render_mode="human"`` needs.
-HUMAN_INSTALL = "pip install 'retrokit-rl[human]'"
+from retrokit.errors import EnvError, MissingExtraError, install_extra
 
 
 def human_available() -> bool:
@@ -40,7 +37,7 @@ def require_human() -> None:
     """
     if not human_available():
         raise MissingExtraError(
-            f"Expected pygame for render_mode='human', but it is not installed. Install it ({HUMAN_INSTALL}), "
+            f"Expected pygame for render_mode='human', but it is not installed. Install it ({install_extra('human')}), "
             f"or use render_mode='rgb_array'."
         )
 

@@ -24,8 +24,9 @@ serve every layer.
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
+
+from retrokit.lazy import lazy_names
 
 __version__ = "0.1.0"
 
@@ -69,15 +70,7 @@ if TYPE_CHECKING:
     from retrokit.host.emulator import Emulator
 
 
-def __getattr__(name: str) -> Any:
-    if name in _MODULES:
-        value = importlib.import_module(_MODULES[name])
-    elif name in _ATTRIBUTES:
-        value = getattr(importlib.import_module(_ATTRIBUTES[name]), name)
-    else:
-        raise AttributeError(f"module 'retrokit' has no attribute {name!r}")
-    globals()[name] = value  # later lookups skip this function
-    return value
+__getattr__ = lazy_names(__name__, _ATTRIBUTES, _MODULES)  # and every subpackage: retrokit.envs.sonic.make
 
 
 def __dir__() -> list[str]:

@@ -170,6 +170,10 @@ class EnvError(RetrokitError, RuntimeError):
     """An environment was used out of order, e.g. stepped before reset."""
 
 
+class MissingExtraError(RetrokitError, ImportError):
+    """What was asked for needs an optional dependency (an extra, e.g. pygame for a window) that is not installed."""
+
+
 # --- Benchmarks and evaluation -----------------------------------------------------------------
 
 

@@ -15,15 +15,20 @@ BUTTON_DTYPES = [np.int8, np.uint8, np.bool_, np.int16, np.int32, np.int64, np.u
 
 
 def random_actions(actions: ActionMap, rng: np.random.Generator, dtype: type, n: int = 200) -> list[np.ndarray]:
-    """Button arrays of every density, including values other than 0 and 1 where the dtype has them."""
-    out = []
-    for _ in range(n):
-        pressed = rng.random(actions.space.n) < rng.random()
-        values = np.where(pressed, rng.integers(1, 3, actions.space.n), 0)
-        if np.issubdtype(dtype, np.signedinteger) or np.issubdtype(dtype, np.floating):
-            values = values * rng.choice([-1, 1], actions.space.n)
-        out.append(values.astype(dtype))
-    return out
+    """Button arrays of 0s and 1s of every density."""
+    return [(rng.random(actions.space.n) < rng.random()).astype(dtype) for _ in range(n)]
+
+
+def not_binary(dtype: type) -> list[object]:
+    """Values a MultiBinary item of this dtype can hold that are neither 0 nor 1."""
+    values: list[object] = [] if dtype is np.bool_ else [2, 255 if np.dtype(dtype).kind == "u" else 127]
+    if np.dtype(dtype).itemsize > 1 and dtype is not np.bool_:
+        values.append(256)  # only its high byte is set
+    if np.issubdtype(dtype, np.signedinteger) or np.issubdtype(dtype, np.floating):
+        values.append(-1)
+    if np.issubdtype(dtype, np.floating):
+        values += [0.5, np.nan, np.inf]
+    return values
 
 
 @pytest.mark.parametrize("players", [1, 2], ids=["1p", "2p"])
@@ -38,6 +43,25 @@ def test_native_packing_equals_python(action_type: str, dtype: type, players: in
         actions.write_masks(action, out)
         assert out[:players].tolist() == actions.to_masks(action), action
         assert (out[players:] == 0xFFFF).all()  # ports past the players are left alone
+
+
+@pytest.mark.parametrize("action_type", ["all", "filtered"])
+@pytest.mark.parametrize("dtype", [*BUTTON_DTYPES, np.float16], ids=lambda d: np.dtype(d).name)
+def test_items_other_than_0_and_1_are_refused(action_type: str, dtype: type) -> None:
+    actions = ActionMap(GENESIS, action_type, players=2)
+    out = np.zeros(_host.MAX_PORTS, dtype=np.uint16)
+    for value in not_binary(dtype):
+        for position in (0, 23):  # player 1's first button, player 2's last
+            action = np.zeros(24, dtype=dtype)
+            action[position] = value
+            out[:] = 0xFFFF
+            assert _host.pack_buttons(action, 12, out) is False
+            assert (out == 0xFFFF).all()  # nothing written
+            for form in (action, action.tolist()):
+                with pytest.raises(InvalidArgumentError, match="0s and 1s"):
+                    actions.write_masks(form, out)
+            with pytest.raises(InvalidArgumentError, match="0s and 1s"):
+                actions.combine([action[:12], action[12:]])
 
 
 @pytest.mark.parametrize("action_type", ACTION_TYPES)

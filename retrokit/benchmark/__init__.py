@@ -10,3 +10,9 @@ the local processes (:mod:`.local`) or Ray (:mod:`.ray_backend`) carry back to
 and report (:mod:`.report`) and the plots (:mod:`.plots`), beside the paper's
 scores (:mod:`.paper`). ``retrokit evaluate`` is the command line.
 """
+
+from __future__ import annotations
+
+from retrokit.lazy import lazy_names
+
+__getattr__ = lazy_names(__name__)  # its submodules, on first use: retrokit.benchmark.<module>

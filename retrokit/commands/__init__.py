@@ -27,8 +27,13 @@ import importlib
 import pkgutil
 from types import ModuleType
 
+from retrokit.lazy import lazy_names
+
 
 def command_modules() -> list[ModuleType]:
     """Import and return every command module of this package, sorted by module name."""
     names = sorted(info.name for info in pkgutil.iter_modules(__path__) if not info.name.startswith("_"))
     return [importlib.import_module(f"{__name__}.{name}") for name in names]
+
+
+__getattr__ = lazy_names(__name__)  # its submodules, on first use: retrokit.commands.<module>

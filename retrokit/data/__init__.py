@@ -21,3 +21,9 @@ scenario language and the envs. One module a concern:
 - ``integrate``: making and checking save states from game.yaml's recipes.
 - ``sonic_levels``: the levels of the Sonic benchmark.
 """
+
+from __future__ import annotations
+
+from retrokit.lazy import lazy_names
+
+__getattr__ = lazy_names(__name__)  # its submodules, on first use: retrokit.data.<module>

@@ -77,6 +77,11 @@ class Game:
     name: str
     folders: tuple[Path, ...]
 
+    def __reduce__(self) -> tuple[type[Game], tuple[str, tuple[Path, ...]]]:
+        # Pickled as its name and folders (an env's arguments may hold a Game): the data read
+        # on first use is read again, and its read-only views (MappingProxyType) do not pickle.
+        return Game, (self.name, self.folders)
+
     # --- The data file ----------------------------------------------------------------------
 
     @cached_property

@@ -12,6 +12,14 @@ The language is documented in ``docs/scenarios.md``. The pipeline:
 
 from __future__ import annotations
 
-from retrokit.dsl.gymretro import convert_scenario_json
+from typing import TYPE_CHECKING
+
+from retrokit.lazy import lazy_names
+
+if TYPE_CHECKING:
+    from retrokit.dsl.gymretro import convert_scenario_json
 
 __all__ = ["convert_scenario_json"]
+
+# Its submodules too, on first use: the compiler's imports (lark) wait until a scenario needs them.
+__getattr__ = lazy_names(__name__, {"convert_scenario_json": "retrokit.dsl.gymretro"})

@@ -17,3 +17,9 @@ command layers build on it. One module a concern:
 - ``play``: ``retrokit play``, a game played by hand, saving states and
   recording movies.
 """
+
+from __future__ import annotations
+
+from retrokit.lazy import lazy_names
+
+__getattr__ = lazy_names(__name__)  # its submodules, on first use: retrokit.envs.<module>

@@ -116,6 +116,8 @@ class ActionMap:
         joint = np.concatenate(parts)
         if self.action_type == "multi_discrete":
             self._check_choices(joint)  # before the cast, which would turn 1.5 into 1
+        else:
+            self._check_buttons(joint)  # before the cast, which would turn 0.5 into 0 and 256 into 0
         return joint.astype(self.space.dtype)
 
     def _make_filter_table(self) -> np.ndarray:
@@ -139,8 +141,9 @@ class ActionMap:
     def write_masks(self, action: object, out: np.ndarray) -> None:
         """Write one RetroPad mask per player into ``out`` (uint16) for an action of this map's type.
 
-        A button array is packed natively, the common case of every step;
-        anything else goes through :meth:`to_masks`.
+        A button array of 0s and 1s is packed natively, the common case of
+        every step; anything else goes through :meth:`to_masks`, which
+        refuses an item other than 0 or 1.
         """
         if (
             self._packs
@@ -187,6 +190,15 @@ class ActionMap:
                 f"the space is {self.space}."
             )
 
+    def _check_buttons(self, flat: np.ndarray) -> None:
+        """Refuse a button array holding anything but 0s and 1s (2, -1 or 0.5 is no button's state)."""
+        if not ((flat == 0) | (flat == 1)).all():
+            bad = [v for v in flat.tolist() if v not in (0, 1)]
+            raise InvalidArgumentError(
+                f"Expected a MultiBinary action of 0s and 1s (one per button), got {shown(bad[:4])} in it; "
+                f"pass an array like env.action_space.sample()."
+            )
+
     def to_masks(self, action: object) -> list[int]:
         """Return one RetroPad mask per player for an action of this map's type."""
         if self.action_type == "discrete":
@@ -214,6 +226,7 @@ class ActionMap:
                 f"Expected an action of {self._size} buttons ({self.players} player(s) x {self.num_buttons}), got "
                 f"{flat.size} items. Pass an array shaped like env.action_space.sample()."
             )
-        pressed = flat.reshape(self.players, self.num_buttons) != 0
+        self._check_buttons(flat)
+        pressed = flat.reshape(self.players, self.num_buttons) == 1
         masks = (pressed @ self._weights).tolist()  # one bit per button, every player at once
         return [self.filter(m) for m in masks] if self.action_type == "filtered" else masks

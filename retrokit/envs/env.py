@@ -23,8 +23,10 @@ from retrokit.data.resolve import Resolved, State, resolve
 from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
 from retrokit.envs.compat import StableRetroCompat
-from retrokit.envs.options import check_crop, check_options, make_arguments
+from retrokit.envs.options import check_crop, check_options, check_seed, make_arguments
+from retrokit.envs.pickling import PicklesAsArguments
 from retrokit.envs.stepper import Stepper, drive
+from retrokit.envs.viewer import render_modes
 from retrokit.errors import InvalidArgumentError
 from retrokit.host.emulator import Emulator
 from retrokit.host.memory import FieldReader
@@ -33,7 +35,7 @@ from retrokit.movie.recorder import EpisodeMovies
 __all__ = ["RetroEnv", "State", "make"]
 
 
-class RetroEnv(StableRetroCompat, gymnasium.Env):
+class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
     """A game as a Gymnasium environment.
 
     Args:
@@ -58,9 +60,14 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
         skip_video: Tell the core that only a step's last frame is seen (none
             with RAM observations and no render mode), so a core that asks
             skips drawing the rest (``retrokit build-core``); False draws all.
+
+    The env pickles as these arguments (see :mod:`retrokit.envs.pickling`):
+    unpickled, it is a fresh env made from them, not yet reset; the
+    emulator's current state and the episode are not carried over.
     """
 
-    metadata = {"render_modes": ["rgb_array", "human"], "render_fps": 60}
+    # Each env sets its own: render_fps is its console's frame rate over its frame skip.
+    metadata = {"render_modes": render_modes(), "render_fps": 60}
 
     def __init__(
         self,
@@ -80,6 +87,11 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
         options: Mapping[str, str] | None = None,
         skip_video: bool = True,
     ) -> None:
+        PicklesAsArguments.__init__(
+            self, game, state, scenario, obs_type=obs_type, action_type=action_type, frameskip=frameskip,
+            sticky_prob=sticky_prob, max_episode_steps=max_episode_steps, players=players, render_mode=render_mode,
+            record=record, scenario_every_frame=scenario_every_frame, options=options, skip_video=skip_video,
+        )
         checked = check_options(
             {
                 "obs_type": obs_type, "action_type": action_type, "frameskip": frameskip, "sticky_prob": sticky_prob,
@@ -105,6 +117,8 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
         self.scenario = self._compile_scenario(setup.scenario)
         self.emulator = Emulator(self.game.system, setup.rom, options=options, ports=max(players, 2))
         self.reader = FieldReader(self.game.fields, self.emulator.space)
+        rate = self.emulator.system.frame_rate(self.emulator.av_info()["fps"])  # the core says NTSC or PAL
+        self.metadata = {"render_modes": render_modes(), "render_fps": rate / frameskip}
         self.actions = ActionMap(self.emulator.system, action_type, getattr(self.scenario, "actions", None), players)
         self.action_space = self.actions.space
         self.stepper = Stepper(
@@ -193,7 +207,7 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
     # --- the Gymnasium API -----------------------------------------------------------------------
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
-        super().reset(seed=seed)
+        super().reset(seed=check_seed(seed))
         self._start()
         self.emulator.forget_action()
         self.emulator.set_sticky(self.sticky_prob, int(self.np_random.integers(0, 2**63)))

@@ -7,6 +7,10 @@ scenario's per-player rewards. A scenario's per-player done conditions
 (``dones:``) take a player out for good: its agent is terminated and leaves
 ``agents``, as PettingZoo's rules ask, and presses nothing from then on; the
 others play on until the scenario's ``done``, or until every player is out.
+
+Both pickle as their arguments (:mod:`retrokit.envs.pickling`), as SuperSuit's
+``concat_vec_envs_v1(..., num_cpus=N)`` needs: unpickled, each is a fresh env
+made from them, without the emulator's state or the episode.
 """
 
 from __future__ import annotations
@@ -16,14 +20,17 @@ from typing import Any
 
 from gymnasium import spaces
 from pettingzoo import AECEnv, ParallelEnv
-from pettingzoo.utils.conversions import parallel_to_aec
+from pettingzoo.utils.conversions import parallel_to_aec_wrapper
+from pettingzoo.utils.wrappers import OrderEnforcingWrapper
 
 from retrokit.data.games import find_game
 from retrokit.envs.env import RetroEnv, State
+from retrokit.envs.pickling import PicklesAsArguments
+from retrokit.envs.viewer import render_modes
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean
 
 
-class RetroParallelEnv(ParallelEnv):
+class RetroParallelEnv(PicklesAsArguments, ParallelEnv):
     """A multi-player game as a PettingZoo ``ParallelEnv``.
 
     Args:
@@ -34,9 +41,10 @@ class RetroParallelEnv(ParallelEnv):
         **options: Other :class:`retrokit.envs.env.RetroEnv` options, except ``players``.
     """
 
-    metadata = {"render_modes": ["rgb_array", "human"], "name": "retrokit_v0", "is_parallelizable": True}
+    metadata = {"render_modes": render_modes(), "name": "retrokit_v0", "is_parallelizable": True}
 
     def __init__(self, game: str, state: Any = State.DEFAULT, scenario: Any = None, **options: Any) -> None:
+        PicklesAsArguments.__init__(self, game, state, scenario, **options)
         if "players" in options:
             raise InvalidArgumentError("Expected no 'players' option: a PettingZoo env has every player of the game.")
         players = find_game(game).players
@@ -55,6 +63,7 @@ class RetroParallelEnv(ParallelEnv):
         self.possible_agents = [f"player_{i + 1}" for i in range(players)]
         self.agents: list[str] = []
         self.render_mode = self._env.render_mode
+        self.metadata = {**self.metadata, **self._env.metadata}  # its frame rate, over its frame skip
         self._obs_space = self._env.observation_space
         self._act_space = self._env.actions.single_player_space()
 
@@ -117,6 +126,20 @@ def parallel_env(game: str, state: Any = State.DEFAULT, scenario: Any = None, **
     return RetroParallelEnv(game, state, scenario, **options)
 
 
+class RetroAECEnv(PicklesAsArguments, OrderEnforcingWrapper):
+    """A multi-player game as a PettingZoo AEC env: PettingZoo's conversion of :class:`RetroParallelEnv`.
+
+    It is what ``pettingzoo.utils.conversions.parallel_to_aec`` makes (the
+    conversion, under the order-enforcing wrapper), as a class of its own so
+    that it pickles as its arguments rather than as the wrappers' state.
+    The arguments are :class:`RetroParallelEnv`'s.
+    """
+
+    def __init__(self, game: str, state: Any = State.DEFAULT, scenario: Any = None, **options: Any) -> None:
+        PicklesAsArguments.__init__(self, game, state, scenario, **options)
+        OrderEnforcingWrapper.__init__(self, parallel_to_aec_wrapper(RetroParallelEnv(game, state, scenario, **options)))
+
+
 def env(game: str, state: Any = State.DEFAULT, scenario: Any = None, **options: Any) -> AECEnv:
     """Make the PettingZoo AEC env of a multi-player game, by conversion of the parallel one."""
-    return parallel_to_aec(parallel_env(game, state, scenario, **options))
+    return RetroAECEnv(game, state, scenario, **options)

@@ -22,6 +22,7 @@ import numpy as np
 
 from retrokit.data.games import Game
 from retrokit.envs.actions import ACTION_TYPES
+from retrokit.envs.viewer import require_human
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean, shown
 from retrokit.paths import writable_folder
 
@@ -93,6 +94,13 @@ def _choice(name: str, choices: tuple[str, ...], optional: bool = False) -> Call
     return check
 
 
+def _render_mode(value: object) -> str | None:
+    mode = _choice("render_mode", RENDER_MODES, optional=True)(value)
+    if mode == "human":
+        require_human()  # at make(), not at the first reset, and with how to install it
+    return mode
+
+
 def _record(value: object) -> str | os.PathLike[str] | None:
     if value is None:
         return None
@@ -135,7 +143,7 @@ OPTIONS: dict[str, Callable[[Any], Any]] = {
     "sticky_prob": _sticky_prob,
     "max_episode_steps": _max_episode_steps,
     "players": _players,
-    "render_mode": _choice("render_mode", RENDER_MODES, optional=True),
+    "render_mode": _render_mode,
     "record": _record,
     "scenario_every_frame": _flag("scenario_every_frame"),
     "skip_video": _flag("skip_video"),
@@ -199,6 +207,28 @@ def make_arguments(game: object, state: object, scenario: object, options: Mappi
         )
     check_names(options)
     return {"game": game, "state": state, "scenario": scenario, **options}
+
+
+def check_seed(seed: object) -> int | None:
+    """Check a ``reset(seed=...)``: every env's reset goes through this one check.
+
+    Returns:
+        The seed as a Python int (numpy integers are taken, as ``make`` takes
+        them for its options), or ``None``.
+
+    Raises:
+        InvalidArgumentError: The seed is not a whole number of 0 or more (or None).
+    """
+    if seed is None:
+        return None
+    if isinstance(seed, (bool, np.bool_)) or not isinstance(seed, numbers.Integral):
+        raise InvalidArgumentError(
+            f"Expected seed to be a whole number of 0 or more, or None, got {shown(seed)} ({type(seed).__name__}); "
+            f"pass e.g. seed=0."
+        )
+    if seed < 0:
+        raise InvalidArgumentError(f"Expected a seed of 0 or more, got {int(seed)}; pass e.g. seed=0.")
+    return int(seed)
 
 
 def check_crop(crop: tuple[int, int, int, int] | None, screen: tuple[int, int]) -> None:

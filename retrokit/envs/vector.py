@@ -18,6 +18,7 @@ and returns its first observation with reward 0.
 
 from __future__ import annotations
 
+import functools
 import os
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -30,14 +31,20 @@ from gymnasium.vector.utils import batch_space, concatenate, create_empty_array,
 
 from retrokit.envs.buffers import BufferPool, Pool, StepArrays
 from retrokit.envs.memory import MIN_ENV_BYTES, build_envs, check_fits
-from retrokit.envs.options import check_num_envs
+from retrokit.envs.options import check_num_envs, check_seed
+from retrokit.envs.pickling import PicklesAsArguments
 from retrokit.envs.stepper import drive
 from retrokit.errors import InvalidArgumentError, shown
 from retrokit.host.runner import Runner
 
 
-class ThreadedVectorEnv(VectorEnv):
+class ThreadedVectorEnv(PicklesAsArguments, VectorEnv):
     """Steps several envs at once, one thread each.
+
+    It pickles as its arguments (see :mod:`retrokit.envs.pickling`), so its
+    ``env_fns`` must pickle for it to: functions of a module, or
+    ``functools.partial`` of them (as :func:`make_vec` gives), not lambdas.
+    Unpickled, it is a fresh vector env made by calling them again.
 
     Args:
         env_fns: Functions that each make one env; all must have the same spaces.
@@ -49,6 +56,7 @@ class ThreadedVectorEnv(VectorEnv):
     metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP}
 
     def __init__(self, env_fns: Sequence[Callable[[], gymnasium.Env]], threads: int | None = None) -> None:
+        PicklesAsArguments.__init__(self, env_fns, threads)
         if not env_fns:
             raise InvalidArgumentError("Expected at least one env function, got none.")
         if threads is not None and (not isinstance(threads, int) or threads < 1):
@@ -112,9 +120,16 @@ class ThreadedVectorEnv(VectorEnv):
         return [done[i] if i in done else futures[i].result() for i in range(self.num_envs)]
 
     def reset(self, *, seed: int | Sequence[int | None] | None = None, options: dict[str, Any] | None = None):
-        seeds = [None if seed is None else seed + i for i in range(self.num_envs)] if not isinstance(seed, Sequence) else list(seed)
-        if len(seeds) != self.num_envs:
-            raise InvalidArgumentError(f"Expected {self.num_envs} seeds, got {len(seeds)}.")
+        if isinstance(seed, (Sequence, np.ndarray)) and not isinstance(seed, str):
+            seeds = [check_seed(s) for s in seed]  # one per env, as Gymnasium's vector envs take them
+            if len(seeds) != self.num_envs:
+                raise InvalidArgumentError(
+                    f"Expected {self.num_envs} seeds (one per env), got {len(seeds)}; pass one int, or a list of "
+                    f"{self.num_envs}."
+                )
+        else:
+            first = check_seed(seed)
+            seeds = [None if first is None else first + i for i in range(self.num_envs)]
         results = self._each(lambda i: self.envs[i].reset(seed=seeds[i], options=options))
         infos: dict[str, Any] = {}
         for i, (_, info) in enumerate(results):
@@ -243,10 +258,15 @@ def available_cpus() -> int:
 def make_vec(
     game: str, num_envs: int, state: Any = None, scenario: Any = None, *, threads: int | None = None, **options: Any
 ) -> ThreadedVectorEnv:
-    """Make ``num_envs`` copies of a game's env stepped on threads (one per CPU unless ``threads`` says)."""
+    """Make ``num_envs`` copies of a game's env stepped on threads (one per CPU unless ``threads`` says).
+
+    The vector env pickles as these arguments: unpickled, it is a fresh one
+    made from them (no emulator state or episode carried over).
+    """
     from retrokit.envs.env import State, make
 
     num_envs = check_num_envs(num_envs)
     check_fits(num_envs, (MIN_ENV_BYTES, MIN_ENV_BYTES), at_least=True)  # before a list of num_envs functions
     start = State.DEFAULT if state is None else state
-    return ThreadedVectorEnv([lambda: make(game, start, scenario, **options) for _ in range(num_envs)], threads)
+    # partials, not lambdas: the vector env pickles as its env functions
+    return ThreadedVectorEnv([functools.partial(make, game, start, scenario, **options)] * num_envs, threads)

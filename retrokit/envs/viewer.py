@@ -1,31 +1,59 @@
 """A window that shows frames, for ``render_mode="human"``.
 
 It uses pygame, which retrokit does not require: install it where a display
-exists (``pip install 'retrokit-rl[human]'``).
+exists (``pip install 'retrokit-rl[human]'``). Whether it is there decides
+the envs' ``metadata["render_modes"]`` (:func:`render_modes`), and
+:func:`require_human` is the one check that ``render_mode="human"`` can work,
+made when the env is made.
 """
 
 from __future__ import annotations
 
+import importlib.util
+
 import numpy as np
 
-from retrokit.errors import EnvError, install_extra
+from retrokit.errors import EnvError, MissingExtraError, install_extra
+
+
+def human_available() -> bool:
+    """Whether pygame can be imported, without importing it (which takes a while and prints a banner)."""
+    try:
+        return importlib.util.find_spec("pygame") is not None
+    except (ImportError, ValueError):  # a broken or blocked pygame
+        return False
+
+
+def render_modes() -> list[str]:
+    """The render modes that can work here: ``"human"`` only where pygame is installed."""
+    return ["rgb_array", "human"] if human_available() else ["rgb_array"]
+
+
+def require_human() -> None:
+    """Refuse ``render_mode="human"`` where pygame is missing, before an env is built.
+
+    Raises:
+        MissingExtraError: pygame is not installed; the message says how to install it.
+    """
+    if not human_available():
+        raise MissingExtraError(
+            f"Expected pygame for render_mode='human', but it is not installed. Install it ({install_extra('human')}), "
+            f"or use render_mode='rgb_array'."
+        )
 
 
 class Viewer:
     """Shows RGB frames in a window, scaled up twice, at most ``fps`` a second.
 
     Raises:
-        EnvError: pygame is not installed or no display can be opened.
+        MissingExtraError: pygame is not installed.
+        EnvError: No display can be opened.
     """
 
-    def __init__(self, title: str, fps: int, scale: int = 2) -> None:
-        try:
-            import pygame
-        except ImportError:
-            raise EnvError(
-                "Expected pygame for render_mode='human', but it is not installed. "
-                f"Install it ({install_extra('human')}), or use render_mode='rgb_array'."
-            ) from None
+    def __init__(self, title: str, fps: float, scale: int = 2) -> None:
+        require_human()
+        import pygame
+
         self._pygame = pygame
         try:
             pygame.display.init()

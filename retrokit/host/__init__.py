@@ -17,3 +17,9 @@ drives emulators through it. One module a concern:
 - ``build`` and ``patching``: building a patched core from stable-retro's
   source (``retrokit build-core``, ``docs/cores.md``).
 """
+
+from __future__ import annotations
+
+from retrokit.lazy import lazy_names
+
+__getattr__ = lazy_names(__name__)  # its submodules, on first use: retrokit.host.<module>

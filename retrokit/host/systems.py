@@ -34,6 +34,9 @@ class System:
         options: Core option defaults for this system.
         actions: Gym Retro's default groups of button combinations.
         screen: ``(height, width)`` of observations, or ``None`` for the first frame's.
+        frame_rates: The console's frames per second, by video standard (``"ntsc"``,
+            ``"pal"``, or ``"lcd"`` for a handheld's one rate); empty where it
+            depends on the game (arcade boards) or is not listed.
     """
 
     name: str
@@ -47,6 +50,7 @@ class System:
     actions: tuple[tuple[tuple[str, ...], ...], ...] = ()
     screen: tuple[int, int] | None = None
     aliases: tuple[str, ...] = ()
+    frame_rates: dict[str, float] = field(default_factory=dict)
 
     def __str__(self) -> str:
         return self.name
@@ -69,6 +73,20 @@ class System:
                 f"Expected one of {self.name}'s buttons ({', '.join(self.button_names)}), got {name!r}."
                 + did_you_mean(name, self.button_names)
             ) from None
+
+    def frame_rate(self, reported: float | None = None) -> float:
+        """The console's real frame rate, in frames per second.
+
+        Args:
+            reported: The rate the core reports for the game it runs; it tells
+                which of the console's video standards the game runs in
+                (NTSC or PAL), and is the answer where the descriptor lists no rate.
+        """
+        if not self.frame_rates:
+            return float(reported) if reported else 60.0
+        if reported is None:
+            return next(iter(self.frame_rates.values()))
+        return min(self.frame_rates.values(), key=lambda rate: abs(rate - reported))
 
     def mask(self, buttons: Iterable[str]) -> int:
         """Return the RetroPad bit mask that presses the named buttons."""
@@ -101,6 +119,7 @@ def _parse(name: str, entry: object) -> System:
             actions=tuple(tuple(tuple(combo) for combo in group) for group in entry.get("actions", ())),
             screen=tuple(entry["screen"]) if "screen" in entry else None,
             aliases=tuple(entry.get("aliases", ())),
+            frame_rates={str(k): float(v) for k, v in (entry.get("frame_rate") or {}).items()},
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise DataFileError(f"{_FILE}: system {name!r} is malformed: {exc!r}.") from exc

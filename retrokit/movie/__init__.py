@@ -10,9 +10,12 @@ made by retrokit plays in stable-retro. See ``docs/movies.md``.
 
 from __future__ import annotations
 
+from retrokit.lazy import lazy_names
 from retrokit.movie.bk2 import encode_bk2, read_bk2, write_bk2
 from retrokit.movie.model import Movie, layout
 from retrokit.movie.playback import export, play
 from retrokit.movie.recorder import MovieRecorder
 
 __all__ = ["Movie", "MovieRecorder", "encode_bk2", "export", "layout", "play", "read_bk2", "write_bk2"]
+
+__getattr__ = lazy_names(__name__)  # its submodules, on first use: retrokit.movie.<module>

@@ -94,9 +94,10 @@ def pack_buttons(
 ) -> bool:
     """Pack a button array, ``buttons`` items per player, into one mask per player in ``out``.
 
-    A nonzero item presses its button. With ``table`` (``2**buttons`` masks),
-    each player's mask is replaced by its entry there. Returns False, writing
-    nothing, when the array's item format is not a number.
+    An item of 1 presses its button, 0 releases it. With ``table``
+    (``2**buttons`` masks), each player's mask is replaced by its entry there.
+    Returns False, writing nothing, when the array's item format is not a
+    number or an item is neither 0 nor 1 (the caller refuses it, saying which).
     """
 
 @overload

@@ -75,12 +75,24 @@ static char item_kind(const Py_buffer *b) {
     return strchr("?bBhHiIlLqQ", *f) ? 'i' : 0;
 }
 
+/* An item's button: 0 or 1; -1 for any other value (2, -1, 0.5: not a MultiBinary item). */
 static int item_pressed(const char *p, char kind, Py_ssize_t itemsize) {
-    if (kind == 'f') return *(const float *)p != 0.0f;
-    if (kind == 'd') return *(const double *)p != 0.0;
-    for (Py_ssize_t k = 0; k < itemsize; k++)
-        if (p[k]) return 1;
-    return 0;
+    if (kind == 'f') {
+        float v = *(const float *)p;
+        return v == 0.0f ? 0 : v == 1.0f ? 1 : -1;
+    }
+    if (kind == 'd') {
+        double v = *(const double *)p;
+        return v == 0.0 ? 0 : v == 1.0 ? 1 : -1;
+    }
+    /* An integer is 0 or 1 when its low byte is and every other byte is 0, in either byte order. */
+    int low = 0, others = 0;
+    for (Py_ssize_t k = 0; k < itemsize; k++) {
+        unsigned char byte = (unsigned char)p[k];
+        if (k == (PY_LITTLE_ENDIAN ? 0 : itemsize - 1)) low = byte;
+        else others |= byte;
+    }
+    return others || low > 1 ? -1 : low;
 }
 
 PyObject *rk_py_pack_buttons(PyObject *module, PyObject *const *args, Py_ssize_t nargs) {
@@ -107,15 +119,24 @@ PyObject *rk_py_pack_buttons(PyObject *module, PyObject *const *args, Py_ssize_t
         PyErr_Format(InvalidArgumentError, "expected %zd buttons for each of at most %zd players, got %zd items", buttons,
                      out.len / out.itemsize < RK_MAX_PORTS ? out.len / out.itemsize : RK_MAX_PORTS, items);
     } else {
-        uint16_t *masks = out.buf;
+        uint16_t packed[RK_MAX_PORTS];
         const char *p = action.buf;
-        for (Py_ssize_t player = 0; player < players; player++) {
+        int valid = 1;
+        for (Py_ssize_t player = 0; player < players && valid; player++) {
             unsigned mask = 0;
-            for (Py_ssize_t b = 0; b < buttons; b++, p += action.itemsize)
-                mask |= (unsigned)item_pressed(p, kind, action.itemsize) << b;
-            masks[player] = lookup ? lookup[mask] : (uint16_t)mask;
+            for (Py_ssize_t b = 0; b < buttons; b++, p += action.itemsize) {
+                int pressed = item_pressed(p, kind, action.itemsize);
+                if (pressed < 0) {
+                    valid = 0;
+                    break;
+                }
+                mask |= (unsigned)pressed << b;
+            }
+            packed[player] = lookup ? lookup[mask] : (uint16_t)mask;
         }
-        result = Py_NewRef(Py_True);
+        /* An item other than 0 or 1 writes nothing: the caller's own conversion refuses it, saying which. */
+        if (valid) memcpy(out.buf, packed, (size_t)players * sizeof(uint16_t));
+        result = Py_NewRef(valid ? Py_True : Py_False);
     }
 done:
     PyBuffer_Release(&action);

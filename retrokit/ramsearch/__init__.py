@@ -15,6 +15,7 @@ See ``docs/ramsearch.md``.
 
 from __future__ import annotations
 
+from retrokit.lazy import lazy_names
 from retrokit.ramsearch.candidates import Candidate, group_candidates
 from retrokit.ramsearch.filters import OPS
 from retrokit.ramsearch.search import RamSearch
@@ -22,3 +23,5 @@ from retrokit.ramsearch.session import DEFAULT_SESSION
 from retrokit.ramsearch.types import SEARCH_TYPES
 
 __all__ = ["DEFAULT_SESSION", "OPS", "SEARCH_TYPES", "Candidate", "RamSearch", "group_candidates"]
+
+__getattr__ = lazy_names(__name__)  # its submodules, on first use: retrokit.ramsearch.<module>

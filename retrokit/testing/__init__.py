@@ -23,6 +23,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from retrokit.lazy import lazy_names
 from retrokit.testing.report import FAIL, PASS, SKIP, GameReport, Result
 
 if TYPE_CHECKING:
@@ -134,3 +135,5 @@ def _check_fields(game: Game, report: GameReport, rom: Path | None) -> None:
             return
     check_fields(game, report, None)
 
+
+__getattr__ = lazy_names(__name__)  # its submodules, on first use: retrokit.testing.<module>

@@ -9,19 +9,17 @@ from PIL import Image
 
 from retrokit.benchmark import plots
 from retrokit.benchmark.definition import load_benchmark
-from retrokit.benchmark.paper import PAPER_ENV, find_paper_dir, load_paper
+from retrokit.benchmark.paper import PAPER_ENV, find_paper_dir, has_paper_scores, load_paper
 from retrokit.benchmark.report import render_report
-from retrokit.benchmark.scores import aggregate
+from retrokit.benchmark.scores import LevelScore, Summary, aggregate
 
 paper = load_paper()
 needs_paper = pytest.mark.skipif(paper is None, reason="the paper's test-scores.csv is not beside the repository")
 
 
-def as_summary(agent: str, scores: dict[str, float]) -> dict:
-    levels = {level: {"mean_score": s, "episodes": 1, "timesteps": 1_000_000, "std": 0.0, "best": s}
-              for level, s in scores.items()}
-    return {"benchmark": "sonic", "agent": agent, "seed": 0, "budget": 1_000_000, "complete": True,
-            "levels": levels, "aggregate": aggregate(levels)}
+def as_summary(agent: str, scores: dict[str, float]) -> Summary:
+    levels = {level: LevelScore(s, 1, 1_000_000, 0.0, s) for level, s in scores.items()}
+    return Summary("sonic", agent, 0, 1_000_000, True, levels, aggregate(levels))
 
 
 @needs_paper
@@ -35,7 +33,7 @@ def test_the_papers_test_levels_are_the_sonic_benchmarks() -> None:
 @pytest.mark.parametrize("agent", ["Rainbow", "JERK", "PPO", "Joint PPO", "Joint Rainbow", "Human"])
 def test_our_aggregate_of_the_papers_level_scores_is_its_aggregate(agent) -> None:
     scores = {level: score for level, (score, _) in paper.levels[agent].items()}
-    assert as_summary(agent, scores)["aggregate"] == pytest.approx(paper.aggregates[agent][0], abs=0.06)
+    assert as_summary(agent, scores).aggregate == pytest.approx(paper.aggregates[agent][0], abs=0.06)
 
 
 @needs_paper
@@ -67,8 +65,17 @@ def test_the_scores_plot_draws_ours_beside_the_papers() -> None:
 def test_without_the_paper_the_report_says_so(tmp_path, monkeypatch) -> None:
     monkeypatch.setenv(PAPER_ENV, str(tmp_path))  # a folder without test-scores.csv
     assert find_paper_dir() is None and load_paper() is None
-    text = render_report(as_summary("jerk", {"Dasher-Genesis/Zone1.Act2": 5.0}), None, plots=[])
-    assert "The paper's scores were not found" in text and "| Dasher-Genesis/Zone1.Act2 | 5.0 |" in text
+    text = render_report(as_summary("jerk", {"SonicTheHedgehog-Genesis/GreenHillZone.Act2": 5.0}), None, plots=[])
+    assert "The paper's scores were not found" in text and "| SonicTheHedgehog-Genesis/GreenHillZone.Act2 | 5.0 |" in text
+
+
+def test_a_benchmark_the_paper_did_not_score_says_nothing_of_the_paper(tmp_path, monkeypatch) -> None:
+    monkeypatch.setenv(PAPER_ENV, str(tmp_path))  # a folder without test-scores.csv
+    levels = ["Dasher-Genesis/Zone1.Act2"]
+    assert not has_paper_scores(levels) and has_paper_scores(["SonicTheHedgehog-Genesis/GreenHillZone.Act2"])
+    text = render_report(as_summary("jerk", dict.fromkeys(levels, 5.0)), None, plots=[],
+                         paper_levels=has_paper_scores(levels))
+    assert "paper" not in text.lower() and "| Dasher-Genesis/Zone1.Act2 | 5.0 |" in text
 
 
 def test_a_damaged_paper_file_is_treated_as_absent(tmp_path, monkeypatch) -> None:

@@ -346,3 +346,12 @@ def test_a_second_run_on_a_folder_in_use_is_refused(agents_file, tmp_path, monke
         flag.touch()
         _, err = first.communicate(timeout=120)
     assert first.returncode == 0, err
+
+
+def test_help_gives_the_agents_signature_the_backend_default_and_examples(capsys) -> None:
+    assert main(["evaluate", "--help"]) == 0
+    text = capsys.readouterr().out
+    assert "agent(env: gymnasium.Env, budget: int, seed: int) -> None" in text
+    assert "(default: local; Ray is the extra retrokit-rl[ray])" in " ".join(text.split())
+    examples = text[text.index("examples:"):].splitlines()[1:]
+    assert len(examples) >= 5 and all(line.strip().startswith("retrokit evaluate --") for line in examples if line)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
 
 import pytest
@@ -63,6 +64,9 @@ def test_several_agents_run_into_their_folders_and_one_report_compares_them(mine
     before = (out / "report.md").read_bytes()
     assert run(mine, out, "jerk", "random", f"{agents}:still") == 2
     assert "already holds" in capsys.readouterr().err
+    assert run(mine, out, "jerk", "random", f"{agents}:still", extra=("--resume",)) == 0
+    assert (out / "report.md").read_bytes() == before
+    shutil.rmtree(out / "still")  # as if interrupted before the last agent's turn
     assert run(mine, out, "jerk", "random", f"{agents}:still", extra=("--resume",)) == 0
     assert (out / "report.md").read_bytes() == before
 

@@ -8,12 +8,14 @@ stop the others; the comparison is written with what finished.
 
 from __future__ import annotations
 
+import os
 import re
 from collections.abc import Callable
 from pathlib import Path
 
 from retrokit.benchmark import plots
 from retrokit.benchmark.evaluation import Evaluation, failure_message, run_evaluation
+from retrokit.benchmark.rundir import RUN_FILE
 from retrokit.benchmark.scores import FROM_UNFINISHED, UNFINISHED_NOTE, Summary
 from retrokit.errors import AgentError, FileConflictError, InvalidArgumentError
 from retrokit.paths import atomic_write
@@ -49,7 +51,8 @@ def compare(make: Callable[[str, Path], Evaluation], agents: list[str], out: Pat
         make: The evaluation of an agent into a folder.
         agents: The agents, in the report's order.
         out: The folder of the comparison.
-        resume: Continue an interrupted comparison (each agent's folder is resumed).
+        resume: Continue an interrupted comparison (each agent's folder is resumed; an agent whose turn had
+            not come starts).
         announce: Called with a line before each agent's evaluation.
 
     Raises:
@@ -59,6 +62,8 @@ def compare(make: Callable[[str, Path], Evaluation], agents: list[str], out: Pat
     folders = agent_folders(agents)
     evaluations = {agent: make(agent, out / folders[agent]) for agent in agents}
     for evaluation in evaluations.values():
+        if resume and not os.path.lexists(evaluation.out / RUN_FILE):
+            evaluation.resume = False  # the interruption came before this agent's turn: it starts now
         evaluation.check()  # every agent's arguments, before anything is made or played
     there = [name for name in COMPARISON_FILES if (out / name).exists()]
     if there and not resume:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -355,3 +356,21 @@ def test_help_gives_the_agents_signature_the_backend_default_and_examples(capsys
     assert "(default: local; Ray is the extra retrokit-rl[ray])" in " ".join(text.split())
     examples = text[text.index("examples:"):].splitlines()[1:]
     assert len(examples) >= 5 and all(line.strip().startswith("retrokit evaluate --") for line in examples if line)
+
+
+def test_ctrl_c_at_a_terminal_stops_the_workers_quietly(reference, tmp_path) -> None:
+    # A terminal sends SIGINT to the whole process group: the workers leave it to the evaluation's process.
+    out = tmp_path / "run"
+    command = [sys.executable, "-m", "retrokit", "evaluate", *SMALL, "--agent", "jerk", "--workers", "2",
+               "--out", str(out)]
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                               start_new_session=True)
+    log = out / "episodes.jsonl"
+    wait_for(lambda: process.poll() is not None or (log.is_file() and log.read_text().count("\n") >= 2),
+             120, "episodes to be logged")
+    os.killpg(process.pid, signal.SIGINT)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130 and "--resume" in err and "Traceback" not in err, err
+    wait_for(lambda: not session_processes(process.pid), 20, "the workers to end")
+    assert evaluate(out, "--agent", "jerk", "--resume") == 0
+    assert summary(out) == summary(reference)

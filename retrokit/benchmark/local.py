@@ -52,7 +52,7 @@ def run_local(tasks: list[LevelTask], handle: Callable[[Message], None], workers
                 reader, writer = context.Pipe(duplex=False)
                 process = context.Process(target=_work, args=(task, writer, os.getpid()), daemon=True,
                                           name=f"retrokit level {task.level.name}")
-                process.start()
+                _start(process)
                 writer.close()  # the worker holds the only writer: its exit ends the pipe
                 watchdog.start(task.level.name)
                 running[reader] = _Worker(task, process, reader)
@@ -79,6 +79,16 @@ def run_local(tasks: list[LevelTask], handle: Callable[[Message], None], workers
         for worker in running.values():
             worker.process.join(timeout=10)
             worker.pipe.close()
+
+
+def _start(process: multiprocessing.process.BaseProcess) -> None:
+    """Start a worker with Ctrl-C blocked: a terminal's SIGINT goes to the whole process group, and it is this
+    process's to handle (it stops the workers); the mask is inherited, so not even the worker's start sees it."""
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        process.start()
+    finally:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # a Ctrl-C meanwhile arrives now
 
 
 def _read(worker: _Worker, handle: Callable[[Message], None], watchdog: Watchdog) -> bool:
@@ -110,7 +120,7 @@ def _died(worker: _Worker, watchdog: Watchdog) -> LevelFailed:
 def _work(task: LevelTask, pipe: Connection, parent: int) -> None:
     """A worker process: play one level, sending every message down ``pipe``."""
     _die_with_parent(parent)
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle; it stops the workers
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # also if the agent unblocks it: Ctrl-C is the parent's
     run_level(task, pipe.send)
     pipe.close()
 

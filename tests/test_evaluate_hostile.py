@@ -39,7 +39,7 @@ def _fixed():
     return flag is not None and pathlib.Path(flag).exists()
 
 def ends_its_process(env, budget, seed):
-    """Ends its process in four ways, one a level; plays Zone2.Act1 normally."""
+    """Ends its process in four ways, one a level; plays Zone2.Act1 normally, leaving a thread that never ends."""
     state = env.unwrapped.state_name
     env.reset()
     for _ in range(20):
@@ -52,6 +52,8 @@ def ends_its_process(env, budget, seed):
         os._exit(3)
     if state == "Zone1.Act1":
         ctypes.string_at(0)  # a native crash: SIGSEGV
+    import threading
+    threading.Thread(target=time.sleep, args=(10**6,)).start()  # a thread that would keep its process alive
     _normal(env)
 
 def stalls(env, budget, seed):

@@ -62,9 +62,9 @@ def run_local(tasks: list[LevelTask], handle: Callable[[Message], None], workers
                     continue
                 del running[pipe]
                 worker.process.join()
-                watchdog.stop(worker.task.level.name)
                 if not worker.ended:
                     handle(_died(worker, watchdog))
+                watchdog.stop(worker.task.level.name)
             for level in watchdog.stalled():
                 pipe, worker = next((p, w) for p, w in running.items() if w.task.level.name == level)
                 worker.process.kill()
@@ -99,6 +99,7 @@ def _read(worker: _Worker, handle: Callable[[Message], None], watchdog: Watchdog
             watchdog.see(message)
             if isinstance(message, LevelDone | LevelFailed):
                 worker.ended = True
+                watchdog.stop(message.level)  # its process may take a moment to exit: that is no stall
             if not isinstance(message, Started):
                 handle(message)
     except (EOFError, OSError):
@@ -123,6 +124,10 @@ def _work(task: LevelTask, pipe: Connection, parent: int) -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # also if the agent unblocks it: Ctrl-C is the parent's
     run_level(task, pipe.send)
     pipe.close()
+    # Exit now: a thread the agent left running must not keep the process (and the evaluation) waiting.
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(0)
 
 
 def _die_with_parent(parent: int) -> None:

@@ -5,8 +5,8 @@ It needs no ROM import: Dasher, retrokit's own Genesis game, ships in
 --agent random`` (the same comparison, :mod:`retrokit.benchmark.comparison`)
 on the test levels; prints the per-level table and the aggregates; and writes
 each run's folder (episodes, summary, report, plots), the side-by-side report
-and plot of the two agents' scores, and a GIF of JERK's best episode. The output folder gets a new
-name if the given one is taken: nothing is replaced.
+and plot of the two agents' scores, and a GIF of JERK's best episode. The
+output folder gets a new name if the given one is taken: nothing is replaced.
 """
 
 from __future__ import annotations
@@ -28,12 +28,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "demo",
         help="evaluate JERK against random on the bundled Dasher benchmark: table, report, plots and a GIF",
         description="Run the Dasher benchmark (no ROM import needed) with the paper's JERK agent and with random "
-        "actions, with a progress bar per level; print the per-level scores and aggregates, and write the reports, "
-        "the plots and a GIF of JERK's best episode.",
+        "actions, with a progress bar per level (a line per level when the output is not a terminal); print the "
+        "per-level scores and aggregates, and write each agent's run folder, a side-by-side report.md and "
+        "scores.png, and a GIF of JERK's best episode. It is `retrokit evaluate --benchmark dasher --agent jerk "
+        "--agent random`.",
     )
     add_evaluation_options(parser, "processes (default: up to 2)")
     parser.add_argument("--out", type=Path, default=Path("retrokit-demo"), help="the output folder (default: retrokit-demo)")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bars or lines")
     parser.set_defaults(run=run)
 
 

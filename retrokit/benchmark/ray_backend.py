@@ -20,9 +20,8 @@ from collections.abc import Callable
 
 from retrokit.benchmark.level import LevelDone, LevelFailed, LevelTask, Message, Started, run_level
 from retrokit.benchmark.watchdog import Watchdog
-from retrokit.errors import BackendUnavailableError
+from retrokit.errors import BackendUnavailableError, install_extra
 
-RAY_EXTRA = "retrokit-rl[ray]"
 POLL_SECONDS = 0.2
 #: How long a cluster's address may take to accept a connection.
 CONNECT_SECONDS = 10.0
@@ -76,7 +75,7 @@ def run_ray(tasks: list[LevelTask], handle: Callable[[Message], None], workers: 
         from ray.util.queue import Empty, Queue
     except ImportError:
         raise BackendUnavailableError(
-            f"Expected Ray for --backend ray, but it is not installed; run `pip install '{RAY_EXTRA}'`."
+            f"Expected Ray for --backend ray, but it is not installed; run `{install_extra('ray')}`."
         ) from None
     os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")  # no telemetry from a benchmark run
     started = not ray.is_initialized()

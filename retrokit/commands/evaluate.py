@@ -15,21 +15,22 @@ from pathlib import Path
 
 from retrokit.commands._common import add_evaluation_options
 
-EXAMPLES = """\
+AGENT_NOTE = """\
 An agent is random, jerk, or MODULE:CALLABLE (an importable module or a .py file), a callable
     agent(env: gymnasium.Env, budget: int, seed: int) -> None
 that loops over env.reset() and env.step(action) until step() raises BudgetSpent (the runner catches it).
 The Ray backend is an extra: pip install 'retrokit-rl[ray]'.
-
-examples:
-  retrokit evaluate --benchmark dasher --agent jerk --out runs/jerk
-  retrokit evaluate --benchmark dasher --agent jerk --agent random --timesteps 2000 --out runs/both
-  retrokit evaluate --benchmark dasher --agent my_agents.py:ppo --levels Zone1.Act2 --out runs/ppo
-  retrokit evaluate --benchmark dasher --agent jerk --out runs/jerk --resume
-  retrokit evaluate --benchmark mine.yaml --agent random --workers 4 --stall-timeout 120 --out runs/mine
-  retrokit evaluate --benchmark sonic --agent jerk --backend ray --ray-address auto --out runs/sonic
-  retrokit evaluate --benchmark sonic --list
 """
+
+EXAMPLES = [
+    "retrokit evaluate --benchmark dasher --agent jerk --out runs/jerk",
+    "retrokit evaluate --benchmark dasher --agent jerk --agent random --timesteps 2000 --out runs/both",
+    "retrokit evaluate --agent my_agents.py:ppo --levels all --workers 2 --out runs/mine --gif",
+    "retrokit evaluate --out runs/mine --resume             # continue an interrupted run",
+    "retrokit evaluate --benchmark mine.yaml --agent random --stall-timeout 120 --out runs/mine",
+    "retrokit evaluate --benchmark sonic --agent jerk --backend ray --ray-address auto --out runs/sonic",
+    "retrokit evaluate --benchmark sonic --list            # the benchmark's levels",
+]
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -43,7 +44,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "process, and write episodes.jsonl, summary.json, summary.csv, report.md (beside the paper's scores) and "
         "PNG plots into --out. Progress shows as a bar per level on a terminal, else as a line per finished level. "
         "With several --agent, each runs into OUT/<agent>/ and OUT/report.md and OUT/scores.png compare them.",
-        epilog=EXAMPLES,
+        epilog=AGENT_NOTE,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--benchmark", default="dasher", help="sonic, dasher, or a benchmark YAML file (default: dasher)")

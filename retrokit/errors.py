@@ -36,7 +36,7 @@ DISTRIBUTION = "retrokit-rl"
 
 
 def install_extra(extra: str) -> str:
-    """Return the command that installs one of retrokit's optional extras: ``pip install 'retrokit-rl[plot]'``."""
+    """Return the command that installs one of retrokit's optional extras: ``pip install 'retrokit-rl[ray]'``."""
     return f"pip install '{DISTRIBUTION}[{extra}]'"
 
 

@@ -23,6 +23,7 @@ def test_demo_evaluates_jerk_and_random_and_saves_the_report_plots_and_a_gif(tmp
         assert (out / agent / "report.md").is_file() and (out / agent / "learning-curves.png").is_file()
     with Image.open(out / "scores.png") as image:
         assert image.format == "PNG"
+    assert "| level | jerk | random |" in (out / "report.md").read_text()  # the same comparison as evaluate's
     with Image.open(out / "jerk-best.gif") as gif:
         assert gif.n_frames > 10 and gif.size == (320, 224)
 

@@ -40,7 +40,7 @@ def test_the_distribution_is_named_retrokit_rl_with_its_links() -> None:
     urls = project["urls"]
     assert set(urls) == {"Homepage", "Documentation", "Source", "Issues"}
     assert all(url.startswith("https://github.com/retrokit-rl/retrokit") for url in urls.values())
-    assert install_extra("plot") == "pip install 'retrokit-rl[plot]'"
+    assert install_extra("ray") == "pip install 'retrokit-rl[ray]'"
 
 
 @pytest.mark.parametrize("path", user_facing_texts(), ids=lambda p: p.relative_to(REPO).as_posix())

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import signal
 import subprocess
 import sys
@@ -10,16 +11,10 @@ import time
 from pathlib import Path
 
 import pytest
+from evaluating import SMALL, TWO_LEVELS, evaluate, session_processes, wait_for, write_agents
 from PIL import Image
 
 from retrokit.cli import main
-
-TWO_LEVELS = "Zone2.Act2,Zone3.Act2"
-SMALL = ["--benchmark", "dasher", "--levels", TWO_LEVELS, "--timesteps", "600", "--no-progress"]
-
-
-def evaluate(out: Path, *args: str) -> int:
-    return main(["evaluate", *SMALL, "--out", str(out), *args])
 
 
 def summary(out: Path) -> bytes:
@@ -153,8 +148,15 @@ def test_an_earlier_evaluation_is_never_overwritten(reference, capsys) -> None:
         (["--agent", "retrokit.benchmark.agents:nothing"], "to define a callable 'nothing'"),
         (["--benchmark", "dashr"], "Did you mean 'dasher'?"),
         (["--workers", "0"], "--workers and --timesteps of 1 or more"),
+        (["--seed", "-1"], "Expected a --seed of 0 or more, got -1"),
+        (["--stall-timeout", "0"], "Expected a --stall-timeout of more than 0 seconds"),
+        (["--stall-timeout", "nan"], "Expected a --stall-timeout of more than 0 seconds"),
+        (["--ray-address", "127.0.0.1:9"], "Expected --backend ray with --ray-address"),
+        (["--agent", "jerk", "--agent", "jerk"], "Expected each --agent once"),
+        (["--agent", "jerk", "--agent", "jerky"], "Did you mean 'jerk'?"),
     ],
-    ids=["unknown-level", "level-typo", "agent-typo", "agent-module", "agent-callable", "benchmark-typo", "workers"],
+    ids=["unknown-level", "level-typo", "agent-typo", "agent-module", "agent-callable", "benchmark-typo", "workers",
+         "negative-seed", "zero-stall", "nan-stall", "ray-address-without-ray", "agent-twice", "second-agent-typo"],
 )
 def test_bad_names_fail_before_anything_is_written(tmp_path, capsys, args, expected) -> None:
     out = tmp_path / "run"
@@ -188,22 +190,6 @@ def out_of_range(env, budget, seed):
         env.step(np.zeros(12, dtype=np.int8))
     env.step(np.full(12, 3, dtype=np.int8))
 
-def dies_in_a_worker(env, budget, seed):
-    """Kills its own process by a signal in a worker process; plays randomly in the command's own."""
-    import multiprocessing, os, pathlib, signal, time
-    flag = pathlib.Path(os.environ["RETROKIT_TEST_FLAG"])
-    if multiprocessing.parent_process() is not None:
-        flag.touch()
-        os.kill(os.getpid(), signal.SIGKILL)
-    deadline = time.monotonic() + 120
-    while not flag.exists() and time.monotonic() < deadline:  # let the worker take the other level
-        time.sleep(0.05)
-    env.reset()
-    while True:
-        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
-        if terminated or truncated:
-            env.reset()
-
 def jerk_pausing(env, budget, seed):
     """JERK; on Zone3.Act2 its 200th step waits for a flag file (so a test can interrupt it there)."""
     import os, pathlib, time
@@ -232,9 +218,7 @@ def no_reset(env, budget, seed):
 
 @pytest.fixture
 def agents_file(tmp_path) -> Path:
-    path = tmp_path / "my_agents.py"
-    path.write_text(AGENTS)
-    return path
+    return write_agents(tmp_path, AGENTS)
 
 
 def test_an_agent_that_raises_names_level_and_step_and_keeps_the_rest(agents_file, tmp_path, capsys) -> None:
@@ -316,16 +300,6 @@ def test_a_missing_state_is_named(tmp_path, capsys) -> None:
     assert "Dasher-Genesis/Zone4.Act1" in capsys.readouterr().err
 
 
-def test_without_matplotlib_the_report_says_how_to_get_plots(tmp_path, monkeypatch) -> None:
-    from retrokit.benchmark import plots
-
-    monkeypatch.setattr(plots, "have_matplotlib", lambda: False)
-    out = tmp_path / "run"
-    assert evaluate(out, "--agent", "random", "--levels", "Zone3.Act2", "--timesteps", "200") == 0
-    assert "pip install 'retrokit-rl[plot]'" in (out / "report.md").read_text()
-    assert not (out / "scores.png").exists() and (out / "summary.json").is_file()
-
-
 def test_a_level_whose_env_cannot_start_fails_alone(tmp_path, capsys) -> None:
     path = tmp_path / "mine.yaml"
     path.write_text("budget: 100\nenv: {obs_type: pixels}\nlevels: {test: [Dasher-Genesis/Zone1.Act1]}\n")
@@ -336,10 +310,67 @@ def test_a_level_whose_env_cannot_start_fails_alone(tmp_path, capsys) -> None:
     assert json.loads(summary(out))["levels"] == {}
 
 
-def test_a_worker_killed_by_a_signal_fails_its_level_only(agents_file, tmp_path, monkeypatch, capsys) -> None:
-    monkeypatch.setenv("RETROKIT_TEST_FLAG", str(tmp_path / "worker-started"))
+@pytest.mark.parametrize("workers", ["1", "2"])
+@pytest.mark.parametrize("point", [0.2, 0.7], ids=["early", "late"])
+def test_a_killed_run_resumes_to_the_uninterrupted_result(reference, tmp_path, workers, point) -> None:
+    # SIGKILL once a share of the reference's episodes is logged: no handler runs, the folder is as the kill left it.
+    lines = (reference / "episodes.jsonl").read_text().count("\n")
     out = tmp_path / "run"
-    assert evaluate(out, "--agent", f"{agents_file}:dies_in_a_worker", "--workers", "2") == 2
-    err = capsys.readouterr().err
-    assert "Dasher-Genesis/Zone3.Act2" in err and ("died (signal 9)" in err or "No worker is left" in err)
-    assert list(json.loads(summary(out))["levels"]) == ["Dasher-Genesis/Zone2.Act2"]
+    command = [sys.executable, "-m", "retrokit", "evaluate", *SMALL, "--agent", "jerk", "--workers", workers,
+               "--out", str(out)]
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+    log = out / "episodes.jsonl"
+    wait_for(lambda: process.poll() is not None or (log.is_file() and log.read_text().count("\n") >= lines * point),
+             120, "episodes to be logged")
+    process.kill()
+    process.communicate(timeout=30)
+    wait_for(lambda: not session_processes(process.pid), 20, "the killed run's workers to end")
+    assert evaluate(out, "--agent", "jerk", "--workers", workers, "--resume") == 0
+    assert summary(out) == summary(reference)
+
+
+def test_a_second_run_on_a_folder_in_use_is_refused(agents_file, tmp_path, monkeypatch, capsys) -> None:
+    flag = tmp_path / "go-on"
+    monkeypatch.setenv("RETROKIT_TEST_FLAG", str(flag))
+    out = tmp_path / "run"
+    command = [sys.executable, "-m", "retrokit", "evaluate", *SMALL, "--agent", f"{agents_file}:jerk_pausing",
+               "--levels", "Zone3.Act2", "--workers", "1", "--out", str(out)]
+    first = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    try:
+        wait_for(lambda: (tmp_path / "waiting").exists() or first.poll() is not None, 120, "the first run to pause")
+        assert evaluate(out, "--agent", f"{agents_file}:jerk_pausing", "--levels", "Zone3.Act2", "--resume") == 2
+        err = capsys.readouterr().err
+        assert f"Expected no other evaluation running in {out}, but one is (process {first.pid})" in err
+        assert err.count("\n") == 1
+        assert json.loads((out / "run.json").read_text())["finished"] == {}
+    finally:
+        flag.touch()
+        _, err = first.communicate(timeout=120)
+    assert first.returncode == 0, err
+
+
+def test_help_gives_the_agents_signature_the_backend_default_and_examples(capsys) -> None:
+    assert main(["evaluate", "--help"]) == 0
+    text = capsys.readouterr().out
+    assert "agent(env: gymnasium.Env, budget: int, seed: int) -> None" in text
+    assert "(default: local; Ray is the extra retrokit-rl[ray])" in " ".join(text.split())
+    examples = text[text.index("examples:"):].splitlines()[1:]
+    assert len(examples) >= 5 and all(line.strip().startswith("retrokit evaluate --") for line in examples if line)
+
+
+def test_ctrl_c_at_a_terminal_stops_the_workers_quietly(reference, tmp_path) -> None:
+    # A terminal sends SIGINT to the whole process group: the workers leave it to the evaluation's process.
+    out = tmp_path / "run"
+    command = [sys.executable, "-m", "retrokit", "evaluate", *SMALL, "--agent", "jerk", "--workers", "2",
+               "--out", str(out)]
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                               start_new_session=True)
+    log = out / "episodes.jsonl"
+    wait_for(lambda: process.poll() is not None or (log.is_file() and log.read_text().count("\n") >= 2),
+             120, "episodes to be logged")
+    os.killpg(process.pid, signal.SIGINT)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130 and "--resume" in err and "Traceback" not in err, err
+    wait_for(lambda: not session_processes(process.pid), 20, "the workers to end")
+    assert evaluate(out, "--agent", "jerk", "--resume") == 0
+    assert summary(out) == summary(reference)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 
@@ -28,3 +29,23 @@ def test_without_ray_the_error_says_how_to_install_it(tmp_path, monkeypatch, cap
     monkeypatch.setitem(sys.modules, "ray", None)  # import ray now raises ImportError
     assert main([*ARGS, "--backend", "ray", "--out", str(tmp_path / "run")]) == 2
     assert "pip install 'retrokit-rl[ray]'" in capsys.readouterr().err
+
+
+def test_ray_stops_a_stalled_level_and_keeps_the_other(tmp_path) -> None:
+    agents = tmp_path / "my_agents.py"
+    agents.write_text(
+        "import time\n"
+        "from retrokit.benchmark.agents import random_agent\n"
+        "def sleeps_on_zone2(env, budget, seed):\n"
+        "    if env.unwrapped.state_name == 'Zone2.Act2':\n"
+        "        time.sleep(10**6)\n"
+        "    random_agent(env, budget, seed)\n"
+    )
+    args = [a for a in ARGS if a != "jerk" and a != "--agent"]
+    child = subprocess.run([sys.executable, "-m", "retrokit", *args, "--agent", f"{agents}:sleeps_on_zone2",
+                            "--workers", "2", "--backend", "ray", "--stall-timeout", "5", "--out", str(tmp_path / "ray")],
+                           check=False, capture_output=True, text=True, timeout=240)
+    assert child.returncode == 2, child.stderr
+    assert "Level Dasher-Genesis/Zone2.Act2 stalled and was stopped after 5 s" in child.stderr
+    summary = json.loads((tmp_path / "ray" / "summary.json").read_text())
+    assert list(summary["levels"]) == ["Dasher-Genesis/Zone3.Act2"]

@@ -3,25 +3,27 @@
 from __future__ import annotations
 
 import io
+import json
+import subprocess
+import sys
 
 import pytest
 from PIL import Image
 
 from retrokit.benchmark import plots
 from retrokit.benchmark.definition import load_benchmark
-from retrokit.benchmark.paper import PAPER_ENV, find_paper_dir, load_paper
+from retrokit.benchmark.paper import PAPER_ENV, find_paper_dir, has_paper_scores, load_paper
 from retrokit.benchmark.report import render_report
-from retrokit.benchmark.scores import aggregate
+from retrokit.benchmark.scores import FROM_UNFINISHED, UNFINISHED_NOTE, LevelScore, Summary, aggregate
+from retrokit.cli import main
 
 paper = load_paper()
 needs_paper = pytest.mark.skipif(paper is None, reason="the paper's test-scores.csv is not beside the repository")
 
 
-def as_summary(agent: str, scores: dict[str, float]) -> dict:
-    levels = {level: {"mean_score": s, "episodes": 1, "timesteps": 1_000_000, "std": 0.0, "best": s}
-              for level, s in scores.items()}
-    return {"benchmark": "sonic", "agent": agent, "seed": 0, "budget": 1_000_000, "complete": True,
-            "levels": levels, "aggregate": aggregate(levels)}
+def as_summary(agent: str, scores: dict[str, float]) -> Summary:
+    levels = {level: LevelScore(s, 1, 1_000_000, 0.0, s) for level, s in scores.items()}
+    return Summary("sonic", agent, 0, 1_000_000, True, levels, aggregate(levels))
 
 
 @needs_paper
@@ -35,7 +37,7 @@ def test_the_papers_test_levels_are_the_sonic_benchmarks() -> None:
 @pytest.mark.parametrize("agent", ["Rainbow", "JERK", "PPO", "Joint PPO", "Joint Rainbow", "Human"])
 def test_our_aggregate_of_the_papers_level_scores_is_its_aggregate(agent) -> None:
     scores = {level: score for level, (score, _) in paper.levels[agent].items()}
-    assert as_summary(agent, scores)["aggregate"] == pytest.approx(paper.aggregates[agent][0], abs=0.06)
+    assert as_summary(agent, scores).aggregate == pytest.approx(paper.aggregates[agent][0], abs=0.06)
 
 
 @needs_paper
@@ -67,8 +69,17 @@ def test_the_scores_plot_draws_ours_beside_the_papers() -> None:
 def test_without_the_paper_the_report_says_so(tmp_path, monkeypatch) -> None:
     monkeypatch.setenv(PAPER_ENV, str(tmp_path))  # a folder without test-scores.csv
     assert find_paper_dir() is None and load_paper() is None
-    text = render_report(as_summary("jerk", {"Dasher-Genesis/Zone1.Act2": 5.0}), None, plots=[])
-    assert "The paper's scores were not found" in text and "| Dasher-Genesis/Zone1.Act2 | 5.0 |" in text
+    text = render_report(as_summary("jerk", {"SonicTheHedgehog-Genesis/GreenHillZone.Act2": 5.0}), None, plots=[])
+    assert "The paper's scores were not found" in text and "| SonicTheHedgehog-Genesis/GreenHillZone.Act2 | 5.0 |" in text
+
+
+def test_a_benchmark_the_paper_did_not_score_says_nothing_of_the_paper(tmp_path, monkeypatch) -> None:
+    monkeypatch.setenv(PAPER_ENV, str(tmp_path))  # a folder without test-scores.csv
+    levels = ["Dasher-Genesis/Zone1.Act2"]
+    assert not has_paper_scores(levels) and has_paper_scores(["SonicTheHedgehog-Genesis/GreenHillZone.Act2"])
+    text = render_report(as_summary("jerk", dict.fromkeys(levels, 5.0)), None, plots=[],
+                         paper_levels=has_paper_scores(levels))
+    assert "paper" not in text.lower() and "| Dasher-Genesis/Zone1.Act2 | 5.0 |" in text
 
 
 def test_a_damaged_paper_file_is_treated_as_absent(tmp_path, monkeypatch) -> None:
@@ -82,3 +93,31 @@ def test_a_damaged_paper_file_is_treated_as_absent(tmp_path, monkeypatch) -> Non
                                               ("random", None), ("pkg.mod:random", None)])
 def test_our_agents_are_matched_to_the_papers_by_name(ours, theirs) -> None:
     assert paper.agent(ours) == theirs
+
+
+def test_a_level_that_finished_no_episode_scores_its_unfinished_episode(tmp_path, monkeypatch) -> None:
+    # 60 timesteps: JERK finishes no episode on Zone2.Act2 (its episodes last hundreds of steps), two on Zone3.Act2.
+    monkeypatch.setenv(PAPER_ENV, str(tmp_path))  # no paper: a Dasher report must not mention it anyway
+    out = tmp_path / "run"
+    assert main(["evaluate", "--levels", "Zone2.Act2,Zone3.Act2", "--timesteps", "60", "--agent", "jerk",
+                 "--no-progress", "--out", str(out)]) == 0
+    data = json.loads((out / "summary.json").read_text())
+    empty, played = data["levels"]["Dasher-Genesis/Zone2.Act2"], data["levels"]["Dasher-Genesis/Zone3.Act2"]
+    assert empty["episodes"] == 0 and empty["scored_from"] == FROM_UNFINISHED and empty["mean_score"] > 0
+    assert played["episodes"] > 0 and played["scored_from"] == "finished episodes"
+    assert data["aggregate"] == pytest.approx((empty["mean_score"] + played["mean_score"]) / 2)
+    assert data["notes"] == [UNFINISHED_NOTE]
+    report = (out / "report.md").read_text()
+    assert UNFINISHED_NOTE in report and "| Dasher-Genesis/Zone2.Act2 * |" in report
+    assert "paper" not in report.lower()
+
+
+def test_without_a_terminal_each_level_prints_one_line(tmp_path) -> None:
+    child = subprocess.run([sys.executable, "-m", "retrokit", "evaluate", "--levels", "Zone2.Act2,Zone3.Act2",
+                            "--timesteps", "100", "--agent", "random", "--out", str(tmp_path / "run")],
+                           capture_output=True, text=True, timeout=240, check=False)
+    assert child.returncode == 0, child.stderr
+    lines = [line for line in child.stdout.splitlines() if line.startswith("[")]
+    assert sorted(line[:5] for line in lines) == ["[1/2]", "[2/2]"], child.stdout
+    assert all(": done, " in line and "score" in line for line in lines)
+    assert "\r" not in child.stdout + child.stderr and "\x1b" not in child.stdout + child.stderr

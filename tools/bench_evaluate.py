@@ -83,7 +83,7 @@ def evaluation_rate(workers: int, timesteps: int, agent: str) -> float:
         summary = evaluate(Evaluation(benchmark=benchmark, levels=benchmark.select(LEVELS), agent=agent,
                                       out=Path(folder) / "run", budget=timesteps, workers=workers, progress=False))
         seconds = time.perf_counter() - began
-    return sum(entry["timesteps"] for entry in summary["levels"].values()) / seconds
+    return sum(entry.timesteps for entry in summary.levels.values()) / seconds
 
 
 def main() -> None:

@@ -1,8 +1,9 @@
 """An evaluation from start to end: check, run the levels, write every output.
 
-:func:`evaluate` is what ``retrokit evaluate`` runs. It checks the levels, the
-ROMs and the agent before playing anything, then runs the levels on a backend
-with a progress bar per level, logs the episodes as they come, and writes
+:func:`evaluate` is what ``retrokit evaluate`` runs. It checks every argument,
+the levels, the ROMs and the agent before it makes anything, then runs the
+levels on a backend (each level in a worker process of its own, watched for
+stalls), shows their progress, logs the episodes as they come, and writes
 ``summary.json``, ``summary.csv``, ``report.md`` and the plots, also when a
 level fails or the run is interrupted: the results so far are kept, and
 ``--resume`` finishes the rest.
@@ -10,6 +11,7 @@ level fails or the run is interrupted: the results so far are kept, and
 
 from __future__ import annotations
 
+import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -18,12 +20,14 @@ from typing import Any
 from retrokit.benchmark import plots
 from retrokit.benchmark.agents import resolve_agent
 from retrokit.benchmark.definition import Benchmark, Level
-from retrokit.benchmark.level import LevelTask, Message
-from retrokit.benchmark.paper import PaperScores, load_paper
+from retrokit.benchmark.level import EpisodeEnded, LevelDone, LevelFailed, LevelTask, Message, Progress
+from retrokit.benchmark.paper import PaperScores, has_paper_scores, load_paper
+from retrokit.benchmark.progress import LevelProgress
 from retrokit.benchmark.report import paper_column, render_report, write_report, write_summary
 from retrokit.benchmark.rundir import RunDir
-from retrokit.benchmark.scores import summarize
-from retrokit.errors import AgentError, InvalidArgumentError, install_extra
+from retrokit.benchmark.scores import Summary, level_score, summarize
+from retrokit.benchmark.watchdog import DEFAULT_STALL_SECONDS, Watchdog
+from retrokit.errors import AgentError, InvalidArgumentError
 from retrokit.paths import atomic_write
 
 BACKENDS = ("local", "ray")
@@ -45,8 +49,10 @@ class Evaluation:
         ray_address: An existing Ray cluster, for the ray backend.
         resume: Continue the evaluation ``out`` holds.
         gif: Save a GIF of the best episode of each level (``gifs/``).
-        progress: Show progress bars.
+        progress: Show progress (bars on a terminal, else a line per level).
         paper_dir: Where the paper's ``test-scores.csv`` is (default: found by :mod:`.paper`).
+        stall_timeout: Seconds a level may go without a timestep before it is stopped and fails.
+        failed: The levels that failed in this run, with why (filled by :func:`evaluate`).
     """
 
     benchmark: Benchmark
@@ -62,7 +68,29 @@ class Evaluation:
     gif: bool = False
     progress: bool = True
     paper_dir: Path | None = None
+    stall_timeout: float = DEFAULT_STALL_SECONDS
     failed: dict[str, str] = field(default_factory=dict)
+
+    def check(self) -> None:
+        """Check the arguments, the levels, the ROMs and the agent; nothing is made before this passes.
+
+        Raises:
+            InvalidArgumentError: A number is out of range, or an option does not fit the backend.
+            RetrokitError: A level, ROM or agent cannot be found (see :meth:`Benchmark.check_levels`).
+        """
+        if self.backend not in BACKENDS:
+            raise InvalidArgumentError(f"Expected --backend local or ray, got {self.backend!r}.")
+        if self.workers < 1 or (self.budget is not None and self.budget < 1):
+            raise InvalidArgumentError(
+                f"Expected --workers and --timesteps of 1 or more, got {self.workers} and {self.budget}.")
+        if self.seed < 0:
+            raise InvalidArgumentError(f"Expected a --seed of 0 or more, got {self.seed}.")
+        if not (math.isfinite(self.stall_timeout) and self.stall_timeout > 0):
+            raise InvalidArgumentError(f"Expected a --stall-timeout of more than 0 seconds, got {self.stall_timeout}.")
+        if self.ray_address is not None and self.backend != "ray":
+            raise InvalidArgumentError(f"Expected --backend ray with --ray-address, got --backend {self.backend}.")
+        self.benchmark.check_levels(self.levels)
+        resolve_agent(self.agent)
 
     def settings(self) -> dict[str, Any]:
         """What determines the results; ``--resume`` requires the same."""
@@ -75,81 +103,81 @@ class Evaluation:
         }
 
 
-def evaluate(evaluation: Evaluation) -> dict[str, Any]:
+def evaluate(evaluation: Evaluation) -> Summary:
     """Run an evaluation and write its outputs; return the summary.
 
     Raises:
-        AgentError: A level failed (the agent raised or gave an invalid action); the
-            other levels' results are written, and ``--resume`` retries the failed ones.
+        AgentError: A level failed (the agent raised, stalled, returned early or ended its process); the
+            other levels' results are written, and ``--resume`` plays the failed ones again.
         KeyboardInterrupt: The run was interrupted; what was finished is written.
     """
-    ev = evaluation
-    if ev.backend not in BACKENDS:
-        raise InvalidArgumentError(f"Expected --backend local or ray, got {ev.backend!r}.")
-    if ev.workers < 1 or (ev.budget is not None and ev.budget < 1):
-        raise InvalidArgumentError(f"Expected --workers and --timesteps of 1 or more, got {ev.workers} and {ev.budget}.")
-    ev.benchmark.check_levels(ev.levels)
-    resolve_agent(ev.agent)  # an unknown agent fails here, before anything is written
-    settings = ev.settings()
-    run = RunDir(ev.out, settings, resume=ev.resume)
-    budget = settings["budget"]
-    tasks = [LevelTask(ev.benchmark, level, ev.agent, budget, ev.seed, ev.gif)
-             for level in ev.levels if level.name not in run.finished]
-    bars = _progress_bars(ev, run, budget)
-
-    def handle(message: Message) -> None:
-        if message.kind == "episode":
-            run.add_episode(message.data)
-            if message.level in bars:
-                bars[message.level].update(message.data["timesteps"] - bars[message.level].n)
-        elif message.kind == "done":
-            if "gif" in message.data:
-                atomic_write(ev.out / "gifs" / f"{level_file_name(message.level)}.gif", message.data["gif"], overwrite=True)
-            run.finish(message.level, message.data["timesteps"])
-            if message.level in bars:
-                bars[message.level].update(budget - bars[message.level].n)
-                bars[message.level].set_postfix_str("done")
-        elif message.kind == "failed":
-            ev.failed[message.level] = message.data["error"]
-            run.fail(message.level, message.data["error"])
-            if message.level in bars:
-                bars[message.level].set_postfix_str("failed")
-
-    try:
-        if tasks:
-            if ev.backend == "ray":
-                from retrokit.benchmark.ray_backend import run_ray
-
-                run_ray(tasks, handle, ev.workers, ev.ray_address)
-            else:
-                from retrokit.benchmark.local import run_local
-
-                run_local(tasks, handle, ev.workers)
-    finally:
-        for bar in bars.values():
-            bar.close()
-        run.close()
-        summary = write_outputs(ev, run, load_paper(ev.paper_dir))
-    if ev.failed:
-        _level, error = next(iter(ev.failed.items()))
-        more = f" ({len(ev.failed) - 1} more level(s) failed: see report.md)" if len(ev.failed) > 1 else ""
-        raise AgentError(f"{error}{more} The results so far are in {ev.out}; fix the cause and add --resume.")
+    summary = run_evaluation(evaluation)
+    if evaluation.failed:
+        raise AgentError(failure_message(evaluation))
     return summary
 
 
-def _progress_bars(ev: Evaluation, run: RunDir, budget: int) -> dict[str, Any]:
-    from tqdm import tqdm
+def failure_message(ev: Evaluation) -> str:
+    """One line on the levels that failed in ``ev``, and how to finish them."""
+    _level, error = next(iter(ev.failed.items()))
+    more = f" ({len(ev.failed) - 1} more level(s) failed: see report.md)" if len(ev.failed) > 1 else ""
+    return f"{error}{more} The results so far are in {ev.out}; fix the cause and add --resume."
 
-    width = max(len(level.name) for level in ev.levels)
-    bars = {}
-    for position, level in enumerate(ev.levels):
-        bar = tqdm(total=budget, desc=level.name.ljust(width), unit="step", position=position, leave=True,
-                   disable=not ev.progress, dynamic_ncols=True, mininterval=0.5)
-        if level.name in run.finished:
-            bar.update(budget)
-            bar.set_postfix_str("done before")
-        bars[level.name] = bar
-    return bars
+
+def run_evaluation(evaluation: Evaluation) -> Summary:
+    """Like :func:`evaluate`, but a level that fails is only noted in ``evaluation.failed``."""
+    ev = evaluation
+    ev.check()
+    settings = ev.settings()
+    budget = settings["budget"]
+    run = RunDir(ev.out, settings, resume=ev.resume)
+    try:
+        tasks = [LevelTask(ev.benchmark, level, ev.agent, budget, ev.seed, ev.gif)
+                 for level in ev.levels if level.name not in run.finished]
+        progress = LevelProgress([level.name for level in ev.levels], budget, set(run.finished), show=ev.progress)
+        try:
+            _run(ev, tasks, run, progress, budget)
+        finally:
+            progress.close()
+    finally:
+        try:
+            summary = write_outputs(ev, run, load_paper(ev.paper_dir))
+        finally:
+            run.close()  # the folder stays locked until its outputs are written
+    return summary
+
+
+def _run(ev: Evaluation, tasks: list[LevelTask], run: RunDir, progress: LevelProgress, budget: int) -> None:
+    """Play ``tasks`` on the evaluation's backend, recording every message in ``run``."""
+
+    def handle(message: Message) -> None:
+        if isinstance(message, Progress):
+            progress.step(message.level, message.timesteps)
+        elif isinstance(message, EpisodeEnded):
+            run.add_episode(message.level, message.episode)
+            progress.step(message.level, message.episode.timesteps)
+        elif isinstance(message, LevelDone):
+            if message.gif is not None:
+                atomic_write(ev.out / "gifs" / f"{level_file_name(message.level)}.gif", message.gif, overwrite=True)
+            run.finish(message.level, message.timesteps, message.unfinished_reward)
+            score = level_score(run.episodes.get(message.level, []), run.finished[message.level])
+            progress.end(message.level, f"done, {score.episodes} episode(s), score {score.mean_score:,.1f}")
+        elif isinstance(message, LevelFailed):
+            ev.failed[message.level] = message.error
+            run.fail(message.level, message.error)
+            progress.end(message.level, f"failed: {message.error}")
+
+    if not tasks:
+        return
+    watchdog = Watchdog(ev.stall_timeout, budget)
+    if ev.backend == "ray":
+        from retrokit.benchmark.ray_backend import run_ray
+
+        run_ray(tasks, handle, ev.workers, ev.ray_address, watchdog)
+    else:
+        from retrokit.benchmark.local import run_local
+
+        run_local(tasks, handle, ev.workers, watchdog)
 
 
 def level_file_name(level: str) -> str:
@@ -157,27 +185,27 @@ def level_file_name(level: str) -> str:
     return level.replace("/", "_").replace(os.sep, "_")
 
 
-def write_outputs(ev: Evaluation, run: RunDir, paper: PaperScores | None) -> dict[str, Any]:
+def write_outputs(ev: Evaluation, run: RunDir, paper: PaperScores | None) -> Summary:
     """Write the summary, the report and the plots of what ``run`` holds; return the summary."""
     summary = summarize(run.settings, run.finished, run.episodes)
     write_summary(ev.out, summary, paper)
     written = []
-    if plots.have_matplotlib() and summary["levels"]:
-        finished = {level: run.episodes.get(level, []) for level in summary["levels"]}
+    if summary.levels:
+        finished = {level: run.episodes.get(level, []) for level in summary.levels}
         title = f"{ev.agent} on {ev.benchmark.name}: episode reward against timesteps"
         atomic_write(ev.out / "learning-curves.png", plots.learning_curves(finished, run.settings["budget"], title),
                      overwrite=True)
         name, theirs = paper_column(summary, paper)
-        series = {ev.agent: {level: entry["mean_score"] for level, entry in summary["levels"].items()}}
-        if name is not None and any(level in theirs for level in summary["levels"]):
+        series: dict[str, dict[str, float | None]] = {
+            ev.agent: {level: entry.mean_score for level, entry in summary.levels.items()}}
+        if name is not None and any(level in theirs for level in summary.levels):
             series[f"paper ({name})"] = {level: score for level, (score, _) in theirs.items()}
         atomic_write(ev.out / "scores.png",
-                     plots.score_bars(series, list(summary["levels"]), f"{ev.agent} on {ev.benchmark.name}: level scores"),
+                     plots.score_bars(series, list(summary.levels), f"{ev.agent} on {ev.benchmark.name}: level scores"),
                      overwrite=True)
         written = ["learning-curves.png", "scores.png"]
     text = render_report(summary, paper, plots=written, failed=ev.failed or run.failed,
-                         env_rules=ev.benchmark.env_options())
-    if not plots.have_matplotlib():
-        text += f"\nNo plots: matplotlib is not installed (`{install_extra('plot')}`).\n"
+                         env_rules=ev.benchmark.env_options(),
+                         paper_levels=has_paper_scores(level.name for level in ev.levels))
     write_report(ev.out, text)
     return summary

@@ -1,20 +1,25 @@
-"""One level's evaluation, as a stream of messages: the unit every backend runs.
+"""One level's evaluation, as a stream of typed messages: the unit every backend runs.
 
 :func:`run_level` makes the level's env, wraps it in a
 :class:`~retrokit.benchmark.monitor.Monitor`, and lets the agent play until its
-budget is spent. It emits an ``episode`` message per finished episode, then
-``done`` (with the level's result) or ``failed`` (with a one-line reason naming
-the level and the step). The local processes put the messages on a queue, Ray
-tasks on a Ray queue: the evaluation reads them the same way.
+budget is spent. A thread emits :class:`Progress` twice a second while the count
+of timesteps grows (the watchdog's sign of life, sent also while the agent
+itself is stuck), the level an :class:`EpisodeEnded` per finished episode, then
+:class:`LevelDone` or :class:`LevelFailed` (with a one-line reason naming the
+level and the step). A level is done only when its whole budget was spent
+through the monitor: an agent that returns early fails its level. The local
+processes send the messages down a pipe, Ray tasks put them on a Ray queue:
+the evaluation reads them the same way.
 """
 
 from __future__ import annotations
 
 import io
+import os
+import threading
 import traceback
 from collections.abc import Callable
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass
 
 from retrokit.benchmark.definition import Benchmark, Level
 from retrokit.benchmark.monitor import BudgetSpent, Episode, Monitor
@@ -22,6 +27,8 @@ from retrokit.errors import AgentError, RetrokitError
 
 #: GIF frame time: a step is 4 frames at 60 frames a second.
 GIF_FRAME_MS = 67
+#: A level reports its timesteps at most this often.
+PROGRESS_SECONDS = 0.5
 
 
 @dataclass(frozen=True)
@@ -37,12 +44,57 @@ class LevelTask:
 
 
 @dataclass(frozen=True)
-class Message:
-    """A worker's report: ``kind`` is ``episode``, ``done`` or ``failed``."""
+class Started:
+    """A process has made ``level``'s env and calls its agent now."""
 
-    kind: str
     level: str
-    data: dict[str, Any] = field(default_factory=dict)
+    pid: int
+
+
+@dataclass(frozen=True)
+class Progress:
+    """``level`` has taken ``timesteps`` so far."""
+
+    level: str
+    timesteps: int
+
+
+@dataclass(frozen=True)
+class EpisodeEnded:
+    """An episode of ``level`` finished."""
+
+    level: str
+    episode: Episode
+
+
+@dataclass(frozen=True)
+class LevelDone:
+    """``level`` spent its whole budget through the monitor.
+
+    Attributes:
+        level: The level.
+        timesteps: Its budget, all spent.
+        unfinished_reward: The reward of the episode under way when the budget ran out (it scores a level
+            that finished no episode; see :mod:`.scores`).
+        gif: The best episode as a GIF, when asked for.
+    """
+
+    level: str
+    timesteps: int
+    unfinished_reward: float
+    gif: bytes | None = None
+
+
+@dataclass(frozen=True)
+class LevelFailed:
+    """``level`` ended without spending its budget; ``error`` says why, in one line."""
+
+    level: str
+    error: str
+    timesteps: int
+
+
+Message = Started | Progress | EpisodeEnded | LevelDone | LevelFailed
 
 
 def run_level(task: LevelTask, emit: Callable[[Message], None]) -> None:
@@ -59,41 +111,59 @@ def run_level(task: LevelTask, emit: Callable[[Message], None]) -> None:
         env = RetroEnv(task.level.game, task.level.state, options.pop("scenario", None), **options)
     except Exception as exc:  # noqa: BLE001 - any failure to start a level fails that level only
         what = str(exc) if isinstance(exc, RetrokitError) else f"{type(exc).__name__}: {exc}"
-        emit(Message("failed", name, {"error": f"Expected to start level {name} (step 0), but: {what}", "timesteps": 0}))
+        emit(LevelFailed(name, f"Expected to start level {name} (step 0), but: {what}", 0))
         return
 
-    def on_episode(episode: Episode) -> None:
-        emit(Message("episode", name, {
-            "level": name, "episode": episode.episode, "steps": episode.steps, "reward": episode.reward,
-            "timesteps": episode.timesteps, "wall": episode.wall,
-        }))
+    lock = threading.Lock()  # the agent's thread and the progress thread share the channel
 
-    monitor = Monitor(env, name, task.budget, task.level.seed(task.seed), on_episode, keep_frames=task.gif)
+    def send(message: Message) -> None:
+        with lock:
+            emit(message)
+
+    monitor = Monitor(env, name, task.budget, task.level.seed(task.seed), lambda e: send(EpisodeEnded(name, e)),
+                      keep_frames=task.gif)
+    stop = threading.Event()
+
+    def report_progress() -> None:
+        sent = 0
+        while not stop.wait(PROGRESS_SECONDS):
+            if monitor.timesteps != sent:
+                sent = monitor.timesteps
+                send(Progress(name, sent))
+
+    reporter = threading.Thread(target=report_progress, name=f"progress of {name}", daemon=True)
+    reporter.start()
+    send(Started(name, os.getpid()))
     try:
         agent(monitor, task.budget, task.level.seed(task.seed))
     except BudgetSpent:
         pass
     except AgentError as exc:
-        emit(Message("failed", name, {"error": str(exc), "timesteps": monitor.timesteps}))
+        emit(LevelFailed(name, str(exc), monitor.timesteps))
         return
-    except Exception as exc:  # noqa: BLE001 - the agent is user code: report it, keep the others' results
+    except BaseException as exc:  # noqa: BLE001 - the agent is user code, SystemExit too: report it, keep the rest
         where = traceback.extract_tb(exc.__traceback__)[-1]
-        emit(Message("failed", name, {
-            "error": f"The agent {task.agent!r} raised {type(exc).__name__}: {exc} (level {name}, step "
-            f"{monitor.timesteps + 1}, at {where.filename}:{where.lineno}).",
-            "timesteps": monitor.timesteps,
-        }))
+        emit(LevelFailed(name, f"The agent {task.agent!r} raised {type(exc).__name__}: {exc} (level {name}, step "
+                         f"{monitor.timesteps + 1}, at {where.filename}:{where.lineno}).", monitor.timesteps))
         return
     finally:
+        stop.set()
+        reporter.join()
         env.close()
-    data: dict[str, Any] = {"timesteps": monitor.timesteps}
+    if monitor.timesteps < task.budget:
+        emit(LevelFailed(name, (
+            f"Expected the agent {task.agent!r} to play level {name} until its budget of {task.budget:,} timesteps "
+            f"was spent, but it returned after {monitor.timesteps:,}; an agent loops over reset() and step() of the "
+            "env it is given (not env.unwrapped, which the budget does not count) until step() ends its play."),
+            monitor.timesteps))
+        return
+    gif = None
     if task.gif and monitor.best_frames:
-        data["gif"] = encode_gif(monitor.best_frames, GIF_FRAME_MS * monitor.best_stride)
-        data["gif_reward"] = monitor.best_reward
-    emit(Message("done", name, data))
+        gif = encode_gif(monitor.best_frames, GIF_FRAME_MS * monitor.best_stride)
+    emit(LevelDone(name, monitor.timesteps, monitor.unfinished_reward, gif))
 
 
-def encode_gif(frames: list[Any], frame_ms: int) -> bytes:
+def encode_gif(frames: list, frame_ms: int) -> bytes:  # numpy frames
     """The frames as a looping GIF, ``frame_ms`` milliseconds each."""
     from PIL import Image
 

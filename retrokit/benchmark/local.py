@@ -1,105 +1,150 @@
-"""The local backend: levels shared among processes on this machine.
+"""The local backend: every level in a worker process of its own, at most N at a time.
 
-With one worker the levels run in this process, one after the other. With N,
-this process is one of the N: it starts N - 1 worker processes and plays
-levels itself too, so no core waits for a process to start up. Each takes
-the next level from a shared counter; the workers' messages come back on one
-queue, which this process reads between its own episodes, then until every
-level is done. A level's result depends only on its own seed, never on
-which process played it.
+The command's own process plays nothing: an agent that calls ``os._exit``,
+raises ``SystemExit`` or crashes in native code takes down only its level's
+worker, and the evaluation reports that level and keeps the others. Each
+worker sends its messages down a pipe; this process waits on the pipes and
+the workers' exits together, and feeds the
+:class:`~retrokit.benchmark.watchdog.Watchdog`, which stops a stalled worker.
+A worker dies with this process (a parent-death signal on Linux, and a thread
+that watches the parent everywhere), so a killed evaluation leaves no worker
+playing on. A level's result depends only on its own seed, never on which
+process played it.
 """
 
 from __future__ import annotations
 
 import multiprocessing
-import queue
+import os
 import signal
+import sys
+import threading
+import time
 from collections.abc import Callable
+from dataclasses import dataclass
+from multiprocessing.connection import Connection, wait
 
-from retrokit.benchmark.level import LevelTask, Message, run_level
+from retrokit.benchmark.level import LevelDone, LevelFailed, LevelTask, Message, Started, run_level
+from retrokit.benchmark.watchdog import Watchdog
 
 POLL_SECONDS = 0.5
+_PR_SET_PDEATHSIG = 1  # from <linux/prctl.h>
 
 
-def run_local(tasks: list[LevelTask], handle: Callable[[Message], None], workers: int) -> None:
-    """Run ``tasks`` on ``workers`` processes, this one included, passing each message to ``handle``."""
-    if workers <= 1 or len(tasks) <= 1:
-        for task in tasks:
-            run_level(task, handle)
-        return
-    # spawn, not fork: the parent may hold threads (tqdm's, the emulator host's) that fork would copy half-way.
+@dataclass
+class _Worker:
+    task: LevelTask
+    process: multiprocessing.process.BaseProcess
+    pipe: Connection
+    ended: bool = False  # the level sent LevelDone or LevelFailed
+
+
+def run_local(tasks: list[LevelTask], handle: Callable[[Message], None], workers: int, watchdog: Watchdog) -> None:
+    """Play each of ``tasks`` in a worker process, ``workers`` at a time, passing each message to ``handle``."""
+    # spawn, not fork: this process may hold threads (tqdm's, the emulator host's) that fork would copy half-way.
     context = multiprocessing.get_context("spawn")
-    counter, messages = context.Value("i", 0), context.Queue()
-    processes = [context.Process(target=_worker, args=(tasks, counter, messages), daemon=True)
-                 for _ in range(min(workers, len(tasks)) - 1)]
-    for process in processes:
-        process.start()
-    running: dict[int, str] = {}  # worker pid -> the level it plays
-    remaining = {task.level.name for task in tasks}
-
-    def take(message: Message) -> None:
-        if message.kind == "start":
-            running[message.data["pid"]] = message.level
-            return
-        if message.kind in ("done", "failed"):
-            remaining.discard(message.level)
-        handle(message)
-
-    def drain() -> None:
-        while True:
-            try:
-                take(messages.get_nowait())
-            except queue.Empty:
-                return
-
-    def mine(message: Message) -> None:  # this process's own messages; the workers' are read between them
-        take(message)
-        drain()
-
+    pending = list(reversed(tasks))
+    running: dict[Connection, _Worker] = {}
     try:
-        while (task := _next(tasks, counter)) is not None:
-            run_level(task, mine)
-        while remaining:
-            try:
-                take(messages.get(timeout=POLL_SECONDS))
-            except queue.Empty:
-                _check_workers(processes, running, remaining, handle)
+        while pending or running:
+            while pending and len(running) < workers:
+                task = pending.pop()
+                reader, writer = context.Pipe(duplex=False)
+                process = context.Process(target=_work, args=(task, writer, os.getpid()), daemon=True,
+                                          name=f"retrokit level {task.level.name}")
+                _start(process)
+                writer.close()  # the worker holds the only writer: its exit ends the pipe
+                watchdog.start(task.level.name)
+                running[reader] = _Worker(task, process, reader)
+            wait([*running, *(worker.process.sentinel for worker in running.values())], timeout=POLL_SECONDS)
+            for pipe, worker in list(running.items()):
+                if _read(worker, handle, watchdog):
+                    continue
+                del running[pipe]
+                worker.process.join()
+                if not worker.ended:
+                    handle(_died(worker, watchdog))
+                watchdog.stop(worker.task.level.name)
+            for level in watchdog.stalled():
+                pipe, worker = next((p, w) for p, w in running.items() if w.task.level.name == level)
+                worker.process.kill()
+                worker.process.join()
+                del running[pipe]
+                pipe.close()
+                handle(LevelFailed(level, watchdog.error(level), watchdog.timesteps(level)))
+                watchdog.stop(level)
     finally:
-        for process in processes:
-            if process.is_alive():
-                process.terminate()
-        for process in processes:
-            process.join(timeout=5)
-        messages.close()
+        for worker in running.values():
+            worker.process.kill()
+        for worker in running.values():
+            worker.process.join(timeout=10)
+            worker.pipe.close()
 
 
-def _next(tasks: list[LevelTask], counter) -> LevelTask | None:  # a shared multiprocessing Value
-    """The next level nobody has taken, or ``None``."""
-    with counter.get_lock():
-        index = counter.value
-        counter.value += 1
-    return tasks[index] if index < len(tasks) else None
+def _start(process: multiprocessing.process.BaseProcess) -> None:
+    """Start a worker with Ctrl-C blocked: a terminal's SIGINT goes to the whole process group, and it is this
+    process's to handle (it stops the workers); the mask is inherited, so not even the worker's start sees it."""
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        process.start()
+    finally:
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # a Ctrl-C meanwhile arrives now
 
 
-def _check_workers(processes, running: dict[int, str], remaining: set[str], handle) -> None:
-    """Fail the level of any worker that died (a crash in native code, the OOM killer)."""
-    for process in processes:
-        if process.exitcode not in (None, 0) and running.get(process.pid) in remaining:
-            level = running.pop(process.pid)
-            remaining.discard(level)
-            how = f"signal {-process.exitcode}" if process.exitcode < 0 else f"exit code {process.exitcode}"
-            handle(Message("failed", level, {"error": f"The worker playing level {level} died ({how}).", "timesteps": 0}))
-    if not any(process.is_alive() for process in processes) and remaining:
-        for level in sorted(remaining):
-            handle(Message("failed", level, {"error": f"No worker is left to play level {level}.", "timesteps": 0}))
-        remaining.clear()
+def _read(worker: _Worker, handle: Callable[[Message], None], watchdog: Watchdog) -> bool:
+    """Pass on every message the worker has sent; ``False`` once its pipe is closed (the worker ended)."""
+    try:
+        while worker.pipe.poll():
+            message = worker.pipe.recv()
+            watchdog.see(message)
+            if isinstance(message, LevelDone | LevelFailed):
+                worker.ended = True
+                watchdog.stop(message.level)  # its process may take a moment to exit: that is no stall
+            if not isinstance(message, Started):
+                handle(message)
+    except (EOFError, OSError):
+        worker.pipe.close()
+        return False
+    return True
 
 
-def _worker(tasks: list[LevelTask], counter, messages) -> None:  # a shared Value and a queue
-    """A worker process: play levels until none is left."""
-    import os
+def _died(worker: _Worker, watchdog: Watchdog) -> LevelFailed:
+    """The failure of a level whose worker ended without finishing it."""
+    level, code = worker.task.level.name, worker.process.exitcode or 0
+    how = f"was killed by signal {signal.Signals(-code).name}" if code < 0 else f"exited with status {code}"
+    step = watchdog.timesteps(level)
+    return LevelFailed(level, (
+        f"The worker playing level {level} {how} (its last report: step {step:,}) before the level was finished: "
+        "the agent ended its process (os._exit) or crashed in native code."), step)
 
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle; it stops the workers
-    while (task := _next(tasks, counter)) is not None:
-        messages.put(Message("start", task.level.name, {"pid": os.getpid()}))
-        run_level(task, messages.put)
+
+def _work(task: LevelTask, pipe: Connection, parent: int) -> None:
+    """A worker process: play one level, sending every message down ``pipe``."""
+    _die_with_parent(parent)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # also if the agent unblocks it: Ctrl-C is the parent's
+    run_level(task, pipe.send)
+    pipe.close()
+    # Exit now: a thread the agent left running must not keep the process (and the evaluation) waiting.
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(0)
+
+
+def _die_with_parent(parent: int) -> None:
+    """End this process as soon as the evaluation's process is gone, whatever the agent is doing."""
+    if sys.platform.startswith("linux"):
+        import ctypes
+
+        try:
+            ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+        except (OSError, AttributeError):
+            pass  # the watching thread below still ends it
+    if os.getppid() != parent:  # the parent died before the signal was set up
+        os._exit(1)
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="retrokit parent watch", daemon=True).start()

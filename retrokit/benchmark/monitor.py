@@ -9,9 +9,10 @@ a plain loop over ``reset`` and ``step``, as in any Gymnasium code.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import gymnasium
@@ -48,6 +49,32 @@ class Episode:
     reward: float
     timesteps: int
     wall: float
+
+    def record(self, level: str) -> dict[str, Any]:
+        """The episode as a line of ``episodes.jsonl``."""
+        return {"level": level, **asdict(self)}
+
+    @classmethod
+    def from_record(cls, record: dict[str, Any], budget: int) -> Episode:
+        """Read back a line of ``episodes.jsonl`` (see :meth:`record`) of a level with ``budget`` timesteps.
+
+        Raises:
+            ValueError: A field is missing, of the wrong type, or out of range (the message says which).
+        """
+        def whole(key: str, low: int, high: int) -> int:
+            value = record.get(key)
+            if not isinstance(value, int) or isinstance(value, bool) or not low <= value <= high:
+                raise ValueError(f"'{key}' must be a whole number from {low} to {high}, got {value!r}")
+            return value
+
+        def real(key: str) -> float:
+            value = record.get(key)
+            if not isinstance(value, int | float) or isinstance(value, bool) or not math.isfinite(value):
+                raise ValueError(f"'{key}' must be a finite number, got {value!r}")
+            return float(value)
+
+        return cls(whole("episode", 1, budget), whole("steps", 1, budget), real("reward"),
+                   whole("timesteps", 1, budget), real("wall"))
 
 
 class Monitor(gymnasium.Wrapper):
@@ -89,6 +116,11 @@ class Monitor(gymnasium.Wrapper):
     def timesteps_left(self) -> int:
         """Timesteps the agent may still take."""
         return self.budget - self.timesteps
+
+    @property
+    def unfinished_reward(self) -> float:
+        """The reward of the episode under way (0.0 when none is): what a level that finished none scores."""
+        return 0.0 if self._ended else self._reward
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         """Start an episode; an unfinished one is dropped (only finished episodes score)."""

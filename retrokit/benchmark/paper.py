@@ -10,13 +10,23 @@ from __future__ import annotations
 
 import csv
 import os
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from retrokit.data.sonic_levels import TEST_LEVELS
 
 PAPER_ENV = "RETROKIT_PAPER"
 SCORES_FILE = "test-scores.csv"
 #: Our agent names that the paper also ran.
 AGENT_NAMES = {"jerk": "JERK"}
+#: The levels the paper scored: its 11 test levels.
+PAPER_LEVELS = frozenset(f"{game}/{state}" for game, states in TEST_LEVELS.items() for state in states)
+
+
+def has_paper_scores(levels: Iterable[str]) -> bool:
+    """Whether the paper scored any of ``levels`` (else a report says nothing of the paper)."""
+    return any(level in PAPER_LEVELS for level in levels)
 
 
 @dataclass

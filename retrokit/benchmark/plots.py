@@ -1,4 +1,4 @@
-"""The PNG plots, drawn with matplotlib (the ``retrokit-rl[plot]`` extra).
+"""The PNG plots, drawn with matplotlib.
 
 The object API is used (no pyplot), so drawing changes no global state and
 needs no display.
@@ -8,14 +8,8 @@ from __future__ import annotations
 
 import io
 import math
-from typing import Any
 
-
-def have_matplotlib() -> bool:
-    """Whether matplotlib can be imported."""
-    import importlib.util
-
-    return importlib.util.find_spec("matplotlib") is not None
+from retrokit.benchmark.monitor import Episode
 
 
 def _figure(width: float, height: float):  # a matplotlib Figure
@@ -44,7 +38,7 @@ def _smooth(values: list[float], window: int) -> list[float]:
     return out
 
 
-def learning_curves(episodes: dict[str, list[dict[str, Any]]], budget: int, title: str) -> bytes:
+def learning_curves(episodes: dict[str, list[Episode]], budget: int, title: str) -> bytes:
     """One panel per level: each episode's reward at the timestep it ended, and their running mean.
 
     The paper's figures draw the same: episode reward against timesteps.
@@ -56,9 +50,9 @@ def learning_curves(episodes: dict[str, list[dict[str, Any]]], budget: int, titl
     figure.suptitle(title)
     for i, level in enumerate(levels):
         axes = figure.add_subplot(rows, columns, i + 1)
-        records = sorted(episodes[level], key=lambda e: e["episode"])
-        x = [e["timesteps"] for e in records]
-        y = [e["reward"] for e in records]
+        records = sorted(episodes[level], key=lambda e: e.episode)
+        x = [e.timesteps for e in records]
+        y = [e.reward for e in records]
         axes.scatter(x, y, s=6, alpha=0.35, color="tab:blue", label="episode")
         if records:
             axes.plot(x, _smooth(y, max(1, len(y) // 10)), color="tab:red", linewidth=1.5, label="running mean")

@@ -6,25 +6,69 @@ finished; on ``--resume`` the episodes of unfinished levels are dropped and
 those levels start again from their seed, so the result equals an
 uninterrupted run. Each episode line is flushed as it comes, and ``run.json``
 is replaced atomically after it, so a killed run leaves a readable folder.
+
+A run holds an OS lock on ``run.lock`` for its lifetime (it dies with the
+process), so a second run on the same folder is refused. Everything read back
+is checked: a damaged folder ends in one :class:`~retrokit.errors.RunFolderError`.
 """
 
 from __future__ import annotations
 
+import fcntl
 import json
+import math
 import os
+import stat
+from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, BinaryIO
 
-from retrokit.errors import FileConflictError, RunFolderError
+from retrokit.benchmark.monitor import Episode
+from retrokit.errors import FileConflictError, RetrokitError, RunFolderError
 from retrokit.paths import atomic_write, ensure_folder
 
 RUN_FILE = "run.json"
 EPISODES_FILE = "episodes.jsonl"
+LOCK_FILE = "run.lock"
 OUTPUTS = (RUN_FILE, EPISODES_FILE, "summary.json", "summary.csv", "report.md")
+MAX_RUN_FILE_BYTES = 16 << 20  # settings and one entry per level: a few kB
+MAX_LINE_BYTES = 1 << 16  # an episode line is about 120 bytes
+
+
+@dataclass(frozen=True)
+class FinishedLevel:
+    """A level that spent its budget.
+
+    Attributes:
+        timesteps: Its timesteps (the budget).
+        episodes: Its finished episodes, all in ``episodes.jsonl``.
+        unfinished_reward: The reward of the episode under way when the budget ran out.
+    """
+
+    timesteps: int
+    episodes: int
+    unfinished_reward: float = 0.0
+
+    @classmethod
+    def from_json(cls, data: Any) -> FinishedLevel:
+        """Read an entry of ``run.json``'s ``finished``.
+
+        Raises:
+            ValueError: It is not of that shape (the message says how).
+        """
+        if not isinstance(data, dict):
+            raise ValueError(f"a finished level must be a mapping, got {type(data).__name__}")  # noqa: TRY004 - bad data
+        values = [data.get("timesteps"), data.get("episodes")]
+        if any(not isinstance(v, int) or isinstance(v, bool) or v < 0 for v in values):
+            raise ValueError(f"'timesteps' and 'episodes' must be whole numbers of 0 or more, got {values}")
+        reward = data.get("unfinished_reward", 0.0)
+        if not isinstance(reward, int | float) or isinstance(reward, bool) or not math.isfinite(reward):
+            raise ValueError(f"'unfinished_reward' must be a finite number, got {reward!r}")
+        return cls(values[0], values[1], float(reward))
 
 
 class RunDir:
-    """An evaluation's output folder.
+    """An evaluation's output folder, locked while this object is open.
 
     Args:
         path: The folder.
@@ -33,91 +77,189 @@ class RunDir:
 
     Raises:
         FileConflictError: Without ``resume``, the folder already holds an evaluation.
-        RunFolderError: With ``resume``, it holds none, or one with other settings.
+        RunFolderError: With ``resume``, it holds none, a damaged one, or one with other settings;
+            or another run is using the folder.
     """
 
     def __init__(self, path: str | os.PathLike[str], settings: dict[str, Any], *, resume: bool) -> None:
         self.path = Path(path)
         self.settings = settings
-        self.finished: dict[str, dict[str, Any]] = {}
+        self.budget: int = settings["budget"]
+        self.finished: dict[str, FinishedLevel] = {}
         self.failed: dict[str, str] = {}
-        self.episodes: dict[str, list[dict[str, Any]]] = {}
-        run_file = self.path / RUN_FILE
-        if resume:
-            self._load(run_file)
-        else:
-            there = [name for name in OUTPUTS if (self.path / name).exists()]
-            if there:
-                raise FileConflictError(
-                    f"Expected a new or empty --out folder, but {self.path} already holds an evaluation "
-                    f"({', '.join(there)}); continue it with --resume, or choose another --out."
-                )
-            ensure_folder(self.path, "for the evaluation's results")
-            self._save()
-            atomic_write(self.path / EPISODES_FILE, b"", overwrite=True)
-        self._log = open(self.path / EPISODES_FILE, "a", encoding="utf-8")  # noqa: SIM115 - open for the run
-
-    def _load(self, run_file: Path) -> None:
-        try:
-            saved = json.loads(run_file.read_text(encoding="utf-8"))
-            settings, finished = saved["settings"], saved["finished"]
-        except FileNotFoundError:
+        self.episodes: dict[str, list[Episode]] = {}
+        self.replayed: list[str] = []  # finished levels of an older run that did not spend their budget
+        if resume and not (self.path / RUN_FILE).exists() and not (self.path / RUN_FILE).is_symlink():
             raise RunFolderError(
                 f"Expected {self.path} to hold an evaluation to resume ({RUN_FILE}), but it has none; "
                 "drop --resume to start one."
-            ) from None
-        except (OSError, ValueError, KeyError, TypeError) as exc:
-            raise RunFolderError(f"Expected a readable {run_file}, but it is damaged ({exc}); start in a new --out.") from None
+            )
+        if not resume:
+            self._refuse_earlier()
+            ensure_folder(self.path, "for the evaluation's results")
+        self._lock = _lock(self.path / LOCK_FILE)
+        try:
+            if resume:
+                self._load()
+            else:
+                self._refuse_earlier()  # again, now that no other run can be writing
+                self._save()
+                atomic_write(self.path / EPISODES_FILE, b"", overwrite=True)
+            self._log = open(self.path / EPISODES_FILE, "a", encoding="utf-8")  # noqa: SIM115 - open for the run
+        except BaseException:
+            os.close(self._lock)
+            raise
+
+    def _refuse_earlier(self) -> None:
+        there = [name for name in OUTPUTS if os.path.lexists(self.path / name)]
+        if there:
+            raise FileConflictError(
+                f"Expected a new or empty --out folder, but {self.path} already holds an evaluation "
+                f"({', '.join(there)}); continue it with --resume, or choose another --out."
+            )
+
+    def _damaged(self, name: str, problem: str) -> RunFolderError:
+        return RunFolderError(
+            f"Expected a readable {self.path / name} to resume, but {problem}; the folder is damaged: "
+            "start in a new --out."
+        )
+
+    def _load(self) -> None:
+        with self._open(RUN_FILE) as f:
+            raw = f.read(MAX_RUN_FILE_BYTES + 1)
+        if len(raw) > MAX_RUN_FILE_BYTES:
+            raise self._damaged(RUN_FILE, f"it is larger than {MAX_RUN_FILE_BYTES >> 20} MB")
+        try:
+            saved = json.loads(raw.decode("utf-8"))
+        except (UnicodeDecodeError, ValueError, RecursionError) as exc:
+            raise self._damaged(RUN_FILE, f"it is not JSON ({type(exc).__name__})") from None
+        if not isinstance(saved, dict) or not isinstance(saved.get("settings"), dict) \
+                or not isinstance(saved.get("finished"), dict):
+            raise self._damaged(RUN_FILE, "it does not map 'settings' and 'finished' to mappings")
+        settings = saved["settings"]
         if settings != self.settings:
             differ = sorted(k for k in {*settings, *self.settings} if settings.get(k) != self.settings.get(k))
             raise RunFolderError(
-                f"Expected --resume with the settings {self.path} was started with, but {', '.join(differ)} differ; "
-                "use the same options, or a new --out."
+                f"Expected --resume with the settings {self.path} was started with, but {', '.join(map(str, differ))} "
+                "differ; use the same options, or a new --out."
             )
-        self.finished = {level: dict(data) for level, data in finished.items()}
-        kept: list[str] = []
-        try:
-            lines = (self.path / EPISODES_FILE).read_text(encoding="utf-8").splitlines()
-        except FileNotFoundError:
-            lines = []
-        for line in lines:
+        for level, data in saved["finished"].items():
             try:
-                record = json.loads(line)
-                level = record["level"]
-            except (ValueError, KeyError, TypeError):
-                continue  # the half-written last line of a killed run
-            if level in self.finished:
-                self.episodes.setdefault(level, []).append(record)
-                kept.append(json.dumps(record))
-        for level, data in self.finished.items():
-            if len(self.episodes.get(level, ())) != data.get("episodes", 0):
+                entry = FinishedLevel.from_json(data)
+            except ValueError as exc:
+                raise self._damaged(RUN_FILE, f"its level {level}: {exc}") from None
+            if level not in self.settings["levels"] or entry.timesteps > self.budget:
+                raise self._damaged(RUN_FILE, f"its level {level} is not of this run or played more than its budget")
+            if entry.timesteps < self.budget:
+                self.replayed.append(level)  # an older retrokit called a level that returned early finished
+            else:
+                self.finished[level] = entry
+        kept = self._read_episodes()
+        for level, entry in self.finished.items():
+            numbers = [episode.episode for episode in self.episodes.get(level, ())]
+            if numbers != list(range(1, entry.episodes + 1)):
                 raise RunFolderError(
-                    f"Expected {data.get('episodes')} episodes of the finished level {level} in {EPISODES_FILE}, "
-                    f"found {len(self.episodes.get(level, ()))}; the folder was changed by hand. Start in a new --out."
+                    f"Expected episodes 1 to {entry.episodes} of the finished level {level} in {EPISODES_FILE}, "
+                    f"found {len(numbers)}; the folder was changed by hand. Start in a new --out."
                 )
         atomic_write(self.path / EPISODES_FILE, "".join(line + "\n" for line in kept).encode(), overwrite=True)
 
+    def _read_episodes(self) -> list[str]:
+        """Read the episodes of the finished levels; return their lines, to keep."""
+        kept: list[str] = []
+        if not os.path.lexists(self.path / EPISODES_FILE):
+            return kept
+        with self._open(EPISODES_FILE) as f:
+            number = 0
+            while line := f.readline(MAX_LINE_BYTES + 1):
+                number += 1
+                if len(line) > MAX_LINE_BYTES:
+                    raise self._damaged(EPISODES_FILE, f"its line {number} is longer than {MAX_LINE_BYTES} bytes")
+                try:
+                    record = json.loads(line.decode("utf-8"))
+                except (UnicodeDecodeError, ValueError, RecursionError):
+                    if not line.endswith(b"\n"):
+                        break  # the half-written last line of a killed run
+                    raise self._damaged(EPISODES_FILE, f"its line {number} is not JSON") from None
+                level = record.get("level") if isinstance(record, dict) else None
+                if not isinstance(level, str):
+                    raise self._damaged(EPISODES_FILE, f"its line {number} names no level")
+                if level in self.finished:
+                    try:
+                        episode = Episode.from_record(record, self.budget)
+                    except ValueError as exc:
+                        raise self._damaged(EPISODES_FILE, f"its line {number}: {exc}") from None
+                    self.episodes.setdefault(level, []).append(episode)
+                    kept.append(json.dumps(episode.record(level)))
+        return kept
+
+    def _open(self, name: str) -> BinaryIO:
+        """Open one of the folder's files for reading: a regular file only (a FIFO would block, a device never end)."""
+        path = self.path / name
+        try:
+            fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+        except OSError as exc:
+            raise self._damaged(name, f"it cannot be opened ({exc.strerror or exc})") from None
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            os.close(fd)
+            raise self._damaged(name, "it is not a regular file (a FIFO, a device or a folder)")
+        return os.fdopen(fd, "rb")
+
     def _save(self) -> None:
-        data = {"settings": self.settings, "finished": self.finished, "failed": self.failed}
+        data = {"settings": self.settings, "finished": {k: asdict(v) for k, v in self.finished.items()},
+                "failed": self.failed}
         atomic_write(self.path / RUN_FILE, (json.dumps(data, indent=1) + "\n").encode(), overwrite=True)
 
-    def add_episode(self, record: dict[str, Any]) -> None:
+    def add_episode(self, level: str, episode: Episode) -> None:
         """Log a finished episode."""
-        self._log.write(json.dumps(record) + "\n")
+        self._log.write(json.dumps(episode.record(level)) + "\n")
         self._log.flush()
-        self.episodes.setdefault(record["level"], []).append(record)
+        self.episodes.setdefault(level, []).append(episode)
 
-    def finish(self, level: str, timesteps: int) -> None:
+    def finish(self, level: str, timesteps: int, unfinished_reward: float) -> None:
         """Mark a level finished: its episodes so far are its result."""
         self.failed.pop(level, None)
-        self.finished[level] = {"timesteps": timesteps, "episodes": len(self.episodes.get(level, ()))}
+        self.finished[level] = FinishedLevel(timesteps, len(self.episodes.get(level, ())), unfinished_reward)
         self._save()
 
     def fail(self, level: str, error: str) -> None:
-        """Note why a level failed (it will start again on --resume)."""
+        """Note why a level failed (it will start again on --resume); its episodes are dropped then."""
         self.failed[level] = error
         self._save()
 
     def close(self) -> None:
-        """Close the episode log."""
+        """Close the episode log and release the folder."""
         self._log.close()
+        os.close(self._lock)
+
+
+def _lock(path: Path) -> int:
+    """Take the folder's lock (released when the descriptor closes or the process dies); return the descriptor.
+
+    Raises:
+        RunFolderError: Another run holds it, or the lock file cannot be made.
+    """
+    try:
+        fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC, 0o644)
+    except OSError as exc:
+        raise RunFolderError(
+            f"Expected to lock {path} for this run, but it cannot be opened ({exc.strerror or exc}); "
+            "remove it if it is not a file, or use another --out."
+        ) from None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise RunFolderError(f"Expected {path} to be a lock file, but it is not a regular file; remove it.")
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "another process"
+            raise RunFolderError(
+                f"Expected no other evaluation running in {path.parent}, but one is (process {holder}); "
+                "wait for it to end, or use another --out."
+            ) from None
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    except (RetrokitError, OSError):
+        os.close(fd)
+        raise
+    return fd

@@ -1,12 +1,12 @@
 """``retrokit demo``: the benchmark on the bundled test cartridge, JERK against random.
 
 It needs no ROM import: Dasher, retrokit's own Genesis game, ships in
-``games/``. The command runs ``retrokit evaluate --benchmark dasher`` twice,
-with the paper's JERK and with random actions, on the test levels, with a
-progress bar per level; prints the per-level table and the aggregates; and
-writes each run's folder (episodes, summary, report, plots), a plot of the two
-agents' scores, and a GIF of JERK's best episode. The output folder gets a new
-name if the given one is taken: nothing is replaced.
+``games/``. The command runs ``retrokit evaluate --benchmark dasher --agent jerk
+--agent random`` (the same comparison, :mod:`retrokit.benchmark.comparison`)
+on the test levels; prints the per-level table and the aggregates; and writes
+each run's folder (episodes, summary, report, plots), the side-by-side report
+and plot of the two agents' scores, and a GIF of JERK's best episode. The
+output folder gets a new name if the given one is taken: nothing is replaced.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import shutil
 from pathlib import Path
 
 from retrokit.commands._common import add_evaluation_options
-from retrokit.errors import FileConflictError, install_extra
+from retrokit.errors import FileConflictError
 from retrokit.paths import ensure_folder
 
 AGENTS = ("jerk", "random")
@@ -28,12 +28,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "demo",
         help="evaluate JERK against random on the bundled Dasher benchmark: table, report, plots and a GIF",
         description="Run the Dasher benchmark (no ROM import needed) with the paper's JERK agent and with random "
-        "actions, with a progress bar per level; print the per-level scores and aggregates, and write the reports, "
-        "the plots and a GIF of JERK's best episode.",
+        "actions, with a progress bar per level (a line per level when the output is not a terminal); print the "
+        "per-level scores and aggregates, and write each agent's run folder, a side-by-side report.md and "
+        "scores.png, and a GIF of JERK's best episode. It is `retrokit evaluate --benchmark dasher --agent jerk "
+        "--agent random`.",
     )
     add_evaluation_options(parser, "processes (default: up to 2)")
     parser.add_argument("--out", type=Path, default=Path("retrokit-demo"), help="the output folder (default: retrokit-demo)")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bars or lines")
     parser.set_defaults(run=run)
 
 
@@ -56,39 +58,30 @@ def free_folder(path: Path) -> Path:
 
 
 def run(args: argparse.Namespace) -> int:
-    """Evaluate both agents, print the table, write the comparison plot and the GIF."""
-    from retrokit.benchmark import plots
+    """Evaluate both agents, print the table, write the comparison and the GIF."""
+    from retrokit.benchmark.comparison import agent_folders, compare
     from retrokit.benchmark.definition import load_benchmark
-    from retrokit.benchmark.evaluation import Evaluation, evaluate, level_file_name
+    from retrokit.benchmark.evaluation import Evaluation, level_file_name
     from retrokit.commands.evaluate import print_table
-    from retrokit.paths import atomic_write
 
     benchmark = load_benchmark("dasher")
     levels = benchmark.select(args.levels)
     out = free_folder(args.out)
-    summaries = {}
-    for agent in AGENTS:
-        print(f"{agent} on the dasher benchmark ({len(levels)} levels):")
-        summaries[agent] = evaluate(Evaluation(
-            benchmark=benchmark, levels=levels, agent=agent, out=out / agent, budget=args.timesteps,
-            seed=args.seed, workers=args.workers, gif=agent == "jerk", progress=not args.no_progress,
-        ))
+
+    def make(agent: str, folder: Path) -> Evaluation:
+        return Evaluation(benchmark=benchmark, levels=levels, agent=agent, out=folder, budget=args.timesteps,
+                          seed=args.seed, workers=args.workers, gif=agent == "jerk", progress=not args.no_progress)
+
+    summaries = compare(make, list(AGENTS), out, announce=print)
     print_table(summaries)
-    jerk, rand = summaries["jerk"]["aggregate"], summaries["random"]["aggregate"]
+    jerk, rand = summaries["jerk"].aggregate, summaries["random"].aggregate
     if jerk is not None and rand:
         print(f"JERK's aggregate is {jerk / rand:.2f}x random's.")
-
-    names = [level.name for level in levels]
-    made = "report.md, summary.json, plots" if plots.have_matplotlib() else "report.md, summary.json"
-    written = [f"{out / agent}/ ({made})" for agent in AGENTS]
-    if not plots.have_matplotlib():
-        written.append(f"(no plots: matplotlib is not installed; {install_extra('plot')})")
-    else:
-        series = {agent: {lv: e["mean_score"] for lv, e in s["levels"].items()} for agent, s in summaries.items()}
-        atomic_write(out / "scores.png", plots.score_bars(series, names, "JERK against random on Dasher: level scores"))
-        written.append(str(out / "scores.png"))
-    best = max(summaries["jerk"]["levels"].items(), key=lambda item: item[1]["best"] or float("-inf"))[0]
-    gif = out / "jerk" / "gifs" / f"{level_file_name(best)}.gif"
+    folders = agent_folders(list(AGENTS))
+    written = [f"{out / folders[agent]}/ (report.md, summary.json, plots)" for agent in AGENTS]
+    written.append(f"{out / 'report.md'} and {out / 'scores.png'} (the two agents side by side)")
+    best = max(summaries["jerk"].levels.items(), key=lambda item: item[1].best or float("-inf"))[0]
+    gif = out / folders["jerk"] / "gifs" / f"{level_file_name(best)}.gif"
     if gif.is_file():
         shutil.copyfile(gif, out / "jerk-best.gif")
         written.append(f"{out / 'jerk-best.gif'} (JERK's best episode, on {best})")

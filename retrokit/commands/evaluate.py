@@ -1,49 +1,74 @@
-"""``retrokit evaluate``: the benchmark protocol, played by an agent, reported beside the paper.
+"""``retrokit evaluate``: the benchmark protocol, played by one agent or several, reported beside the paper.
 
-Each level is played for the benchmark's budget of timesteps; a level's score
-is the mean total reward of its episodes, the aggregate the mean of the level
-scores. See docs/evaluate.md.
+Each level is played for the benchmark's budget of timesteps, in a worker
+process of its own; a level's score is the mean total reward of its episodes,
+the aggregate the mean of the level scores. With several ``--agent``, each
+agent's run goes into ``OUT/<agent>/`` and ``OUT/report.md`` sets them side by
+side. See docs/evaluate.md.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 from retrokit.commands._common import add_evaluation_options
 
+AGENT_NOTE = """\
+An agent is random, jerk, or MODULE:CALLABLE (an importable module or a .py file), a callable
+    agent(env: gymnasium.Env, budget: int, seed: int) -> None
+that loops over env.reset() and env.step(action) until step() raises BudgetSpent (the runner catches it).
+The Ray backend is an extra: pip install 'retrokit-rl[ray]'.
+"""
+
 EXAMPLES = [
     "retrokit evaluate --benchmark dasher --agent jerk --out runs/jerk",
-    "retrokit evaluate --benchmark sonic --list            # the benchmark's levels",
-    "retrokit evaluate --agent my_agents:make_agent --levels all --workers 2 --out runs/mine --gif",
+    "retrokit evaluate --benchmark dasher --agent jerk --agent random --timesteps 2000 --out runs/both",
+    "retrokit evaluate --agent my_agents.py:ppo --levels all --workers 2 --out runs/mine --gif",
     "retrokit evaluate --out runs/mine --resume             # continue an interrupted run",
+    "retrokit evaluate --benchmark mine.yaml --agent random --stall-timeout 120 --out runs/mine",
+    "retrokit evaluate --benchmark sonic --agent jerk --backend ray --ray-address auto --out runs/sonic",
+    "retrokit evaluate --benchmark sonic --list            # the benchmark's levels",
 ]
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``evaluate`` command."""
+    from retrokit.benchmark.watchdog import DEFAULT_STALL_SECONDS
+
     parser = subparsers.add_parser(
         "evaluate",
-        help="run a benchmark (sonic, dasher or a YAML file) with an agent; write scores, a report and plots",
-        description="Play each level of a benchmark for its budget of timesteps with an agent, with a progress bar "
-        "per level, and write episodes.jsonl, summary.json, summary.csv, report.md (beside the paper's scores) and "
-        "PNG plots into --out.",
+        help="run a benchmark (sonic, dasher or a YAML file) with one agent or several; write scores, a report and plots",
+        description="Play each level of a benchmark for its budget of timesteps with an agent, each level in a worker "
+        "process, and write episodes.jsonl, summary.json, summary.csv, report.md (beside the paper's scores) and "
+        "PNG plots into --out. Progress shows as a bar per level on a terminal, else as a line per finished level. "
+        "With several --agent, each runs into OUT/<agent>/ and OUT/report.md and OUT/scores.png compare them.",
+        epilog=AGENT_NOTE,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--benchmark", default="dasher", help="sonic, dasher, or a benchmark YAML file (default: dasher)")
-    parser.add_argument("--agent", default="jerk", help="random, jerk, or MODULE:CALLABLE (default: jerk)")
+    parser.add_argument("--agent", action="append", default=None, metavar="AGENT",
+                        help="random, jerk, or MODULE:CALLABLE; repeat it to compare agents (default: jerk)")
     add_evaluation_options(parser, "processes (or Ray CPUs) sharing the levels (default: up to 2)")
-    parser.add_argument("--backend", choices=("local", "ray"), default="local", help="local processes, or Ray")
-    parser.add_argument("--ray-address", default=None, help="an existing Ray cluster (default: start a local Ray)")
+    parser.add_argument("--stall-timeout", type=float, default=DEFAULT_STALL_SECONDS, metavar="SECONDS",
+                        help="stop a level whose agent takes no timestep for this long, and fail it "
+                        f"(default: {DEFAULT_STALL_SECONDS:g})")
+    parser.add_argument("--backend", choices=("local", "ray"), default="local",
+                        help="local processes, or Ray (default: local; Ray is the extra retrokit-rl[ray])")
+    parser.add_argument("--ray-address", default=None,
+                        help="an existing Ray cluster: HOST:PORT, ray://HOST:PORT or auto (default: start a local Ray)")
     parser.add_argument("--out", type=Path, default=None, metavar="DIR", help="the run folder (required, except with --list)")
     parser.add_argument("--resume", action="store_true", help="continue the interrupted evaluation in --out")
     parser.add_argument("--gif", action="store_true", help="save a GIF of each level's best episode in --out/gifs")
     parser.add_argument("--list", action="store_true", help="list the benchmark's levels and stop")
-    parser.add_argument("--no-progress", action="store_true", help="no progress bars")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bars or lines")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Evaluate, then print the per-level table and the aggregate."""
+    from retrokit.benchmark.comparison import compare
     from retrokit.benchmark.definition import load_benchmark
     from retrokit.benchmark.evaluation import Evaluation, evaluate
     from retrokit.errors import InvalidArgumentError
@@ -56,30 +81,39 @@ def run(args: argparse.Namespace) -> int:
         return 0
     if args.out is None:
         raise InvalidArgumentError("Expected --out DIR, the folder for the results; got none.")
-    evaluation = Evaluation(
-        benchmark=benchmark, levels=benchmark.select(args.levels), agent=args.agent, out=args.out,
-        budget=args.timesteps, seed=args.seed, workers=args.workers, backend=args.backend,
-        ray_address=args.ray_address, resume=args.resume, gif=args.gif, progress=not args.no_progress,
-    )
+    agents = args.agent or ["jerk"]
+    levels = benchmark.select(args.levels)
+
+    def make(agent: str, out: Path) -> Evaluation:
+        return Evaluation(
+            benchmark=benchmark, levels=levels, agent=agent, out=out, budget=args.timesteps, seed=args.seed,
+            workers=args.workers, backend=args.backend, ray_address=args.ray_address, resume=args.resume,
+            gif=args.gif, progress=not args.no_progress, stall_timeout=args.stall_timeout,
+        )
+
     try:
-        summary = evaluate(evaluation)
+        if len(agents) == 1:
+            summaries = {agents[0]: evaluate(make(agents[0], args.out))}
+        else:
+            summaries = compare(make, agents, args.out, resume=args.resume, announce=print)
     except KeyboardInterrupt:
         print(f"retrokit: interrupted; the finished levels are in {args.out}: add --resume to the same command "
-              "to finish the rest", file=__import__("sys").stderr)
+              "to finish the rest", file=sys.stderr)
         return 130
-    print_table({args.agent: summary})
-    print(f"wrote {args.out}/: episodes.jsonl, summary.json, summary.csv, report.md"
-          + (", learning-curves.png, scores.png" if (args.out / "scores.png").exists() else ""))
+    print_table(summaries)
+    print(f"wrote {args.out}/: " + ("episodes.jsonl, summary.json, summary.csv, report.md, learning-curves.png, "
+                                    "scores.png" if len(agents) == 1 else
+                                    "report.md, scores.png, and a run folder per agent"))
     return 0
 
 
-def print_table(summaries: dict[str, dict]) -> None:
+def print_table(summaries: dict) -> None:  # agent -> retrokit.benchmark.scores.Summary
     """Print each level's score for each agent, and the aggregates."""
-    levels = list(dict.fromkeys(level for s in summaries.values() for level in s["levels"]))
+    levels = list(dict.fromkeys(level for s in summaries.values() for level in s.levels))
     width = max([len("aggregate"), *map(len, levels)])
     print("\n" + "level".ljust(width) + "".join(f"  {agent:>12}" for agent in summaries))
     for level in levels:
-        cells = [s["levels"].get(level, {}).get("mean_score") for s in summaries.values()]
+        cells = [s.levels[level].mean_score if level in s.levels else None for s in summaries.values()]
         print(level.ljust(width) + "".join(f"  {'-' if c is None else f'{c:12.1f}':>12}" for c in cells))
-    aggregates = [s["aggregate"] for s in summaries.values()]
+    aggregates = [s.aggregate for s in summaries.values()]
     print("aggregate".ljust(width) + "".join(f"  {'-' if a is None else f'{a:12.1f}':>12}" for a in aggregates))

@@ -82,7 +82,9 @@ def check_one_line(child, *expected: str) -> None:
         (lambda path, good: path.write_bytes(with_member(good, "snapshots.npy", huge_header())), "declares shape"),
         (lambda path, good: path.write_bytes(with_member(good, "meta.npy", deep_json())), "RecursionError"),
         (
-            lambda path, good: path.write_bytes(with_member(good, "snapshots.npy", npy(np.zeros((0, 65536), np.uint8)))),
+            lambda path, good: path.write_bytes(
+                with_member(good, "snapshots.npy", npy(np.zeros((0, 65536), np.uint8)))
+            ),
             "expected at least one snapshot",
         ),
     ],
@@ -127,7 +129,9 @@ def test_save_through_a_symlinked_game_yaml_updates_its_target(tmp_path, game_co
     status = cli.main(["ramsearch", "save", "coins", "0xFF0040", "|u1", "--game-file", str(link)])
     assert status == 0, capsys.readouterr().err
     assert link.is_symlink() and link.resolve() == game_copy.resolve()  # the link is still a link
-    assert re.search(r'\n  coins: +\{address: 0xFF0040, type: "\|u1"\}\n', game_copy.read_text())  # the real file has it
+    assert re.search(
+        r'\n  coins: +\{address: 0xFF0040, type: "\|u1"\}\n', game_copy.read_text()
+    )  # the real file has it
 
 
 def test_a_game_yaml_that_is_a_fifo_is_refused_not_read(tmp_path, game_copy):
@@ -152,7 +156,7 @@ def test_press_given_twice_holds_both_buttons(game_copy, capsys):
     assert cli.main(["ramsearch", "run", "--press", "B", "--press", "UP", "--frames", "3"]) == 0
     assert capsys.readouterr().out == "Snapshot 1: B UP for 3 frames.\n"
     with RamSearch.load(DEFAULT_SESSION) as search:
-        (frames, masks), = search.inputs
+        ((frames, masks),) = search.inputs
         assert frames == 3 and masks[0] == search.emulator.system.mask(["B", "UP"])
 
 

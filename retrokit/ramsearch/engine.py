@@ -324,7 +324,5 @@ def list_candidates(engine: Engine, limit: int | None = None) -> list[Candidate]
         values = tuple(ftype.decode(bytes(s[position : position + ftype.width])) for s in engine.snapshots)
         changes = sum(a != b for a, b in pairwise(values))
         mask = int(cands.scale[t][position])
-        out.append(
-            Candidate(int(address), ftype.code, values, scale_label(mask), changes, scale_labels(mask))
-        )
+        out.append(Candidate(int(address), ftype.code, values, scale_label(mask), changes, scale_labels(mask)))
     return out

@@ -75,7 +75,11 @@ class Filter:
         """The filter as the command line writes it."""
         words = [self.op] + ([] if self.value is None else [str(self.value)])
         if self.than is not None:
-            than = (layout.format(self.than) if layout is not None else hex(self.than)) if isinstance(self.than, int) else self.than
+            than = (
+                (layout.format(self.than) if layout is not None else hex(self.than))
+                if isinstance(self.than, int)
+                else self.than
+            )
             words.append(f"--than {than}")
         return " ".join(words)
 
@@ -102,9 +106,7 @@ def check_filter(op: str, value: int | None = None, than: str | int | None = Non
             f"Expected a filter operation ({', '.join(OPS)}), got {op!r}." + did_you_mean(op, OPS)
         )
     if isinstance(than, str) and than not in REFERENCES and not than.isdigit():
-        raise InvalidArgumentError(
-            f"Expected --than {THAN_FORMS}; got {shown(than)}." + did_you_mean(than, REFERENCES)
-        )
+        raise InvalidArgumentError(f"Expected --than {THAN_FORMS}; got {shown(than)}." + did_you_mean(than, REFERENCES))
     if op in CHANGES:
         if value is not None:
             raise InvalidArgumentError(

@@ -228,38 +228,53 @@ def set_default_state(path: str | os.PathLike[str], name: str) -> None:
         raise DataFileError(
             f"{path}: expected 'states' to be a mapping; found {type(states).__name__}. Fix the file first."
         )
-    value = name if _PLAIN_NAME.match(name) else json.dumps(name)  # JSON strings are YAML double-quoted scalars
+    value = _scalar(name)
     lines = text.splitlines(keepends=True)
     nl = "\r\n" if lines and lines[0].endswith("\r\n") else "\n"
     if lines and not lines[-1].endswith("\n"):
         lines[-1] += nl
+    wanted = dict(_plain(states) or {})
+    wanted["default"] = name
+    if isinstance(wanted.get("by_players"), list) and wanted["by_players"]:
+        wanted["by_players"][0] = name  # the 1-player default comes before `default`: it names the new state too
     if "states" not in doc:
         lines.append(f"states:{nl}  default: {value}{nl}")
-    elif not states or (getattr(states, "fa", None) is not None and states.fa.flow_style()):
+    elif not states or states.fa.flow_style():
         line = doc.lc.key("states")[0]
-        comment = _trailing_comment_of(lines[line])
-        flow = {k: v for k, v in (states or {}).items() if k != "default"}
-        inner = ", ".join([f"default: {value}", *(f"{k}: {json.dumps(_plain(v))}" for k, v in flow.items())])
         if _entry_end(lines, line, 0) != line:
-            raise DataFileError(f"{path}: expected 'states' on one line; found it spread over several. Fix the file first.")
-        lines[line] = f"states: {{{inner}}}{comment}{nl}"
-    elif "default" in states:
-        line = states.lc.key("default")[0]
-        column = states.lc.key("default")[1]
-        if _entry_end(lines, line, column) != line:
-            raise DataFileError(f"{path}: expected 'states: default:' on one line; found it spread over several.")
-        lines[line] = f"{' ' * column}default: {value}{_trailing_comment_of(lines[line])}{nl}"
-    else:
-        first = next(iter(states))
-        line, column = states.lc.key(first)
-        lines.insert(line, f"{' ' * column}default: {value}{nl}")
+            raise DataFileError(
+                f"{path}: expected 'states' on one line; found it spread over several. Fix the file first."
+            )
+        inner = ", ".join(f"{k}: {_flow(v)}" for k, v in wanted.items())
+        lines[line] = f"states: {{{inner}}}{_trailing_comment_of(lines[line])}{nl}"
+    else:  # a block mapping: edit its lines in place (by_players first: inserting `default` moves the lines after it)
+        for key in ("by_players", "default"):
+            if key not in states:
+                continue
+            line, column = states.lc.key(key)
+            if _entry_end(lines, line, column) != line:
+                raise DataFileError(f"{path}: expected 'states: {key}:' on one line; found it spread over several.")
+            lines[line] = f"{' ' * column}{key}: {_flow(wanted[key])}{_trailing_comment_of(lines[line])}{nl}"
+        if "default" not in states:
+            line, column = states.lc.key(next(iter(states)))
+            lines.insert(line, f"{' ' * column}default: {value}{nl}")
     new_text = "".join(lines)
     expected = _plain(_load(text, path)) or {}
-    if not isinstance(expected.get("states"), dict):
-        expected["states"] = {}
-    expected["states"]["default"] = name
+    expected["states"] = wanted
     _verify(path, new_text, expected, f"states: default: {value}")
     atomic_write(path, new_text.encode("utf-8"), overwrite=True)
+
+
+def _scalar(name: str) -> str:
+    """A state name as a YAML scalar: plain when it can be, else double-quoted (JSON strings are YAML's)."""
+    return name if _PLAIN_NAME.match(name) else json.dumps(name)
+
+
+def _flow(value: Any) -> str:
+    """A plain value (a name, or a list of them) in YAML flow style."""
+    if isinstance(value, list):
+        return "[" + ", ".join(_flow(v) for v in value) + "]"
+    return _scalar(value) if isinstance(value, str) else json.dumps(value)
 
 
 def _trailing_comment_of(line: str) -> str:

@@ -56,7 +56,9 @@ def parse_script(text: str, check_buttons: Callable[[Sequence[str]], object] | N
         InvalidArgumentError: The script is empty, too long, or a step is malformed or names an unknown button.
     """
     if not isinstance(text, str) or len(text) > MAX_SCRIPT:
-        raise InvalidArgumentError(f"Expected a script of at most {MAX_SCRIPT:,} characters: {SYNTAX}; got {shown(text)}.")
+        raise InvalidArgumentError(
+            f"Expected a script of at most {MAX_SCRIPT:,} characters: {SYNTAX}; got {shown(text)}."
+        )
     steps: list[Step] = []
     total = 0
     for number, match in enumerate(_STEP.finditer(text), 1):

@@ -192,9 +192,9 @@ class RamSearch:
             history=list(self.engine.history),
             redo=list(self.engine.redo_stack),
             start_state=self.start_state,
-            inputs=np.array(
-                [(frames, *masks) for frames, masks in self.inputs], dtype=np.uint32
-            ).reshape(-1, self.emulator.ports + 1),
+            inputs=np.array([(frames, *masks) for frames, masks in self.inputs], dtype=np.uint32).reshape(
+                -1, self.emulator.ports + 1
+            ),
             unreplayable=self.unreplayable,
         )
 

@@ -85,7 +85,9 @@ def _load(prefix: str, archive, types: int, size: int, scales: list[int]) -> Pac
     if stored.dtype != MASK_DTYPE:
         raise SessionError(f"expected scale masks of {MASK_DTYPE}; found {stored.dtype}. {_START}")
     if len(stored) and int(np.bitwise_or.reduce(stored)) >> len(scales):
-        raise SessionError(f"expected scale masks of the {len(scales)} scales the file lists; found more bits. {_START}")
+        raise SessionError(
+            f"expected scale masks of the {len(scales)} scales the file lists; found more bits. {_START}"
+        )
     masks = np.zeros(len(stored), dtype=MASK_DTYPE)
     for bit, index in enumerate(scales):
         masks |= ((stored >> MASK_DTYPE.type(bit)) & MASK_DTYPE.type(1)) << MASK_DTYPE.type(index)

@@ -256,9 +256,9 @@ def _narrow(result: np.ndarray, mask: np.ndarray, defined) -> tuple[np.ndarray, 
     Unpinned candidates keep ``result``; a pinned one keeps the scales that
     pass, and stays while one does.
     """
-    pinned = mask != UNPINNED
-    if not pinned.any():
+    if not np.count_nonzero(mask):  # UNPINNED is 0: nothing pinned (a fresh search)
         return result, None
+    pinned = mask != UNPINNED
     masks = np.where(result, mask, MASK_DTYPE.type(0))
     for index in _bits_in(mask, _DIVIDING):
         bit = MASK_DTYPE.type(1 << index)
@@ -268,9 +268,9 @@ def _narrow(result: np.ndarray, mask: np.ndarray, defined) -> tuple[np.ndarray, 
 
 def _per_scale(passes, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
     """A filter that reads differently through each scale: unpinned candidates as stored, pinned ones per scale."""
-    pinned = mask != UNPINNED
-    if not pinned.any():
+    if not np.count_nonzero(mask):
         return passes(None), None
+    pinned = mask != UNPINNED
     keep = passes(None) & ~pinned if not pinned.all() else np.zeros(len(mask), dtype=bool)
     masks = np.zeros(len(mask), dtype=MASK_DTYPE)
     for index in _bits_in(mask):
@@ -299,11 +299,24 @@ def _value_search(ftype: FieldType, cur: np.ndarray, mask: np.ndarray, value: in
         stored = candidate.stored(value)
         if ftype.kind in candidate.kinds and stored is not None and low <= stored <= high:
             targets[stored] = targets.get(stored, 0) | 1 << index
-    # Few positions hold any of the stored values: one pass per value.
     masks = np.zeros(len(cur), dtype=MASK_DTYPE)
+    if not targets:
+        return np.zeros(len(cur), dtype=bool), masks
+    # Few positions hold any of the stored values: find them with one pass per
+    # value, then tell which scales each matched only there.
+    values = iter(targets)
+    hit = cur == next(values)
+    for stored in values:
+        hit |= cur == stored
+    where = np.flatnonzero(hit)
+    found = cur[where]
+    matched = np.zeros(len(where), dtype=MASK_DTYPE)
     for stored, bits in targets.items():
-        masks[cur == stored] |= MASK_DTYPE.type(bits)
-    masks = np.where(mask != UNPINNED, masks & mask, masks)
+        matched[found == stored] |= MASK_DTYPE.type(bits)
+    masks[where] = matched
+    if not np.count_nonzero(mask):  # (UNPINNED is 0) nothing pinned yet: every hit is kept
+        return hit, masks
+    masks = np.where(mask != UNPINNED, masks & mask, masks)  # pinned ones keep only scales they had
     return masks != 0, masks
 
 

@@ -161,6 +161,9 @@ def test_savestate_and_movie_through_the_api(tmp_path, data):
             search.save_state("Api.Start")
         with pytest.raises(InvalidArgumentError, match="state name"):
             search.save_state("")
+        search.inputs.append((1_000_000, (0, 0)))  # as if a long script had run: the movie would be too long
+        with pytest.raises(MovieError, match="at most 1,000,000 frames"):
+            search.movie()
         search.poke(LIVES, 5)
         with pytest.raises(MovieError, match="poke 0xFF002B 5"):
             search.movie()

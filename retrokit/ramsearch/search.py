@@ -44,7 +44,7 @@ from retrokit.ramsearch import gamefile
 from retrokit.ramsearch.candidates import Candidate
 from retrokit.ramsearch.engine import Engine, list_candidates
 from retrokit.ramsearch.ram import RamLayout
-from retrokit.ramsearch.script import parse_script
+from retrokit.ramsearch.script import MAX_FRAMES, parse_script
 from retrokit.ramsearch.session import SessionData, read_session, write_session
 from retrokit.ramsearch.types import parse_search_types
 
@@ -246,8 +246,8 @@ class RamSearch:
 
     def step(self, press: Sequence[str] = (), frames: int = 1) -> None:
         """Hold buttons for some frames, without a snapshot (to script play between snapshots)."""
-        if not isinstance(frames, int) or isinstance(frames, bool) or frames < 0:
-            raise InvalidArgumentError(f"Expected a number of frames of 0 or more, got {frames!r}.")
+        if not isinstance(frames, int) or isinstance(frames, bool) or not 0 <= frames <= MAX_FRAMES:
+            raise InvalidArgumentError(f"Expected a number of frames from 0 to {MAX_FRAMES:,}, got {frames!r}.")
         masks = self.buttons(press)
         self.emulator.run(masks, frames)
         self._played(masks, frames)
@@ -406,6 +406,12 @@ class RamSearch:
                 f"Expected inputs that lead to the game's state now; the session changed RAM by hand since its "
                 f"start state ({self.unreplayable}), which a movie cannot reproduce. Start from a state again "
                 "(ramsearch run --state NAME), play without poking, then write the movie."
+            )
+        total = sum(count for count, _ in self.inputs)
+        if total > MAX_FRAMES:
+            raise MovieError(
+                f"Expected at most {MAX_FRAMES:,} frames for a movie; the session played {total:,} since its start "
+                "state. Save a state on the way (ramsearch savestate) and start from it."
             )
         used = [port for _, masks in self.inputs for port, mask in enumerate(masks, 1) if mask]
         players = max([self.game.players, *used])

@@ -196,7 +196,7 @@ class Engine:
 
         return _per_scale(passes, mask)
 
-        # --- undo and redo ---------------------------------------------------------------------
+    # --- undo and redo ---------------------------------------------------------------------
 
     def undo(self) -> str:
         """Undo the last filter; return its description.

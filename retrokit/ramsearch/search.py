@@ -101,7 +101,7 @@ class RamSearch:
         masks = tuple(int(m) for m in masks) + (0,) * (self.emulator.ports - len(masks))
         if not frames:
             return
-        if self.inputs and self.inputs[-1][1] == masks:
+        if self.inputs and self.inputs[-1][1] == masks and self.inputs[-1][0] + frames <= MAX_FRAMES:
             self.inputs[-1] = (self.inputs[-1][0] + frames, masks)
         else:
             self.inputs.append((frames, masks))

@@ -274,3 +274,18 @@ def test_save_writes_a_range_the_game_reads(tmp_path, data, monkeypatch):
     for bad, message in [(("9", "0"), "LO <= HI"), (("0", "300"), "HI <= 255"), (("a", "2"), "--range")]:
         done = ramsearch(tmp_path, "save", "other", "0xFF002B", "|u1", "--range", *bad)
         assert done.returncode == 2 and message in done.stderr and done.stderr.count("\n") == 1, done.stderr
+
+
+def test_the_inputs_of_a_played_movie_begin_at_its_start(tmp_path):
+    from retrokit.data.states import read_state
+    from retrokit.movie import Movie, write_bk2
+
+    right = (1 << 7, 0)
+    state = read_state(DASHER / "Zone1.Act1.state")
+    write_bk2(tmp_path / "right.bk2", Movie("Dasher-Genesis", "Genesis", 2, state, [right] * 45))
+    with RamSearch("Dasher-Genesis", "Zone2.Act1") as search:
+        search.run(["LEFT"], 10)  # before the movie: not part of its inputs
+        search.play(tmp_path / "right.bk2", until=30)
+        search.run(["B"], 2)
+        movie = search.movie()
+    assert movie.state == state and movie.frames == [right] * 30 + [(1 << 0, 0)] * 2

@@ -87,7 +87,7 @@ class RamSearch:
         self.layout = RamLayout.of(self.emulator.space)
         self.engine = Engine(self.layout, parse_search_types(types))
         self.labels: list[str] = []
-        self.start_state = b""  # the state the inputs played begin at
+        self.start_state = b""  # the state the inputs played begin at (b"": power-on)
         self.inputs: list[tuple[int, tuple[int, ...]]] = []  # runs: (frames, a mask per port)
         self.unreplayable: str | None = None  # why those inputs no longer lead to the state now
 
@@ -315,9 +315,10 @@ class RamSearch:
         else:
             self.emulator.reset()
         self.emulator.forget_action()
-        self._restart()
         for frame in recorded.frames[:end]:
             self.emulator.run(list(frame), 1)
+        # The inputs played now begin at the movie's start (b"": power-on), whatever replayed it.
+        self.start_state, self.inputs, self.unreplayable = recorded.state or b"", [], None
         for frame in recorded.frames[:end]:
             self._played(frame, 1)
         return self._snap(f"movie {Path(movie).name} to frame {end}", snapshot)
@@ -416,7 +417,7 @@ class RamSearch:
         used = [port for _, masks in self.inputs for port, mask in enumerate(masks, 1) if mask]
         players = max([self.game.players, *used])
         frames = [masks[:players] for count, masks in self.inputs for _ in range(count)]
-        return Movie(self.game.name, self.game.system.name, players, self.start_state, frames)
+        return Movie(self.game.name, self.game.system.name, players, self.start_state or None, frames)
 
     def write_movie(self, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
         """Write :meth:`movie` as a stable-retro ``.bk2`` (for ``retrokit integrate --movie`` and ``validate``).

@@ -295,3 +295,27 @@ def test_layout_addresses_and_bounds():
     with pytest.raises(InvalidArgumentError, match=r"0xC000-0xC0FF, 0xE000-0xE00F.*0xC0FF with 2 bytes"):
         layout.position(0xC0FF, 2)  # the second byte is past the region
     assert not layout.valid(2)[0xFF] and layout.valid(2)[0xFE]
+
+
+def test_the_candidate_set_does_not_import_the_engine_that_uses_it():
+    """candidates.py sits below engine.py: the listing of candidates lives in the engine, so no import circle."""
+    import ast
+    from pathlib import Path
+
+    from retrokit.ramsearch import candidates
+
+    tree = ast.parse(Path(candidates.__file__).read_text())
+    imported = {node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)}
+    assert "retrokit.ramsearch.engine" not in imported and "retrokit.ramsearch.search" not in imported
+
+
+def test_the_ramsearch_command_does_not_import_the_cli():
+    import ast
+    from pathlib import Path
+
+    import retrokit.commands.ramsearch as command
+
+    tree = ast.parse(Path(command.__file__).read_text())
+    imported = {node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)}
+    imported |= {alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names}
+    assert "retrokit.cli" not in imported

@@ -170,12 +170,7 @@ class RamSearch:
         Raises:
             FileConflictError: ``path`` exists and ``overwrite`` is false.
         """
-        try:
-            write_session(path, self.session_data(), overwrite=overwrite)
-        except FileExistsError:
-            raise FileConflictError(
-                f"Expected no file at {path}; found one. Pass --force (overwrite=True) to replace it, or another name."
-            ) from None
+        write_session(path, self.session_data(), overwrite=overwrite)
 
     def session_data(self) -> SessionData:
         """Everything a session file holds."""
@@ -356,12 +351,7 @@ class RamSearch:
         path = Path(path)
         buffer = io.BytesIO()
         Image.fromarray(self.screen()).save(buffer, format="PNG")
-        try:
-            atomic_write(path, buffer.getvalue(), overwrite=overwrite)
-        except FileExistsError:
-            raise FileConflictError(
-                f"Expected no file at {path}; found one. Choose another name, or pass --overwrite."
-            ) from None
+        atomic_write(path, buffer.getvalue(), overwrite=overwrite)
         return path
 
     # --- searching ------------------------------------------------------------------------------

@@ -154,11 +154,12 @@ class RamSearch:
         self.start_state, self.unreplayable = data.start_state, data.unreplayable
         self.inputs = [(int(row[0]), tuple(int(m) for m in row[1:])) for row in data.inputs]
         try:
-            # Trusted when it is the state this tool wrote (its SHA-256 is in the session);
-            # otherwise first run in a child process, so a state that crashes the core cannot.
+            # The record may refuse it (another ROM), never vouch for it: unless this machine
+            # wrote or probed the state, it is first run in a child process.
             record = StateRecord(data.game, data.rom_sha1, data.state_sha256)
-            statecheck.check_state(self.game, data.emulator_state, record, source=str(path), rom=self.rom)
-            self.emulator.set_state(data.emulator_state)
+            self.emulator.set_state(
+                statecheck.check_state(self.game, data.emulator_state, record, source=str(path), rom=self.rom)
+            )
         except StateError as exc:
             raise SessionError(
                 f"{path}: expected an emulator state of {data.game}; the core refused it ({exc})."
@@ -170,7 +171,9 @@ class RamSearch:
         Raises:
             FileConflictError: ``path`` exists and ``overwrite`` is false.
         """
-        write_session(path, self.session_data(), overwrite=overwrite)
+        data = self.session_data()
+        statecheck.remember_written(self.game, data.emulator_state, self.rom)  # resuming it needs no probe
+        write_session(path, data, overwrite=overwrite)
 
     def session_data(self) -> SessionData:
         """Everything a session file holds."""
@@ -288,7 +291,7 @@ class RamSearch:
             MovieError: The movie is malformed or of another game.
         """
         from retrokit.movie import read_bk2
-        from retrokit.movie.playback import check_movie_state
+        from retrokit.movie.playback import replay
 
         recorded = read_bk2(movie)
         if recorded.game != self.game.name:
@@ -304,14 +307,8 @@ class RamSearch:
             raise InvalidArgumentError(
                 f"Expected --until from 0 to the movie's {len(recorded.frames)} frames, got {until!r}."
             )
-        if recorded.state is not None:
-            check_movie_state(recorded, self.emulator, str(movie))  # a state that could crash the core is refused
-            self.emulator.set_state(recorded.state)
-        else:
-            self.emulator.reset()
-        self.emulator.forget_action()
-        for frame in recorded.frames[:end]:
-            self.emulator.run(list(frame), 1)
+        for _ in replay(recorded, self.emulator, source=str(movie), stop=end):  # its start state checked there
+            pass
         # The inputs played now begin at the movie's start (b"": power-on), whatever replayed it.
         self.start_state, self.inputs, self.unreplayable = recorded.state or b"", [], None
         for frame in recorded.frames[:end]:

@@ -64,7 +64,9 @@ def check_game(
         if progress is not None:
             progress(stage, detail)
 
-    game = _resolve(game)
+    from retrokit.data.games import find_game
+
+    game = find_game(game, check=False)  # its data file is checked below, as a step of the report
     report = GameReport(game.name)
 
     step("schema")
@@ -104,26 +106,6 @@ def check_game(
     step("movies")
     check_movies(game, report, rom)
     return report
-
-
-def _resolve(game: Game | str | os.PathLike[str]) -> Game:
-    """A Game from a Game, a name or a folder, without checking its files (that is a check of its own)."""
-    from retrokit.data.games import Game, list_games, normalize_name
-    from retrokit.errors import GameNotFoundError
-
-    if isinstance(game, Game):
-        return game
-    text = os.fspath(game)
-    known = {g.name: g for g in list_games()}
-    if normalize_name(text) in known:
-        return known[normalize_name(text)]
-    folder = Path(text)
-    if folder.is_dir() and any((folder / m).is_file() for m in ("game.yaml", "data.json", "rom.sha")):
-        return Game(normalize_name(folder.resolve().name), (folder,))
-    from retrokit.data.games import find_game
-
-    find_game(text)  # raises the usual message, with did-you-mean
-    raise GameNotFoundError(f"Expected a game name or a game folder; found {text!r}.")  # pragma: no cover
 
 
 def _check_fields(game: Game, report: GameReport, rom: Path | None) -> None:

@@ -22,6 +22,7 @@ import pytest
 
 from retrokit import cli
 from retrokit.data.games import find_game
+from retrokit.data.statecheck import vet_state
 from retrokit.data.states import read_state_file
 from retrokit.errors import FileConflictError, InvalidArgumentError, MovieError, RamSearchError
 from retrokit.host.emulator import Emulator
@@ -57,7 +58,7 @@ def ok(done: subprocess.CompletedProcess) -> str:
 
 def ram_after(state: bytes) -> bytes:
     with Emulator("Genesis", DASHER / "rom.md") as emu:
-        emu.set_state(state)
+        emu.set_state(vet_state(state, "Genesis", DASHER / "rom.md"))
         return bytes(np.asarray(emu.ram))
 
 
@@ -105,9 +106,7 @@ def test_savestate_default_and_movie_from_the_command_line(tmp_path, data):
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     replayed = read_state_file(data / "games" / "Dasher-Genesis" / "FromMovie.state").data
-    with Emulator("Genesis", DASHER / "rom.md") as emu:
-        emu.set_state(replayed)
-        assert bytes(np.asarray(emu.ram)) == ram
+    assert ram_after(replayed) == ram
 
 
 def test_savestate_and_movie_refusals_are_one_line(tmp_path, data):

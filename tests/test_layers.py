@@ -73,10 +73,6 @@ def test_every_source_file_is_in_a_layer() -> None:
     assert {layer_of_file(p) for p in SOURCES} == set(LAYERS)
 
 
-#: Upward imports another engineer is removing; each entry names the file and what it imports.
-KNOWN = {"commands": {"commands/ramsearch.py imports retrokit.cli", "commands/ramsearch.py imports retrokit.cli.build_parser"}}
-
-
 @pytest.mark.parametrize("layer", LAYERS[1:], ids=str)
 def test_a_layer_imports_no_layer_above_it(layer: str) -> None:
     above = LAYERS[: LAYERS.index(layer)]
@@ -89,9 +85,6 @@ def test_a_layer_imports_no_layer_above_it(layer: str) -> None:
         for m in imported_modules(p)
         if layer_of_module(m) in above
     }
-    if offending and offending == KNOWN.get(layer):
-        pytest.xfail("commands/ramsearch.py imports retrokit.cli (its shell): the ramsearch work removes it, "
-                     "and this KNOWN entry with it")
     assert not offending
 
 

@@ -89,7 +89,7 @@ def test_show_lists_groups_with_addresses_as_game_yaml_writes_them(session, caps
     assert lines[0].startswith(f"{len(RamSearch.load(session).candidates())} candidates in ")
     assert lines[1].split()[:4] == ["address", "type", "scale", "changes"]
     assert lines[2].split()[:6] == ["0xFF002B", "|u1", "-", "1", "3", "2"]
-    assert lines[-1] == "snapshots: 1 new Zone1.Act1; 2 RIGHT for 150 frames"
+    assert lines[-1] == "snapshots: 0 new Zone1.Act1; 1 RIGHT for 150 frames"  # numbered from 0, as --than N
 
 
 def test_undo_redo_round_trip_on_the_command_line(session, capsys):
@@ -283,7 +283,7 @@ def test_run_plays_a_movie_up_to_a_frame(session, capsys):
     write_bk2("right.bk2", Movie("Dasher-Genesis", "Genesis", 1, state, [(right,)] * 90))
     status, out, err = run(capsys, "run", "--movie", "right.bk2", "--until", "45")
     assert status == 0, err
-    assert out == "Snapshot 2: movie right.bk2 to frame 45.\n"
+    assert out == "Snapshot 1: movie right.bk2 to frame 45.\n"
     status, out, _ = run(capsys, "filter", "increased")
     assert status == 0
     status, out, _ = run(capsys, "show", "--json", "--limit", "0")

@@ -7,10 +7,10 @@ import pytest
 
 from retrokit.errors import FieldTypeError, InvalidArgumentError, RamSearchError
 from retrokit.host.typecodes import parse_type
-from retrokit.ramsearch.engine import Engine
+from retrokit.ramsearch.engine import Engine, list_candidates
 from retrokit.ramsearch.filters import OPS
 from retrokit.ramsearch.ram import RamLayout
-from retrokit.ramsearch.scales import SCALES, Scale
+from retrokit.ramsearch.scales import SCALES, Scale, scale_labels
 from retrokit.ramsearch.types import SEARCH_TYPES, decode_all, parse_search_types, require_type
 
 BASE = 0xFF0000
@@ -92,13 +92,63 @@ def test_value_search_finds_scaled_values_and_pins_the_scale(stored, scale):
     search.filter("equal", 3)
     t = 0
     assert 0x10 in np.flatnonzero(search.candidates.alive[t])
-    assert SCALES[search.candidates.scale[t][0x10]].label == scale
+    assert scale_labels(int(search.candidates.scale[t][0x10])) == (scale,)
     # The pinned scale reads the next value the same way: 3 -> 2 on screen.
     search.add_snapshot(
         np.where(np.arange(256) == 0x10, {"": 2, "+1": 1, "-1": 3, "/2": 4, "/4": 8, "/16": 0x20}[scale], 0)
     )
     search.filter("equal", 2)
     assert search.candidates.alive[t][0x10]
+
+
+def test_a_stored_value_keeps_every_scale_it_is_consistent_with():
+    # At `equal 1`, a stored 2 reads as "shown + 1" (-1) and as "shown x 2" (/2); a level stored as 2n.
+    search = engine({0x10: 2}, types="|u1")
+    search.filter("equal", 1)
+    assert scale_labels(int(search.candidates.scale[0][0x10])) == ("-1", "/2")
+    search.add_snapshot(np.where(np.arange(256) == 0x10, 4, 0).astype(np.uint8))
+    search.filter("equal", 2)  # 4 is 2 shown x 2, not 2 + 1: the word survives, its scale now known
+    assert search.candidates.alive[0][0x10]
+    assert scale_labels(int(search.candidates.scale[0][0x10])) == ("/2",)
+    (row,) = [c for c in list_candidates(search) if c.address == BASE + 0x10]
+    assert row.scale == "/2" and row.values == (2, 4)
+
+
+def stable_retro_rule(rows: list[np.ndarray], values: list[int], code: str) -> set[int]:
+    """The positions stable-retro keeps after a value search per snapshot: each (position, scale) on its own.
+
+    Its search keeps a candidate per (address, mult, div, bias) that matched the
+    first value, and drops each one the next values do not match: a position
+    survives while any of its scales does.
+    """
+    ftype = parse_type(code)
+    kept = set()
+    for position in range(256 - ftype.width + 1):
+        stored = [ftype.decode(bytes(row[position : position + ftype.width])) for row in rows]
+        for scale in SCALES:
+            if ftype.kind not in scale.kinds:
+                continue
+            if all(scale.stored(v) == s for v, s in zip(values, stored)):
+                kept.add(position)
+    return kept
+
+
+@pytest.mark.parametrize("code", ["|u1", ">u2", "<i2", ">d2"])
+def test_value_searches_keep_a_superset_of_stable_retros_candidates(code):
+    rng = np.random.default_rng(3)
+    rows = [rng.integers(0, 6, 256).astype(np.uint8) for _ in range(3)]
+    for row, value in zip(rows, (1, 2, 3)):  # plant words that read 1, 2, 3 through each simple scale
+        row[0x10], row[0x20], row[0x30], row[0x40] = value, value - 1, value + 1, 2 * value
+    values = [1, 2, 3]
+    search = Engine(LAYOUT, parse_search_types(code))
+    for row, value in zip(rows, values):
+        search.add_snapshot(row)
+        search.filter("equal", value)
+    theirs = stable_retro_rule(rows, values, code)
+    ours = set(np.flatnonzero(search.candidates.alive[0]).tolist())
+    assert theirs <= ours and ours == theirs  # every one they keep, and nothing they would drop
+    if code == "|u1":
+        assert {0x10, 0x20, 0x30, 0x40} <= ours
 
 
 def test_score_times_ten_and_bcd_are_found():
@@ -245,3 +295,27 @@ def test_layout_addresses_and_bounds():
     with pytest.raises(InvalidArgumentError, match=r"0xC000-0xC0FF, 0xE000-0xE00F.*0xC0FF with 2 bytes"):
         layout.position(0xC0FF, 2)  # the second byte is past the region
     assert not layout.valid(2)[0xFF] and layout.valid(2)[0xFE]
+
+
+def test_the_candidate_set_does_not_import_the_engine_that_uses_it():
+    """candidates.py sits below engine.py: the listing of candidates lives in the engine, so no import circle."""
+    import ast
+    from pathlib import Path
+
+    from retrokit.ramsearch import candidates
+
+    tree = ast.parse(Path(candidates.__file__).read_text())
+    imported = {node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)}
+    assert "retrokit.ramsearch.engine" not in imported and "retrokit.ramsearch.search" not in imported
+
+
+def test_the_ramsearch_command_does_not_import_the_cli():
+    import ast
+    from pathlib import Path
+
+    import retrokit.commands.ramsearch as command
+
+    tree = ast.parse(Path(command.__file__).read_text())
+    imported = {node.module for node in ast.walk(tree) if isinstance(node, ast.ImportFrom)}
+    imported |= {alias.name for node in ast.walk(tree) if isinstance(node, ast.Import) for alias in node.names}
+    assert "retrokit.cli" not in imported

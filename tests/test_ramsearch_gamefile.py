@@ -9,7 +9,7 @@ import pytest
 
 from retrokit.data.gamefiles import read_game_yaml
 from retrokit.errors import DataFileError, FileConflictError, InvalidArgumentError
-from retrokit.ramsearch.gamefile import add_field
+from retrokit.ramsearch.gamefile import add_field, set_default_state
 
 DASHER_YAML = Path(__file__).resolve().parent.parent / "games" / "Dasher-Genesis" / "game.yaml"
 
@@ -113,3 +113,50 @@ def test_windows_line_ends_are_kept(tmp_path):
     data = path.read_bytes().decode()
     assert data.count("\r\n") == data.count("\n") == original.count("\n") + 1
     assert '  p1_y:        {address: 0xFF0022, type: ">u2"}   # feet; the usual floor is 192\r\n' in data
+
+
+# --- the default state (ramsearch savestate --default) ----------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("before", "after"),
+    [
+        ("system: Genesis\n", "system: Genesis\nstates:\n  default: Mine\n"),
+        ("states:\n  default: Old   # the start\nplayers: 1\n", "states:\n  default: Mine   # the start\nplayers: 1\n"),
+        ("states:\n  list: [A, B]\n", "states:\n  default: Mine\n  list: [A, B]\n"),
+        ("states: {default: Old, list: [A]}  # kept\n", "states: {default: Mine, list: [A]}  # kept\n"),
+        ("states:\n", "states: {default: Mine}\n"),
+        (
+            "states:\n  default: A\n  by_players: [A, A.2P]   # 1 and 2 players\n",
+            "states:\n  default: Mine\n  by_players: [Mine, A.2P]   # 1 and 2 players\n",
+        ),
+    ],
+    ids=["no-states", "replace-keeps-comment", "insert-before-list", "flow", "empty", "by-players-first-too"],
+)
+def test_the_default_state_is_one_edited_line(tmp_path, before, after):
+    path = tmp_path / "game.yaml"
+    path.write_text(before)
+    set_default_state(path, "Mine")
+    assert path.read_text() == after
+
+
+def test_the_default_state_of_dasher_keeps_every_other_line(tmp_path):
+    path = tmp_path / "game.yaml"
+    path.write_text(DASHER_YAML.read_text())
+    set_default_state(path, "Zone2.Act1")
+    assert changes(DASHER_YAML.read_text(), path.read_text()) == [
+        "-   default: Zone1.Act1",
+        "+   default: Zone2.Act1",
+        "-   by_players: [Zone1.Act1, Zone1.Act1.2P]   # the default for 1 and for 2 players",
+        "+   by_players: [Zone2.Act1, Zone1.Act1.2P]   # the default for 1 and for 2 players",
+    ]
+    assert read_game_yaml(path).default_state == "Zone2.Act1"
+
+
+def test_a_range_is_written_in_the_line(tmp_path):
+    path = tmp_path / "game.yaml"
+    path.write_text(DASHER_YAML.read_text())
+    add_field(path, "lives", "0xFF002B", "|u1", value_range=(0, 9))
+    assert changes(DASHER_YAML.read_text(), path.read_text()) == [
+        '+   lives:       {address: 0xFF002B, type: "|u1", range: [0, 9]}'
+    ]

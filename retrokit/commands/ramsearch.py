@@ -5,14 +5,20 @@ folder unless ``--session`` names another): each subcommand reads it, does one
 thing and writes it back. See ``docs/ramsearch.md``::
 
     retrokit ramsearch new GAME [--state STATE] [--session FILE]
-    retrokit ramsearch run [--press BUTTON ...] [--frames N] [--movie FILE.bk2 [--until FRAME]] [--session FILE]
-    retrokit ramsearch filter OP [VALUE] [--than previous|first] [--session FILE]
+    retrokit ramsearch run [--press BUTTON ...] [--frames N] [--script "START*1 _*60 RIGHT*30"]
+                           [--movie FILE.bk2 [--until FRAME]] [--no-snapshot] [--session FILE]
+    retrokit ramsearch filter OP [VALUE] [--than previous|first|N|0xADDRESS|changes] [--session FILE]
     retrokit ramsearch show [--limit N] [--json] [--session FILE]
-    retrokit ramsearch undo | redo [--session FILE]
+    retrokit ramsearch history | undo | redo [--session FILE]
     retrokit ramsearch poke ADDRESS VALUE [--type TYPE] [--session FILE]
     retrokit ramsearch screenshot FILE.png [--session FILE]
-    retrokit ramsearch save NAME ADDRESS TYPE [--game-file PATH] [--session FILE]
+    retrokit ramsearch save NAME ADDRESS TYPE [--range LO HI] [--game-file PATH] [--session FILE]
+    retrokit ramsearch savestate NAME [--default] [--force] [--session FILE]
+    retrokit ramsearch movie FILE.bk2 [--force] [--session FILE]
     retrokit ramsearch shell [--session FILE]       # the others typed at a prompt, one a line
+
+The search itself (the session-replacement policy, the listing of groups)
+lives in :mod:`retrokit.ramsearch`; this module parses and prints.
 """
 
 from __future__ import annotations
@@ -29,12 +35,12 @@ if TYPE_CHECKING:
 
 _SESSION_HELP = "the session file (default: ramsearch.session in the current folder)"
 _VALUES_SHOWN = 8  # snapshots whose values `show` prints; older ones are elided
-MAX_LISTED = 100_000  # `show` lists no more: each row is decoded at every snapshot in Python
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``ramsearch`` command and its subcommands."""
-    from retrokit.ramsearch.filters import OPS
+    from retrokit.ramsearch.filters import OPS, THAN_FORMS
+    from retrokit.ramsearch.script import SYNTAX
 
     parser = subparsers.add_parser(
         "ramsearch",
@@ -59,34 +65,35 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--force", action="store_true", help="replace an existing session file")
 
-    p = sub("run", "move the game on (hold buttons, or play a movie), then take a snapshot", _run)
+    p = sub("run", "move the game on (hold buttons, play a script or a movie), then take a snapshot", _run)
     p.add_argument(
         "--press",
         nargs="+",
+        action="extend",
         default=[],
         metavar="BUTTON",
-        help="buttons to hold, by the game's names (RIGHT, B; 2:START for port 2)",
+        help="buttons to hold together, by the game's names (RIGHT, B; 2:START for port 2); "
+        "--press B --press UP holds both",
     )
     p.add_argument("--frames", metavar="N", help="frames to run (default: 1)")
+    p.add_argument("--script", metavar="STEPS", help=f"play a sequence of inputs instead: {SYNTAX}")
     p.add_argument("--movie", metavar="FILE.bk2", help="play this movie from its start instead")
     p.add_argument("--until", metavar="FRAME", help="stop the movie after this many frames (default: its end)")
     p.add_argument("--state", help="load this save state first")
+    p.add_argument("--no-snapshot", action="store_true", help="move the game on without taking a snapshot")
 
     p = sub("filter", "keep the candidates whose newest value passes a comparison", _filter)
     p.add_argument("op", metavar="OP", help=", ".join(OPS))
     p.add_argument(
         "value", nargs="?", metavar="VALUE", help="the number to compare with (for changed-by: the difference)"
     )
-    p.add_argument(
-        "--than",
-        metavar="previous|first",
-        help="compare with the previous (default) or first snapshot, the value at an ADDRESS, or, with 'changes', the change count with VALUE",
-    )
+    p.add_argument("--than", metavar="REF", help=f"what to compare with: {THAN_FORMS}")
 
     p = sub("show", "list the candidates: address, type, scale, change count, value at each snapshot", _show)
     p.add_argument("--limit", default="20", metavar="N", help="list at most N (default: 20; 0: all)")
     p.add_argument("--json", action="store_true", help='print a JSON list of {"address", "type", "values"}')
 
+    sub("history", "list the snapshots, numbered from 0 in the order taken (for --than N), and the filters", _history)
     sub("undo", "undo the last filter", _undo)
     sub("redo", "apply the last undone filter again", _redo)
     sub("shell", "read subcommands from a prompt (or standard input), one a line, until 'quit'", _shell)
@@ -106,10 +113,25 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("type", metavar="TYPE", help="its type code, e.g. '|u1'")
     p.add_argument("--game-file", metavar="PATH", help="the game.yaml to write (default: the game's own)")
     p.add_argument("--force", action="store_true", help="replace a field of the same name")
+    p.add_argument(
+        "--range", nargs=2, metavar=("LO", "HI"), help="the values the field may hold, written as range: [LO, HI]"
+    )
+
+    p = sub("savestate", "save the game's state now as a state of the game, in the data folder", _savestate)
+    p.add_argument("name", metavar="NAME", help="the state's name, e.g. Level1")
+    p.add_argument("--default", action="store_true", help="make it the state make(game) starts from")
+    p.add_argument("--force", action="store_true", help="replace a different state of that name")
+
+    p = sub("movie", "write the inputs played since the start state as a stable-retro movie", _movie)
+    p.add_argument("file", metavar="FILE.bk2")
+    p.add_argument("--force", action="store_true", help="replace an existing file")
     parser.set_defaults(run=run)
 
 
-SUBCOMMANDS = ("new", "run", "filter", "show", "undo", "redo", "poke", "screenshot", "save", "shell")
+SUBCOMMANDS = (
+    "new", "run", "filter", "show", "history", "undo", "redo", "poke", "screenshot", "save", "savestate", "movie",
+    "shell",
+)  # fmt: skip
 
 
 def run(args: argparse.Namespace) -> int:
@@ -149,31 +171,13 @@ def _open(args: argparse.Namespace) -> RamSearch:
 
 
 def _new(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from retrokit.data.games import find_game
-    from retrokit.errors import FileConflictError, SessionError
     from retrokit.ramsearch import RamSearch
-    from retrokit.ramsearch.session import read_session
+    from retrokit.ramsearch.session import check_new_session
 
-    path = Path(_session(args))
+    path = _session(args)
     game = find_game(args.game)
-    if path.exists() and not args.force:
-        try:
-            old = read_session(path)
-        except SessionError:
-            raise FileConflictError(
-                f"Expected no file at {path}; found one that is not a session. Pass --session OTHER, or --force to replace it."
-            ) from None
-        if old.game != game.name:
-            raise SessionError(
-                f"Expected {path} to be free or a session of {game.name}; found a session of another game, {old.game}. "
-                f"Pass --session OTHER for {game.name}, or --force to replace it."
-            )
-        raise FileConflictError(
-            f"Expected no session at {path}; found one of {old.game} with {len(old.labels)} snapshot(s). "
-            "Pass --force to start over, or --session OTHER."
-        )
+    check_new_session(path, game.name, force=args.force)
     with RamSearch(game, args.state, types=args.types) as search:
         search.save(path, overwrite=args.force)
         print(
@@ -187,23 +191,36 @@ def _run(args: argparse.Namespace) -> int:
     frames, until = _number(args.frames, "--frames"), _number(args.until, "--until")
     if args.movie is None and until is not None:
         raise InvalidArgumentError("Expected --until with --movie FILE.bk2; got --until alone.")
-    if args.movie is not None and (args.press or frames is not None or args.state):
-        raise InvalidArgumentError("Expected either --movie (with --until) or --press/--frames/--state, not both.")
+    if args.movie is not None and (args.press or frames is not None or args.state or args.script is not None):
+        raise InvalidArgumentError(
+            "Expected either --movie (with --until) or --press/--frames/--script/--state, not both."
+        )
+    if args.script is not None and (args.press or frames is not None):
+        raise InvalidArgumentError(
+            "Expected either --script or --press/--frames, not both: a script holds its own buttons, e.g. RIGHT*30."
+        )
+    snapshot = not args.no_snapshot
     with _open(args) as search:
         if args.movie is not None:
-            index = search.play(args.movie, until)
+            index = search.play(args.movie, until, snapshot=snapshot)
+        elif args.script is not None:
+            index = search.run_script(args.script, state=args.state, snapshot=snapshot)
         else:
-            index = search.run(args.press, 1 if frames is None else frames, state=args.state)
+            index = search.run(args.press, 1 if frames is None else frames, state=args.state, snapshot=snapshot)
         search.save(_session(args))
-        print(f"Snapshot {index + 1}: {search.labels[index]}.")
+        if index is None:
+            frames_played = sum(count for count, _ in search.inputs)
+            print(f"Moved on, no snapshot taken ({frames_played} frames played since the start state).")
+        else:
+            print(f"Snapshot {index}: {search.labels[index]}.")
     return 0
 
 
 def _filter(args: argparse.Namespace) -> int:
     than = args.than
-    if than is not None and than not in ("previous", "first", "changes"):
+    if than is not None and than.lower().startswith("0x"):  # an address; a decimal number is a snapshot
         try:
-            than = int(than, 0)
+            than = int(than, 16)
         except ValueError:
             pass  # the engine names what --than takes, and the closest one
     with _open(args) as search:
@@ -230,47 +247,50 @@ def _rows(search: RamSearch, groups: list[list[Candidate]]) -> list[list[str]]:
 
 
 def _show(args: argparse.Namespace) -> int:
-    from retrokit.ramsearch import group_candidates
+    from retrokit.ramsearch.candidates import check_listable, list_groups
 
     limit = _number(args.limit, "--limit")
     if limit is None or limit < 0:
         raise InvalidArgumentError(f"Expected --limit of 0 (all) or more, got {args.limit!r}.")
     with _open(args) as search:
-        if (not limit or limit > MAX_LISTED) and search.count > MAX_LISTED:
-            raise InvalidArgumentError(
-                f"Expected at most {MAX_LISTED:,} candidates to list; found {search.count:,}. "
-                "Filter them first, or pass --limit N."
-            )
         if args.json:
+            check_listable(search.count, limit)
             candidates = search.candidates(limit or None)
             print(json.dumps([{"address": c.address, "type": c.type, "values": list(c.values)} for c in candidates]))
             return 0
-        total = search.count
-        # A group holds at most one candidate per type and start address around its low byte.
-        fetched = search.candidates(limit * len(search.types) * 8 if limit else None)
-        groups = group_candidates(fetched)
-        if limit and len(fetched) < total:
-            groups = groups[:limit]  # the last groups may be cut short, and are not listed
-        shown = groups[:limit] if limit else groups
-        complete = len(fetched) == total
+        listing = list_groups(search.count, search.candidates, limit, len(search.types))
+        total, shown = listing.total, listing.groups
         print(
             f"{total:,} candidate{'s' * (total != 1)}"
             + (
-                f" in {len(groups):,} group{'s' * (len(groups) != 1)} (types reading the same bytes alike)"
-                if complete
+                f" in {listing.count:,} group{'s' * (listing.count != 1)} (types reading the same bytes alike)"
+                if listing.count is not None
                 else ""
             )
-            + (f"; the first {len(shown)} by address:" if len(shown) < len(groups) or not complete else ":")
+            + (f"; the first {len(shown)} by address:" if listing.more else ":")
         )
         if not shown:
             return 0
         first = max(0, len(search.labels) - _VALUES_SHOWN)
-        header = ["address", "type", "scale", "changes", f"values at snapshots {first + 1}-{len(search.labels)}"]
+        header = ["address", "type", "scale", "changes", f"values at snapshots {first}-{len(search.labels) - 1}"]
         rows = [header, *_rows(search, shown)]
         widths = [max(len(r[i]) for r in rows) for i in range(4)]
         for row in rows:
             print("  ".join(cell.ljust(width) for cell, width in zip(row[:4], widths)) + "  " + row[4])
-        print("snapshots: " + "; ".join(f"{i + 1} {label}" for i, label in enumerate(search.labels) if i >= first))
+        print("snapshots: " + "; ".join(f"{i} {label}" for i, label in enumerate(search.labels) if i >= first))
+    return 0
+
+
+def _history(args: argparse.Namespace) -> int:
+    with _open(args) as search:
+        print(f"{len(search.labels)} snapshot{'s' * (len(search.labels) != 1)} (--than N compares with snapshot N):")
+        for index, label in enumerate(search.labels):
+            print(f"  {index}  {label}")
+        filters = search.history
+        print(f"{len(filters)} filter{'s' * (len(filters) != 1)}{':' if filters else '.'}")
+        for label in filters:
+            print(f"  {label}")
+        print(f"{search.count:,} candidate{'s' * (search.count != 1)} left.")
     return 0
 
 
@@ -313,10 +333,12 @@ def _shell(args: argparse.Namespace) -> int:
     import shlex
     import sys
 
-    from retrokit.cli import build_parser
     from retrokit.errors import RetrokitError
 
-    parser, interactive = build_parser(), sys.stdin.isatty()
+    # Its own parser of these subcommands: a command never imports the CLI above it.
+    parser = argparse.ArgumentParser(prog="retrokit")
+    register(parser.add_subparsers())
+    interactive = sys.stdin.isatty()
     session = ["--session", args.session] if args.session else []
     while True:
         try:
@@ -346,9 +368,31 @@ def _shell(args: argparse.Namespace) -> int:
 
 def _save(args: argparse.Namespace) -> int:
     address = _number(args.address, "ADDRESS")
+    value_range = None if args.range is None else tuple(_number(v, "--range") for v in args.range)
     with _open(args) as search:
-        path = search.save_field(args.name, address, args.type, game_file=args.game_file, force=args.force)
-        print(f"Wrote field {args.name} ({search.layout.format(address)}, {args.type}) into {path}.")
+        path = search.save_field(
+            args.name, address, args.type, game_file=args.game_file, force=args.force, value_range=value_range
+        )
+        extra = "" if value_range is None else f", range [{value_range[0]}, {value_range[1]}]"
+        print(f"Wrote field {args.name} ({search.layout.format(address)}, {args.type}{extra}) into {path}.")
+    return 0
+
+
+def _savestate(args: argparse.Namespace) -> int:
+    with _open(args) as search:
+        outcome = search.save_state(args.name, default=args.default, force=args.force)
+        done = {"made": "Saved", "replaced": "Replaced", "up to date": "Kept (already the same state)"}[outcome.status]
+        print(f"{done} state {args.name} of {search.game.name}: {outcome.path}.")
+        if args.default:
+            print(f"Default state of {search.game.name} is now {args.name} ({outcome.path.parent / 'game.yaml'}).")
+    return 0
+
+
+def _movie(args: argparse.Namespace) -> int:
+    with _open(args) as search:
+        path = search.write_movie(args.file, overwrite=args.force)
+        frames = sum(count for count, _ in search.inputs)
+        print(f"Wrote {frames} frames played since the start state to {path}.")
     return 0
 
 
@@ -357,17 +401,24 @@ EXAMPLES = [
     "retrokit ramsearch new Dasher-Genesis --state Zone1.Act1",
     "retrokit ramsearch run --press RIGHT B --frames 60",
     "retrokit ramsearch run --movie Mine-000000.bk2 --until 300",
+    "retrokit ramsearch run --script 'START*1 _*60 RIGHT*30 RIGHT+B*2'   # taps, holds and waits",
+    "retrokit ramsearch run --script 'LEFT*40' --no-snapshot",
     "retrokit ramsearch filter increased                 # than the previous snapshot",
     "retrokit ramsearch filter equal 3                   # equal to the number 3",
     "retrokit ramsearch filter unchanged --than first",
+    "retrokit ramsearch filter increased --than 2        # than snapshot 2 (ramsearch history)",
     "retrokit ramsearch filter greater --than 0xFF0020   # than the value at that address",
     "retrokit ramsearch filter changed-by 1",
     "retrokit ramsearch filter greater 2 --than changes  # changed more than twice",
     "retrokit ramsearch show --limit 50",
+    "retrokit ramsearch history",
     "retrokit ramsearch undo",
     "retrokit ramsearch redo",
     "retrokit ramsearch poke 0xFF002B 5 --type '|u1'",
     "retrokit ramsearch screenshot poked.png",
     "retrokit ramsearch save lives 0xFF002B '|u1'",
+    "retrokit ramsearch save lives 0xFF002B '|u1' --range 0 9",
+    "retrokit ramsearch savestate Level1 --default",
+    "retrokit ramsearch movie level1.bk2",
     "retrokit ramsearch shell --session dasher.session",
 ]

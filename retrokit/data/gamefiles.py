@@ -69,7 +69,7 @@ class GameInfo:
 
 
 _YAML_KEYS = ("system", "title", "roms", "fields", "states", "players")
-_FIELD_KEYS = ("address", "type", "mask")
+_FIELD_KEYS = ("address", "type", "mask", "range")
 _SHA1 = re.compile(r"^[0-9a-fA-F]{40}$")
 
 

@@ -3,11 +3,12 @@
 - :class:`RamSearch` (:mod:`.search`): the search on a running game, its moves and its session file.
 - :mod:`.engine`: snapshots and candidates, narrowed by filters, with undo and redo.
 - :mod:`.filters`: the operations and references a filter compares with.
-- :mod:`.candidates`: the candidate set, packed for undo, and listed for ``show``.
+- :mod:`.candidates`: the candidate set, packed for undo, and grouped for ``show``.
 - :mod:`.types`: every type interpretation of a snapshot, decoded at once.
 - :mod:`.scales`: the scaled matches of a value search.
 - :mod:`.ram`: the RAM regions as console-order bytes, and console addresses.
-- :mod:`.session`: the session file.
+- :mod:`.script`: input scripts (taps, holds and waits in one line).
+- :mod:`.session`: the session file, and when a new one may replace it.
 - :mod:`.gamefile`: writing a field into a game.yaml, keeping its layout.
 
 See ``docs/ramsearch.md``.
@@ -16,12 +17,12 @@ See ``docs/ramsearch.md``.
 from __future__ import annotations
 
 from retrokit.lazy import lazy_names
-from retrokit.ramsearch.candidates import Candidate, group_candidates
+from retrokit.ramsearch.candidates import Candidate, group_candidates, list_groups
 from retrokit.ramsearch.filters import OPS
 from retrokit.ramsearch.search import RamSearch
 from retrokit.ramsearch.session import DEFAULT_SESSION
 from retrokit.ramsearch.types import SEARCH_TYPES
 
-__all__ = ["DEFAULT_SESSION", "OPS", "SEARCH_TYPES", "Candidate", "RamSearch", "group_candidates"]
+__all__ = ["DEFAULT_SESSION", "OPS", "SEARCH_TYPES", "Candidate", "RamSearch", "group_candidates", "list_groups"]
 
 __getattr__ = lazy_names(__name__)  # its submodules, on first use: retrokit.ramsearch.<module>

@@ -1,28 +1,24 @@
 """Candidates: the (type, position) pairs a search still holds, kept and listed.
 
 :class:`Candidates` is the set as the engine filters it: a boolean array per
-type over every snapshot position, and the scale each candidate was matched
-with; :class:`Packed` is the same in a few bytes per candidate, for undo and
-the session file. :func:`list_candidates` lists them as :class:`Candidate`
-rows with their values at every snapshot, and :func:`group_candidates`
-gathers the rows that read the same bytes the same way.
+type over every snapshot position, and the scales each candidate is still
+consistent with; :class:`Packed` is the same in a few bytes per candidate, for
+undo and the session file. :class:`Candidate` is one listed candidate with its
+values at every snapshot, :func:`group_candidates` gathers the rows that read
+the same bytes the same way, and :func:`list_groups` is what ``show`` lists.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from itertools import pairwise
-from typing import TYPE_CHECKING
 
 import numpy as np
 
+from retrokit.errors import InvalidArgumentError
 from retrokit.host.typecodes import FieldType, parse_type
 from retrokit.ramsearch.ram import RamLayout
-from retrokit.ramsearch.scales import SCALES, UNPINNED, scale_label
-
-if TYPE_CHECKING:
-    from retrokit.ramsearch.engine import Engine
+from retrokit.ramsearch.scales import ALL_SCALES, MASK_DTYPE, UNPINNED
 
 
 @dataclass(frozen=True)
@@ -31,7 +27,7 @@ class Packed:
 
     Attributes:
         bits: The alive flags of every type's positions, one after the other, packed 8 to a byte.
-        scales: The scale index of each alive candidate, in that order.
+        scales: The scale mask of each alive candidate, in that order.
     """
 
     bits: np.ndarray
@@ -39,11 +35,11 @@ class Packed:
 
 
 class Candidates:
-    """Which (type, position) pairs are still candidates, and the scale each was matched with.
+    """Which (type, position) pairs are still candidates, and the scales each is still consistent with.
 
     Args:
         alive: Per type, a boolean array over positions.
-        scale: Per type, an ``int8`` array of scale indices (:data:`~retrokit.ramsearch.scales.UNPINNED` if none).
+        scale: Per type, an array of scale masks (:mod:`retrokit.ramsearch.scales`; ``UNPINNED`` if none).
     """
 
     def __init__(self, alive: list[np.ndarray], scale: list[np.ndarray]) -> None:
@@ -54,7 +50,7 @@ class Candidates:
     def everything(cls, layout: RamLayout, types: Sequence[FieldType]) -> Candidates:
         """Every position of every type whose bytes fit in a region."""
         alive = [layout.valid(t.width) for t in types]
-        return cls(alive, [np.full(layout.size, UNPINNED, dtype=np.int8) for _ in types])
+        return cls(alive, [np.full(layout.size, UNPINNED, dtype=MASK_DTYPE) for _ in types])
 
     def copy(self) -> Candidates:
         return Candidates([a.copy() for a in self.alive], [s.copy() for s in self.scale])
@@ -78,11 +74,11 @@ class Candidates:
         if packed.bits.dtype != np.uint8 or len(packed.bits) != -(-types * size // 8):
             raise ValueError(f"expected {types * size} packed candidate bits, found {len(packed.bits) * 8}")
         alive = np.unpackbits(packed.bits, count=types * size).astype(bool)
-        if packed.scales.dtype != np.int8 or len(packed.scales) != np.count_nonzero(alive):
-            raise ValueError(f"expected a scale per alive candidate, found {len(packed.scales)}")
-        if len(packed.scales) and not (UNPINNED <= packed.scales.min() and packed.scales.max() < len(SCALES)):
-            raise ValueError("expected scale indices of known scales")
-        scale = np.full(types * size, UNPINNED, dtype=np.int8)
+        if packed.scales.dtype != MASK_DTYPE or len(packed.scales) != np.count_nonzero(alive):
+            raise ValueError(f"expected a scale mask per alive candidate, found {len(packed.scales)}")
+        if len(packed.scales) and packed.scales.max() > ALL_SCALES:
+            raise ValueError("expected scale masks of known scales")
+        scale = np.full(types * size, UNPINNED, dtype=MASK_DTYPE)
         scale[alive] = packed.scales
         return cls(list(alive.reshape(types, size)), list(scale.reshape(types, size)))
 
@@ -105,9 +101,11 @@ class Candidate:
         address: The console address of its first byte.
         type: Its type code, e.g. ``">u2"``.
         values: Its stored value at each snapshot, oldest first.
-        scale: How the screen's value follows from the stored one (``""``: it is the same; see
-            :mod:`retrokit.ramsearch.scales`).
+        scale: How the screen's value follows from the stored one (``""``: it is the same; ``"-1,/2"``:
+            either; see :mod:`retrokit.ramsearch.scales`).
         changes: At how many snapshots its value differed from the one before.
+        scales: Every scale still consistent with the value searches (``""`` is the value itself;
+            none before a value search).
     """
 
     address: int
@@ -115,6 +113,7 @@ class Candidate:
     values: tuple[int, ...]
     scale: str = ""
     changes: int = 0
+    scales: tuple[str, ...] = ()
 
     @property
     def low_byte(self) -> int:
@@ -137,21 +136,58 @@ def group_candidates(candidates: Sequence[Candidate]) -> list[list[Candidate]]:
     return [sorted(g, key=lambda c: parse_type(c.type).width) for g in groups.values()]
 
 
-def list_candidates(engine: Engine, limit: int | None = None) -> list[Candidate]:
-    """The candidates by address (then simplest type first), at most ``limit`` of them."""
-    cands = engine.candidates
-    picked = []
-    for t, alive in enumerate(cands.alive):
-        positions = np.flatnonzero(alive)
-        picked.extend((int(p), t) for p in (positions if limit is None else positions[:limit]))
-    picked.sort()
-    if limit is not None:
-        picked = picked[:limit]
-    out = []
-    addresses = engine.layout.addresses(np.array([p for p, _ in picked], dtype=np.int64)) if picked else []
-    for (position, t), address in zip(picked, addresses):
-        ftype = engine.types[t]
-        values = tuple(ftype.decode(bytes(s[position : position + ftype.width])) for s in engine.snapshots)
-        changes = sum(a != b for a, b in pairwise(values))
-        out.append(Candidate(int(address), ftype.code, values, scale_label(int(cands.scale[t][position])), changes))
-    return out
+MAX_LISTED = 100_000  # `show` lists no more: each row is decoded at every snapshot in Python
+
+
+@dataclass(frozen=True)
+class Groups:
+    """What ``show`` lists: the candidates gathered into groups that read the same bytes alike.
+
+    Attributes:
+        total: How many candidates are left.
+        groups: The groups listed, by address, each narrowest type first.
+        count: How many groups there are, if every candidate was fetched (else ``None``).
+        more: Whether groups beyond those listed exist (or may, when not all were fetched).
+    """
+
+    total: int
+    groups: list[list[Candidate]]
+    count: int | None
+    more: bool
+
+
+def check_listable(total: int, limit: int) -> None:
+    """Check ``limit`` candidates (0: all) of ``total`` may be listed.
+
+    Raises:
+        InvalidArgumentError: ``limit`` is negative, or all (or over :data:`MAX_LISTED`) are asked of more than that many.
+    """
+    if not isinstance(limit, int) or limit < 0:
+        raise InvalidArgumentError(f"Expected --limit of 0 (all) or more, got {limit!r}.")
+    if (not limit or limit > MAX_LISTED) and total > MAX_LISTED:
+        raise InvalidArgumentError(
+            f"Expected at most {MAX_LISTED:,} candidates to list; found {total:,}. Filter them first, or pass --limit N."
+        )
+
+
+def list_groups(total: int, fetch: Callable[[int | None], list[Candidate]], limit: int, types: int) -> Groups:
+    """The first ``limit`` groups of candidates (all when 0), fetching no more candidates than they can hold.
+
+    Args:
+        total: How many candidates are left.
+        fetch: Lists the candidates by address, at most N of them (all for ``None``).
+        limit: How many groups to list; 0 for all.
+        types: How many types are searched.
+
+    Raises:
+        InvalidArgumentError: See :func:`check_listable`.
+    """
+    check_listable(total, limit)
+    # A group holds at most one candidate per type and start address around its low byte.
+    fetched = fetch(limit * types * 8 if limit else None)
+    complete = len(fetched) == total
+    groups = group_candidates(fetched)
+    if limit and not complete:
+        groups = groups[:limit]  # the last groups may be cut short, and are not listed
+    shown = groups[:limit] if limit else groups
+    return Groups(total, shown, len(groups) if complete else None, len(shown) < len(groups) or not complete)

@@ -1,7 +1,7 @@
 """The search engine: candidates over snapshots, narrowed by filters, with undo and redo.
 
 A candidate is a type and a snapshot position (the value of that type that
-starts there), with the scale a value search matched it with
+starts there), with every scale its value searches are consistent with
 (:mod:`retrokit.ramsearch.scales`). Candidates are kept as one boolean array
 per type over every position, so a filter is a few numpy comparisons over the
 type's decoded values (:mod:`retrokit.ramsearch.types`); once few candidates
@@ -14,16 +14,20 @@ the candidate set in :mod:`retrokit.ramsearch.candidates`.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from itertools import pairwise
 
 import numpy as np
 
 from retrokit.errors import InvalidArgumentError, RamSearchError
 from retrokit.host.typecodes import FieldType
-from retrokit.ramsearch.candidates import Candidates, Packed
+from retrokit.ramsearch.candidates import Candidate, Candidates, Packed
 from retrokit.ramsearch.filters import CHANGES, COMPARISONS, Filter, check_filter
 from retrokit.ramsearch.ram import RamLayout
-from retrokit.ramsearch.scales import SCALES, UNPINNED
+from retrokit.ramsearch.scales import MASK_DTYPE, SCALES, UNPINNED, scale_label, scale_labels
 from retrokit.ramsearch.types import decode_all
+
+# Scales that divide: a value shown through one is defined only where the division is exact.
+_DIVIDING = sum(1 << index for index, scale in enumerate(SCALES) if scale.div != 1)
 
 _SPARSE = 8  # compare only the candidates' positions once fewer than 1 in 8 positions are left
 _DECODED_KEPT = 4  # decoded snapshots kept for the next filter
@@ -96,6 +100,14 @@ class Engine:
                 f"Expected two snapshots to compare for '{spec.describe()}'; found 1. Move the game on first, "
                 "e.g. retrokit ramsearch run --frames 60, or compare with a number: filter equal N."
             )
+        if spec.snapshot is not None and not 0 <= spec.snapshot < len(self.snapshots) - 1:
+            raise RamSearchError(
+                f"Expected --than a snapshot taken before the newest, 0 to {len(self.snapshots) - 2}; got "
+                f"{spec.snapshot} of {len(self.snapshots)} snapshot(s). `retrokit ramsearch history` lists them."
+                if len(self.snapshots) > 1
+                else "Expected an earlier snapshot to compare with; found only snapshot 0. Move the game on first, "
+                "e.g. retrokit ramsearch run --frames 60."
+            )
         if isinstance(spec.than, int):
             self.layout.position(spec.than)  # outside RAM: a clear error now
         before = Candidates(list(self.candidates.alive), list(self.candidates.scale))  # filters replace arrays
@@ -121,51 +133,68 @@ class Engine:
         left = np.count_nonzero(alive)
         if not left:
             return
-        value_search = spec.than is None and spec.op == "equal"
-        if value_search:  # it pins scales: on a copy
-            scales = self.candidates.scale[t] = scales.copy()
         if left * _SPARSE < len(alive):  # few left: compare only their positions
             positions = np.flatnonzero(alive)
 
             def pick(a: np.ndarray) -> np.ndarray:
                 return a[positions]
 
-            scale = scales[positions]
+            keep, masks = self._compare(t, spec, pick(self.decoded(-1)[t]), scales[positions], pick)
             kept = alive.copy()
-            kept[positions] = self._compare(t, spec, pick(self.decoded(-1)[t]), scale, pick)
+            kept[positions] = keep
             self.candidates.alive[t] = kept
-            if value_search:
-                scales[positions] = scale
+            if masks is not None:
+                scales = self.candidates.scale[t] = scales.copy()
+                scales[positions] = masks
         else:
-            self.candidates.alive[t] = alive & self._compare(t, spec, self.decoded(-1)[t], scales, lambda a: a)
+            keep, masks = self._compare(t, spec, self.decoded(-1)[t], scales, lambda a: a)
+            self.candidates.alive[t] = alive & keep
+            if masks is not None:
+                self.candidates.scale[t] = masks
 
-    def _compare(self, t: int, spec: Filter, cur: np.ndarray, scale: np.ndarray, pick) -> np.ndarray:
+    def _compare(
+        self, t: int, spec: Filter, cur: np.ndarray, mask: np.ndarray, pick
+    ) -> tuple[np.ndarray, np.ndarray | None]:
+        """Which candidates pass, and their scale masks after it (``None``: unchanged)."""
         ftype = self.types[t]
         if spec.than is None and spec.op == "equal":
-            return _value_search(ftype, cur, scale, spec.value)
+            return _value_search(ftype, cur, mask, spec.value)
         if spec.than == "changes":
-            return COMPARISONS[spec.op](pick(self._counts[t]), spec.value)
-        scaled = bool((scale > 0).any())  # else every value is shown as stored: compare the compact arrays
-        shown, ok = _shown(cur, scale) if scaled else (cur, None)
-        if spec.than is None:
-            ref, ref_ok = spec.value, None
+            return COMPARISONS[spec.op](pick(self._counts[t]), spec.value), None
+        reference = spec.reference_snapshot(len(self.snapshots))
+        if reference is not None:
+            ref = pick(self.decoded(reference)[t])
+            if spec.op != "changed-by":
+                # shown = stored * mult / div + bias rises with stored: a comparison of two values
+                # shown through one scale is that of the stored ones, where both divide exactly.
+                result = COMPARISONS[CHANGES.get(spec.op, spec.op)](cur, ref)
+                return _narrow(result, mask, lambda index: _exact(index, cur) & _exact(index, ref))
         elif isinstance(spec.than, int):  # another address: its stored value in the newest snapshot
             try:
                 position = self.layout.position(spec.than, ftype.width)
             except InvalidArgumentError:
-                return np.zeros(len(cur), dtype=bool)
-            ref, ref_ok = self.decoded(-1)[t][position], None
+                return np.zeros(len(cur), dtype=bool), None
+            ref = self.decoded(-1)[t][position]
         else:
-            ref = pick(self.decoded(0 if spec.than == "first" else -2)[t])
-            ref, ref_ok = _shown(ref, scale) if scaled else (ref, None)
-        if spec.op == "changed-by":
-            result = _changed_by(shown, ref, spec.value)
-        else:
-            result = COMPARISONS[CHANGES.get(spec.op, spec.op)](shown, ref)
-        for defined in (ok, ref_ok):
-            if defined is not None:
-                result &= defined
-        return result
+            ref = spec.value
+
+        def passes(index: int | None) -> np.ndarray:
+            """The filter read through scale ``index`` (``None``: the stored values themselves)."""
+            if index is None:
+                shown, here = cur, ref
+            else:
+                shown, ok = SCALES[index].shown(cur)
+                here = ref
+                if reference is not None:  # both sides are shown through the scale
+                    here, ref_ok = SCALES[index].shown(ref)
+                    ok &= ref_ok
+            if spec.op == "changed-by":
+                result = _changed_by(shown, here, spec.value)
+            else:
+                result = COMPARISONS[CHANGES.get(spec.op, spec.op)](shown, here)
+            return result if index is None else result & ok
+
+        return _per_scale(passes, mask)
 
     # --- undo and redo ---------------------------------------------------------------------
 
@@ -215,46 +244,98 @@ def _changed_by(cur: np.ndarray, ref: np.ndarray | int, by: int) -> np.ndarray:
     return result
 
 
-def _shown(stored: np.ndarray, scale: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The shown values of candidates (as int64), and where they are defined (exact division)."""
-    shown, ok = stored.astype(np.int64), np.ones(len(stored), dtype=bool)
-    for index in np.unique(scale[scale > 0]):
-        where = scale == index
-        shown[where], ok[where] = SCALES[index].shown(stored[where])
-    return shown, ok
+def _exact(index: int, stored: np.ndarray) -> np.ndarray | bool:
+    """Where a scale's division of stored values is exact (everywhere for a scale that does not divide)."""
+    scale = SCALES[index]
+    return True if scale.div == 1 else stored.astype(np.int64) * scale.mult % scale.div == 0
 
 
-def _value_search(ftype: FieldType, cur: np.ndarray, scale: np.ndarray, value: int) -> np.ndarray:
-    """``equal N``: pinned candidates by their scale; the others by the first scale that matches, which pins it."""
-    pinned = scale != UNPINNED
-    any_pinned = bool(pinned.any())
-    if any_pinned:
-        shown, ok = _shown(cur, np.where(pinned, scale, 0).astype(np.int8))
-        keep = pinned & ok & (shown == value)
-    else:
-        keep = np.zeros(len(cur), dtype=bool)
+def _narrow(result: np.ndarray, mask: np.ndarray, defined) -> tuple[np.ndarray, np.ndarray | None]:
+    """A result that holds alike through every scale, where ``defined(index)`` says the scale reads both values.
+
+    Unpinned candidates keep ``result``; a pinned one keeps the scales that
+    pass, and stays while one does.
+    """
+    if not np.count_nonzero(mask):  # UNPINNED is 0: nothing pinned (a fresh search)
+        return result, None
+    pinned = mask != UNPINNED
+    masks = np.where(result, mask, MASK_DTYPE.type(0))
+    for index in _bits_in(mask, _DIVIDING):
+        bit = MASK_DTYPE.type(1 << index)
+        masks[~np.asarray(defined(index), dtype=bool) & (masks & bit != 0)] &= ~bit
+    return result & ~pinned | (masks != 0), np.where(pinned, masks, mask)
+
+
+def _per_scale(passes, mask: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """A filter that reads differently through each scale: unpinned candidates as stored, pinned ones per scale."""
+    if not np.count_nonzero(mask):
+        return passes(None), None
+    pinned = mask != UNPINNED
+    keep = passes(None) & ~pinned if not pinned.all() else np.zeros(len(mask), dtype=bool)
+    masks = np.zeros(len(mask), dtype=MASK_DTYPE)
+    for index in _bits_in(mask):
+        bit = MASK_DTYPE.type(1 << index)
+        masks[passes(index) & (mask & bit != 0)] |= bit
+    return keep | (masks != 0), np.where(pinned, masks, mask)
+
+
+def _bits_in(mask: np.ndarray, among: int = -1) -> list[int]:
+    """The scale indices set in any of ``mask`` (and in ``among``)."""
+    union = int(np.bitwise_or.reduce(mask)) if len(mask) else 0
+    union &= among
+    return [index for index in range(len(SCALES)) if (union >> index) & 1]
+
+
+def _value_search(ftype: FieldType, cur: np.ndarray, mask: np.ndarray, value: int) -> tuple[np.ndarray, np.ndarray]:
+    """``equal N``: every scale through which a candidate shows ``N`` stays in its mask.
+
+    A pinned candidate keeps the scales of its mask that still show ``N``; an
+    unpinned one takes every scale that shows it. A candidate with no scale
+    left is dropped.
+    """
     low, high = ftype.value_range()
-    targets = []  # (scale index, stored value), first preferred
+    targets: dict[int, int] = {}  # stored value -> the mask of the scales that show it as N
     for index, candidate in enumerate(SCALES):
         stored = candidate.stored(value)
-        if ftype.kind not in candidate.kinds or stored is None or not low <= stored <= high:
-            continue
-        if all(stored != s for _, s in targets):
-            targets.append((index, stored))
+        if ftype.kind in candidate.kinds and stored is not None and low <= stored <= high:
+            targets[stored] = targets.get(stored, 0) | 1 << index
+    masks = np.zeros(len(cur), dtype=MASK_DTYPE)
     if not targets:
-        return keep
+        return np.zeros(len(cur), dtype=bool), masks
     # Few positions hold any of the stored values: find them with one pass per
-    # value, then tell which scale each matched only there.
-    hit = cur == targets[0][1]
-    for _, stored in targets[1:]:
+    # value, then tell which scales each matched only there.
+    values = iter(targets)
+    hit = cur == next(values)
+    for stored in values:
         hit |= cur == stored
-    if any_pinned:
-        hit &= ~pinned
     where = np.flatnonzero(hit)
     found = cur[where]
-    chosen = np.empty(len(where), dtype=np.int8)
-    for index, stored in reversed(targets):
-        chosen[found == stored] = index
-    scale[where] = chosen
-    keep[where] = True
-    return keep
+    matched = np.zeros(len(where), dtype=MASK_DTYPE)
+    for stored, bits in targets.items():
+        matched[found == stored] |= MASK_DTYPE.type(bits)
+    masks[where] = matched
+    if not np.count_nonzero(mask):  # (UNPINNED is 0) nothing pinned yet: every hit is kept
+        return hit, masks
+    masks = np.where(mask != UNPINNED, masks & mask, masks)  # pinned ones keep only scales they had
+    return masks != 0, masks
+
+
+def list_candidates(engine: Engine, limit: int | None = None) -> list[Candidate]:
+    """The candidates by address (then simplest type first), at most ``limit`` of them."""
+    cands = engine.candidates
+    picked = []
+    for t, alive in enumerate(cands.alive):
+        positions = np.flatnonzero(alive)
+        picked.extend((int(p), t) for p in (positions if limit is None else positions[:limit]))
+    picked.sort()
+    if limit is not None:
+        picked = picked[:limit]
+    out = []
+    addresses = engine.layout.addresses(np.array([p for p, _ in picked], dtype=np.int64)) if picked else []
+    for (position, t), address in zip(picked, addresses):
+        ftype = engine.types[t]
+        values = tuple(ftype.decode(bytes(s[position : position + ftype.width])) for s in engine.snapshots)
+        changes = sum(a != b for a, b in pairwise(values))
+        mask = int(cands.scale[t][position])
+        out.append(Candidate(int(address), ftype.code, values, scale_label(mask), changes, scale_labels(mask)))
+    return out

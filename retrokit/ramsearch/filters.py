@@ -2,7 +2,8 @@
 
 Filters follow BizHawk's RAM Search: compare each candidate's value in the
 newest snapshot with a number, with its value in the previous or the first
-snapshot, or with the value at another address, by ``equal``,
+snapshot or any earlier one (by its number, from 0 in the order taken), or
+with the value at another address, by ``equal``,
 ``not-equal``, ``less``, ``greater``, ``less-equal``, ``greater-equal``,
 ``changed-by N``, ``increased``, ``decreased``, ``changed`` or
 ``unchanged``; or compare its change count (snapshots at which its value
@@ -18,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from retrokit.errors import InvalidArgumentError, did_you_mean
+from retrokit.errors import InvalidArgumentError, did_you_mean, shown
 from retrokit.ramsearch.ram import RamLayout
 
 COMPARISONS: dict[str, Callable[[np.ndarray, object], np.ndarray]] = {
@@ -33,6 +34,12 @@ COMPARISONS: dict[str, Callable[[np.ndarray, object], np.ndarray]] = {
 CHANGES = {"increased": "greater", "decreased": "less", "changed": "not-equal", "unchanged": "equal"}
 OPS = (*COMPARISONS, "changed-by", *CHANGES)
 REFERENCES = ("previous", "first", "changes")
+#: Every form ``--than`` takes, as the messages and ``--help`` name them.
+THAN_FORMS = (
+    "previous (the snapshot before the newest: the default), first (snapshot 0), N (snapshot N, numbered from 0 "
+    "in the order taken: `ramsearch history` lists them), 0xADDRESS (the value at that console address, in hex), "
+    "or changes (with a number: how many times the value changed)"
+)
 
 
 @dataclass(frozen=True)
@@ -42,7 +49,8 @@ class Filter:
     Attributes:
         op: One of :data:`OPS`.
         value: The number compared with (for ``changed-by``, the difference).
-        than: ``"previous"``, ``"first"``, ``"changes"`` or a console address;
+        than: ``"previous"``, ``"first"``, ``"changes"``, a snapshot's number as a
+            string of digits (``"2"``), or a console address (an ``int``);
             ``None`` with a number means the number itself.
     """
 
@@ -50,11 +58,28 @@ class Filter:
     value: int | None = None
     than: str | int | None = None
 
+    @property
+    def snapshot(self) -> int | None:
+        """The snapshot number ``than`` names, if it names one by number."""
+        return int(self.than) if isinstance(self.than, str) and self.than.isdigit() else None
+
+    def reference_snapshot(self, count: int) -> int | None:
+        """The index of the snapshot compared with, of ``count`` (``None``: not a snapshot)."""
+        if self.than == "previous":
+            return count - 2
+        if self.than == "first":
+            return 0
+        return self.snapshot
+
     def describe(self, layout: RamLayout | None = None) -> str:
         """The filter as the command line writes it."""
         words = [self.op] + ([] if self.value is None else [str(self.value)])
         if self.than is not None:
-            than = layout.format(self.than) if layout is not None and isinstance(self.than, int) else str(self.than)
+            than = (
+                (layout.format(self.than) if layout is not None else hex(self.than))
+                if isinstance(self.than, int)
+                else self.than
+            )
             words.append(f"--than {than}")
         return " ".join(words)
 
@@ -74,28 +99,29 @@ def check_filter(op: str, value: int | None = None, than: str | int | None = Non
             raise InvalidArgumentError(f"Expected a whole number as the filter's {what}, got {number!r}.")
     value = None if value is None else int(value)  # numpy integers become plain ones
     than = int(than) if _is_int(than) else than
+    if isinstance(than, str) and than.isdigit():
+        than = str(int(than))  # "007" is snapshot 7
     if op not in OPS:
         raise InvalidArgumentError(
             f"Expected a filter operation ({', '.join(OPS)}), got {op!r}." + did_you_mean(op, OPS)
         )
-    if isinstance(than, str) and than not in REFERENCES:
-        raise InvalidArgumentError(
-            f"Expected --than previous, first, changes or a console address, got {than!r}."
-            + did_you_mean(than, REFERENCES)
-        )
+    if isinstance(than, str) and than not in REFERENCES and not than.isdigit():
+        raise InvalidArgumentError(f"Expected --than {THAN_FORMS}; got {shown(than)}." + did_you_mean(than, REFERENCES))
     if op in CHANGES:
         if value is not None:
             raise InvalidArgumentError(
                 f"Expected no number after {op!r}, got {value}. For a difference, use: changed-by N."
             )
         if than == "changes":
-            raise InvalidArgumentError(f"Expected --than previous, first or an address for {op!r}, got 'changes'.")
+            raise InvalidArgumentError(f"Expected --than previous, first, N or an address for {op!r}, got 'changes'.")
         return Filter(op, None, "previous" if than is None else than)
     if op == "changed-by":
         if value is None:
             raise InvalidArgumentError("Expected a number after 'changed-by' (the difference, e.g. -1), got none.")
         if than == "changes":
-            raise InvalidArgumentError("Expected --than previous, first or an address for 'changed-by', got 'changes'.")
+            raise InvalidArgumentError(
+                "Expected --than previous, first, N or an address for 'changed-by', got 'changes'."
+            )
         return Filter(op, value, "previous" if than is None else than)
     if value is None:
         if than == "changes":

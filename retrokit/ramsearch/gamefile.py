@@ -7,21 +7,28 @@ written in the style of its neighbours (flow mapping, column of the values,
 hex addresses) and inserted after the last field, or in place of the field it
 replaces. Every other byte stays as it was. The result is parsed again and
 checked to hold exactly the old data plus the new field before it is written,
-through a temporary file renamed into place.
+through a temporary file renamed into place. A game.yaml that is a symlink is
+written through to the file it names, so the link stays and its target is
+the file updated.
 """
 
 from __future__ import annotations
 
 import io
+import json
 import os
 import re
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from retrokit.errors import DataFileError, FileConflictError, InvalidArgumentError
-from retrokit.paths import atomic_write
+from retrokit.errors import DataFileError, FileConflictError, FileSystemError, InvalidArgumentError, shown
+from retrokit.host.typecodes import FieldType
+from retrokit.paths import atomic_write, require_regular_file
 
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+MAX_NAME = 64  # a field name is a scenario's variable: longer is a mistake (and YAML keys stop at 1024)
+MAX_FILE = 16 << 20  # a game.yaml of a few thousand fields takes a few hundred KiB
 _FLOW_VALUE = re.compile(r"^(\s*)([^:#]+?):(\s*)(\{[^}]*\})(.*)$")
 
 
@@ -59,13 +66,58 @@ def _plain(node: Any) -> Any:
     return str(node)
 
 
-def field_line(indent: str, name: str, address: str, type_code: str, pad_to: int = 0) -> str:
+def check_field_name(name: object) -> str:
+    """Return ``name`` if it can be a field's name (a scenario's variable); raise otherwise.
+
+    Raises:
+        InvalidArgumentError: ``name`` is not letters, digits and underscores, starts with a digit, or is too long.
+    """
+    if not isinstance(name, str) or not _NAME.match(name) or len(name) > MAX_NAME:
+        raise InvalidArgumentError(
+            f"Expected a field name of at most {MAX_NAME} letters, digits and underscores, not starting with a "
+            f"digit; got {shown(name)}. Scenarios use field names as variables."
+        )
+    return name
+
+
+def check_range(value_range: object, ftype: FieldType) -> tuple[int, int]:
+    """Return ``value_range`` as ``(lo, hi)`` if it is two whole numbers ``lo <= hi`` that ``ftype`` can hold.
+
+    Raises:
+        InvalidArgumentError: It is not.
+    """
+    low, high = ftype.value_range()
+    ok = (
+        isinstance(value_range, (tuple, list))
+        and len(value_range) == 2
+        and all(isinstance(v, int) and not isinstance(v, bool) for v in value_range)
+    )
+    if not ok or not low <= value_range[0] <= value_range[1] <= high:
+        raise InvalidArgumentError(
+            f"Expected a range LO HI of whole numbers with {low} <= LO <= HI <= {high} (what {ftype.code} holds); "
+            f"got {shown(value_range)}."
+        )
+    return int(value_range[0]), int(value_range[1])
+
+
+def field_line(
+    indent: str, name: str, address: str, type_code: str, pad_to: int = 0, value_range: tuple[int, int] | None = None
+) -> str:
     """One field as a flow-mapping line, its value starting at column ``pad_to`` if the name leaves room."""
     key = f"{indent}{name}:"
-    return f'{key.ljust(max(pad_to, len(key) + 1))}{{address: {address}, type: "{type_code}"}}'
+    extra = "" if value_range is None else f", range: [{value_range[0]}, {value_range[1]}]"
+    return f'{key.ljust(max(pad_to, len(key) + 1))}{{address: {address}, type: "{type_code}"{extra}}}'
 
 
-def add_field(path: str | os.PathLike[str], name: str, address: str, type_code: str, *, force: bool = False) -> bool:
+def add_field(
+    path: str | os.PathLike[str],
+    name: str,
+    address: str,
+    type_code: str,
+    *,
+    force: bool = False,
+    value_range: tuple[int, int] | None = None,
+) -> bool:
     """Write a field ``name: {address: ..., type: "..."}`` into a game.yaml.
 
     Args:
@@ -74,6 +126,7 @@ def add_field(path: str | os.PathLike[str], name: str, address: str, type_code: 
         address: The console address as it is to be written, e.g. ``"0xFF002B"``.
         type_code: The type code, e.g. ``"|u1"``.
         force: Replace a field of the same name.
+        value_range: The values the field may hold, ``(lo, hi)``, written as ``range: [lo, hi]``.
 
     Returns:
         Whether a field of that name was replaced.
@@ -83,18 +136,8 @@ def add_field(path: str | os.PathLike[str], name: str, address: str, type_code: 
         FileConflictError: The file has a field of that name and ``force`` is false.
         DataFileError: The file is missing, is not YAML, or its ``fields`` is not a mapping.
     """
-    path = Path(path)
-    if not _NAME.match(name):
-        raise InvalidArgumentError(
-            f"Expected a field name of letters, digits and underscores not starting with a digit, got {name!r}. "
-            "Scenarios use field names as variables."
-        )
-    try:
-        text = path.read_bytes().decode("utf-8")  # as it is: read_text would turn \r\n into \n
-    except UnicodeDecodeError as exc:
-        raise DataFileError(f"{path}: expected a UTF-8 text file; found {exc.reason} at byte {exc.start}.") from None
-    except OSError as exc:
-        raise DataFileError(f"Expected a game.yaml at {str(path)!r}; found an error: {exc.strerror or exc}.") from None
+    check_field_name(name)
+    path, text = _read(path)
     doc = _load(text, path)
     if doc is None:
         doc, text = {}, ""
@@ -114,19 +157,148 @@ def add_field(path: str | os.PathLike[str], name: str, address: str, type_code: 
             f"Expected no field {name!r} in {path}; found one ({line}). "
             "Choose another name, or pass --force (force=True) to replace it."
         )
-    new_text = _insert(text, doc, fields, name, address, type_code)
-    _check(path, text, new_text, name, address, type_code)
+    entry = _Entry(name, address, type_code, value_range)
+    new_text = _insert(text, doc, fields, entry)
+    _check(path, text, new_text, entry)
     atomic_write(path, new_text.encode("utf-8"), overwrite=True)
     return replaced
 
 
-def _insert(text: str, doc: Any, fields: Any, name: str, address: str, type_code: str) -> str:
+@dataclass(frozen=True)
+class _Entry:
+    """The field being written."""
+
+    name: str
+    address: str
+    type_code: str
+    value_range: tuple[int, int] | None = None
+
+    def line(self, indent: str, pad_to: int = 0) -> str:
+        return field_line(indent, self.name, self.address, self.type_code, pad_to, self.value_range)
+
+    def data(self) -> dict[str, Any]:
+        """The field as the file's data holds it."""
+        out: dict[str, Any] = {"address": int(self.address, 0), "type": self.type_code}
+        if self.value_range is not None:
+            out["range"] = list(self.value_range)
+        return out
+
+
+def _read(path: str | os.PathLike[str]) -> tuple[Path, str]:
+    """The game.yaml a path names (a symlink's target, written through it) and its text.
+
+    Raises:
+        DataFileError: It is missing, not a regular file, too big, or not UTF-8.
+    """
+    path = Path(path)
+    try:
+        # Written through a symlink to its target: replacing the link with a copy would leave the real file as it was.
+        path = require_regular_file(path, "a game.yaml").resolve()
+        if path.stat().st_size > MAX_FILE:
+            raise DataFileError(f"{path}: expected a game.yaml of at most {MAX_FILE >> 20} MiB; found a bigger file.")
+        return path, path.read_bytes().decode("utf-8")  # as it is: read_text would turn \r\n into \n
+    except FileSystemError as exc:
+        raise DataFileError(str(exc)) from None
+    except UnicodeDecodeError as exc:
+        raise DataFileError(f"{path}: expected a UTF-8 text file; found {exc.reason} at byte {exc.start}.") from None
+    except OSError as exc:
+        raise DataFileError(f"Expected a game.yaml at {str(path)!r}; found an error: {exc.strerror or exc}.") from None
+
+
+_PLAIN_NAME = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
+
+
+def set_default_state(path: str | os.PathLike[str], name: str) -> None:
+    """Write ``states: default: NAME`` into a game.yaml, keeping every other byte as it was.
+
+    Raises:
+        DataFileError: The file is missing or not YAML, its ``states`` is not a mapping, or its
+            layout defeats a one-line edit.
+    """
+    path, text = _read(path)
+    doc = _load(text, path)
+    if doc is None:
+        doc, text = {}, ""
+    if not isinstance(doc, dict):
+        raise DataFileError(
+            f"{path}: expected a mapping at the top of the file; found {type(doc).__name__}. Fix the file first."
+        )
+    states = doc.get("states")
+    if states is not None and not isinstance(states, dict):
+        raise DataFileError(
+            f"{path}: expected 'states' to be a mapping; found {type(states).__name__}. Fix the file first."
+        )
+    value = _scalar(name)
+    lines = text.splitlines(keepends=True)
+    nl = "\r\n" if lines and lines[0].endswith("\r\n") else "\n"
+    if lines and not lines[-1].endswith("\n"):
+        lines[-1] += nl
+    wanted = dict(_plain(states) or {})
+    wanted["default"] = name
+    if isinstance(wanted.get("by_players"), list) and wanted["by_players"]:
+        wanted["by_players"][0] = name  # the 1-player default comes before `default`: it names the new state too
+    if "states" not in doc:
+        lines.append(f"states:{nl}  default: {value}{nl}")
+    elif not states or states.fa.flow_style():
+        line = doc.lc.key("states")[0]
+        if _entry_end(lines, line, 0) != line:
+            raise DataFileError(
+                f"{path}: expected 'states' on one line; found it spread over several. Fix the file first."
+            )
+        inner = ", ".join(f"{k}: {_flow(v)}" for k, v in wanted.items())
+        lines[line] = f"states: {{{inner}}}{_trailing_comment_of(lines[line])}{nl}"
+    else:  # a block mapping: edit its lines in place (by_players first: inserting `default` moves the lines after it)
+        for key in ("by_players", "default"):
+            if key not in states:
+                continue
+            line, column = states.lc.key(key)
+            if _entry_end(lines, line, column) != line:
+                raise DataFileError(f"{path}: expected 'states: {key}:' on one line; found it spread over several.")
+            lines[line] = f"{' ' * column}{key}: {_flow(wanted[key])}{_trailing_comment_of(lines[line])}{nl}"
+        if "default" not in states:
+            line, column = states.lc.key(next(iter(states)))
+            lines.insert(line, f"{' ' * column}default: {value}{nl}")
+    new_text = "".join(lines)
+    expected = _plain(_load(text, path)) or {}
+    expected["states"] = wanted
+    _verify(path, new_text, expected, f"states: default: {value}")
+    atomic_write(path, new_text.encode("utf-8"), overwrite=True)
+
+
+def _scalar(name: str) -> str:
+    """A state name as a YAML scalar: plain when it can be, else double-quoted (JSON strings are YAML's)."""
+    return name if _PLAIN_NAME.match(name) else json.dumps(name)
+
+
+def _flow(value: Any) -> str:
+    """A plain value (a name, or a list of them) in YAML flow style."""
+    if isinstance(value, list):
+        return "[" + ", ".join(_flow(v) for v in value) + "]"
+    return _scalar(value) if isinstance(value, str) else json.dumps(value)
+
+
+def _trailing_comment_of(line: str) -> str:
+    """A line's trailing ``# comment`` (with the spaces before it), if it has one outside quotes."""
+    body = line.rstrip("\r\n")
+    match = re.search(r"\s+#[^'\"]*$", body)
+    return match.group() if match else ""
+
+
+def _verify(path: Path, new_text: str, expected: Any, line: str) -> None:
+    if _plain(_load(new_text, path)) != expected:
+        raise DataFileError(
+            f"{path}: expected to edit one line; the file's layout defeated it (the edit would change other "
+            f"data). Add the line by hand: {line}"
+        )
+
+
+def _insert(text: str, doc: Any, fields: Any, new: _Entry) -> str:
     lines = text.splitlines(keepends=True)
     nl = "\r\n" if lines and lines[0].endswith("\r\n") else "\n"  # the file's own line ends
     if lines and not lines[-1].endswith("\n"):
         lines[-1] += nl
     if not fields:  # no fields yet: a new block at the end, or in place of an empty 'fields:'
-        entry = field_line("  ", name, address, type_code) + nl
+        entry = new.line("  ") + nl
         if "fields" in doc:
             line = doc.lc.key("fields")[0]
             comment = lines[line].partition("#")[2]
@@ -136,15 +308,15 @@ def _insert(text: str, doc: Any, fields: Any, name: str, address: str, type_code
             lines.append("fields:" + nl + entry)
         return "".join(lines)
     if getattr(fields, "fa", None) is not None and fields.fa.flow_style():
-        return _dump_round_trip(doc, fields, name, address, type_code)
+        return _dump_round_trip(doc, fields, new)
     names = list(fields)
     column = fields.lc.key(names[-1])[1]
     indent = " " * column
     columns = [c for c in (_value_column(lines[fields.lc.key(k)[0]]) for k in names) if c]
     pad = max(set(columns), key=columns.count) if columns else 0  # the column most values start at
-    entry = field_line(indent, name, address, type_code, pad)
-    if name in fields:
-        first = fields.lc.key(name)[0]
+    entry = new.line(indent, pad)
+    if new.name in fields:
+        first = fields.lc.key(new.name)[0]
         last = _entry_end(lines, first, column)
         comment = _trailing_comment(lines[first]) if first == last else ""
         lines[first : last + 1] = [entry + comment + nl]
@@ -179,32 +351,30 @@ def _entry_end(lines: list[str], first: int, column: int) -> int:
     return last
 
 
-def _dump_round_trip(doc: Any, fields: Any, name: str, address: str, type_code: str) -> str:
+def _dump_round_trip(doc: Any, fields: Any, new: _Entry) -> str:
     """A file whose fields are one flow mapping: let ruamel.yaml write it (comments kept, alignment not)."""
-    from ruamel.yaml.comments import CommentedMap
+    from ruamel.yaml.comments import CommentedMap, CommentedSeq
     from ruamel.yaml.scalarint import HexCapsInt
     from ruamel.yaml.scalarstring import DoubleQuotedScalarString
 
+    address = new.address
     value = HexCapsInt(int(address, 0), width=len(address) - 2) if address.lower().startswith("0x") else int(address)
-    entry = CommentedMap(address=value, type=DoubleQuotedScalarString(type_code))
+    entry = CommentedMap(address=value, type=DoubleQuotedScalarString(new.type_code))
+    if new.value_range is not None:
+        entry["range"] = CommentedSeq(new.value_range)
+        entry["range"].fa.set_flow_style()
     entry.fa.set_flow_style()
-    fields[name] = entry
+    fields[new.name] = entry
     out = io.StringIO()
     _yaml().dump(doc, out)
     return out.getvalue()
 
 
-def _check(path: Path, old_text: str, new_text: str, name: str, address: str, type_code: str) -> None:
+def _check(path: Path, old_text: str, new_text: str, new: _Entry) -> None:
     """Parse the edited text and check it holds the old data plus (or with) the new field, nothing else."""
     expected = _plain(_load(old_text, path)) or {}
     expected.setdefault("fields", {})
     if expected["fields"] is None:
         expected["fields"] = {}
-    expected["fields"][name] = {"address": int(address, 0), "type": type_code}
-    found = _plain(_load(new_text, path))
-    if found != expected:
-        raise DataFileError(
-            f"{path}: expected to add field {name!r} by inserting one line; the file's layout defeated it "
-            "(the edit would change other data). Add the line by hand: "
-            + field_line("  ", name, address, type_code).strip()
-        )
+    expected["fields"][new.name] = new.data()
+    _verify(path, new_text, expected, new.line("").strip())

@@ -8,6 +8,12 @@ division exact. retrokit adds the stored-multiplied cases the other way round
 (3 shown, ``0x30`` stored is ``/16``), for integers shifted by a nibble: a
 shift by a whole byte, or a BCD digit, is already another type read at a
 nearby address.
+
+A candidate keeps every scale that is still consistent with the value searches
+so far, as a bit mask over :data:`SCALES` (bit ``i`` for ``SCALES[i]``): at
+``equal 1`` a stored 2 is both "shown + 1" and "shown x 2", and only the next
+value search tells them apart. :data:`UNPINNED` (no bit) is a candidate no
+value search has matched yet, read as the value itself.
 """
 
 from __future__ import annotations
@@ -65,9 +71,26 @@ SCALES: tuple[Scale, ...] = (
     Scale("/16", div=16, kinds=(UNSIGNED, SIGNED)),
 )
 
-UNPINNED = -1  # a candidate no value search has matched yet: read as the value itself
+UNPINNED = 0  # a candidate no value search has matched yet (no scale bit): read as the value itself
+MASK_DTYPE = np.dtype(np.uint32)  # one bit per scale
+ALL_SCALES = (1 << len(SCALES)) - 1
+_LABELS_SHOWN = 3
 
 
-def scale_label(index: int) -> str:
-    """The label of a scale index (``""`` for unpinned or the value itself)."""
-    return "" if index <= 0 else SCALES[index].label
+def bits(mask: int) -> list[int]:
+    """The scale indices whose bit is set in ``mask``, in :data:`SCALES` order."""
+    return [index for index in range(len(SCALES)) if mask >> index & 1]
+
+
+def scale_labels(mask: int) -> tuple[str, ...]:
+    """The labels of the scales in ``mask`` (``""`` for the value itself); none when unpinned."""
+    return tuple(SCALES[index].label for index in bits(mask))
+
+
+def scale_label(mask: int) -> str:
+    """How ``show`` writes a candidate's scales: ``""`` for the value itself (or unpinned), else e.g. ``"-1,/2"``."""
+    labels = [label or "=" for label in scale_labels(mask)]
+    if labels in ([], ["="]):
+        return ""
+    more = len(labels) - _LABELS_SHOWN
+    return ",".join(labels[:_LABELS_SHOWN]) + (f",+{more} more" if more > 0 else "")

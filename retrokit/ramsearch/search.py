@@ -1,9 +1,11 @@
 """``RamSearch``: a RAM search on a running game, in the spirit of BizHawk's and Gym Retro's.
 
 Start from a save state, move the game between snapshots (hold buttons for
-some frames, play a ``.bk2`` movie, poke a value), narrow the candidates with
-filters, look at them, and write the one you found into the game's
-``game.yaml``::
+some frames, play a script of taps, holds and waits or a ``.bk2`` movie, poke
+a value), narrow the candidates with filters, look at them, and write the one
+you found into the game's ``game.yaml``. The inputs played since the last
+state loaded are kept, so the search can be saved as a movie from that state,
+and the state it reached as a state of the game::
 
     from retrokit.ramsearch import RamSearch
 
@@ -15,6 +17,7 @@ filters, look at them, and write the one you found into the game's
         print(candidate.address, candidate.type, candidate.values)
     search.save_field("lives", 0xFF002B, "|u1", game_file="my-games/Dasher-Genesis/game.yaml")
     search.save("dasher.session")              # resume with RamSearch.load
+    search.write_movie("to-the-pit.bk2")       # the inputs played, from Zone1.Act1
 """
 
 from __future__ import annotations
@@ -23,25 +26,34 @@ import io
 import os
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Self
+from typing import TYPE_CHECKING, Self
 
 import numpy as np
 
 from retrokit import paths
 from retrokit.data import statecheck
 from retrokit.data.games import Game, find_game
+from retrokit.data.names import check_state_name
 from retrokit.data.roms import rom_sha1
 from retrokit.data.states import StateRecord
-from retrokit.errors import DataFileError, InvalidArgumentError, MovieError, SessionError, StateError
+from retrokit.errors import DataFileError, FileConflictError, InvalidArgumentError, MovieError, SessionError, StateError
 from retrokit.host.emulator import Emulator
 from retrokit.host.typecodes import parse_type
 from retrokit.paths import atomic_write, wheel_dir
 from retrokit.ramsearch import gamefile
-from retrokit.ramsearch.candidates import Candidate, list_candidates
-from retrokit.ramsearch.engine import Engine
+from retrokit.ramsearch.candidates import Candidate
+from retrokit.ramsearch.engine import Engine, list_candidates
 from retrokit.ramsearch.ram import RamLayout
+from retrokit.ramsearch.script import MAX_FRAMES, parse_script
 from retrokit.ramsearch.session import SessionData, read_session, write_session
 from retrokit.ramsearch.types import parse_search_types
+
+if TYPE_CHECKING:
+    from retrokit.data.integrate import Outcome
+    from retrokit.movie import Movie
+
+
+_LABEL_SCRIPT = 80  # a snapshot's label shows this much of a script
 
 
 class RamSearch:
@@ -62,6 +74,7 @@ class RamSearch:
         except BaseException:
             self.close()
             raise
+        self._restart()
         self.snapshot(f"new {self.state or 'power-on'}")
 
     def _open(self, game: Game, types: Sequence[str] | None) -> None:
@@ -74,6 +87,24 @@ class RamSearch:
         self.layout = RamLayout.of(self.emulator.space)
         self.engine = Engine(self.layout, parse_search_types(types))
         self.labels: list[str] = []
+        self.start_state = b""  # the state the inputs played begin at (b"": power-on)
+        self.inputs: list[tuple[int, tuple[int, ...]]] = []  # runs: (frames, a mask per port)
+        self.unreplayable: str | None = None  # why those inputs no longer lead to the state now
+
+    def _restart(self) -> None:
+        """Begin the inputs played afresh from the emulator's state now (a state was loaded)."""
+        self.start_state = self.emulator.get_state()
+        self.inputs, self.unreplayable = [], None
+
+    def _played(self, masks: Sequence[int], frames: int) -> None:
+        """Record ``frames`` frames holding ``masks`` (one per port)."""
+        masks = tuple(int(m) for m in masks) + (0,) * (self.emulator.ports - len(masks))
+        if not frames:
+            return
+        if self.inputs and self.inputs[-1][1] == masks and self.inputs[-1][0] + frames <= MAX_FRAMES:
+            self.inputs[-1] = (self.inputs[-1][0] + frames, masks)
+        else:
+            self.inputs.append((frames, masks))
 
     # --- sessions ------------------------------------------------------------------------------
 
@@ -117,6 +148,11 @@ class RamSearch:
             self.engine.add_snapshot(row)
         self.engine.candidates, self.engine.history, self.engine.redo_stack = data.candidates, data.history, data.redo
         self.labels, self.state = list(data.labels), data.state
+        ports = self.emulator.ports
+        if data.inputs.shape[1] != ports + 1:
+            raise SessionError(f"{path}: expected inputs of {ports} ports; found {data.inputs.shape[1] - 1}.")
+        self.start_state, self.unreplayable = data.start_state, data.unreplayable
+        self.inputs = [(int(row[0]), tuple(int(m) for m in row[1:])) for row in data.inputs]
         try:
             # The record may refuse it (another ROM), never vouch for it: unless this machine
             # wrote or probed the state, it is first run in a child process.
@@ -153,6 +189,11 @@ class RamSearch:
             candidates=self.engine.candidates,
             history=list(self.engine.history),
             redo=list(self.engine.redo_stack),
+            start_state=self.start_state,
+            inputs=np.array([(frames, *masks) for frames, masks in self.inputs], dtype=np.uint32).reshape(
+                -1, self.emulator.ports + 1
+            ),
+            unreplayable=self.unreplayable,
         )
 
     def close(self) -> None:
@@ -176,6 +217,7 @@ class RamSearch:
         """Put the game in one of its save states (no snapshot is taken)."""
         self.emulator.set_state(statecheck.load_state(self.game, self.game.state_path(name)))
         self.emulator.forget_action()
+        self._restart()
 
     def snapshot(self, label: str = "snapshot") -> int:
         """Take a snapshot of the RAM now; return its index."""
@@ -202,20 +244,47 @@ class RamSearch:
 
     def step(self, press: Sequence[str] = (), frames: int = 1) -> None:
         """Hold buttons for some frames, without a snapshot (to script play between snapshots)."""
-        if not isinstance(frames, int) or frames < 0:
-            raise InvalidArgumentError(f"Expected a number of frames of 0 or more, got {frames!r}.")
-        self.emulator.run(self.buttons(press), frames)
+        if not isinstance(frames, int) or isinstance(frames, bool) or not 0 <= frames <= MAX_FRAMES:
+            raise InvalidArgumentError(f"Expected a number of frames from 0 to {MAX_FRAMES:,}, got {frames!r}.")
+        masks = self.buttons(press)
+        self.emulator.run(masks, frames)
+        self._played(masks, frames)
 
-    def run(self, press: Sequence[str] = (), frames: int = 1, *, state: str | None = None) -> int:
-        """Hold buttons for some frames (from a state, if given), then take a snapshot; return its index."""
+    def run(
+        self, press: Sequence[str] = (), frames: int = 1, *, state: str | None = None, snapshot: bool = True
+    ) -> int | None:
+        """Hold buttons for some frames (from a state, if given), then take a snapshot; return its index.
+
+        With ``snapshot=False`` the game moves on and no snapshot is taken (``None`` is returned).
+        """
         self.buttons(press)  # unknown buttons fail before the state is loaded
         if state is not None:
             self.load_state(state)
         self.step(press, frames)
         held = " ".join(press) if press else "nothing"
-        return self.snapshot(f"{'state ' + state + ', ' if state else ''}{held} for {frames} frames")
+        return self._snap(f"{'state ' + state + ', ' if state else ''}{held} for {frames} frames", snapshot)
 
-    def play(self, movie: str | os.PathLike[str], until: int | None = None) -> int:
+    def run_script(self, script: str, *, state: str | None = None, snapshot: bool = True) -> int | None:
+        """Play an input script (taps, holds and waits: see :mod:`retrokit.ramsearch.script`), then take a snapshot.
+
+        Raises:
+            InvalidArgumentError: The script is malformed or names an unknown button (all of it is checked first).
+        """
+        steps = parse_script(script, self.buttons)
+        if state is not None:
+            self.load_state(state)
+        for step in steps:
+            self.step(step.buttons, step.frames)
+        text = " ".join(step.describe() for step in steps)
+        frames = sum(step.frames for step in steps)
+        text = text if len(text) <= _LABEL_SCRIPT else text[: _LABEL_SCRIPT - 3] + "..."
+        label = f"{'state ' + state + ', ' if state else ''}script {text} ({frames} frames)"
+        return self._snap(label, snapshot)
+
+    def _snap(self, label: str, snapshot: bool) -> int | None:
+        return self.snapshot(label) if snapshot else None
+
+    def play(self, movie: str | os.PathLike[str], until: int | None = None, *, snapshot: bool = True) -> int | None:
         """Play a ``.bk2`` movie from its start up to frame ``until`` (all of it by default), then take a snapshot.
 
         Raises:
@@ -240,7 +309,11 @@ class RamSearch:
             )
         for _ in replay(recorded, self.emulator, source=str(movie), stop=end):  # its start state checked there
             pass
-        return self.snapshot(f"movie {Path(movie).name} to frame {end}")
+        # The inputs played now begin at the movie's start (b"": power-on), whatever replayed it.
+        self.start_state, self.inputs, self.unreplayable = recorded.state or b"", [], None
+        for frame in recorded.frames[:end]:
+            self._played(frame, 1)
+        return self._snap(f"movie {Path(movie).name} to frame {end}", snapshot)
 
     def poke(self, address: int, value: int, type_code: str = "|u1") -> None:
         """Write a value into RAM (the next snapshot sees it).
@@ -254,6 +327,7 @@ class RamSearch:
         if not isinstance(value, int) or isinstance(value, bool):
             raise InvalidArgumentError(f"Expected a whole number to poke, got {value!r}.")
         self.emulator.poke(address, value, type_code)
+        self.unreplayable = f"poke {self.layout.format(address)} {value}"
 
     def screen(self) -> np.ndarray:
         """The screen of the next frame from here, emulated on a scratch run, so pokes show on it."""
@@ -305,6 +379,88 @@ class RamSearch:
         """The candidates by address (then simplest type first), at most ``limit`` of them."""
         return list_candidates(self.engine, limit)
 
+    # --- saving the game's state and the inputs played ------------------------------------------------
+
+    def movie(self) -> Movie:
+        """The inputs played since the last state loaded (or the start), as a movie from that state.
+
+        Raises:
+            MovieError: A poke changed RAM since that state, which no input can reproduce.
+        """
+        from retrokit.movie import Movie
+
+        if self.unreplayable is not None:
+            raise MovieError(
+                f"Expected inputs that lead to the game's state now; the session changed RAM by hand since its "
+                f"start state ({self.unreplayable}), which a movie cannot reproduce. Start from a state again "
+                "(ramsearch run --state NAME), play without poking, then write the movie."
+            )
+        total = sum(count for count, _ in self.inputs)
+        if total > MAX_FRAMES:
+            raise MovieError(
+                f"Expected at most {MAX_FRAMES:,} frames for a movie; the session played {total:,} since its start "
+                "state. Save a state on the way (ramsearch savestate) and start from it."
+            )
+        used = [port for _, masks in self.inputs for port, mask in enumerate(masks, 1) if mask]
+        players = max([self.game.players, *used])
+        frames = [masks[:players] for count, masks in self.inputs for _ in range(count)]
+        return Movie(self.game.name, self.game.system.name, players, self.start_state or None, frames)
+
+    def write_movie(self, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
+        """Write :meth:`movie` as a stable-retro ``.bk2`` (for ``retrokit integrate --movie`` and ``validate``).
+
+        Raises:
+            MovieError: A poke changed RAM since the start state.
+            FileConflictError: A different file is at ``path`` and ``overwrite`` is false.
+        """
+        from retrokit.movie import write_bk2
+
+        write_bk2(path, self.movie(), overwrite=overwrite)
+        return Path(path)
+
+    def save_state(self, name: str, *, default: bool = False, force: bool = False) -> Outcome:
+        """Save the emulator's state now as state ``name`` of the game, where ``retrokit integrate`` writes.
+
+        It goes to ``<data>/games/<Game>/NAME.state`` (with its record), or next to a game.yaml of
+        the user's own outside every games folder. With ``default``, ``states: default: NAME`` is
+        written into that folder's game.yaml, so ``make(game)`` starts from it; a game whose
+        game.yaml is elsewhere gets a copy of it there first (which then overrides it).
+
+        Returns:
+            What was done: ``"made"``, ``"up to date"`` or ``"replaced"`` (see :func:`~retrokit.data.integrate.place_state`).
+
+        Raises:
+            InvalidArgumentError: ``name`` is not a valid state name.
+            FileConflictError: A different state of that name exists and ``force`` is false.
+            DataFileError: ``default`` and the game's data file is not a game.yaml.
+        """
+        from retrokit.data.integrate import place_state, target_folder
+
+        check_state_name(name)
+        folder = target_folder(self.game)
+        game_file = folder / "game.yaml"
+        if default and not game_file.exists():
+            self._check_own_game_yaml()
+        outcome = place_state(self.game, name, self.emulator.get_state(), folder, force=force)
+        if outcome.status in ("differs", "damaged"):
+            kind = "a different state" if outcome.status == "differs" else "a file the core cannot load"
+            raise FileConflictError(
+                f"Expected no state {name!r} of {self.game.name} or the same one; found {kind} at {outcome.path}. "
+                "Pass --force (force=True) to replace it, or choose another name."
+            )
+        if default:
+            if not game_file.exists():
+                atomic_write(game_file, self.game.info.source.read_bytes())
+            gamefile.set_default_state(game_file, name)
+        return outcome
+
+    def _check_own_game_yaml(self) -> None:
+        if self.game.info.source.name != "game.yaml":
+            raise DataFileError(
+                f"Expected {self.game.name} to have a game.yaml to write its default state into; its data file is "
+                f"{self.game.info.source}, in Gym Retro's format. Pass the state by name instead: make(game, state=NAME)."
+            )
+
     # --- saving a find --------------------------------------------------------------------------
 
     def default_game_file(self) -> Path:
@@ -331,27 +487,40 @@ class RamSearch:
         *,
         game_file: str | os.PathLike[str] | None = None,
         force: bool = False,
+        value_range: tuple[int, int] | None = None,
     ) -> Path:
         """Write a field into a game.yaml, keeping its comments and layout; return the file.
 
+        Args:
+            name: The field's name.
+            address: Its console address.
+            type_code: Its type code.
+            game_file: The game.yaml to write (by default :meth:`default_game_file`).
+            force: Replace a field of the same name.
+            value_range: The values it may hold, ``(lo, hi)``, written as ``range: [lo, hi]``.
+
         Raises:
             FieldTypeError: The type code is unknown.
-            InvalidArgumentError: The address is outside RAM, or the name is not a valid field name.
+            InvalidArgumentError: The address is outside RAM, the name is not a valid field name, or
+                the range is not two whole numbers ``lo <= hi`` the type can hold.
             SessionError: ``game_file`` is the data file of another game.
             FileConflictError: The file has a field of that name and ``force`` is false.
         """
+        gamefile.check_field_name(name)  # first: a bad name is the name's fault, not the file's
         ftype = parse_type(type_code)
         self.layout.position(address, ftype.width)
+        if value_range is not None:
+            value_range = gamefile.check_range(value_range, ftype)
         path = Path(game_file) if game_file is not None else self.default_game_file()
         if game_file is not None:
             self._check_game_file(path)
-        gamefile.add_field(path, name, self.layout.format(address), ftype.code, force=force)
+        gamefile.add_field(path, name, self.layout.format(address), ftype.code, force=force, value_range=value_range)
         return path
 
     def _check_game_file(self, path: Path) -> None:
         from retrokit.data.gamefiles import read_game_yaml
 
-        if not path.is_file():
+        if not path.is_file():  # a FIFO or a device is not one either
             raise DataFileError(
                 f"Expected a game.yaml at {path}; found no file. Give the path of an existing game.yaml."
             )

@@ -32,9 +32,9 @@ def run(args: argparse.Namespace) -> int:
     from retrokit.data.games import list_games, normalize_name
     from retrokit.errors import GameNotFoundError, RetrokitError, did_you_mean
 
-    games = list_games(args.pattern)
-    exact = [g for g in games if args.pattern is not None and g.name == normalize_name(args.pattern)]
-    games = exact or games  # a game's full name shows that game, not every name that contains it
+    # A game's full name (or its -v0 name) shows that game, not every name that contains it.
+    exact = [g for g in list_games() if args.pattern is not None and g.name == normalize_name(args.pattern)]
+    games = exact or list_games(args.pattern)
     if not games:
         names = [g.name for g in list_games()]
         raise GameNotFoundError(

@@ -256,7 +256,7 @@ def check_states(game: Game, report: GameReport, rom: Path | None) -> dict[str, 
                        "Replace the file with one made for this game (retrokit integrate, or retrokit play).",
                        state=name)
             continue
-        if name in recipes and probe.start:
+        if name in recipes and probe.start and _expected_values(recipes[name]):
             mismatch = _recipe_mismatch(recipes[name], probe.start)
             if mismatch:
                 report.add("state is the game's", FAIL,
@@ -267,7 +267,7 @@ def check_states(game: Game, report: GameReport, rom: Path | None) -> dict[str, 
                 continue
             report.add("state is the game's", PASS, f"reaches its recipe's {_recipe_text(recipes[name])}", state=name)
         else:
-            report.add("state is the game's", PASS, "not a copy of another game's state (no recipe to compare with)",
+            report.add("state is the game's", PASS, "not a copy of another game's state (no recipe values to compare with)",
                        state=name)
         if not check_ranges(game, report, probe, name):
             continue

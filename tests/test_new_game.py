@@ -107,7 +107,13 @@ def test_a_known_rom_or_a_file_that_is_no_rom_is_refused(data, tmp_path, capsys)
     empty.write_bytes(b"")
     fifo = tmp_path / "pipe.md"
     os.mkfifo(fifo)
+    zero = tmp_path / "zero.md"
+    zero.symlink_to("/dev/zero")
+    huge = tmp_path / "huge.md"
+    with open(huge, "wb") as f:  # sparse: 40 MiB on paper, nothing on disk
+        f.truncate(40 * 2**20)
     for path, message in [(notes, "found neither"), (empty, "found an empty file"), (fifo, "found a FIFO"),
+                          (zero, "found a device"), (huge, "at most 32 MiB"),
                           (tmp_path / "missing.md", "No such file"), (tmp_path, "found a folder")]:
         status, _, err = cli(capsys, "new", str(path), "--name", "Junk-Genesis")
         assert status == 2 and message in err, err

@@ -41,6 +41,15 @@ def shown(value: object, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
+DISTRIBUTION = "retrokit-rl"
+"""retrokit's name on the package index ("retrokit" there is another project); the import name stays ``retrokit``."""
+
+
+def install_extra(extra: str) -> str:
+    """Return the command that installs one of retrokit's optional extras: ``pip install 'retrokit-rl[plot]'``."""
+    return f"pip install '{DISTRIBUTION}[{extra}]'"
+
+
 class RetrokitError(Exception):
     """The root of every error retrokit raises on purpose."""
 

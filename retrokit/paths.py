@@ -32,7 +32,7 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import BinaryIO
 
-from retrokit.errors import FileSystemError
+from retrokit.errors import FileConflictError, FileSystemError, UnknownNameError, did_you_mean, shown
 
 GAMES_ENV = "RETROKIT_GAMES"
 DATA_ENV = "RETROKIT_DATA"
@@ -85,6 +85,41 @@ def repo_games_dir() -> Path | None:
         if path.is_dir():
             return path
     return None
+
+
+BUNDLED_DOCS = "_docs"
+"""The package folder an installed retrokit keeps ``docs/*.md`` in (``setup.py`` copies them there)."""
+
+
+def docs_dir() -> Path | None:
+    """Return the user guides: ``docs/`` of a checkout, or the copy inside an installed package."""
+    package = Path(__file__).resolve().parent
+    for path in (package / BUNDLED_DOCS, package.parent / "docs"):
+        if path.is_dir():
+            return path
+    return None
+
+
+def doc_topics() -> list[str]:
+    """Return the names of the guides ``retrokit docs TOPIC`` prints (``integrate`` for ``docs/integrate.md``)."""
+    folder = docs_dir()
+    return sorted(path.stem for path in folder.glob("*.md")) if folder is not None else []
+
+
+def doc_path(topic: str) -> Path:
+    """Return the guide named ``topic`` (``integrate``, ``integrate.md`` or ``docs/integrate.md``).
+
+    Raises:
+        UnknownNameError: No guide has that name (with a did-you-mean), or this install has no guides.
+    """
+    topics = doc_topics()
+    name = topic.removeprefix("docs/").removesuffix(".md")
+    if name not in topics:
+        raise UnknownNameError(
+            f"Expected one of retrokit's guides ({', '.join(topics) or 'none found in this install'}); "
+            f"got {shown(topic)}. `retrokit docs` lists them." + did_you_mean(name, topics)
+        )
+    return docs_dir() / f"{name}.md"  # type: ignore[operator]
 
 
 def env_games_dirs() -> list[Path]:
@@ -149,7 +184,11 @@ def _umask() -> int:
     return umask
 
 
-def atomic_write(path: Path | str, data: bytes, *, overwrite: bool = False) -> None:
+REPLACE_HINT = "Choose another name, or ask to replace it (--force; overwrite=True from Python)."
+"""How to get past a file in the way, unless a caller knows better: every command says ``--force``."""
+
+
+def atomic_write(path: Path | str, data: bytes, *, overwrite: bool = False, hint: str = REPLACE_HINT) -> None:
     """Write ``data`` to ``path`` through a temporary file renamed into place.
 
     Readers never see a half-written file. With ``overwrite=False`` the final
@@ -160,18 +199,19 @@ def atomic_write(path: Path | str, data: bytes, *, overwrite: bool = False) -> N
         path: The destination; its parent folders are created.
         data: The bytes to write.
         overwrite: Replace ``path`` if it exists.
+        hint: How to get past a file in the way, for the error (by default :data:`REPLACE_HINT`).
 
     Raises:
-        FileExistsError: ``path`` exists and ``overwrite`` is false.
+        FileConflictError: ``path`` exists and ``overwrite`` is false (nothing is written).
         FileSystemError: The folder cannot be made or written (a file in its
             way, no permission, a read-only or full disk).
     """
-    with atomic_output(path, overwrite=overwrite) as f:
+    with atomic_output(path, overwrite=overwrite, hint=hint) as f:
         f.write(data)
 
 
 @contextlib.contextmanager
-def atomic_output(path: Path | str, *, overwrite: bool = False) -> Iterator[BinaryIO]:
+def atomic_output(path: Path | str, *, overwrite: bool = False, hint: str = REPLACE_HINT) -> Iterator[BinaryIO]:
     """Open a temporary file beside ``path`` to write into; put it in place when the block ends.
 
     Like :func:`atomic_write`, for output written piece by piece (a long GIF)
@@ -179,10 +219,14 @@ def atomic_output(path: Path | str, *, overwrite: bool = False) -> Iterator[Bina
     temporary file is deleted and ``path`` is left as it was.
 
     Raises:
-        FileExistsError: ``path`` exists and ``overwrite`` is false.
+        FileConflictError: ``path`` exists and ``overwrite`` is false: checked
+            before the block runs (so no work is wasted) and again when the file
+            is put in place.
         FileSystemError: The folder cannot be made or written.
     """
     path = Path(path)
+    if not overwrite and os.path.lexists(path):
+        raise _conflict(path, hint)
     ensure_folder(path.parent, f"to write {path.name} into")
     try:
         fd, tmp_name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
@@ -202,19 +246,23 @@ def atomic_output(path: Path | str, *, overwrite: bool = False) -> Iterator[Bina
         try:
             os.link(tmp, path)  # fails if path exists, unlike a rename
         except FileExistsError:
-            raise
+            raise _conflict(path, hint) from None
         except OSError:  # the file system has no hard links: check, then rename
-            if path.exists():
-                raise FileExistsError(path) from None
+            if os.path.lexists(path):
+                raise _conflict(path, hint) from None
             os.replace(tmp, path)
-    except FileExistsError:
-        raise
-    except FileSystemError:
+    except (FileConflictError, FileSystemError):
         raise
     except OSError as exc:  # a full disk, a file system gone read-only meanwhile
         raise _cannot(path, "written", exc) from None
     finally:
         tmp.unlink(missing_ok=True)
+
+
+def _conflict(path: Path, hint: str) -> FileConflictError:
+    """The error for a file in the way of a write that may not replace it."""
+    kind = "a folder" if path.is_dir() else "a file"
+    return FileConflictError(f"Expected no file at {str(path)!r}; found {kind} there, left as it is. {hint}")
 
 
 def _cannot(path: Path, purpose: str, exc: OSError) -> FileSystemError:

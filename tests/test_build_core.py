@@ -146,6 +146,85 @@ def test_a_version_that_does_not_exist(monkeypatch, tmp_path, capsys, pip_withou
     assert_one_line_error(status, err, "sdist) of stable-retro 0.0.7", "versions there: 1.0.1")
 
 
+# pip prepares a downloaded sdist's metadata: this in-tree build backend gives it, with nothing to install.
+METADATA_ONLY_BACKEND = {
+    "pyproject.toml": b'[build-system]\nrequires = []\nbuild-backend = "backend"\nbackend-path = ["."]\n',
+    "backend.py": b"""import os
+
+
+def prepare_metadata_for_build_wheel(metadata_directory, config_settings=None):
+    name = "stable_retro-1.0.1.dist-info"
+    os.makedirs(os.path.join(metadata_directory, name))
+    with open(os.path.join(metadata_directory, name, "METADATA"), "w") as file:
+        file.write("Metadata-Version: 2.1\\nName: stable-retro\\nVersion: 1.0.1\\n")
+    return name
+""",
+}
+
+
+@pytest.fixture
+def http_index(tmp_path: Path):
+    """Serve ``tmp_path/index`` over HTTP on this machine; yield a function that makes its stable-retro page."""
+    import functools
+    import http.server
+    import threading
+
+    root = tmp_path / "index"
+    (root / "stable-retro").mkdir(parents=True)
+    class Quiet(http.server.SimpleHTTPRequestHandler):
+        def log_message(self, *args: object) -> None:  # the command's stderr is what the test reads
+            pass
+
+    handler = functools.partial(Quiet, directory=str(root))
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    threading.Thread(target=server.serve_forever, daemon=True).start()
+
+    def serve(sdist: Path) -> str:
+        (root / "stable-retro" / sdist.name).write_bytes(sdist.read_bytes())
+        (root / "stable-retro" / "index.html").write_text(f'<a href="{sdist.name}">{sdist.name}</a>\n')
+        return f"http://127.0.0.1:{server.server_address[1]}/"
+
+    yield serve
+    server.shutdown()
+
+
+def test_the_stock_pip_downloads_the_source_with_progress(monkeypatch, tmp_path, capsys, isolated, pip_without_config,
+                                                          http_index) -> None:
+    """The whole command against an index over HTTP, with the pip this venv has (a stock venv's: 23.0 or later)."""
+    monkeypatch.setenv("PATH", f"{tools(tmp_path)}{os.pathsep}{os.environ['PATH']}")
+    padding = os.urandom(300_000)  # incompressible, so pip announces a size in kB and the download takes a while
+    sdist = fake_sdist(tmp_path, {**METADATA_ONLY_BACKEND, f"{RECIPE.folder}/{PATCHED_FILE}": original_source(),
+                                  "cores/nes/blob": padding})  # fmt: skip
+    status, out, err = run_cli(capsys, "--index-url", http_index(sdist), "--stable-retro", "1.0.1")
+    assert status == 0, err
+    assert "  download: 100%" in err and "Installed" in err
+    assert out.strip() == str(built_cores_dir(isolated) / "genesis_plus_gx_libretro.so")
+
+
+def test_pip_failing_otherwise_names_the_command_to_rerun(monkeypatch, tmp_path, capsys, pip_without_config,
+                                                          http_index) -> None:
+    monkeypatch.setenv("PATH", f"{tools(tmp_path)}{os.pathsep}{os.environ['PATH']}")
+    broken = {**METADATA_ONLY_BACKEND, "backend.py": b"raise SystemExit('this sdist is broken')\n"}
+    index = http_index(fake_sdist(tmp_path, broken))
+    status, _, err = run_cli(capsys, "--index-url", index, "--stable-retro", "1.0.1")
+    assert_one_line_error(status, err, "Expected pip to download stable-retro 1.0.1's source; it failed (exit 1)",
+                          f"-m pip download --no-deps --no-binary stable-retro stable-retro==1.0.1 --index-url {index}",
+                          "--sdist FILE")
+
+
+def test_a_python_without_pip_says_how_to_get_it(monkeypatch, tmp_path, capsys) -> None:
+    """A venv made without pip (as uv makes them): the message names ensurepip and --sdist."""
+    import subprocess
+    import sys
+
+    subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(tmp_path / "bare")], check=True)
+    bare = tmp_path / "bare" / "bin" / "python"
+    monkeypatch.setattr(build.sys, "executable", str(bare))
+    monkeypatch.setenv("PATH", f"{tools(tmp_path)}{os.pathsep}{os.environ['PATH']}")
+    status, _, err = run_cli(capsys, "--stable-retro", "1.0.1")
+    assert_one_line_error(status, err, f"Expected pip in {bare}", "-m ensurepip", "--sdist FILE")
+
+
 def test_a_patch_against_a_modified_source(monkeypatch, tmp_path, capsys) -> None:
     monkeypatch.setenv("PATH", str(tools(tmp_path)))
     source = original_source().replace(b"system_frame_gen(0);", b"system_frame_gen(frameskip);")

@@ -88,7 +88,7 @@ def test_import_conflict_exits_1(capsys, tmp_path, data_dir):
     dest.parent.mkdir(parents=True)
     dest.write_bytes(b"something else")
     status, out, _ = run(capsys, "import", str(AIRSTRIKER_DIR / "rom.md"))
-    assert status == 1 and "--overwrite" in out
+    assert status == 1 and "--force" in out
     assert dest.read_bytes() == b"something else"
 
 

@@ -27,8 +27,12 @@ def test_convert_never_replaces_a_file_unasked(tmp_path, capsys) -> None:
     out = tmp_path / "mine.yaml"
     out.write_text("# my own\n")
     assert main(["convert", str(source), str(out)]) == 2
-    assert "--overwrite" in capsys.readouterr().err and out.read_text() == "# my own\n"
-    assert main(["convert", str(source), str(out), "--overwrite"]) == 0
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "--force" in err and "--overwrite" not in err and out.read_text() == "# my own\n"
+    assert main(["convert", str(source), str(out), "--force"]) == 0
+    assert "reward" in out.read_text()
+    out.write_text("# my own\n")
+    assert main(["convert", str(source), str(out), "--overwrite"]) == 0  # the old word, kept as a hidden alias
     assert "reward" in out.read_text()
 
 

@@ -322,7 +322,7 @@ def test_without_matplotlib_the_report_says_how_to_get_plots(tmp_path, monkeypat
     monkeypatch.setattr(plots, "have_matplotlib", lambda: False)
     out = tmp_path / "run"
     assert evaluate(out, "--agent", "random", "--levels", "Zone3.Act2", "--timesteps", "200") == 0
-    assert "pip install 'retrokit[plot]'" in (out / "report.md").read_text()
+    assert "pip install 'retrokit-rl[plot]'" in (out / "report.md").read_text()
     assert not (out / "scores.png").exists() and (out / "summary.json").is_file()
 
 

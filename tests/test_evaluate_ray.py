@@ -27,4 +27,4 @@ def test_ray_gives_the_same_summary_as_local(tmp_path) -> None:
 def test_without_ray_the_error_says_how_to_install_it(tmp_path, monkeypatch, capsys) -> None:
     monkeypatch.setitem(sys.modules, "ray", None)  # import ray now raises ImportError
     assert main([*ARGS, "--backend", "ray", "--out", str(tmp_path / "run")]) == 2
-    assert "pip install 'retrokit[ray]'" in capsys.readouterr().err
+    assert "pip install 'retrokit-rl[ray]'" in capsys.readouterr().err

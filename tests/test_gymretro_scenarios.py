@@ -226,7 +226,7 @@ def test_converter_output_reads_well(tmp_path) -> None:
         "done": {"condition": "all", "variables": {"lives": {"op": "zero"}, "frame": {"op": "greater-than", "reference": 99}}},
     }))
     assert convert_scenario_json(path) == (
-        "# Converted from Gym Retro's scenario.json by retrokit; see docs/scenarios.md.\n"
+        "# Converted from Gym Retro's scenario.json by retrokit; see retrokit docs scenarios.\n"
         "reward: 10.0 * max(delta(score), 0) + 100.0 * min(delta(lives), 0) + 1.0 * max(delta(`odd name`), 0)\n"
         "done: lives == 0 and `frame` > 99\n"
     )

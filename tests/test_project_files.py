@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import subprocess
 import tomllib
 from pathlib import Path
@@ -23,3 +24,20 @@ def test_the_demo_output_is_ignored_by_git() -> None:
         pytest.skip("an installed copy has no git")
     probe = subprocess.run(["git", "-C", str(REPO), "check-ignore", "-q", "retrokit-demo/Dasher-Genesis.gif"], check=False)
     assert probe.returncode == 0
+
+
+def readme_commands() -> list[str]:
+    """The README's shell blocks' commands: the install-and-demo one, then the install-and-test one."""
+    return re.findall(r"```sh\n(python3 -m venv .venv [^\n]*)\n```", (REPO / "README.md").read_text())
+
+
+def test_ci_runs_the_readme_commands_exactly_with_the_stock_pip() -> None:
+    ci = (REPO / ".ci" / "run").read_text()
+    commands = readme_commands()
+    assert len(commands) == 2 and "retrokit demo" in commands[0] and "pytest" in commands[1], commands
+    lines = [line.rstrip("\\ ").strip() for line in ci.splitlines()]
+    positions = [lines.index(command) for command in commands]  # each verbatim, as a line of its own
+    build = lines.index("retrokit build-core genesis_plus_gx")
+    assert positions[0] < build < positions[1]  # the patched core is built before the tests run
+    for text in (ci, (REPO / "README.md").read_text()):
+        assert not re.search(r"pip install[^\n]*(-U|--upgrade)[^\n]*\bpip\b", text)  # the stock pip, never upgraded

@@ -189,7 +189,7 @@ def test_poke_and_screenshot_on_the_command_line(session, capsys):
     assert status == 0 and out == "Saved the screen (320x224) to lives.png.\n"
     assert Path("lives.png").read_bytes()[:4] == b"\x89PNG"
     status, _, err = run(capsys, "screenshot", "lives.png")
-    assert status == 2 and "--overwrite" in err
+    assert status == 2 and "--force" in err
     run(capsys, "run")
     status, out, _ = run(capsys, "filter", "equal", "9")
     assert status == 0

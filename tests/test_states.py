@@ -100,7 +100,7 @@ def test_writing_the_same_state_again_is_fine(tmp_path):
 
 def test_no_silent_overwrite(tmp_path):
     path = write_state(tmp_path / "A.state", b"state one")
-    with pytest.raises(FileConflictError, match="Pass overwrite=True"):
+    with pytest.raises(FileConflictError, match="overwrite=True"):
         write_state(path, b"state two")
     assert read_state(path) == b"state one"
     (tmp_path / "Mine.state").write_bytes(b"a file the user made, not a state")

@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
 """Smoke test of an installed retrokit, run by CI from an empty folder in a fresh venv.
 
-It checks what a user of ``pip install retrokit`` gets, with no checkout on
+It checks what a user of ``pip install retrokit-rl`` gets, with no checkout on
 the path: the bundled games and test cartridge, the lazy public names, the
-envs on the real emulator, and the Sonic preset up to the missing-ROM error.
+envs on the real emulator, the Sonic preset up to the missing-ROM error, and
+the guides that ``retrokit docs`` prints.
 Exits non-zero, naming the check, when one fails.
 """
 
@@ -59,8 +60,30 @@ def main() -> int:
             return fail(f"Sonic's missing-ROM error names no fix: {exc}")
     else:
         return fail("Sonic made without its ROM")
+    problem = check_docs(package)
+    if problem:
+        return fail(problem)
     print(f"wheel smoke test: ok ({package}, Dasher reward {total:.1f}, {np.__version__=})")
     return 0
+
+
+def check_docs(package: Path) -> str:
+    """What is wrong with ``retrokit docs`` run from the installed command, or ``""``: the guides ship in the wheel."""
+    import subprocess
+
+    command = Path(sys.executable).with_name("retrokit")
+    listing = subprocess.run([command, "docs"], capture_output=True, text=True, check=False)
+    guide = subprocess.run([command, "docs", "integrate"], capture_output=True, text=True, check=False)
+    typo = subprocess.run([command, "docs", "integrat"], capture_output=True, text=True, check=False)
+    if not (package / "_docs" / "integrate.md").is_file():
+        return "the guides (docs/*.md) are not in the wheel"
+    if listing.returncode != 0 or not listing.stdout.startswith("architecture ") or "scenarios" not in listing.stdout:
+        return f"retrokit docs listed: {listing.stdout[:200]!r} {listing.stderr[-200:]!r}"
+    if guide.returncode != 0 or guide.stdout != (package / "_docs" / "integrate.md").read_text(encoding="utf-8"):
+        return f"retrokit docs integrate printed: {guide.stdout[:100]!r} {guide.stderr[-200:]!r}"
+    if typo.returncode != 2 or "Did you mean 'integrate'?" not in typo.stderr:
+        return f"retrokit docs integrat said: {typo.stderr[-200:]!r}"
+    return ""
 
 
 def fail(what: str) -> int:

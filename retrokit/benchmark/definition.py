@@ -211,7 +211,7 @@ def read_benchmark(path: str | os.PathLike[str]) -> Benchmark:
     path = Path(path)
 
     def fail(problem: str) -> BenchmarkFileError:
-        return BenchmarkFileError(f"Expected a benchmark file, but {path}: {problem}. See docs/evaluate.md for its shape.")
+        return BenchmarkFileError(f"Expected a benchmark file, but {path}: {problem}. See retrokit docs evaluate for its shape.")
 
     try:
         if path.stat().st_size > MAX_FILE_BYTES:

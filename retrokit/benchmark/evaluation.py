@@ -23,7 +23,7 @@ from retrokit.benchmark.paper import PaperScores, load_paper
 from retrokit.benchmark.report import paper_column, render_report, write_report, write_summary
 from retrokit.benchmark.rundir import RunDir
 from retrokit.benchmark.scores import summarize
-from retrokit.errors import AgentError, InvalidArgumentError
+from retrokit.errors import AgentError, InvalidArgumentError, install_extra
 from retrokit.paths import atomic_write
 
 BACKENDS = ("local", "ray")
@@ -178,6 +178,6 @@ def write_outputs(ev: Evaluation, run: RunDir, paper: PaperScores | None) -> dic
     text = render_report(summary, paper, plots=written, failed=ev.failed or run.failed,
                          env_rules=ev.benchmark.env_options())
     if not plots.have_matplotlib():
-        text += f"\nNo plots: matplotlib is not installed (`pip install '{plots.PLOT_EXTRA}'`).\n"
+        text += f"\nNo plots: matplotlib is not installed (`{install_extra('plot')}`).\n"
     write_report(ev.out, text)
     return summary

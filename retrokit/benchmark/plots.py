@@ -1,4 +1,4 @@
-"""The PNG plots, drawn with matplotlib (the ``retrokit[plot]`` extra).
+"""The PNG plots, drawn with matplotlib (the ``retrokit-rl[plot]`` extra).
 
 The object API is used (no pyplot), so drawing changes no global state and
 needs no display.
@@ -9,8 +9,6 @@ from __future__ import annotations
 import io
 import math
 from typing import Any
-
-PLOT_EXTRA = "retrokit[plot]"
 
 
 def have_matplotlib() -> bool:

@@ -2,7 +2,7 @@
 
 Each task runs :func:`~retrokit.benchmark.level.run_level` and puts its
 messages on a Ray queue as they come, so episodes stream back while levels
-play. Ray is the optional extra ``retrokit[ray]``; every node of a cluster
+play. Ray is the optional extra ``retrokit-rl[ray]``; every node of a cluster
 needs retrokit (and the ROMs of the benchmark's games) installed.
 """
 
@@ -14,9 +14,8 @@ import queue
 from collections.abc import Callable
 
 from retrokit.benchmark.level import LevelTask, Message, run_level
-from retrokit.errors import BackendUnavailableError
+from retrokit.errors import BackendUnavailableError, install_extra
 
-RAY_EXTRA = "retrokit[ray]"
 POLL_SECONDS = 0.2
 
 
@@ -40,7 +39,7 @@ def run_ray(tasks: list[LevelTask], handle: Callable[[Message], None], workers: 
         from ray.util.queue import Empty, Queue
     except ImportError:
         raise BackendUnavailableError(
-            f"Expected Ray for --backend ray, but it is not installed; run `pip install '{RAY_EXTRA}'`."
+            f"Expected Ray for --backend ray, but it is not installed; run `{install_extra('ray')}`."
         ) from None
     os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")  # no telemetry from a benchmark run
     started = not ray.is_initialized()

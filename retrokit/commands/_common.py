@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import os
 from pathlib import Path
 
@@ -25,6 +26,15 @@ def add_data_dir_option(parser) -> None:  # an argparse parser
         help=f"the data folder that holds imported ROMs (default: ${paths.DATA_ENV}, "
         "else $XDG_DATA_HOME/retrokit, else ~/.local/share/retrokit)",
     )
+
+
+def add_force_option(parser, help: str) -> None:  # an argparse parser
+    """Add ``--force``, the one word of every command for "replace what is there" (into ``args.force``).
+
+    ``--overwrite``, the word some commands used before, still works as a hidden alias, so scripts keep running.
+    """
+    parser.add_argument("--force", action="store_true", help=help)
+    parser.add_argument("--overwrite", dest="force", action="store_true", help=argparse.SUPPRESS)
 
 
 def add_evaluation_options(parser, workers_help: str) -> None:  # an argparse parser

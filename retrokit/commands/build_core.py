@@ -16,7 +16,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "stable-retro's wheel uses, and install it into the data folder, where retrokit uses it instead of the "
         "wheel's (the data folder is $RETROKIT_DATA, else $XDG_DATA_HOME/retrokit, else ~/.local/share/retrokit). "
         "Needs a C compiler (cc, or $CC), make, and network access to the package index. "
-        "The patched genesis_plus_gx skips drawing the frames an env does not show.",
+        "The patched genesis_plus_gx skips drawing the frames an env does not show (retrokit docs cores).",
     )
     parser.add_argument("core", metavar="CORE", help="the core to build: genesis_plus_gx")
     parser.add_argument("--stable-retro", metavar="VERSION", dest="version",

@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from retrokit.commands._common import add_force_option
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``convert`` command."""
@@ -13,18 +15,17 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="convert a Gym Retro scenario.json to retrokit scenario YAML",
         description="Write a Gym Retro scenario.json as retrokit scenario YAML, with the same rewards and done "
         "condition (Lua scripts cannot be converted). Without OUT, the YAML goes to standard output. "
-        "An existing OUT is never replaced unless --overwrite.",
+        "An existing OUT is never replaced unless --force.",
     )
     parser.add_argument("source", type=Path, help="the scenario.json")
     parser.add_argument("out", type=Path, nargs="?", help="the .yaml to write")
-    parser.add_argument("--overwrite", action="store_true", help="replace OUT if it exists")
+    add_force_option(parser, "replace OUT if it exists")
     parser.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Convert, then print or write the YAML."""
     from retrokit.dsl import convert_scenario_json
-    from retrokit.errors import FileConflictError
     from retrokit.paths import atomic_write, require_regular_file
 
     if args.source.exists():  # a FIFO would block, a device never end
@@ -33,12 +34,6 @@ def run(args: argparse.Namespace) -> int:
     if args.out is None:
         print(text, end="")
         return 0
-    try:
-        atomic_write(args.out, text.encode("utf-8"), overwrite=args.overwrite)
-    except FileExistsError:
-        raise FileConflictError(
-            f"Expected to write {args.out}, but a file is already there; it was left as it is. "
-            f"Pass --overwrite to replace it, or choose another name."
-        ) from None
+    atomic_write(args.out, text.encode("utf-8"), overwrite=args.force)
     print(f"wrote {args.out}")
     return 0

@@ -16,7 +16,7 @@ import shutil
 from pathlib import Path
 
 from retrokit.commands._common import add_evaluation_options
-from retrokit.errors import FileConflictError
+from retrokit.errors import FileConflictError, install_extra
 from retrokit.paths import ensure_folder
 
 AGENTS = ("jerk", "random")
@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
     made = "report.md, summary.json, plots" if plots.have_matplotlib() else "report.md, summary.json"
     written = [f"{out / agent}/ ({made})" for agent in AGENTS]
     if not plots.have_matplotlib():
-        written.append(f"(no plots: matplotlib is not installed; pip install '{plots.PLOT_EXTRA}')")
+        written.append(f"(no plots: matplotlib is not installed; {install_extra('plot')})")
     else:
         series = {agent: {lv: e["mean_score"] for lv, e in s["levels"].items()} for agent, s in summaries.items()}
         atomic_write(out / "scores.png", plots.score_bars(series, names, "JERK against random on Dasher: level scores"))

@@ -7,7 +7,7 @@ import os
 import shlex
 from typing import TYPE_CHECKING
 
-from retrokit.commands._common import add_data_dir_option, rom_status
+from retrokit.commands._common import add_data_dir_option, add_force_option, rom_status
 
 if TYPE_CHECKING:
     from retrokit.data.importer import UnmatchedFile
@@ -22,12 +22,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="import ROMs of known games from folders and zip files",
         description="Search files, folders and zip files for the ROMs of known games (by SHA-1, "
         "by stable-retro's rules), and copy each match into the data folder. A different ROM "
-        "already imported is never replaced unless --overwrite is given. A progress bar counts the files "
+        "already imported is never replaced unless --force is given. A progress bar counts the files "
         "searched, on standard error.",
     )
     parser.add_argument("paths", nargs="*", metavar="PATH", help="files, folders or zip files to search")
     parser.add_argument("--game", metavar="NAME", help="show the SHA-1s this game expects, and whether its ROM is present")
-    parser.add_argument("--overwrite", action="store_true", help="replace a different ROM already imported")
+    add_force_option(parser, "replace a different ROM already imported")
     parser.add_argument("-v", "--verbose", action="store_true", help="list every file that matched nothing")
     add_data_dir_option(parser)
     parser.set_defaults(run=run)
@@ -67,12 +67,12 @@ def run(args: argparse.Namespace) -> int:
             )
     status = 0
     if args.paths:
-        report = import_roms(args.paths, data_dir=args.data_dir, overwrite=args.overwrite, progress=True)
+        report = import_roms(args.paths, data_dir=args.data_dir, overwrite=args.force, progress=True)
         print(f"Imported {len(report.imported)} ROM{'s' * (len(report.imported) != 1)} into {report.data_dir / 'roms'}.")
         _section("Imported", [f"{r.game} <- {r.source}" for r in report.imported], True)
         _section("Already imported", [f"{r.game} <- {r.source}" for r in report.already_present], args.verbose)
         _section(
-            "Not overwritten, a different file is there (pass --overwrite to replace it)",
+            "Not overwritten, a different file is there (pass --force to replace it)",
             [f"{c.game}: {c.path} has SHA-1 {c.existing_sha1}; {c.source} has {c.sha1}" for c in report.conflicts],
             True,
         )

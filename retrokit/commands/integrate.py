@@ -16,7 +16,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--movie, the state is the one the movie reaches. States are written to your data folder "
         "($RETROKIT_DATA/games/<Game>, else $XDG_DATA_HOME/retrokit/games/<Game>), which extends the shipped "
         "game, or to --out; never into the installed package. A state already there that leads to the same "
-        "RAM and screen is left alone; one that differs is kept unless --force. Format: docs/integrate.md.",
+        "RAM and screen is left alone; one that differs is kept unless --force. Format: retrokit docs integrate.",
     )
     parser.add_argument("names", nargs="+", metavar="NAME",
                         help="STATE, GAME, or GAME STATE (e.g. Zone1.Act1, Dasher-Genesis, Dasher-Genesis Zone1.Act1)")

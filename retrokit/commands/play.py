@@ -13,7 +13,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Play a game from the keyboard: arrows, Z X C (A B C), Enter (START), Tab (MODE/SELECT), "
         "A S D (X Y Z). F5 saves the current state as NAME.state, F9 starts recording a movie and F9 again "
         "writes it to movies/NAME-NNNNNN.bk2, Escape quits. Files go to your data folder's games/<Game> "
-        "(which extends the shipped game) or --out. See docs/integrate.md.",
+        "(which extends the shipped game) or --out. See retrokit docs integrate.",
     )
     parser.add_argument("game", help="the game, e.g. Dasher-Genesis")
     parser.add_argument("--state", help="the state to start from (default: the game's)")

@@ -1,8 +1,10 @@
-"""``retrokit playback MOVIE.bk2 OUT [--every N] [--overwrite]``: replay a movie into images or a video."""
+"""``retrokit playback MOVIE.bk2 OUT [--every N] [--force]``: replay a movie into images or a video."""
 
 from __future__ import annotations
 
 import argparse
+
+from retrokit.commands._common import add_force_option
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -12,13 +14,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="replay a .bk2 movie into PNG frames, a GIF or an MP4",
         description="Replay a .bk2 movie (recorded by retrokit or stable-retro) on its game's ROM, "
         "and write the screens: into a folder as frame_000000.png, ... (numbered by movie frame), "
-        "or into OUT.gif (30 frames a second at most), or OUT.mp4 (needs: pip install 'retrokit[video]'). "
+        "or into OUT.gif (30 frames a second at most), or OUT.mp4 (needs: pip install 'retrokit-rl[video]'). "
         "A progress bar shows on standard error.",
     )
     parser.add_argument("movie", metavar="MOVIE.bk2", help="the movie to replay")
     parser.add_argument("out", metavar="OUT", help="a folder for PNG frames, or a .gif or .mp4 file")
     parser.add_argument("--every", type=int, default=1, metavar="N", help="keep one frame in N (default: 1, all)")
-    parser.add_argument("--overwrite", action="store_true", help="replace an existing output file or frames")
+    add_force_option(parser, "replace an existing output file or frames")
     parser.set_defaults(run=run)
 
 
@@ -26,6 +28,6 @@ def run(args: argparse.Namespace) -> int:
     """Replay the movie and write its screens."""
     from retrokit.movie import export
 
-    count = export(args.movie, args.out, every=args.every, overwrite=args.overwrite, progress=True)
+    count = export(args.movie, args.out, every=args.every, overwrite=args.force, progress=True)
     print(f"Wrote {count} frame{'s' * (count != 1)} of {args.movie} to {args.out}.")
     return 0

@@ -21,6 +21,7 @@ import argparse
 import json
 from typing import TYPE_CHECKING
 
+from retrokit.commands._common import add_force_option
 from retrokit.errors import InvalidArgumentError
 
 if TYPE_CHECKING:
@@ -97,7 +98,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     p = sub("screenshot", "save the screen (the next frame, so pokes show) as a PNG", _screenshot)
     p.add_argument("file", metavar="FILE.png")
-    p.add_argument("--overwrite", action="store_true", help="replace an existing file")
+    add_force_option(p, "replace an existing file")
 
     p = sub("save", "write a field into the game's game.yaml, keeping its comments and layout", _save)
     p.add_argument("name", metavar="NAME", help="the field's name, e.g. lives")
@@ -301,7 +302,7 @@ def _poke(args: argparse.Namespace) -> int:
 
 def _screenshot(args: argparse.Namespace) -> int:
     with _open(args) as search:
-        path = search.screenshot(args.file, overwrite=args.overwrite)
+        path = search.screenshot(args.file, overwrite=args.force)
         height, width = search.emulator.screen_shape()
         print(f"Saved the screen ({width}x{height}) to {path}.")
     return 0

@@ -28,7 +28,7 @@ from tqdm import tqdm
 from retrokit import paths
 from retrokit.data import roms
 from retrokit.data.games import Game, list_games
-from retrokit.errors import RetrokitError, RomError
+from retrokit.errors import FileConflictError, RetrokitError, RomError
 from retrokit.host.systems import extension_of
 
 MAX_ZIP_DEPTH = 3
@@ -276,7 +276,7 @@ def _store(game: Game, source: str, data: bytes, sha1: str, report: ImportReport
                 continue
         try:
             paths.atomic_write(target, data, overwrite=overwrite)
-        except FileExistsError:  # appeared meanwhile
+        except FileConflictError:  # appeared meanwhile
             report.conflicts.append(ImportConflict(game.name, source, target, sha1, "(unknown)"))
             continue
         report.imported.append(entry)

@@ -282,7 +282,7 @@ def integrate(
     if not known:
         raise StateNotFoundError(
             f"Expected state recipes under 'integrate' in {game.info.source}; found none. "
-            "Add one per state (the format is in docs/integrate.md), or make a state from a movie: "
+            "Add one per state (the format: retrokit docs integrate), or make a state from a movie: "
             f"retrokit integrate {game.name} NAME --movie FILE.bk2."
         )
     wanted = list(known) if names is None else names
@@ -290,7 +290,7 @@ def integrate(
         if name not in known:
             raise StateNotFoundError(
                 f"Expected a state with a recipe in {game.info.source} ({', '.join(known)}); found {name!r}. "
-                "Add its recipe under 'integrate' (docs/integrate.md)." + did_you_mean(name, known)
+                "Add its recipe under 'integrate' (retrokit docs integrate)." + did_you_mean(name, known)
             )
     folder = out if out is not None else target_folder(game)
     return [place_state(game, name, make_state(game, known[name]), folder, force=force) for name in wanted]

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from retrokit.errors import FileConflictError, StateError
-from retrokit.paths import atomic_write
+from retrokit.paths import REPLACE_HINT, atomic_write
 
 GZIP_MAGIC = b"\x1f\x8b"
 MAX_STATE_SIZE = 16 * 2**20
@@ -224,17 +224,13 @@ def write_state(
         if same:
             return path
         raise _conflict(path)
-    try:
-        atomic_write(path, compress_state(data, record), overwrite=overwrite)
-    except FileExistsError:
-        raise _conflict(path) from None
+    atomic_write(path, compress_state(data, record), overwrite=overwrite)
     return path
 
 
 def _conflict(path: Path) -> FileConflictError:
     return FileConflictError(
-        f"Expected no file at {str(path)!r} or the same state; found a different file. "
-        "Pass overwrite=True to replace it, or choose another name."
+        f"Expected no file at {str(path)!r} or the same state; found a different file. {REPLACE_HINT}"
     )
 
 

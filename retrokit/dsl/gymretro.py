@@ -125,14 +125,14 @@ class _Converter:
             raise self.error(
                 [*path, "script"],
                 "Lua scripts cannot be converted; write the reward and done in retrokit's language "
-                "(docs/scenarios.md; the wheel's Lua scenarios are rewritten in games/<Game>/)",
+                "(retrokit docs scenarios; the wheel's Lua scenarios are rewritten in games/<Game>/)",
             )
         return obj
 
     def convert(self) -> dict:
         data = self.check_keys(self.data, TOP_KEYS, [])
         if "scripts" in data:
-            raise self.error(["scripts"], "Lua scripts cannot be converted; write the scenario in retrokit's language (docs/scenarios.md)")
+            raise self.error(["scripts"], "Lua scripts cannot be converted; write the scenario in retrokit's language (retrokit docs scenarios)")
         if "crops" in data:
             raise self.error(["crops"], "per-player crops are not supported; give one 'crop'")
         players = [dict(self.check_keys(data["reward"], REWARD_KEYS, ["reward"]))] if "reward" in data else [{}]
@@ -267,7 +267,7 @@ def convert_scenario_json(path: str | os.PathLike[str]) -> str:
     """
     data, source = _read_json(Path(path))
     converted = convert_json_dict(data, source=source)
-    lines = [f"# Converted from Gym Retro's {Path(path).name} by retrokit; see docs/scenarios.md."]
+    lines = [f"# Converted from Gym Retro's {Path(path).name} by retrokit; see retrokit docs scenarios."]
     for key, value in converted.items():
         if key == "rewards":
             lines += ["rewards:"] + [f"  - {_yaml_value(reward)}" for reward in value]

@@ -50,7 +50,7 @@ class RetroParallelEnv(ParallelEnv):
             self._env.close()
             raise InvalidArgumentError(
                 f"Expected a scenario with one reward per player ({players}), got one with {scenario_players}. "
-                f"Give the scenario per-player rewards (docs/scenarios.md)."
+                f"Give the scenario per-player rewards (retrokit docs scenarios)."
             )
         self.possible_agents = [f"player_{i + 1}" for i in range(players)]
         self.agents: list[str] = []

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from retrokit.data.games import Game
 from retrokit.data.states import read_state, write_state
-from retrokit.errors import EnvError
+from retrokit.errors import EnvError, install_extra
 from retrokit.host.emulator import Emulator
 from retrokit.movie.recorder import MovieRecorder, claim_movie_path
 
@@ -55,7 +55,7 @@ class PlaySession:
         try:
             import pygame
         except ImportError:
-            raise EnvError("Expected pygame for retrokit play; install it: pip install 'retrokit[human]'.") from None
+            raise EnvError(f"Expected pygame for retrokit play; install it: {install_extra('human')}.") from None
         self._pygame = pygame
         try:
             pygame.display.init()

@@ -1,14 +1,14 @@
 """A window that shows frames, for ``render_mode="human"``.
 
 It uses pygame, which retrokit does not require: install it where a display
-exists (``pip install 'retrokit[human]'``).
+exists (``pip install 'retrokit-rl[human]'``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from retrokit.errors import EnvError
+from retrokit.errors import EnvError, install_extra
 
 
 class Viewer:
@@ -24,7 +24,7 @@ class Viewer:
         except ImportError:
             raise EnvError(
                 "Expected pygame for render_mode='human', but it is not installed. "
-                "Install it (pip install 'retrokit[human]'), or use render_mode='rgb_array'."
+                f"Install it ({install_extra('human')}), or use render_mode='rgb_array'."
             ) from None
         self._pygame = pygame
         try:

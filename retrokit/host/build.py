@@ -131,31 +131,47 @@ def fetch_sdist(
 ) -> Path:
     """Download stable-retro's sdist of ``version`` into ``dest`` with pip; return its path.
 
+    Only options pip 23.0 has are passed (the pip a stock ``python3 -m venv``
+    ships): pip's own progress bar is off, and progress comes from the size of
+    the files pip writes, which it writes into its temporary folder (here a
+    folder of ``dest``'s, through ``TMPDIR``) and then into ``dest``.
+
     Raises:
+        BuildToolError: This Python has no pip.
         SourceFetchError: The index could not be reached.
         SourceNotFoundError: The index has no sdist of that version.
+        CoreBuildError: pip failed otherwise (the message quotes its error and the command to rerun).
     """
-    command = [sys.executable, "-m", "pip", "download", "--no-deps", "--no-binary", "stable-retro",
-               f"stable-retro=={version}", "-d", str(dest), "--progress-bar", "raw", "--retries", "2"]  # fmt: skip
-    if index_url is not None:
-        command += ["--index-url", index_url]
+    what = [sys.executable, "-m", "pip", "download", "--no-deps", "--no-binary", "stable-retro",
+            f"stable-retro=={version}", *(["--index-url", index_url] if index_url is not None else [])]  # fmt: skip
+    command = [*what, "-d", str(dest), "--progress-bar", "off", "--retries", "2", "--no-input",
+               "--disable-pip-version-check"]  # fmt: skip
     where = index_url or "the package index"
-    lines: list[str] = []
+    scratch = dest / ".pip-tmp"
+    scratch.mkdir(parents=True, exist_ok=True)
+    log_path = dest / "pip.log"
     try:
-        proc = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        with open(log_path, "w+", encoding="utf-8", errors="replace") as log:
+            proc = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                                    env={**os.environ, "TMPDIR": str(scratch)}, text=True)  # fmt: skip
+            _follow_download(proc, log_path, (scratch, dest), progress)
     except OSError as exc:
-        raise BuildToolError(f"Expected to run pip ({sys.executable} -m pip); it failed: {exc}.") from None
-    assert proc.stdout is not None
-    for line in proc.stdout:
-        lines.append(line.rstrip())
-        match = re.match(r"Progress (\d+) of (\d+)", line)
-        if match:
-            progress("download", int(match.group(1)), int(match.group(2)))
-    proc.wait()
+        raise BuildToolError(
+            f"Expected to run pip ({sys.executable} -m pip); it failed: {exc}. "
+            "Download stable-retro's sdist yourself and pass it with --sdist FILE."
+        ) from None
+    lines = log_path.read_text(encoding="utf-8", errors="replace").splitlines()
     found = sorted(dest.glob("stable_retro-*.tar.gz")) + sorted(dest.glob("stable-retro-*.tar.gz"))
     if proc.returncode == 0 and found:
+        size = found[0].stat().st_size
+        progress("download", size, size)
         return found[0]
     text = "\n".join(lines)
+    if "No module named pip" in text:
+        raise BuildToolError(
+            f"Expected pip in {sys.executable} to download stable-retro's source; found none. "
+            f"Install it ({sys.executable} -m ensurepip), or download the sdist yourself and pass --sdist FILE."
+        )
     if any(marker in text for marker in _NETWORK_FAILURES):
         reason = next(line for line in lines if any(m in line for m in _NETWORK_FAILURES))
         raise SourceFetchError(
@@ -170,8 +186,49 @@ def fetch_sdist(
             f"(versions there: {listed}). Install a stable-retro version that has one (1.0.1 has), "
             f"or build from one with --stable-retro VERSION."
         )
-    last = next((line for line in reversed(lines) if line.strip()), "no output")
-    raise CoreBuildError(f"Expected pip to download stable-retro {version}'s source; it failed: {_shorten(last)}")
+    errors = [line for line in lines if line.strip().lower().startswith("error:")]
+    last = errors[0] if errors else next((line for line in reversed(lines) if line.strip()), "no output")
+    raise CoreBuildError(
+        f"Expected pip to download stable-retro {version}'s source; it failed (exit {proc.returncode}): "
+        f"{_shorten(last)}. Run `{shlex.join(what)}` to see why, or download the sdist yourself and pass --sdist FILE."
+    )
+
+
+def _follow_download(
+    proc: subprocess.Popen[str], log_path: Path, folders: tuple[Path, ...], progress: Progress
+) -> None:
+    """Wait for pip, reporting the bytes in ``folders`` against the size pip's log announces (0 until then)."""
+    total = 0
+    while True:
+        try:
+            proc.wait(timeout=0.5)
+        except subprocess.TimeoutExpired:
+            pass
+        if not total:  # pip logs "Downloading URL (150.3 MB)" before it writes a byte
+            sizes = re.findall(r"Downloading \S+ \(([\d.]+) (bytes|kB|MB|GB)\)", log_path.read_text(errors="replace"))
+            if sizes:
+                number, unit = sizes[-1]
+                total = int(float(number) * {"bytes": 1, "kB": 1e3, "MB": 1e6, "GB": 1e9}[unit])
+        done = sum(_tree_size(folder) for folder in folders)
+        if done or total:
+            progress("download", min(done, total) if total else done, total)
+        if proc.returncode is not None:
+            return
+
+
+def _tree_size(folder: Path) -> int:
+    """The bytes of the archives below ``folder`` (what pip unpacks from them is not counted; files vanish while
+    pip works: those are skipped)."""
+    size = 0
+    for root, _, files in os.walk(folder):
+        for name in files:
+            if not name.endswith(".tar.gz"):
+                continue
+            try:
+                size += os.lstat(os.path.join(root, name)).st_size
+            except OSError:
+                continue
+    return size
 
 
 def _shorten(text: str, limit: int = 200) -> str:
@@ -233,14 +290,19 @@ def make_core(
                     progress("compile", min(done, total), total)
             proc.wait()
     except OSError as exc:
-        raise BuildToolError(f"Expected to run make in {source}; it failed: {exc}.") from None
+        raise BuildToolError(
+            f"Expected to run make in {source}; it failed: {exc}. Install make and a C compiler "
+            f"(Debian/Ubuntu: apt install build-essential), then run the command again."
+        ) from None
     library = source / core_filename(recipe.core)
     if proc.returncode != 0 or not library.is_file():
         lines = log_path.read_text(encoding="utf-8", errors="replace").splitlines()
         first = next((line for line in lines if "error" in line.lower()), lines[-1] if lines else "no output")
         raise CoreBuildError(
             f"Expected make to build {library.name}; it failed (exit {proc.returncode}): {_shorten(first)}. "
-            f"Full log: {log_path}"
+            f"Full log: {log_path} . Fix what it names (a missing compiler or header: on Debian/Ubuntu "
+            f"apt install build-essential), then run retrokit build-core {recipe.core} again; meanwhile retrokit "
+            f"uses the wheel's core."
         )
     return library
 

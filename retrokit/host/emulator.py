@@ -17,8 +17,8 @@ import numpy as np
 
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean
 from retrokit.host import primitives
+from retrokit.host.corecheck import vet_core
 from retrokit.host.cores import find_core
-from retrokit.host.elf import check_core_file
 from retrokit.host.memory import AddressSpace
 from retrokit.host.systems import System, get_system, system_for_extension
 from retrokit.paths import data_dir
@@ -64,7 +64,7 @@ class Emulator:
             raise InvalidArgumentError(f"Expected 1 to {primitives.MAX_PORTS} ports, got {ports}.")
         self.ports = ports
         core = Path(core_path) if core_path is not None else find_core(self.system.core)
-        check_core_file(core)  # a damaged library would make the loader kill the process
+        vet_core(core, self.system.name, rom)  # a damaged library would make the loader kill the process
         merged = {**self.system.options, **(options or {})}
         folder = data_dir()
         system_dir, save_dir = folder / "system", folder / "saves"

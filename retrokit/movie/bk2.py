@@ -36,7 +36,7 @@ import zlib
 from pathlib import Path
 
 from retrokit.data.states import MAX_STATE_SIZE
-from retrokit.errors import FileConflictError, MovieError, UnsupportedSystemError
+from retrokit.errors import MovieError, UnsupportedSystemError
 from retrokit.movie.model import Layout, Movie, layout, platform_of, system_of_platform
 from retrokit.paths import atomic_write, require_regular_file
 
@@ -267,13 +267,7 @@ def write_bk2(path: str | os.PathLike[str], movie: Movie, *, overwrite: bool = F
     data = encode_bk2(movie)
     if not overwrite and path.exists() and _holds(path, movie):
         return
-    try:
-        atomic_write(path, data, overwrite=overwrite)
-    except FileExistsError:
-        raise FileConflictError(
-            f"Expected to write a new movie at {path}; found a different file there. "
-            "Delete it, choose another name, or pass overwrite=True to replace it."
-        ) from None
+    atomic_write(path, data, overwrite=overwrite)
 
 
 def _holds(path: Path, movie: Movie) -> bool:

@@ -21,12 +21,13 @@ from retrokit.errors import (
     InvalidArgumentError,
     MovieError,
     RomError,
+    install_extra,
 )
 from retrokit.host.emulator import Emulator
 from retrokit.movie.bk2 import read_bk2
 from retrokit.movie.gif import GifWriter, gif_step
 from retrokit.movie.model import STATE_DIGEST, Movie
-from retrokit.paths import atomic_output, atomic_write, ensure_folder
+from retrokit.paths import REPLACE_HINT, atomic_output, atomic_write, ensure_folder
 
 if TYPE_CHECKING:
     from retrokit.data.games import Game
@@ -154,10 +155,8 @@ def export(
     if kind == ".mp4":
         imageio = _require_imageio(out)
     if not overwrite and (out.exists() if kind else any(out.glob("frame_*.png"))):
-        raise FileConflictError(
-            f"Expected {'no file at ' + str(out) if kind else 'no frames in ' + str(out)}; found "
-            f"{'one' if kind else 'frames from an earlier export'}. Choose another path, or pass overwrite (--overwrite)."
-        )
+        where, found = (f"no file at {out}", "one") if kind else (f"no frames in {out}", "frames of an earlier export")
+        raise FileConflictError(f"Expected {where}; found {found}, left as it is. {REPLACE_HINT}")
     movie = read_bk2(movie_path)
     try:
         emu = open_emulator(movie)
@@ -210,7 +209,7 @@ def _require_imageio(out: Path):  # the imageio.v2 module
     except ImportError:
         raise InvalidArgumentError(
             f"Expected imageio with its ffmpeg plugin to write {out}; found them not installed. "
-            "Export to a .gif or to a folder of PNG frames instead, or: pip install 'retrokit[video]'"
+            f"Export to a .gif or to a folder of PNG frames instead, or: {install_extra('video')}"
         ) from None
     return imageio
 
@@ -233,19 +232,14 @@ def _write_pngs(frames: Iterator[tuple[int, np.ndarray]], folder: Path) -> int:
 def _write_gif(frames: Iterator[tuple[int, np.ndarray]], out: Path, fps: float, overwrite: bool) -> int:
     """Stream the frames into a GIF at 30 fps at most, one frame encoded at a time (see :mod:`retrokit.movie.gif`)."""
     step = gif_step(fps)
-    try:
-        with atomic_output(out, overwrite=overwrite) as stream:
-            writer = GifWriter(stream, fps / step)
-            for k, (_, frame) in enumerate(frames):
-                if k % step == 0:
-                    writer.add(frame)
-            if writer.count == 0:
-                raise MovieError(f"Expected a movie with frames to write {out}; found none.")
-            writer.close()
-    except FileExistsError:
-        raise FileConflictError(
-            f"Expected no file at {out}; found one. Choose another path, or pass overwrite (--overwrite)."
-        ) from None
+    with atomic_output(out, overwrite=overwrite) as stream:
+        writer = GifWriter(stream, fps / step)
+        for k, (_, frame) in enumerate(frames):
+            if k % step == 0:
+                writer.add(frame)
+        if writer.count == 0:
+            raise MovieError(f"Expected a movie with frames to write {out}; found none.")
+        writer.close()
     return writer.count
 
 
@@ -259,19 +253,10 @@ def _write_mp4(imageio, frames: Iterator[tuple[int, np.ndarray]], out: Path, fps
             for _, frame in frames:
                 writer.append_data(frame)
                 count += 1
-        _place(out, Path(tmp_name).read_bytes(), overwrite)
+        atomic_write(out, Path(tmp_name).read_bytes(), overwrite=overwrite)
     finally:
         Path(tmp_name).unlink(missing_ok=True)
     return count
-
-
-def _place(out: Path, data: bytes, overwrite: bool) -> None:
-    try:
-        atomic_write(out, data, overwrite=overwrite)
-    except FileExistsError:
-        raise FileConflictError(
-            f"Expected no file at {out}; found one. Choose another path, or pass overwrite (--overwrite)."
-        ) from None
 
 
 def state_from_movie(game: Game, movie_path: str | os.PathLike[str], frame: int | None = None) -> bytes:

@@ -32,7 +32,7 @@ from retrokit.data import statecheck
 from retrokit.data.games import Game, find_game
 from retrokit.data.roms import rom_sha1
 from retrokit.data.states import StateRecord
-from retrokit.errors import DataFileError, FileConflictError, InvalidArgumentError, MovieError, SessionError, StateError
+from retrokit.errors import DataFileError, InvalidArgumentError, MovieError, SessionError, StateError
 from retrokit.host.emulator import Emulator
 from retrokit.host.typecodes import parse_type
 from retrokit.paths import atomic_write, wheel_dir
@@ -134,12 +134,7 @@ class RamSearch:
         Raises:
             FileConflictError: ``path`` exists and ``overwrite`` is false.
         """
-        try:
-            write_session(path, self.session_data(), overwrite=overwrite)
-        except FileExistsError:
-            raise FileConflictError(
-                f"Expected no file at {path}; found one. Pass --force (overwrite=True) to replace it, or another name."
-            ) from None
+        write_session(path, self.session_data(), overwrite=overwrite)
 
     def session_data(self) -> SessionData:
         """Everything a session file holds."""
@@ -282,12 +277,7 @@ class RamSearch:
         path = Path(path)
         buffer = io.BytesIO()
         Image.fromarray(self.screen()).save(buffer, format="PNG")
-        try:
-            atomic_write(path, buffer.getvalue(), overwrite=overwrite)
-        except FileExistsError:
-            raise FileConflictError(
-                f"Expected no file at {path}; found one. Choose another name, or pass --overwrite."
-            ) from None
+        atomic_write(path, buffer.getvalue(), overwrite=overwrite)
         return path
 
     # --- searching ------------------------------------------------------------------------------

@@ -109,7 +109,7 @@ def write_session(path: str | os.PathLike[str], data: SessionData, *, overwrite:
     """Write a session file atomically, replacing the one there unless ``overwrite`` is false.
 
     Raises:
-        FileExistsError: ``path`` exists and ``overwrite`` is false.
+        FileConflictError: ``path`` exists and ``overwrite`` is false.
     """
     atomic_write(path, encode_session(data), overwrite=overwrite)
 

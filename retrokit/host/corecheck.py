@@ -1,0 +1,255 @@
+"""Vetting a core before it is loaded: a damaged core ends in a CoreError, never in a signal.
+
+The dynamic loader trusts a shared library. A core with its ``.dynamic``
+section zeroed or its ``.dynsym`` scrambled crashes the process inside
+``dlopen``; flipped bytes in ``.text`` crash it at the first frame. The ELF
+check (:mod:`retrokit.host.elf`) sees none of that, so before a core is
+loaded, :func:`vet_core` also asks who vouches for its bytes:
+
+1. The stable-retro wheel's ``RECORD`` lists the SHA-256 of every core it
+   ships, and ``retrokit build-core`` records the SHA-256 of what it built
+   (``<data>/cores/<core>.build.json``). A core at one of those places with
+   other bytes is damaged, and refused with how to restore it; a core
+   elsewhere with one of those digests is a copy, and trusted.
+2. Any other core (one named by ``RETROKIT_CORES`` or ``core_path``, a
+   system's libretro folder) is probed once: a child process loads it with
+   the ROM at hand and runs a few frames. The verdict is kept in the data
+   folder under the core's SHA-256 (``<data>/core-probes/``), so each content
+   is probed once per machine.
+
+Trust comes only from what the package installed or this machine wrote, never
+from the bytes of the core itself. A file is hashed once per process (cached
+by path, size, modification time and inode).
+
+Run as ``python -m retrokit.host.corecheck SYSTEM ROM CORE``, this module is the probe's child.
+"""
+
+from __future__ import annotations
+
+import base64
+import functools
+import hashlib
+import importlib
+import importlib.metadata
+import json
+import os
+import resource
+import signal
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+from retrokit.errors import CoreError, RetrokitError
+from retrokit.host.cores import built_cores_dir, core_filename
+from retrokit.host.elf import check_core_file
+from retrokit.paths import atomic_write, data_dir
+
+PROBE_FRAMES = 60
+"""Frames the probe runs after loading: a damaged ``.text`` shows within the first."""
+PROBE_TIMEOUT = 30.0
+"""Seconds a probe may take before the core counts as one that hangs."""
+PROBE_ADDRESS_SPACE = 3 * 2**30
+"""The probe's address-space cap: far above what Python, numpy and a core map, far below a runaway."""
+_REFUSED = 3  # the child's exit status when retrokit refused the core with its own error
+_SAFE = "safe"
+
+_StatKey = tuple[str, int, int, int]
+_digests: dict[_StatKey, str] = {}  # SHA-256 by (path, size, mtime, inode): each file hashed once per process
+_vetted: set[_StatKey] = set()
+
+
+@dataclass(frozen=True)
+class Voucher:
+    """Who vouches for the bytes of a core at one path.
+
+    Attributes:
+        sha256: The digest its bytes must have.
+        source: Who says so, for messages (``"stable-retro 1.0.1's RECORD"``).
+        fix: How to get the right bytes back.
+    """
+
+    sha256: str
+    source: str
+    fix: str
+
+
+def _stat_key(path: Path) -> _StatKey:
+    info = path.stat()
+    return (str(path.resolve()), info.st_size, info.st_mtime_ns, info.st_ino)
+
+
+def file_sha256(path: Path) -> str:
+    """Return the SHA-256 of a file, hashing it once per process while it is unchanged."""
+    key = _stat_key(path)
+    if key not in _digests:
+        digest = hashlib.sha256()
+        with path.open("rb") as file:
+            for block in iter(lambda: file.read(1 << 20), b""):
+                digest.update(block)
+        _digests[key] = digest.hexdigest()
+    return _digests[key]
+
+
+@functools.lru_cache(maxsize=1)
+def wheel_vouchers() -> dict[Path, Voucher]:
+    """Return the stable-retro wheel's cores by path, with the SHA-256 its ``RECORD`` lists for each."""
+    try:
+        dist = importlib.metadata.distribution("stable-retro")
+    except importlib.metadata.PackageNotFoundError:
+        return {}
+    source = f"stable-retro {dist.version}'s RECORD"
+    fix = "Reinstall it: pip install --force-reinstall --no-deps stable-retro"
+    found = {}
+    for file in dist.files or []:
+        if "_libretro." in file.name and file.hash is not None and file.hash.mode == "sha256":
+            raw = base64.urlsafe_b64decode(file.hash.value + "=" * (-len(file.hash.value) % 4))
+            found[Path(str(file.locate())).resolve()] = Voucher(raw.hex(), source, fix)
+    return found
+
+
+def built_vouchers(data: Path | None = None) -> dict[Path, Voucher]:
+    """Return the cores ``retrokit build-core`` made, by path, with the SHA-256 each build record holds."""
+    found = {}
+    for record_path in sorted(built_cores_dir(data).glob("*.build.json")):
+        try:
+            record = json.loads(record_path.read_text(encoding="utf-8"))
+            core, digest = str(record["core"]), str(record["library_sha256"])
+        except (OSError, ValueError, TypeError, KeyError):
+            continue  # no readable record vouches for nothing
+        fix = f"Build it again: retrokit build-core {core} --force"
+        found[(built_cores_dir(data) / core_filename(core)).resolve()] = Voucher(digest, f"its build record {record_path}", fix)
+    return found
+
+
+def vet_core(core: str | os.PathLike[str], system: str, rom: str | os.PathLike[str]) -> None:
+    """Raise unless ``core`` is safe to load into this process (see the module's docstring).
+
+    Args:
+        core: The core's shared library.
+        system: The system it is loaded for (the probe's child opens the same).
+        rom: The ROM it is loaded with (the probe's child runs it).
+
+    Raises:
+        CoreError: The core is no whole shared library, differs from what its
+            wheel or build recorded, or crashed or hung the probe.
+    """
+    path = Path(core)
+    check_core_file(path)
+    try:
+        key = _stat_key(path)
+        if key in _vetted:
+            return
+        digest = file_sha256(path)
+    except OSError as exc:
+        raise CoreError(f"Expected a readable core at {path}; found an error: {exc.strerror or exc}.") from None
+    vouchers = {**wheel_vouchers(), **built_vouchers()}
+    voucher = vouchers.get(path.resolve())
+    if voucher is not None and voucher.sha256 != digest:
+        raise CoreError(
+            f"{path} is damaged: its SHA-256 is {digest[:16]}..., but {voucher.source} says "
+            f"{voucher.sha256[:16]}.... {voucher.fix}."
+        )
+    if voucher is None and digest not in {v.sha256 for v in vouchers.values()}:
+        verdict = _remembered(digest)
+        if verdict is None:
+            verdict = probe_core(path, system, rom)
+            if verdict.lasting:
+                _remember(digest, verdict)
+        if not verdict.safe:
+            raise CoreError(
+                f"{path} is not a core retrokit can load: {verdict.reason}. Use the stable-retro wheel's core "
+                f"(remove this one from RETROKIT_CORES), or rebuild it; the verdict is kept in {_verdict_file(digest)} "
+                "(delete that file to probe the core again)."
+            )
+    _vetted.add(key)
+
+
+@dataclass(frozen=True)
+class ProbeVerdict:
+    """What probing a core found.
+
+    Attributes:
+        safe: The child loaded it and ran its frames, or refused it with retrokit's own error
+            (which this process will meet the same way, safely).
+        reason: Why it is not safe: the signal, a hang, or the child's last words.
+        lasting: Whether the verdict says something about the core itself (kept), or about this moment (a hang
+            on a loaded machine, a child that could not start: probed again next time).
+    """
+
+    safe: bool
+    reason: str = ""
+    lasting: bool = True
+
+
+def probe_core(core: Path, system: str, rom: str | os.PathLike[str], *, timeout: float = PROBE_TIMEOUT) -> ProbeVerdict:
+    """Load ``core`` with ``rom`` in a child process and run :data:`PROBE_FRAMES` frames; report how it ended."""
+    command = [sys.executable, "-m", "retrokit.host.corecheck", system, os.fspath(rom), os.fspath(core)]
+    root = str(Path(__file__).resolve().parents[2])  # the child imports this same retrokit
+    path = os.environ.get("PYTHONPATH")
+    env = {**os.environ, "PYTHONPATH": root + (os.pathsep + path if path else "")}
+    try:
+        done = subprocess.run(
+            command, capture_output=True, text=True, timeout=timeout, check=False, stdin=subprocess.DEVNULL,
+            preexec_fn=_child_limits, env=env,
+        )  # fmt: skip
+    except subprocess.TimeoutExpired:
+        return ProbeVerdict(False, f"it still ran {timeout:.0f} s after loading (it hangs)", lasting=False)
+    except OSError as exc:
+        return ProbeVerdict(False, f"the probe could not start: {exc.strerror or exc}", lasting=False)
+    if done.returncode in (0, _REFUSED):
+        return ProbeVerdict(True)
+    if done.returncode < 0:
+        name = signal.Signals(-done.returncode).name
+        return ProbeVerdict(False, f"it crashed the probe ({name}) while loading or within {PROBE_FRAMES} frames")
+    last = (done.stderr.strip().splitlines() or ["no message"])[-1]
+    return ProbeVerdict(False, f"the probe failed (exit {done.returncode}: {last})", lasting=False)
+
+
+def _child_limits() -> None:
+    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))  # a crashing probe leaves no core file
+    resource.setrlimit(resource.RLIMIT_AS, (PROBE_ADDRESS_SPACE, PROBE_ADDRESS_SPACE))
+
+
+def _verdict_file(digest: str) -> Path:
+    return data_dir() / "core-probes" / digest
+
+
+def _remembered(digest: str) -> ProbeVerdict | None:
+    try:
+        text = _verdict_file(digest).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return None
+    return ProbeVerdict(True) if text == _SAFE else ProbeVerdict(False, text)
+
+
+def _remember(digest: str, verdict: ProbeVerdict) -> None:
+    try:
+        atomic_write(_verdict_file(digest), (_SAFE if verdict.safe else verdict.reason).encode(), overwrite=True)
+    except RetrokitError:
+        pass  # a read-only data folder: the core is probed again next time, which is only slower
+
+
+def mark_probing(core: Path) -> None:
+    """Let this process load ``core`` unvetted: only the probe's child does, since it is the probe."""
+    _vetted.add(_stat_key(core))
+
+
+def _child(argv: list[str]) -> int:
+    """The probe: open the emulator with the core, run the frames; exit 0, or _REFUSED on retrokit's error."""
+    from retrokit.host.emulator import Emulator
+
+    system, rom, core = argv
+    # Run with -m, this file is __main__: mark the core in the module the emulator calls, not in this copy.
+    importlib.import_module(__spec__.name).mark_probing(Path(core))
+    try:
+        with Emulator(system, rom, core_path=core) as emulator:
+            emulator.run(0, PROBE_FRAMES)
+    except RetrokitError as exc:
+        print(exc, file=sys.stderr)
+        return _REFUSED
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(_child(sys.argv[1:]))

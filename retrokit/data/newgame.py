@@ -154,10 +154,8 @@ def new_game(
         raise FileConflictError(
             f"Expected no folder at {folder} for the new game; found one. Move it away, or pick another name."
         )
-    try:
-        paths.atomic_write(folder / "game.yaml", game_yaml(name, chosen, sha1, Path(rom).name).encode())
-    except FileExistsError:
-        raise FileConflictError(f"Expected no file at {folder / 'game.yaml'}; found one made meanwhile.") from None
+    paths.atomic_write(folder / "game.yaml", game_yaml(name, chosen, sha1, Path(rom).name).encode(),
+                       hint="Pick another name, or work on that game.")
     game = Game(name, (folder,))
     report = import_roms([rom], data_dir=data_dir, games=[game])
     stored = [r.path for r in (*report.imported, *report.already_present)]

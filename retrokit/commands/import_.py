@@ -82,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
         likely = [u for u in report.unmatched if u.system is not None]
         if likely:
             print(f"A game nobody has integrated yet? Start one with: retrokit new {shlex.quote(likely[0].source)} "
-                  f"--name NAME-{likely[0].system} (docs/integrate.md)")
+                  f"--name NAME-{likely[0].system} (retrokit docs integrate)")
         status = 1 if report.conflicts else 0
     if game is not None:
         where, path = rom_status(game, args.data_dir)

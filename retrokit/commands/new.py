@@ -22,7 +22,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "0x100, even as a .bin), else from its extension, else from --system. The game is made in your games "
         "folder, <data>/games/NAME-SYSTEM/ (every command looks there, and in the folders of $RETROKIT_GAMES), "
         "with a game.yaml holding the system and the ROM's SHA-1 and no fields yet; the ROM is imported into "
-        "<data>/roms/NAME-SYSTEM/. The next commands are printed. docs/integrate.md walks through the rest.",
+        "<data>/roms/NAME-SYSTEM/. The next commands are printed; retrokit docs integrate walks through the rest.",
         epilog=EXAMPLES,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -43,10 +43,10 @@ def run(args: argparse.Namespace) -> int:
     print(f"Made {name} ({made.game.system}, told by its {made.told_by}; ROM SHA-1 {made.sha1}):")
     print(f"  game file  {made.folder / 'game.yaml'}")
     print(f"  ROM        {made.rom}")
-    print("Next: a first state, from a recipe in game.yaml (docs/integrate.md: \"Your own game, from a ROM\"), such as")
+    print("Next: a first state, from a recipe in game.yaml (retrokit docs integrate: \"Your own game, from a ROM\"), such as")
     print("  integrate:")
     print("    Level1: {press: [START], frames: 120}")
     print(f"then: retrokit integrate {name}")
-    print(f"      retrokit ramsearch new {name} --state Level1    # find its fields (docs/ramsearch.md)")
+    print(f"      retrokit ramsearch new {name} --state Level1    # find its fields (retrokit docs ramsearch)")
     print(f"      retrokit validate {name}")
     return 0

@@ -173,7 +173,7 @@ def game_yaml(name: str, system: System, sha1: str, source: str) -> str:
     return (
         f"# {name}: made by `retrokit new`. Fields come from ramsearch\n"
         "# (retrokit ramsearch save NAME ADDRESS TYPE), states from recipes or\n"
-        "# ramsearch savestate; the format is in docs/integrate.md.\n"
+        "# ramsearch savestate; the format: retrokit docs integrate.\n"
         f"system: {system.name}\n"
         f"title: {name.rsplit('-', 1)[0]}\n"
         "roms:\n"

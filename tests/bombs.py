@@ -86,3 +86,19 @@ def zip_parts(members: list[Member]) -> list[bytes | int]:
 def zip_bytes(members: list[Member]) -> bytes:
     """The bytes of a zip of ``members``."""
     return b"".join(p if isinstance(p, bytes) else bytes(p * MIB) for p in zip_parts(members))
+
+
+def tar_gz_of_zeros(members: list[tuple[str, int]]) -> bytes:
+    """A .tar.gz whose members (name, MiB of zeros) inflate to their full size; it is about 1 KB a MiB.
+
+    Each piece is a gzip member of its own (gzip allows that): a header, then
+    the zeros from :func:`gzip_of_zeros`, then the two zero blocks that end a tar.
+    """
+    import tarfile
+
+    out = []
+    for name, mib in members:
+        info = tarfile.TarInfo(name)
+        info.size = mib * MIB
+        out += [gzip.compress(info.tobuf(format=tarfile.GNU_FORMAT), mtime=0), gzip_of_zeros(mib)]
+    return b"".join(out) + gzip.compress(bytes(1024), mtime=0)

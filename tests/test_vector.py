@@ -71,7 +71,7 @@ def test_vector_threads_must_be_a_positive_count(threads: object) -> None:
 
 
 def test_vector_needs_at_least_one_env() -> None:
-    with pytest.raises(InvalidArgumentError, match="num_envs of 1 or more"):
+    with pytest.raises(InvalidArgumentError, match="num_envs from 1 to"):
         retrokit.make_vec("Airstriker-Genesis", 0)
 
 

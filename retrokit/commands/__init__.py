@@ -10,6 +10,11 @@ Each module in this package is a command. It defines::
     def run(args: argparse.Namespace) -> int:
         ...  # return the exit status; raise RetrokitError for a clean error message
 
+    EXAMPLES = [  # full command lines, shown at the end of --help; tests/test_cli_teaches.py parses each
+        "retrokit name ARG --option VALUE      # what this does (an optional comment)",
+        "retrokit name sub ARG                  # and one at least for every subcommand",
+    ]
+
 Modules are found automatically (:func:`command_modules`), so adding a command
 means adding a module, nothing else. A module should import heavy things
 (emulators, numpy) inside ``run``, so that ``retrokit --help`` stays fast.

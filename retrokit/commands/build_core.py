@@ -73,3 +73,11 @@ def run(args: argparse.Namespace) -> int:
             bar.pop().close()
     print(path)
     return 0
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit build-core genesis_plus_gx                 # fetch stable-retro's source with pip, build, install",
+    "retrokit build-core genesis_plus_gx --sdist stable_retro-1.0.1.tar.gz   # from a downloaded sdist, offline",
+    "retrokit build-core genesis_plus_gx --index-url https://pypi.example.org/simple --force",
+]

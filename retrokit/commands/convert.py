@@ -1,4 +1,4 @@
-"""``retrokit convert SCENARIO.json [OUT.yaml]``: a Gym Retro scenario as retrokit scenario YAML."""
+"""``retrokit convert SCENARIO.json [OUT]``: a Gym Retro scenario as retrokit scenario YAML."""
 
 from __future__ import annotations
 
@@ -17,8 +17,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "condition (Lua scripts cannot be converted). Without OUT, the YAML goes to standard output. "
         "An existing OUT is never replaced unless --force.",
     )
-    parser.add_argument("source", type=Path, help="the scenario.json")
-    parser.add_argument("out", type=Path, nargs="?", help="the .yaml to write")
+    parser.add_argument("source", type=Path, metavar="SCENARIO.json", help="the Gym Retro scenario to convert")
+    parser.add_argument("out", type=Path, nargs="?", metavar="OUT", help="the .yaml to write")
     add_force_option(parser, "replace OUT if it exists")
     parser.set_defaults(run=run)
 
@@ -37,3 +37,10 @@ def run(args: argparse.Namespace) -> int:
     atomic_write(args.out, text.encode("utf-8"), overwrite=args.force)
     print(f"wrote {args.out}")
     return 0
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit convert scenario.json scenario.yaml      # a Gym Retro scenario as retrokit YAML",
+    "retrokit convert scenario.json                    # print the YAML instead",
+]

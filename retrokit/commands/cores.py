@@ -24,8 +24,9 @@ def run(args: argparse.Namespace) -> int:
     from retrokit.host.systems import all_systems
 
     systems = all_systems()
-    width = max(len(name) for name in systems)
-    core_width = max(len(s.core) for s in systems.values())
+    width = max(len("SYSTEM"), *(len(name) for name in systems))
+    core_width = max(len("CORE"), *(len(s.core) for s in systems.values()))
+    print(f"{'SYSTEM':<{width}}  {'CORE':<{core_width}}  {'FOUND IN':<14}  PATH")
     for name, system in systems.items():
         try:
             found = locate_core(system.core)
@@ -37,3 +38,9 @@ def run(args: argparse.Namespace) -> int:
     print(f"Cores retrokit can build, to skip drawing the frames an env does not show: {buildable} "
           "(retrokit build-core CORE).")
     return 0
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit cores                     # each system's core, and where it was found",
+]

@@ -94,3 +94,10 @@ def run(args: argparse.Namespace) -> int:
         written.append(f"{out / 'jerk-best.gif'} (JERK's best episode, on {best})")
     print("wrote " + "\n      ".join(written))
     return 0
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit demo                                   # the whole demo, into ./retrokit-demo",
+    "retrokit demo --levels Zone1.Act1 --timesteps 2000 --out quick-demo",
+]

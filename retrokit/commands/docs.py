@@ -36,3 +36,11 @@ def run(args: argparse.Namespace) -> int:
         print(f"{topic:<{width}}  {title}")
     print("Print one with: retrokit docs TOPIC")
     return 0
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit docs                      # the guides, and what each covers",
+    "retrokit docs integrate            # print one: integrating a game (states, movies, checks)",
+    "retrokit docs scenarios            # rewards and done conditions",
+]

@@ -12,6 +12,13 @@ from pathlib import Path
 
 from retrokit.commands._common import add_evaluation_options
 
+EXAMPLES = [
+    "retrokit evaluate --benchmark dasher --agent jerk --out runs/jerk",
+    "retrokit evaluate --benchmark sonic --list            # the benchmark's levels",
+    "retrokit evaluate --agent my_agents:make_agent --levels all --workers 2 --out runs/mine --gif",
+    "retrokit evaluate --out runs/mine --resume             # continue an interrupted run",
+]
+
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``evaluate`` command."""

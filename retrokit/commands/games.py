@@ -82,3 +82,11 @@ def scenarios_refused(game: Game) -> list[str]:
         except RetrokitError:
             refused.append(name)
     return refused
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit games                     # every known game",
+    "retrokit games 'Sonic*'            # only the games whose name matches",
+    "retrokit games --imported          # only those whose ROM is here",
+]

@@ -95,3 +95,11 @@ def run(args: argparse.Namespace) -> int:
             print(f"Its ROM is missing: expected at {game.imported_rom_path(args.data_dir)}. "
                   "Import it with: retrokit import /path/to/your/roms")
     return status
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit import ~/roms                              # search a folder (and the .zip files in it)",
+    "retrokit import Sonic.zip Airstriker.md -v",
+    "retrokit import --game SonicTheHedgehog-Genesis     # which ROM that game expects",
+]

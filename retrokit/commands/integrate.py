@@ -70,3 +70,11 @@ def _movie_target(names: list[str], movie: str):  # -> (Game, state name)
     if len(names) == 2:
         return find_game(names[0]), names[1]
     return find_game(read_bk2(movie).game), names[0]
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit integrate Dasher-Genesis                   # every state recipe of the game",
+    "retrokit integrate Dasher-Genesis Zone1.Act1 --force",
+    "retrokit integrate Dasher-Genesis Mine --movie Mine-000000.bk2 --frame 600",
+]

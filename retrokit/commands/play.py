@@ -32,6 +32,11 @@ def run(args: argparse.Namespace) -> int:
     from retrokit.envs.play import PlaySession
 
     game = find_game(args.game)
+    # What only the user can fix comes first: someone without pygame should not install it only to learn
+    # that the ROM is missing or the state unknown (the session needs pygame before it starts the game).
+    game.require_rom()
+    if args.state is not None:
+        game.state_path(args.state)
     folder = Path(args.out) if args.out else target_folder(game)
     session = PlaySession(game, args.state, folder, name=args.name, scale=args.scale)
     try:
@@ -40,3 +45,10 @@ def run(args: argparse.Namespace) -> int:
         session.close()
     print(f"{len(session.saved)} state(s) and {len(session.movies)} movie(s) saved in {folder}")
     return 0
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit play Dasher-Genesis                        # F5 saves a state, F9 records a movie",
+    "retrokit play Airstriker-Genesis --state Level1 --name Mine --scale 3",
+]

@@ -31,3 +31,10 @@ def run(args: argparse.Namespace) -> int:
     count = export(args.movie, args.out, every=args.every, overwrite=args.force, progress=True)
     print(f"Wrote {count} frame{'s' * (count != 1)} of {args.movie} to {args.out}.")
     return 0
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit playback Mine-000000.bk2 mine.gif          # an animated GIF",
+    "retrokit playback Mine-000000.bk2 frames --every 4  # one PNG in 4 into the folder frames",
+]

@@ -350,3 +350,24 @@ def _save(args: argparse.Namespace) -> int:
         path = search.save_field(args.name, address, args.type, game_file=args.game_file, force=args.force)
         print(f"Wrote field {args.name} ({search.layout.format(address)}, {args.type}) into {path}.")
     return 0
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit ramsearch new Dasher-Genesis --state Zone1.Act1",
+    "retrokit ramsearch run --press RIGHT B --frames 60",
+    "retrokit ramsearch run --movie Mine-000000.bk2 --until 300",
+    "retrokit ramsearch filter increased                 # than the previous snapshot",
+    "retrokit ramsearch filter equal 3                   # equal to the number 3",
+    "retrokit ramsearch filter unchanged --than first",
+    "retrokit ramsearch filter greater --than 0xFF0020   # than the value at that address",
+    "retrokit ramsearch filter changed-by 1",
+    "retrokit ramsearch filter greater 2 --than changes  # changed more than twice",
+    "retrokit ramsearch show --limit 50",
+    "retrokit ramsearch undo",
+    "retrokit ramsearch redo",
+    "retrokit ramsearch poke 0xFF002B 5 --type '|u1'",
+    "retrokit ramsearch screenshot poked.png",
+    "retrokit ramsearch save lives 0xFF002B '|u1'",
+    "retrokit ramsearch shell --session dasher.session",
+]

@@ -81,3 +81,11 @@ def own_games() -> list[str]:
 
     wheel = paths.wheel_dir()
     return [g.name for g in list_games() if wheel is None or not g.folders[0].is_relative_to(wheel)]
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit validate Dasher-Genesis                    # one game, by name",
+    "retrokit validate games/MyGame-Genesis --json report.json",
+    "retrokit validate --all --quiet                     # every game, failures only",
+]

@@ -54,6 +54,15 @@ def _players(value: object) -> int:
     return _integer("players", value, 1, 2**16)
 
 
+def check_num_envs(value: object) -> int:
+    """The number of envs of a vector env: a whole number (Python or numpy) from 1 up.
+
+    Raises:
+        InvalidArgumentError: It is not one (``2.5``, ``"2"``, ``True``, ``0``).
+    """
+    return _integer("num_envs", value, 1, MAX_STEPS)
+
+
 def _max_episode_steps(value: object) -> int | None:
     return None if value is None else _integer("max_episode_steps", value, 1, MAX_STEPS)
 

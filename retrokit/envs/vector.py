@@ -29,8 +29,10 @@ from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space, concatenate, create_empty_array, iterate
 
 from retrokit.envs.buffers import BufferPool, Pool, StepArrays
+from retrokit.envs.memory import MIN_ENV_BYTES, build_envs, check_fits
+from retrokit.envs.options import check_num_envs
 from retrokit.envs.stepper import drive
-from retrokit.errors import InvalidArgumentError
+from retrokit.errors import InvalidArgumentError, shown
 from retrokit.host.runner import Runner
 
 
@@ -52,7 +54,7 @@ class ThreadedVectorEnv(VectorEnv):
         if threads is not None and (not isinstance(threads, int) or threads < 1):
             raise InvalidArgumentError(f"Expected threads of 1 or more (or None for one per CPU), got {threads!r}.")
         self.threads = min(len(env_fns), threads or available_cpus())
-        self.envs = [fn() for fn in env_fns]
+        self.envs = build_envs(env_fns)  # refuses a count that would not fit in memory, after two
         self.num_envs = len(self.envs)
         first = self.envs[0]
         for i, env in enumerate(self.envs[1:], 1):
@@ -131,7 +133,7 @@ class ThreadedVectorEnv(VectorEnv):
         if isinstance(actions, np.ndarray) and actions.shape[:1] == (self.num_envs,):
             rows: Sequence[Any] = actions  # row i is env i's action, as iterate() would give it
         else:
-            rows = list(iterate(self.action_space, actions))
+            rows = self._action_rows(actions)
         if self._runner is None:
             results = self._step_threads(rows)
             observations = self._batch([r[0] for r in results])
@@ -147,6 +149,26 @@ class ThreadedVectorEnv(VectorEnv):
         for i, result in enumerate(results):
             infos = self._add_info(infos, result[4], i)
         return observations, rewards, terminations, truncations, infos
+
+    def _action_rows(self, actions: Any) -> list[Any]:
+        """One action per env, from a batch that is not already an array of ``num_envs`` rows.
+
+        Raises:
+            InvalidArgumentError: There are more or fewer actions than envs (once, a length check).
+        """
+        try:
+            rows = list(iterate(self.action_space, actions))
+        except (TypeError, ValueError) as exc:  # a number, None: not a batch at all
+            raise InvalidArgumentError(
+                f"Expected {self.num_envs} actions (one per env, e.g. an array of shape {self.action_space.shape}); "
+                f"found {shown(actions)}, which is not a batch ({exc}). Pass vec.action_space.sample() to see one."
+            ) from None
+        if len(rows) != self.num_envs:
+            raise InvalidArgumentError(
+                f"Expected {self.num_envs} actions (one per env, e.g. an array of shape {self.action_space.shape}); "
+                f"found {len(rows)}. Pass one action for each env, in the envs' order."
+            )
+        return rows
 
     def _fields_step(self, results: list[tuple], observations: Any) -> tuple:
         """The step's arrays, when every env is a one-player RetroEnv whose info is exactly its fields.
@@ -224,7 +246,7 @@ def make_vec(
     """Make ``num_envs`` copies of a game's env stepped on threads (one per CPU unless ``threads`` says)."""
     from retrokit.envs.env import State, make
 
-    if num_envs < 1:
-        raise InvalidArgumentError(f"Expected num_envs of 1 or more, got {num_envs}.")
+    num_envs = check_num_envs(num_envs)
+    check_fits(num_envs, (MIN_ENV_BYTES, MIN_ENV_BYTES), at_least=True)  # before a list of num_envs functions
     start = State.DEFAULT if state is None else state
     return ThreadedVectorEnv([lambda: make(game, start, scenario, **options) for _ in range(num_envs)], threads)

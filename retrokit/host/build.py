@@ -16,24 +16,28 @@ prefers it to the wheel's, with a record of what it was built from.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
 import os
 import re
 import shlex
 import shutil
+import signal
 import subprocess
 import sys
 import tarfile
-import tempfile
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from urllib.parse import urlsplit
 
 from retrokit.errors import (
     BuildToolError,
     CoreBuildError,
     FileConflictError,
+    InvalidArgumentError,
     SourceFetchError,
     SourceNotFoundError,
     UnknownNameError,
@@ -41,9 +45,17 @@ from retrokit.errors import (
 )
 from retrokit.host.cores import build_record_path, built_cores_dir, core_filename, read_build_record
 from retrokit.host.patching import apply_patch
-from retrokit.paths import atomic_write
+from retrokit.host.workdirs import work_folder
+from retrokit.paths import atomic_write, require_regular_file
 
 PATCHES_DIR = Path(__file__).resolve().parent.parent / "native" / "patches"
+
+MIB = 2**20
+# Bounds on the core's folder extracted from an sdist: stable-retro 1.0.1's cores/genesis holds 558 files,
+# 16 MiB in all, the biggest 3.4 MiB; these leave room for growth and none for a bomb.
+MAX_MEMBER_BYTES = 32 * MIB
+MAX_SOURCE_BYTES = 128 * MIB
+MAX_SOURCE_FILES = 10_000
 
 # What stable-retro's CMakeLists.txt passes to every core's makefile with GCC
 # (add_core): warnings off, C17, the C++ runtime linked in.
@@ -54,8 +66,13 @@ WHEEL_MAKE_ENV = {"CFLAGS": "-w -std=gnu17", "CXXFLAGS": "-w", "LDFLAGS": "-w -s
 _NETWORK_FAILURES = (
     "NewConnectionError", "Failed to establish a new connection", "Connection refused", "Network is unreachable",
     "Temporary failure in name resolution", "Name or service not known", "ConnectTimeout", "Read timed out",
-    "Max retries exceeded", "ProxyError", "SSLError", "Could not fetch URL",
+    "Max retries exceeded", "ProxyError", "SSLError", "Could not fetch URL", "ReadTimeoutError",
+    "ConnectTimeoutError", "is either a non-existing path or lacks a specific scheme",
 )  # fmt: skip
+# How long pip waits for any one answer of the index, and for the whole download (150 MB): an index
+# that accepts connections and never answers is given up on, not waited for forever.
+PIP_TIMEOUT = 15.0
+FETCH_DEADLINE = 1800.0
 
 
 @dataclass(frozen=True)
@@ -115,7 +132,13 @@ def check_tools(env: dict[str, str] | None = None) -> tuple[str, str]:
     env = dict(os.environ if env is None else env)
     path = env.get("PATH", "")
     cc = env.get("CC") or "cc"
-    words = shlex.split(cc) or ["cc"]  # CC may carry a wrapper or flags: "ccache gcc"
+    try:
+        words = shlex.split(cc) or ["cc"]  # CC may carry a wrapper or flags: "ccache gcc"
+    except ValueError as exc:  # an unclosed quote or a trailing backslash
+        raise BuildToolError(
+            f"Expected CC to be a command line, as a shell splits it (e.g. 'gcc' or 'ccache gcc'); found {cc!r}, "
+            f"which does not split ({exc}). Fix its quoting, or unset CC to use cc."
+        ) from None
     found_cc, found_make = shutil.which(words[0], path=path), shutil.which("make", path=path)
     for name, found, what in ((words[0], found_cc, "a C compiler"), ("make", found_make, "make")):
         if found is None:
@@ -126,8 +149,59 @@ def check_tools(env: dict[str, str] | None = None) -> tuple[str, str]:
     return shlex.join([found_cc, *words[1:]]), found_make  # type: ignore[list-item,return-value]
 
 
+def check_index_url(url: str) -> str:
+    """Return ``url`` if pip can take it as an index: ``http(s)://host/...`` or ``file:///folder``.
+
+    Raises:
+        InvalidArgumentError: It is not such a URL (pip would ignore it and report no versions at all).
+    """
+    parts = urlsplit(url)
+    if (parts.scheme in ("http", "https") and parts.netloc) or (parts.scheme == "file" and parts.path):
+        return url
+    raise InvalidArgumentError(
+        f"Expected --index-url to be an http(s) or file URL, e.g. https://pypi.org/simple; found {url!r}. "
+        "Pass the index's full URL, or leave --index-url out to use pip's."
+    )
+
+
+@contextlib.contextmanager
+def _killed_after(proc: subprocess.Popen, seconds: float) -> Iterator[threading.Event]:
+    """Kill ``proc``'s process group if it still runs after ``seconds``, or when the block is left early.
+
+    ``proc`` must lead its own session (``start_new_session=True``), so that
+    what it started (pip's build backend, which holds its output open) goes
+    with it. The event yielded is set if the time ran out.
+    """
+    expired = threading.Event()
+
+    def kill() -> None:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)
+
+    def expire() -> None:
+        expired.set()
+        kill()
+
+    timer = threading.Timer(seconds, expire)
+    timer.daemon = True
+    timer.start()
+    try:
+        yield expired
+    finally:
+        timer.cancel()
+        if proc.poll() is None:  # left early (Ctrl-C, an error): pip must not run on alone
+            kill()
+            proc.wait()
+
+
 def fetch_sdist(
-    version: str, dest: Path, *, index_url: str | None = None, progress: Progress = _no_progress
+    version: str,
+    dest: Path,
+    *,
+    index_url: str | None = None,
+    progress: Progress = _no_progress,
+    timeout: float = PIP_TIMEOUT,
+    deadline: float = FETCH_DEADLINE,
 ) -> Path:
     """Download stable-retro's sdist of ``version`` into ``dest`` with pip; return its path.
 
@@ -136,16 +210,24 @@ def fetch_sdist(
     the files pip writes, which it writes into its temporary folder (here a
     folder of ``dest``'s, through ``TMPDIR``) and then into ``dest``.
 
+    Args:
+        version: The stable-retro version.
+        dest: The folder to download into.
+        index_url: The index; by default pip's configuration.
+        progress: Called as the download advances.
+        timeout: Seconds pip waits for any one answer of the index (pip's ``--timeout``).
+        deadline: Seconds the whole download may take; pip is killed past them.
+
     Raises:
         BuildToolError: This Python has no pip.
-        SourceFetchError: The index could not be reached.
+        SourceFetchError: The index could not be reached, or did not answer in time.
         SourceNotFoundError: The index has no sdist of that version.
         CoreBuildError: pip failed otherwise (the message quotes its error and the command to rerun).
     """
     what = [sys.executable, "-m", "pip", "download", "--no-deps", "--no-binary", "stable-retro",
             f"stable-retro=={version}", *(["--index-url", index_url] if index_url is not None else [])]  # fmt: skip
     command = [*what, "-d", str(dest), "--progress-bar", "off", "--retries", "2", "--no-input",
-               "--disable-pip-version-check"]  # fmt: skip
+               "--disable-pip-version-check", "--timeout", f"{timeout:g}"]  # fmt: skip
     where = index_url or "the package index"
     scratch = dest / ".pip-tmp"
     scratch.mkdir(parents=True, exist_ok=True)
@@ -153,13 +235,21 @@ def fetch_sdist(
     try:
         with open(log_path, "w+", encoding="utf-8", errors="replace") as log:
             proc = subprocess.Popen(command, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                    env={**os.environ, "TMPDIR": str(scratch)}, text=True)  # fmt: skip
-            _follow_download(proc, log_path, (scratch, dest), progress)
+                                    env={**os.environ, "TMPDIR": str(scratch)}, text=True,
+                                    start_new_session=True)  # fmt: skip
+            with _killed_after(proc, deadline) as expired:
+                _follow_download(proc, log_path, (scratch, dest), progress)
     except OSError as exc:
         raise BuildToolError(
             f"Expected to run pip ({sys.executable} -m pip); it failed: {exc}. "
             "Download stable-retro's sdist yourself and pass it with --sdist FILE."
         ) from None
+    if expired.is_set():
+        raise SourceFetchError(
+            f"Expected to download stable-retro {version}'s source from {where} within {deadline:g} s; it was not "
+            f"done by then (the index answers too slowly, or not at all), so pip was stopped. Check the network "
+            f"connection (or --index-url), or download the sdist yourself and pass --sdist FILE."
+        )
     lines = log_path.read_text(encoding="utf-8", errors="replace").splitlines()
     found = sorted(dest.glob("stable_retro-*.tar.gz")) + sorted(dest.glob("stable-retro-*.tar.gz"))
     if proc.returncode == 0 and found:
@@ -171,6 +261,19 @@ def fetch_sdist(
         raise BuildToolError(
             f"Expected pip in {sys.executable} to download stable-retro's source; found none. "
             f"Install it ({sys.executable} -m ensurepip), or download the sdist yourself and pass --sdist FILE."
+        )
+    if "ReadTimeoutError" in text or "Read timed out" in text:
+        raise SourceFetchError(
+            f"Expected to download stable-retro {version}'s source from {where}; it accepted the connection but did "
+            f"not answer within {timeout:g} s, three times. Check that the URL is a package index (or "
+            f"--index-url), or download the sdist yourself and pass --sdist FILE."
+        )
+    untrusted = re.search(r"The repository located at (\S+) is not a trusted or secure host", text)
+    if untrusted:
+        raise SourceFetchError(
+            f"Expected to download stable-retro {version}'s source from {where}; pip did not read it, as it reads "
+            f"a plain-http index only on this machine or on a host it is told to trust. Use https, or trust the "
+            f"host: PIP_TRUSTED_HOST={untrusted.group(1)} retrokit build-core ..."
         )
     if any(marker in text for marker in _NETWORK_FAILURES):
         reason = next(line for line in lines if any(m in line for m in _NETWORK_FAILURES))
@@ -239,16 +342,23 @@ def _shorten(text: str, limit: int = 200) -> str:
 def unpack_core_source(sdist: Path, folder: str, dest: Path, *, progress: Progress = _no_progress) -> Path:
     """Extract only ``folder`` (e.g. ``cores/genesis``) of the sdist into ``dest``; return where it is.
 
+    What is extracted is bounded (:data:`MAX_MEMBER_BYTES` a file, :data:`MAX_SOURCE_BYTES` and
+    :data:`MAX_SOURCE_FILES` in all), by the sizes the archive declares, before a byte is written.
+
     Raises:
-        CoreBuildError: The sdist is unreadable or has no such folder.
+        FileSystemError: ``sdist`` is missing, or not a regular file (a FIFO would block forever).
+        CoreBuildError: The sdist is unreadable, has no such folder, or its folder is over the bounds.
     """
+    require_regular_file(sdist, "a stable-retro sdist (.tar.gz)")
     try:
         with tarfile.open(sdist, "r:gz") as tar:
-            members = []
+            members, total = [], 0
             for member in tar:
                 rest = member.name.partition("/")[2]
                 if rest == folder or rest.startswith(folder + "/"):
                     members.append(member)
+                    total += member.size
+                    _check_bounds(sdist, member, len(members), total)
             if not members:
                 raise CoreBuildError(f"Expected {folder}/ in {sdist.name}; found no such folder. Is it stable-retro's sdist?")
             for i, member in enumerate(members, 1):
@@ -257,6 +367,24 @@ def unpack_core_source(sdist: Path, folder: str, dest: Path, *, progress: Progre
     except (tarfile.TarError, OSError, EOFError) as exc:
         raise CoreBuildError(f"Expected a readable .tar.gz at {sdist}; reading it failed: {exc}.") from None
     return dest / members[0].name.partition("/")[0] / folder
+
+
+def _check_bounds(sdist: Path, member: tarfile.TarInfo, count: int, total: int) -> None:
+    """Refuse a core folder bigger than any real one (an archive bomb fills the disk, not the source tree)."""
+    over = (
+        f"{member.name} of {member.size / MIB:,.0f} MiB (at most {MAX_MEMBER_BYTES // MIB} MiB a file)"
+        if member.size > MAX_MEMBER_BYTES
+        else f"{total / MIB:,.0f} MiB in all (at most {MAX_SOURCE_BYTES // MIB} MiB)"
+        if total > MAX_SOURCE_BYTES
+        else f"more than {MAX_SOURCE_FILES:,} files"
+        if count > MAX_SOURCE_FILES
+        else None
+    )
+    if over is not None:
+        raise CoreBuildError(
+            f"Expected a core's source in {sdist.name}, as in stable-retro's sdist (16 MiB, 558 files for "
+            f"genesis_plus_gx); found {over}, so nothing was extracted past it. Use stable-retro's own sdist."
+        )
 
 
 def patch_text(recipe: Recipe) -> str:
@@ -362,6 +490,7 @@ def build_core(
     force: bool = False,
     progress: Progress = _no_progress,
     step: Callable[[str], None] = lambda message: None,
+    **fetch_limits: float,
 ) -> Path:
     """Fetch, patch, build and install a core; return the installed library.
 
@@ -375,6 +504,7 @@ def build_core(
             core in the way that ``build-core`` did not make.
         progress: Called as steps advance: ``(what, done, total)``.
         step: Called with a line saying what happens next.
+        fetch_limits: ``timeout`` and ``deadline`` of :func:`fetch_sdist`, in seconds.
 
     Raises:
         CoreBuildError: A tool is missing, the index is unreachable or has no
@@ -383,6 +513,8 @@ def build_core(
     from retrokit.host.cores import stable_retro_version
 
     recipe = recipe_for(core)
+    if index_url is not None and sdist is None:
+        check_index_url(index_url)
     version = version or stable_retro_version()
     if version is None:
         raise SourceNotFoundError(
@@ -395,11 +527,10 @@ def build_core(
         return current
     check_target(recipe, data, force=force)
     cc, _ = check_tools()
-    with tempfile.TemporaryDirectory(prefix="retrokit-build-") as tmp:
-        work = Path(tmp)
+    with work_folder() as work:  # removes the folders of builds that were killed, too
         if sdist is None:
             step(f"Fetching stable-retro {version}'s source from {index_url or 'the package index'} (about 150 MB)")
-            sdist = fetch_sdist(version, work / "sdist", index_url=index_url, progress=progress)
+            sdist = fetch_sdist(version, work / "sdist", index_url=index_url, progress=progress, **fetch_limits)
         step(f"Unpacking {recipe.folder}/ from {sdist.name}")
         source = unpack_core_source(sdist, recipe.folder, work / "src", progress=progress)
         step(f"Applying {recipe.patch}")

@@ -6,11 +6,6 @@ import argparse
 
 from retrokit.commands._common import add_data_dir_option
 
-EXAMPLES = """examples:
-  retrokit new ~/roms/runner.bin --name Runner-Genesis
-  retrokit new ~/roms/mystery.rom --name Mystery-Nes --system Nes
-"""
-
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``new`` command."""
@@ -23,8 +18,6 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "folder, <data>/games/NAME-SYSTEM/ (every command looks there, and in the folders of $RETROKIT_GAMES), "
         "with a game.yaml holding the system and the ROM's SHA-1 and no fields yet; the ROM is imported into "
         "<data>/roms/NAME-SYSTEM/. The next commands are printed; retrokit docs integrate walks through the rest.",
-        epilog=EXAMPLES,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("rom", metavar="ROM", help="the ROM file")
     parser.add_argument("--name", required=True, metavar="NAME-SYSTEM",
@@ -50,3 +43,10 @@ def run(args: argparse.Namespace) -> int:
     print(f"      retrokit ramsearch new {name} --state Level1    # find its fields (retrokit docs ramsearch)")
     print(f"      retrokit validate {name}")
     return 0
+
+
+#: Full command lines, shown at the end of --help (retrokit/cli.py); tests/test_cli_teaches.py parses each.
+EXAMPLES = [
+    "retrokit new ~/roms/runner.bin --name Runner-Genesis",
+    "retrokit new ~/roms/mystery.rom --name Mystery-Nes --system Nes   # header and extension tell nothing",
+]

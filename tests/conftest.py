@@ -32,8 +32,11 @@ def airstriker_rom(airstriker_dir: Path) -> Path:
 
 @pytest.fixture(scope="session")
 def airstriker_state(airstriker_dir: Path) -> bytes:
-    """Airstriker's Level1 state, uncompressed."""
-    return gzip.decompress((airstriker_dir / "Level1.state").read_bytes())
+    """Airstriker's Level1 state, uncompressed, checked (the wheel ships it: no probe) so an emulator loads it."""
+    from retrokit.data.statecheck import vet_state
+
+    path = airstriker_dir / "Level1.state"
+    return vet_state(gzip.decompress(path.read_bytes()), "Genesis", airstriker_dir / "rom.md", shipped=path)
 
 
 @pytest.fixture(scope="session")

@@ -99,7 +99,9 @@ def test_validate_names_the_fields_of_another_games_state_out_of_range(copy, air
 def test_validate_catches_a_state_saved_on_another_games_rom(copy, airstriker_dir, airstriker_rom):
     """Saved with Airstriker's ROM by a tool that records nothing: only the ranges can tell."""
     with retrokit.Emulator("Genesis", airstriker_rom) as emu:
-        emu.set_state(gzip.decompress((airstriker_dir / "Level1.state").read_bytes()))
+        from retrokit.data.statecheck import load_state
+
+        emu.set_state(load_state(find_game("Airstriker-Genesis"), airstriker_dir / "Level1.state"))
         emu.run([0, 0], 10)
         write_state(copy / "Saved.state", emu.get_state())
     report = check_game(GAME, frames=30)

@@ -12,7 +12,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from retrokit.errors import CoreError, CoreNotFoundError, InvalidArgumentError, StateError, UnknownNameError
+from retrokit.data.statecheck import vet_state
+from retrokit.errors import (
+    CoreError,
+    CoreNotFoundError,
+    InvalidArgumentError,
+    RetrokitError,
+    StateError,
+    UnknownNameError,
+)
 from retrokit.host.emulator import Emulator
 from retrokit.host.systems import get_system
 from retrokit.native import _host
@@ -108,10 +116,11 @@ def test_same_inputs_give_identical_ram_and_screen(airstriker_rom: Path, airstri
 CHILD = """
 import gzip, hashlib, sys
 import numpy as np
+from retrokit.data.statecheck import vet_state
 from retrokit.host.emulator import Emulator
 from tests.test_host import play, script
 emu = Emulator("Genesis", sys.argv[1])
-emu.set_state(gzip.decompress(open(sys.argv[2], "rb").read()))
+emu.set_state(vet_state(gzip.decompress(open(sys.argv[2], "rb").read()), "Genesis", sys.argv[1], shipped=sys.argv[2]))
 emu.set_sticky(0.25, 7)
 play(emu, script(300, 1))
 print(hashlib.sha1(emu.ram.tobytes() + emu.screen().tobytes()).hexdigest())
@@ -135,7 +144,7 @@ def test_runs_are_identical_across_processes(airstriker_rom: Path, airstriker_di
         play(emu, script(100, 2))
         expected = digest(emu)
     with Emulator("Genesis", airstriker_rom) as other:
-        other.set_state((tmp_path / "s").read_bytes())
+        other.set_state(vet_state((tmp_path / "s").read_bytes(), "Genesis", airstriker_rom))  # probed: not ours
         play(other, script(100, 2))
         assert digest(other) == expected
 
@@ -286,14 +295,40 @@ def test_an_emulator_used_from_two_threads_at_once_raises(airstriker: Emulator) 
 # --- bad input ---------------------------------------------------------------------------------------
 
 
-def test_truncated_state_is_a_clear_error(airstriker: Emulator, airstriker_state: bytes) -> None:
+def test_truncated_state_is_a_clear_error(airstriker_rom: Path, airstriker_state: bytes) -> None:
     with pytest.raises(StateError, match=rf"expected a state of {len(airstriker_state)} bytes.*got 1000 bytes.*truncated"):
-        airstriker.set_state(airstriker_state[:1000])
+        vet_state(airstriker_state[:1000], "Genesis", airstriker_rom)  # the probe's child says what the core refused
 
 
-def test_corrupt_state_of_the_right_size_is_refused(airstriker: Emulator, airstriker_state: bytes) -> None:
+def test_corrupt_state_of_the_right_size_is_refused(airstriker_rom: Path, airstriker_state: bytes) -> None:
     with pytest.raises(StateError, match="refused the state"):
-        airstriker.set_state(b"\xff" * len(airstriker_state))
+        vet_state(b"\xff" * len(airstriker_state), "Genesis", airstriker_rom)
+
+
+@pytest.mark.parametrize(
+    "state", [None, b"", "a string", bytearray(8)], ids=["none", "empty-bytes", "string", "bytearray"]
+)
+def test_set_state_takes_only_a_checked_state(airstriker: Emulator, state: object) -> None:
+    with pytest.raises(StateError, match="Expected a checked state .* found (None|bytes|str|bytearray)"):
+        airstriker.set_state(state)  # type: ignore[arg-type]
+
+
+def test_a_checked_state_cannot_be_made_directly(airstriker_state: bytes) -> None:
+    from retrokit.host.emulator import VettedState, claim_mint
+
+    with pytest.raises(StateError, match="made directly as VettedState"):
+        VettedState(bytes(airstriker_state), "Genesis")
+    with pytest.raises(RetrokitError, match="claimed already"):
+        claim_mint()  # retrokit.data.probe holds it
+
+
+def test_a_slice_or_a_pickle_of_a_checked_state_is_unchecked(airstriker: Emulator, airstriker_state: bytes) -> None:
+    import pickle
+
+    for copy in (airstriker_state[:], pickle.loads(pickle.dumps(airstriker_state)), bytes(airstriker_state)):
+        assert copy == airstriker_state
+        with pytest.raises(StateError, match="Expected a checked state"):
+            airstriker.set_state(copy)
 
 
 def test_wrong_screen_buffer_says_what_shape_it_needs(airstriker: Emulator) -> None:
@@ -458,3 +493,14 @@ def test_libc_rand_in_the_process_does_not_reach_the_cores(airstriker_rom: Path)
     libc = ctypes.CDLL(None)
     untouched = reset_after(None)
     assert [reset_after(seed) for seed in (42, 4242, 12345)] == [untouched] * 3
+
+
+def test_a_packed_state_unpacks_checked_and_cannot_be_made_directly(airstriker: Emulator) -> None:
+    from retrokit.host.emulator import PackedState
+
+    state = airstriker.get_state()
+    packed = state.pack()
+    assert len(packed) < len(state) and packed.unpack() == state
+    airstriker.set_state(packed.unpack())
+    with pytest.raises(StateError, match="made directly as PackedState"):
+        PackedState(b"x", "Genesis")

@@ -10,6 +10,7 @@ import pytest
 from retrokit.cli import main
 from retrokit.data.games import find_game, load_game
 from retrokit.data.integrate import integrate, make_state, recipes
+from retrokit.data.statecheck import vet_state
 from retrokit.data.states import read_state
 from retrokit.errors import DataFileError, StateError, StateNotFoundError
 from retrokit.host.emulator import Emulator
@@ -30,7 +31,7 @@ def dasher_copy(tmp_path: Path) -> Path:
 
 def fields_after(game, state: bytes) -> dict[str, int]:
     with Emulator(game.system, game.require_rom()) as emu:
-        emu.set_state(state)
+        emu.set_state(vet_state(state, game.system, game.require_rom()))
         return FieldReader(game.fields, emu.space).read()
 
 

@@ -16,6 +16,7 @@ import pytest
 import retrokit
 from retrokit.cli import main
 from retrokit.data.games import find_game
+from retrokit.data.statecheck import vet_state
 from retrokit.data.states import read_state
 from retrokit.errors import DataFileError
 from retrokit.host.emulator import Emulator
@@ -43,7 +44,7 @@ def snapshot(*folders: Path) -> dict[str, tuple[int, int]]:
 
 def ram_of(state: bytes) -> bytes:
     with Emulator("Genesis", DASHER / "rom.md") as emu:
-        emu.set_state(state)
+        emu.set_state(vet_state(state, "Genesis", DASHER / "rom.md"))
         return bytes(np.asarray(emu.ram))
 
 
@@ -108,7 +109,7 @@ def test_a_movie_made_state_is_what_playback_reaches(data: Path, frame: int | No
         reached = bytes(np.asarray(emu.ram))
     assert ram_of(made) == reached
     with Emulator("Genesis", DASHER / "rom.md") as emu:  # and it is where the movie says: cleared, or on the way
-        emu.set_state(made)
+        emu.set_state(vet_state(made, "Genesis", DASHER / "rom.md"))
         assert emu.peek(0xFF0003) == (0 if frame else 1)  # level_done
 
 

@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from retrokit.cli import main
+from retrokit.data.statecheck import vet_state
 from retrokit.errors import FileConflictError, InvalidArgumentError, MovieError
 from retrokit.host.emulator import Emulator
 from retrokit.host.systems import get_system
@@ -114,7 +115,7 @@ def test_a_retrokit_movie_plays_in_stable_retro(tmp_path: Path, airstriker_rom: 
     assert movie.get_state() == airstriker_state
     reference = stable_retro.RetroEmulator(str(airstriker_rom))
     try:
-        reference.set_state(movie.get_state())
+        reference.set_state(vet_state(movie.get_state(), "Genesis", airstriker_rom))
         theirs = []
         for step, mask in enumerate(masks):
             assert movie.step(), f"stable-retro's movie ended at frame {step} of {len(masks)}"

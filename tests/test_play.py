@@ -11,7 +11,7 @@ import pytest
 pygame = pytest.importorskip("pygame")
 
 from retrokit.data.games import find_game
-from retrokit.data.states import read_state
+from retrokit.data.statecheck import load_state
 from retrokit.envs.play import PlaySession
 from retrokit.host.emulator import Emulator
 from retrokit.movie import play, read_bk2
@@ -58,10 +58,10 @@ def test_keys_save_a_state_and_record_a_movie_that_replays_to_it(tmp_path: Path)
         for _ in play(movie, emulator=emu):
             pass
         replayed = bytes(np.asarray(emu.ram))
-        emu.set_state(read_state(session.saved[0]))
+        emu.set_state(load_state(game, session.saved[0]))
         assert emu.peek(0xFF0020, ">i2") > 48 + 150  # player 1 ran right
     with Emulator("Genesis", game.require_rom()) as emu:
-        emu.set_state(read_state(session.saved[1]))
+        emu.set_state(load_state(game, session.saved[1]))
         assert bytes(np.asarray(emu.ram)) == replayed  # the movie ends where the second state was saved
 
 

@@ -317,25 +317,24 @@ def test_the_shell_runs_subcommands_line_by_line(tmp_path):
 
 
 def test_a_session_whose_state_changed_is_probed_before_it_is_loaded(session, capsys, monkeypatch):
-    from retrokit.data import statecheck
-    from retrokit.errors import StateError
+    from retrokit.data import probe
 
     probed = []
 
-    def crashing_probe(data, system, rom, rom_sha1, *, source):
-        probed.append(source)
-        raise StateError(f"{source}: expected a state the core can run; found one that kills it (SIGSEGV).")
+    def crashing_probe(data, system, rom, **kwargs):
+        probed.append(len(data))
+        return probe.ProbeVerdict(False, "the emulator crashed (SIGSEGV) within 600 frames of loading it")
 
-    monkeypatch.setattr(statecheck, "vet_state", crashing_probe)
-    assert run(capsys, "show")[0] == 0 and probed == []  # the state this tool wrote is trusted
+    monkeypatch.setattr(probe, "probe_state", crashing_probe)
+    assert run(capsys, "show")[0] == 0 and probed == []  # the state this tool wrote (and noted as written)
     with np.load(session) as archive:
         arrays = dict(archive)
-    meta = json.loads(bytes(arrays["meta"]))
-    meta["state_sha256"] = "0" * 64  # as if the state's bytes had been edited since
-    arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
+    body = bytearray(arrays["emulator_state"].tobytes())
+    body[4096:8192] = bytes(4096)  # its bytes edited since; the record in the meta still vouches for the old ones
+    arrays["emulator_state"] = np.frombuffer(bytes(body), dtype=np.uint8)
     tampered = session.with_name("tampered.session")
     with tampered.open("wb") as out:
         np.savez_compressed(out, **arrays)
     status, _, err = run(capsys, "show", "--session", str(tampered))
-    assert probed == [str(tampered)]
+    assert probed == [len(body)]
     assert status == 2 and "SIGSEGV" in err and err.count("\n") == 1

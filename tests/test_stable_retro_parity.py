@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from retrokit.data.statecheck import vet_state
 from retrokit.host.emulator import Emulator
 from retrokit.host.fields import FieldSpec
 from retrokit.host.memory import FieldReader
@@ -29,7 +30,7 @@ def test_airstriker_fields_and_frames_match_stable_retro(airstriker_fields: dict
         env.reset(seed=0)
         reference = env.unwrapped
         ours = Emulator("Genesis", reference.romfile if hasattr(reference, "romfile") else _rom_path())
-        ours.set_state(reference.em.get_state())
+        ours.set_state(vet_state(reference.em.get_state(), "Genesis", ours.rom))  # stable-retro's: probed once
         reader = FieldReader(
             [FieldSpec(name, spec["address"], spec["type"]) for name, spec in airstriker_fields.items()], ours.space
         )
@@ -86,5 +87,5 @@ def test_sonic_state_is_accepted_by_the_core_unchanged(genesis: Emulator, state:
     # Without the Sonic ROM, the most we can show is that Genesis Plus GX takes
     # the state as it is: the right size, a valid header, restored without error.
     data = gzip.decompress(state.read_bytes())
-    genesis.set_state(data)
+    genesis.set_state(vet_state(data, "Genesis", genesis.rom, shipped=state))  # the wheel ships it: no probe
     assert genesis.get_state()[:16] == data[:16]

@@ -50,7 +50,6 @@ Usage: python tools/bench_env.py [--ticks 4] [--burst 25] [--rounds 25] [--many 
 from __future__ import annotations
 
 import argparse
-import gzip
 import statistics
 import sys
 import time
@@ -59,6 +58,8 @@ from collections.abc import Callable
 import numpy as np
 
 import retrokit
+from retrokit.data.games import find_game
+from retrokit.data.statecheck import load_state
 from retrokit.host.cores import locate_core, wheel_core
 from retrokit.host.emulator import Emulator
 from retrokit.native import _host
@@ -206,7 +207,7 @@ def main() -> int:
     args = parser.parse_args()
 
     folder = wheel_dir() / "data" / "stable" / "Airstriker-Genesis-v0"
-    state = gzip.decompress((folder / "Level1.state").read_bytes())
+    state = load_state(find_game(GAME), folder / "Level1.state")  # the wheel's: no probe
     env = retrokit.make(GAME, **OPTIONS)
     vec = retrokit.make_vec(GAME, 2, **OPTIONS)
     episode = episode_length(env)

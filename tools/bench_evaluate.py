@@ -39,12 +39,12 @@ TARGET, CEILING_SHARE = 1.8, 0.95
 def bare(states: list[str], steps: int, start, done) -> None:  # two multiprocessing primitives
     """A process of bare emulators: ``steps`` 4-frame steps from each state, after ``start``; put the seconds."""
     from retrokit.data.games import find_game
-    from retrokit.data.states import read_state
+    from retrokit.data.statecheck import load_state
     from retrokit.host.emulator import Emulator
 
     game = find_game("Dasher-Genesis")
     emulator = Emulator(game.system, game.require_rom())
-    blobs = [read_state(game.state_path(state)) for state in states]
+    blobs = [load_state(game, game.state_path(state)) for state in states]
     start.wait()
     began = time.perf_counter()
     for blob in blobs:

@@ -14,13 +14,14 @@ Usage: python tools/bench_host.py [--frames 4000] [--repeats 7] [--check]
 from __future__ import annotations
 
 import argparse
-import gzip
 import statistics
 import sys
 import time
 
 import numpy as np
 
+from retrokit.data.games import find_game
+from retrokit.data.statecheck import load_state
 from retrokit.host.emulator import Emulator
 from retrokit.paths import wheel_dir
 
@@ -35,7 +36,7 @@ def main() -> int:
     args = parser.parse_args()
 
     folder = wheel_dir() / "data" / "stable" / "Airstriker-Genesis-v0"
-    state = gzip.decompress((folder / "Level1.state").read_bytes())
+    state = load_state(find_game("Airstriker-Genesis"), folder / "Level1.state")  # the wheel's: no probe
     emu = Emulator("Genesis", folder / "rom.md")
     actions = np.zeros(emu.ports, dtype=np.uint16)
     calls = args.frames // 4

@@ -17,14 +17,13 @@ from __future__ import annotations
 
 import argparse
 import sys
-import zlib
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO))
 
 from retrokit.data.games import find_game
-from retrokit.data.states import read_state
+from retrokit.data.statecheck import load_state
 from retrokit.host.emulator import Emulator
 from retrokit.host.memory import FieldReader
 from retrokit.movie import Movie, write_bk2
@@ -76,7 +75,7 @@ class BacktrackingAgent:
         # A position reached once (same place, speed, rings) is not searched again:
         # without this, every backtrack re-explores the same ground.
         seen: set[tuple[int, ...]] = set()
-        stack = [[zlib.compress(self.emu.get_state(), 1), 0, 0, 0]]  # state, next pattern, frames so far, waits
+        stack = [[self.emu.get_state().pack(), 0, 0, 0]]  # state, next pattern, frames so far, waits
         for _ in range(max_nodes):
             if not stack:
                 break
@@ -87,7 +86,7 @@ class BacktrackingAgent:
             if index >= len(self.patterns):
                 stack.pop()  # its parent already moved on to its next pattern
                 continue
-            self.emu.set_state(zlib.decompress(state))
+            self.emu.set_state(state.unpack())
             del frames[length:]
             still = index == self.wait
             node[1] += 1
@@ -98,13 +97,13 @@ class BacktrackingAgent:
                 key = (v["p1_x"], v["p1_y"], v["p1_vx"], v["p1_vy"], v["p1_rings"], v["p1_invuln"], v["frame"] if still else 0)
                 if key not in seen:
                     seen.add(key)
-                    stack.append([zlib.compress(self.emu.get_state(), 1), 0, len(frames), waits + 1 if still else 0])
+                    stack.append([self.emu.get_state().pack(), 0, len(frames), waits + 1 if still else 0])
         raise RuntimeError(f"no way to clear the act found (reached x = {self.reader.read()['p1_x']})")
 
 
 def solve(game, state: str) -> Movie:
     """Play the act from its state until it is cleared; return the movie of it."""
-    start = read_state(game.state_path(state))
+    start = load_state(game, game.state_path(state))
     with Emulator(game.system, game.require_rom()) as emu:
         emu.set_sticky(0.0, 0)
         emu.set_state(start)

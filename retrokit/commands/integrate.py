@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -30,9 +31,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """Integrate the states; exit 1 if any differs from what was made."""
-    from pathlib import Path
-
-    from retrokit.data.integrate import integrate, place_state, resolve, target_folder
+    from retrokit.data.integrate import integrate, place_state, target_folder
     from retrokit.errors import InvalidArgumentError
     from retrokit.movie.playback import state_from_movie
 
@@ -42,6 +41,11 @@ def run(args: argparse.Namespace) -> int:
         )
     if args.frame is not None and not args.movie:
         raise InvalidArgumentError("Expected --frame only with --movie FILE.bk2; found it alone.")
+    if args.state and args.movie:
+        raise InvalidArgumentError(
+            f"Expected --state or --movie, not both; found --state {args.state[0]} with --movie {args.movie}. "
+            f"To make a state from the movie, name it: retrokit integrate [GAME] NAME --movie {args.movie}"
+        )
     out = Path(args.out) if args.out else None
     if args.movie:
         game, name = _movie_target(args.names, args.movie)
@@ -65,8 +69,10 @@ def run(args: argparse.Namespace) -> int:
 def _movie_target(names: list[str], movie: str):  # -> (Game, state name)
     """The game and state name of ``integrate [GAME] NAME --movie FILE``: the game defaults to the movie's."""
     from retrokit.data.games import find_game
+    from retrokit.data.names import check_state_name
     from retrokit.movie import read_bk2
 
+    check_state_name(names[-1])  # before the movie is replayed: the name becomes a file name
     if len(names) == 2:
         return find_game(names[0]), names[1]
     return find_game(read_bk2(movie).game), names[0]
@@ -78,3 +84,40 @@ EXAMPLES = [
     "retrokit integrate Dasher-Genesis Zone1.Act1 --force",
     "retrokit integrate Dasher-Genesis Mine --movie Mine-000000.bk2 --frame 600",
 ]
+
+
+def resolve(first: str, second: str | None = None, *, cwd: Path | None = None):  # -> (Game, list[str] | None)
+    """Which game and states ``retrokit integrate FIRST [SECOND]`` means.
+
+    ``GAME STATE`` is that state of that game; ``GAME`` alone is all its recipes.
+    A lone ``STATE`` belongs to the one known game that has a state file or a
+    recipe of that name, else to the game.yaml in ``cwd``.
+
+    Raises:
+        UnknownNameError: Several games have that state, or none does and ``cwd`` has no game.yaml.
+    """
+    from retrokit.data.games import find_game, list_games, normalize_name
+    from retrokit.data.integrate import games_with_state
+    from retrokit.errors import GameNotFoundError, UnknownNameError, did_you_mean
+
+    cwd = Path.cwd() if cwd is None else cwd
+    if second is not None:
+        return find_game(cwd if first == "." else first), [second]
+    names = {g.name for g in list_games()}
+    if normalize_name(first) in names:
+        return find_game(first), None
+    owners = games_with_state(first)
+    if len(owners) == 1:
+        return find_game(owners[0]), [first]
+    if len(owners) > 1:
+        raise UnknownNameError(
+            f"Expected one game with a state or recipe named {first!r}; found {len(owners)}: {', '.join(owners)}. "
+            f"Name the game: retrokit integrate {owners[0]} {first}"
+        )
+    if (cwd / "game.yaml").is_file():
+        return find_game(cwd), [first]
+    raise GameNotFoundError(
+        f"Expected a game name, or a state or recipe that one known game has; found {first!r}, which no game "
+        f"has, and no game.yaml in {cwd} to make it for. Name the game: retrokit integrate GAME {first}"
+        + did_you_mean(first, names)
+    )

@@ -366,7 +366,9 @@ def list_games(pattern: str | None = None) -> list[Game]:
 
 
 def load_game(folder: str | os.PathLike[str], *extra_folders: str | os.PathLike[str]) -> Game:
-    """Load and check the game in ``folder`` (either format), with optional extra state folders.
+    """Load and check the game in the folder ``folder`` only (either format), with optional extra state folders.
+
+    To turn what a user typed (a name or a folder) into a game, use :func:`find_game`.
 
     Raises:
         GameNotFoundError: ``folder`` holds no data file.
@@ -381,21 +383,34 @@ def load_game(folder: str | os.PathLike[str], *extra_folders: str | os.PathLike[
     return Game(normalize_name(folder.resolve().name), (folder, *map(Path, extra_folders))).check()
 
 
-def find_game(name: str) -> Game:
-    """Return the game called ``name`` (``"Airstriker-Genesis"`` or ``"Airstriker-Genesis-v0"``).
+def find_game(name: Game | str | os.PathLike[str], *, check: bool = True) -> Game:
+    """The one answer to "which game does this mean": a :class:`Game`, a name, or a game folder.
 
-    Its data files are read and checked now. A path to a game folder also works.
+    A name is ``"Airstriker-Genesis"`` or ``"Airstriker-Genesis-v0"``, looked
+    up in the search folders first; else a folder holding a data file
+    (``game.yaml``, or ``data.json`` and ``rom.sha``: ``.`` is the current one)
+    is that folder's game.
+
+    Args:
+        name: The game, its name, or its folder.
+        check: Read and check its data files now (``retrokit validate`` checks them as a step of its own).
 
     Raises:
-        GameNotFoundError: No search folder holds a game of that name.
-        DataFileError: The game's data file is malformed.
+        GameNotFoundError: No search folder holds a game of that name, and it is no game folder.
+        DataFileError: The game's data file is malformed (with ``check``).
     """
+    if isinstance(name, Game):
+        return name.check() if check else name
+    name = os.fspath(name)
     index = _index()
     key = normalize_name(name)
     if key in index:
-        return Game(key, index[key]).check()
-    if (os.sep in name or "/" in name) and Path(name).is_dir():
-        return load_game(name)
+        game = Game(key, index[key])
+        return game.check() if check else game
+    folder = Path(name)
+    if folder.is_dir() and _is_game_folder(folder):
+        game = Game(normalize_name(folder.resolve().name), (folder,))
+        return game.check() if check else game
     searched = ", ".join(str(d) for d in paths.game_search_dirs()) or "(none: is stable-retro installed?)"
     missing = [str(d) for d in paths.env_games_dirs() if not d.is_dir()]
     note = f" {paths.GAMES_ENV} names folders that do not exist: {', '.join(missing)}." if missing else ""

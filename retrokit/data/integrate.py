@@ -38,20 +38,20 @@ from typing import Any
 import numpy as np
 
 from retrokit import paths
-from retrokit.data.games import Game, cached_rom_sha1, find_game, list_games, load_game, normalize_name
-from retrokit.data.statecheck import load_state
+from retrokit.data.games import Game, cached_rom_sha1, list_games
+from retrokit.data.names import check_state_name
+from retrokit.data.statecheck import check_state, load_state, remember_written
 from retrokit.data.states import StateRecord, write_state
 from retrokit.errors import (
     DataFileError,
-    GameNotFoundError,
     InvalidArgumentError,
     RetrokitError,
+    RomNotFoundError,
     StateError,
     StateNotFoundError,
-    UnknownNameError,
     did_you_mean,
 )
-from retrokit.host.emulator import Emulator
+from retrokit.host.emulator import Emulator, VettedState
 from retrokit.host.memory import FieldReader
 
 HOLD_FRAMES = 2  # a press is held this long, then released as long, until arrival
@@ -202,7 +202,7 @@ def _count(where: str, key: str, value: Any, least: int) -> int:
     return number
 
 
-def make_state(game: Game, recipe: Recipe) -> bytes:
+def make_state(game: Game, recipe: Recipe) -> VettedState:
     """Play a recipe from power-on and return the state it reaches.
 
     An ``until`` recipe plays until its fields hold their values (at most
@@ -245,7 +245,7 @@ def _not_arrived(game: Game, recipe: Recipe, values: Mapping[str, int]) -> None:
     )
 
 
-def fingerprint(game: Game, state: bytes) -> str:
+def fingerprint(game: Game, state: VettedState) -> str:
     """A digest of where a state leads: RAM and screen after some idle frames."""
     with Emulator(game.system, game.require_rom()) as emu:
         emu.set_state(state)
@@ -278,7 +278,16 @@ def integrate(
         it does not match its recipe, ``"damaged"`` that it was kept although it
         is not a state the core can load (rerun with ``force`` to replace either).
     """
+    for name in names or []:
+        check_state_name(name)
     known = recipes(game)
+    shipped = [n for n in names or [] if n not in known and n in game.states]
+    if shipped and game.rom_path() is None:  # nothing to make: the state is there, the ROM is what is missing
+        raise RomNotFoundError(
+            f"Expected {game.name}'s ROM to integrate {', '.join(shipped)}; found the state shipped with the game "
+            f"({game.state_path(shipped[0])}) but no ROM. Import the ROM, then the state plays as it is: "
+            "retrokit import /path/to/your/roms"
+        )
     if not known:
         raise StateNotFoundError(
             f"Expected state recipes under 'integrate' in {game.info.source}; found none. "
@@ -305,7 +314,11 @@ def place_state(game: Game, name: str, state: bytes, folder: Path, *, force: boo
         ``"differs"`` (a different one was kept) or ``"damaged"`` (one that cannot be
         loaded was kept).
     """
+    check_state_name(name)  # the name becomes a file name in the game's folder: no '..', '/' or control characters
+    if not isinstance(state, VettedState):  # bytes from elsewhere are checked as any state
+        state = check_state(game, state, source=f"the state {name} to place")
     record = StateRecord.of(game.name, cached_rom_sha1(game.require_rom(), game.system), state)
+    remember_written(game, state)  # this machine wrote it: reading it back needs no probe
     path = folder / f"{name}.state"
     if not path.exists():
         write_state(path, state, record=record)
@@ -333,48 +346,6 @@ def target_folder(game: Game, data_dir: Path | None = None) -> Path:
     if len(game.folders) == 1 and own.parent not in searched:
         return game.folders[0]
     return paths.user_games_dir(data_dir) / game.name
-
-
-def resolve(first: str, second: str | None = None, *, cwd: Path | None = None) -> tuple[Game, list[str] | None]:
-    """Which game and states ``retrokit integrate FIRST [SECOND]`` means.
-
-    ``GAME STATE`` is that state of that game; ``GAME`` alone is all its recipes.
-    A lone ``STATE`` belongs to the one known game that has a state file or a
-    recipe of that name, else to the game.yaml in ``cwd``.
-
-    Raises:
-        UnknownNameError: Several games have that state, or none does and ``cwd`` has no game.yaml.
-    """
-    cwd = Path.cwd() if cwd is None else cwd
-    if second is not None:
-        return (_folder_game(cwd) if first == "." else find_game(first)), [second]
-    names = {g.name for g in list_games()}
-    if normalize_name(first) in names:
-        return find_game(first), None
-    if (cwd / "game.yaml").is_file():  # inside a game's folder, a state name is that game's (Level1 is many games')
-        return _folder_game(cwd), [first]
-    owners = games_with_state(first)
-    if len(owners) == 1:
-        return find_game(owners[0]), [first]
-    if len(owners) > 1:
-        raise UnknownNameError(
-            f"Expected one game with a state or recipe named {first!r}; found {len(owners)}: {', '.join(owners)}. "
-            f"Name the game: retrokit integrate {owners[0]} {first}"
-        )
-    raise GameNotFoundError(
-        f"Expected a game name, or a state or recipe that one known game has; found {first!r}, which no game "
-        f"has, and no game.yaml in {cwd} to make it for. Name the game: retrokit integrate GAME {first}"
-        + did_you_mean(first, names)
-    )
-
-
-def _folder_game(folder: Path) -> Game:
-    """The game whose game.yaml is in ``folder``: the known game of that name if it is one (with all its folders)."""
-    game = load_game(folder)
-    for known in list_games(game.name):
-        if known.name == game.name and folder.resolve() in {f.resolve() for f in known.folders}:
-            return find_game(game.name)
-    return game
 
 
 def games_with_state(name: str) -> list[str]:

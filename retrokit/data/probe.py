@@ -1,39 +1,190 @@
-"""Probing a save state in a child process, so a state that crashes the core cannot kill the caller.
+"""The one gate between a state's bytes and a core: trust by this machine's records, else a probe in a child.
 
 Genesis Plus GX trusts a state's contents: a state with the right size and a
-valid header but a corrupt body makes it crash (SIGSEGV) on the next frame.
-Such a state is caught by loading it into a fresh emulator in a child
-process and running a few seconds of frames; the child dying by a signal, or
-hanging, marks the state unsafe. The verdict is cached in the data folder
-(``<data>/state-probes/``) under the SHA-256 of the system, the ROM's SHA-1
-and the state, so each state is probed once per machine.
+valid header but a corrupt body makes it crash (SIGSEGV), on the next frame,
+on the second load or only under input. So a state reaches an emulator only
+as a :class:`~retrokit.host.emulator.VettedState`, and this module holds the
+only way to make one from bytes (it claims the mint when imported). It makes
+one when:
 
-Run as ``python -m retrokit.data.probe SYSTEM ROM STATE_FILE FRAMES``, this
-module is the child.
+- the bytes are a state file retrokit or the stable-retro wheel ships, by the
+  SHA-256 of the file (:mod:`retrokit.data.shipped`);
+- this machine probed the state before and found it safe, or retrokit wrote
+  it from a core (:func:`remember`): verdicts are kept in the data folder
+  (``<data>/state-probes/``) under the SHA-256 of the system, the ROM's SHA-1
+  and the state;
+- otherwise, once it has passed the probe: loaded into a fresh emulator in a
+  child process, run, loaded again, and run 3,000 frames under random input. The child
+  dying by a signal, running out of memory, or hanging marks it unsafe.
+
+Nothing inside the file (retrokit's ``RK`` record, a movie's header) makes a
+state trusted: a record may only refuse one (:mod:`retrokit.data.statecheck`).
+
+The child (``python -m retrokit.data.probe``, reading a JSON request on
+stdin) is shared with ``retrokit validate`` (:mod:`retrokit.testing.states`),
+which wants a report per state rather than a cached verdict: the child loads
+each state of the request in turn and prints one JSON line before and one
+after each, with the fields' values. It runs under a memory cap, leaves no
+core file, and imports the retrokit its parent imported.
 """
 
 from __future__ import annotations
 
-import hashlib
+import json
 import os
-import resource
+import selectors
 import signal
 import subprocess
 import sys
 import tempfile
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from retrokit import paths
+from retrokit.data.shipped import is_shipped_blob
+from retrokit.data.states import MAX_STATE_FILE_SIZE, decompress_state
 from retrokit.errors import RetrokitError, StateError
+from retrokit.host.emulator import VettedState, claim_mint
 from retrokit.host.systems import System, get_system
 
+_mint = claim_mint()
+
 PROBE_FRAMES = 300
-"""Frames run from a probed state: five seconds of play, long enough for a corrupt body to show."""
+"""Idle frames run from a probed state after its first load."""
+PROBE_INPUT_FRAMES = 3000
+"""Frames of random input run after the second load: a corrupt body may crash the core only thousands of frames
+in (where depends on the process's memory layout), so the probe plays as long as a short episode."""
 PROBE_TIMEOUT = 60.0
-"""Seconds a probe may take before the state counts as one that hangs the core."""
-_REFUSED = 3  # the child's exit status when retrokit refused the state with an error
+"""Seconds a child may run one state before the state counts as one that hangs the core."""
+CHILD_STARTUP = 120.0
+"""Seconds a child may take to start (importing retrokit, loading the core) on a busy machine."""
+CHILD_MEMORY = 512 << 20
+"""Bytes of address space a child may map: a state that makes the core allocate wildly fails there."""
 _SAFE = "safe"
+
+
+# --- The child's results -------------------------------------------------------------------------
+
+
+@dataclass
+class ChildResult:
+    """What the child found of one state.
+
+    Attributes:
+        name: The state's name in the request.
+        path: Its file.
+        loaded: It loaded, ran, loaded again and ran under input.
+        error: Why it did not: retrokit's error, a signal, a hang (``""`` when it did).
+        start: Every field's value right after the first load, by name.
+        first: Every field's value one idle frame in (what validate checks ranges on).
+        after: Every field's value after the idle frames.
+        detail: The core's signature and the state's size.
+    """
+
+    name: str
+    path: str
+    loaded: bool = False
+    error: str = ""
+    start: dict[str, int] = field(default_factory=dict)
+    first: dict[str, int] = field(default_factory=dict)
+    after: dict[str, int] = field(default_factory=dict)
+    detail: str = ""
+
+
+def _child_env() -> dict[str, str]:
+    """This process's environment, with the folder retrokit was imported from first on the path."""
+    root = str(Path(__file__).resolve().parents[2])
+    path = os.environ.get("PYTHONPATH")
+    return {**os.environ, "PYTHONPATH": root + (os.pathsep + path if path else "")}
+
+
+def _child_limits() -> None:
+    """In the child, before it loads a core: no core file from a crash, and a cap on memory."""
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+    try:
+        resource.setrlimit(resource.RLIMIT_AS, (CHILD_MEMORY, CHILD_MEMORY))
+    except (ValueError, OSError):  # a lower hard limit already
+        pass
+
+
+def run_child(
+    system: str, rom: str | os.PathLike[str], states: Sequence[tuple[str, str]], *, frames: int,
+    input_frames: int, fields: Sequence[Mapping[str, Any]] = (), timeout: float = PROBE_TIMEOUT,
+) -> tuple[dict[str, ChildResult], str | None, str]:
+    """Run one child over ``states``; return the results it finished, the state it was on when it stopped, and why.
+
+    The child prints a line before and after each state; a state that prints
+    nothing for ``timeout`` seconds has hung the core, and the child is killed.
+    Its log goes to a file, so a chatty core cannot fill a pipe.
+
+    Args:
+        system: The system's name.
+        rom: The ROM to load the states on.
+        states: ``(name, path)`` of each state file, in order.
+        frames: Idle frames to run after the first load of each state.
+        input_frames: Frames of random input to run after loading it again.
+        fields: RAM fields (``name``, ``address``, ``type``, ``mask``) to read after loading.
+        timeout: Seconds one state may take.
+    """
+    request = {"system": system, "rom": os.fspath(rom), "frames": frames, "input_frames": input_frames,
+               "fields": list(fields),
+               "states": [list(s) for s in states]}
+    results: dict[str, ChildResult] = {}
+    current, failure = None, ""
+    with tempfile.TemporaryFile("w+") as log:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "retrokit.data.probe"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+            stderr=log, bufsize=0, env=_child_env(),
+        )
+        try:
+            proc.stdin.write(json.dumps(request).encode())  # type: ignore[union-attr]
+            proc.stdin.close()  # type: ignore[union-attr]
+        except BrokenPipeError:  # it died at once; its status says why
+            pass
+        # Raw reads, split here: a buffered reader could hold a line that select() then waits for.
+        fd = proc.stdout.fileno()  # type: ignore[union-attr]
+        pending = b""
+        with selectors.DefaultSelector() as selector:
+            selector.register(fd, selectors.EVENT_READ)
+            wait = CHILD_STARTUP + timeout
+            while True:
+                if not selector.select(timeout=wait):
+                    proc.kill()
+                    failure = f"the emulator still ran {timeout:g} s after loading it (it hangs the core)"
+                    break
+                chunk = os.read(fd, 1 << 16)
+                if not chunk:
+                    break
+                wait = timeout
+                *lines, pending = (pending + chunk).split(b"\n")
+                for line in lines:
+                    try:
+                        message = json.loads(line)
+                    except json.JSONDecodeError:
+                        continue
+                    if "begin" in message:
+                        current = message["begin"]
+                    else:
+                        results[message["name"]] = ChildResult(**message)
+                        current = None
+        proc.stdout.close()  # type: ignore[union-attr]
+        status = proc.wait()
+        if not failure and status != 0:
+            if status < 0:
+                name = signal.Signals(-status).name if -status in signal.valid_signals() else f"signal {-status}"
+                failure = f"the emulator crashed ({name}) within {frames + input_frames} frames of loading it"
+            else:
+                log.seek(0)
+                last = log.read().strip().splitlines()[-1:] or ["no message"]
+                failure = f"the state loader exited with status {status}: {last[0]}"
+    return results, current, failure
+
+
+# --- One state's verdict -------------------------------------------------------------------------
 
 
 @dataclass(frozen=True)
@@ -51,27 +202,18 @@ class ProbeVerdict:
 
 def probe_key(state: bytes, system: str, rom_sha1: str) -> str:
     """The cache key of a probe: SHA-256 of the system, the ROM's SHA-1 and the state."""
+    import hashlib
+
     digest = hashlib.sha256(f"{system}\0{rom_sha1}\0".encode())
     digest.update(state)
     return digest.hexdigest()
 
 
-def _child_env() -> dict[str, str]:
-    """This process's environment, with the folder retrokit was imported from first on the path."""
-    root = str(Path(__file__).resolve().parents[2])
-    path = os.environ.get("PYTHONPATH")
-    return {**os.environ, "PYTHONPATH": root + (os.pathsep + path if path else "")}
-
-
-def _child_limits() -> None:
-    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))  # a crashing probe leaves no core file
-
-
 def probe_state(
     state: bytes, system: str | System, rom: str | os.PathLike[str], *, frames: int = PROBE_FRAMES,
-    timeout: float = PROBE_TIMEOUT,
+    input_frames: int = PROBE_INPUT_FRAMES, timeout: float = PROBE_TIMEOUT,
 ) -> ProbeVerdict:
-    """Load ``state`` on ``rom`` in a child process and run ``frames`` frames; report how the child ended.
+    """Load ``state`` on ``rom`` in a child process, run, load again, run under input; report how it ended.
 
     This is not cached: see :func:`vet_state`.
 
@@ -79,56 +221,62 @@ def probe_state(
         state: The serialized state (uncompressed).
         system: The system (a name or descriptor).
         rom: The ROM to load it on.
-        frames: How many frames to run after loading it.
+        frames: Idle frames to run after the first load.
+        input_frames: Frames of random input to run after the second.
         timeout: Seconds before the child counts as hung, and is killed.
     """
+    from retrokit.data.states import compress_state
+
     system = get_system(system).name
-    with tempfile.NamedTemporaryFile(prefix="retrokit-probe-", suffix=".bin") as tmp:
-        tmp.write(state)
+    with tempfile.NamedTemporaryFile(prefix="retrokit-probe-", suffix=".state") as tmp:
+        tmp.write(compress_state(state))
         tmp.flush()
-        command = [sys.executable, "-m", "retrokit.data.probe", system, os.fspath(rom), tmp.name, str(frames)]
-        try:
-            done = subprocess.run(
-                command, capture_output=True, text=True, timeout=timeout, check=False, stdin=subprocess.DEVNULL,
-                preexec_fn=_child_limits, env=_child_env(),
-            )
-        except subprocess.TimeoutExpired:
-            return ProbeVerdict(False, f"the emulator still ran {timeout:.0f} s after loading it (it hangs the core)")
-    if done.returncode == 0:
-        return ProbeVerdict(True)
-    if done.returncode < 0:
-        name = signal.Signals(-done.returncode).name
-        return ProbeVerdict(False, f"the emulator crashed ({name}) within {frames} frames of loading it")
-    message = (done.stderr.strip().splitlines() or ["(no message)"])[-1]
-    if done.returncode == _REFUSED:
-        return ProbeVerdict(False, message)
-    return ProbeVerdict(False, f"the probe failed with exit status {done.returncode}: {message}")
+        results, _, failure = run_child(
+            system, rom, [("state", tmp.name)], frames=frames, input_frames=input_frames, timeout=timeout
+        )
+    result = results.get("state")
+    if result is None:
+        return ProbeVerdict(False, failure or "the probe stopped before it loaded the state")
+    return ProbeVerdict(True) if result.loaded else ProbeVerdict(False, result.error)
 
 
-def _cache_file(key: str, data_dir: Path | None) -> Path:
-    return (data_dir if data_dir is not None else paths.data_dir()) / "state-probes" / key
+def _cache_file(key: str) -> Path:
+    return paths.data_dir() / "state-probes" / key
 
 
-def _cached(key: str, data_dir: Path | None) -> ProbeVerdict | None:
+def _cached(key: str) -> ProbeVerdict | None:
     try:
-        text = _cache_file(key, data_dir).read_text(encoding="utf-8")
+        with open(_cache_file(key), "rb") as f:
+            text = f.read(4096).decode("utf-8")
     except (OSError, UnicodeDecodeError):
         return None
     return ProbeVerdict(True) if text == _SAFE else ProbeVerdict(False, text)
 
 
-def _remember(key: str, verdict: ProbeVerdict, data_dir: Path | None) -> None:
+def _remember(key: str, verdict: ProbeVerdict) -> None:
     try:
-        paths.atomic_write(_cache_file(key, data_dir), (_SAFE if verdict.safe else verdict.reason).encode(), overwrite=True)
+        paths.atomic_write(_cache_file(key), (_SAFE if verdict.safe else verdict.reason).encode(), overwrite=True)
     except OSError:
         pass  # an unwritable data folder only means probing again next time
 
 
+def remember(state: VettedState, rom_sha1: str) -> None:
+    """Note that this machine wrote ``state`` (it came from a core), so loading it from a file again needs no probe.
+
+    Args:
+        state: A state a core made (:meth:`~retrokit.host.emulator.Emulator.get_state`) or one already checked.
+        rom_sha1: The SHA-1 of the ROM it runs on.
+    """
+    if not isinstance(state, VettedState):
+        raise StateError(f"Expected a checked state (VettedState) to remember as safe; found {type(state).__name__}.")
+    _remember(probe_key(state, state.system, rom_sha1), ProbeVerdict(True))
+
+
 def vet_state(
     state: bytes, system: str | System, rom: str | os.PathLike[str], rom_sha1: str, *, source: str,
-    data_dir: str | os.PathLike[str] | None = None,
-) -> None:
-    """Refuse a state that crashes or hangs the core, probing it in a child once per machine.
+    shipped: str | os.PathLike[str] | None = None,
+) -> VettedState:
+    """Return ``state`` as a :class:`VettedState` once it is known not to crash or hang the core.
 
     Args:
         state: The serialized state.
@@ -136,40 +284,100 @@ def vet_state(
         rom: The ROM the state is for.
         rom_sha1: The ROM's SHA-1 (part of the cache key).
         source: What to call the state in the error (its path, or a movie's Core.bin).
-        data_dir: The data folder holding the cache; by default :func:`retrokit.paths.data_dir`.
+        shipped: The ``.state`` file ``state`` was read from: if its bytes are a
+            shipped state file's, and it holds exactly ``state``, no probe is needed.
 
     Raises:
         StateError: The state crashed, hung or was refused in the child.
     """
     system = get_system(system).name
-    folder = Path(data_dir) if data_dir is not None else None
+    if isinstance(state, VettedState) and state.system == system:
+        return state
+    state = bytes(state)
     key = probe_key(state, system, rom_sha1)
-    verdict = _cached(key, folder)
+    if shipped is not None and _ships(Path(shipped), state):
+        if _cached(key) is None:  # a movie that starts from it (Core.bin) is then known too
+            _remember(key, ProbeVerdict(True))
+        return _mint(state, system)
+    verdict = _cached(key)
     if verdict is None:
         verdict = probe_state(state, system, rom)
-        _remember(key, verdict, folder)
+        _remember(key, verdict)
     if not verdict.safe:
         raise StateError(
             f"{source}: expected a save state the {system} core can run; found one that it cannot: "
             f"{verdict.reason}. The file is corrupt or was made by something else; record or copy it again."
         )
+    return _mint(state, system)
 
 
-def _child(argv: list[str]) -> int:
-    """Load the state and run its frames; exit 0, or 3 with retrokit's error on the last line of stderr."""
-    from retrokit.host.emulator import Emulator
-
-    system, rom, state_file, frames = argv
+def _ships(path: Path, state: bytes) -> bool:
+    """Whether the file at ``path`` is a shipped state file (by its SHA-256) and holds exactly ``state``."""
     try:
-        with Emulator(system, rom) as emu:
-            emu.set_state(Path(state_file).read_bytes())
-            emu.run(0, int(frames))
+        with open(path, "rb") as f:
+            blob = f.read(MAX_STATE_FILE_SIZE + 1)
+    except OSError:
+        return False
+    if not is_shipped_blob(blob):
+        return False
+    try:
+        return decompress_state(blob) == state
+    except StateError:
+        return False
+
+
+# --- The child -----------------------------------------------------------------------------------
+
+
+def _child_main() -> int:
+    """Load the states a request names, one by one; print one JSON line per state (and one before each)."""
+    import random
+
+    from retrokit.data.states import read_state, state_format
+    from retrokit.host.emulator import Emulator
+    from retrokit.host.fields import FieldSpec
+    from retrokit.host.memory import FieldReader
+
+    _child_limits()
+    request = json.load(sys.stdin)
+    frames, input_frames = int(request["frames"]), int(request["input_frames"])
+    emu = Emulator(request["system"], request["rom"])
+    specs = [FieldSpec(f["name"], f["address"], f["type"], f["mask"]) for f in request["fields"]]
+    reader = FieldReader([s for s in specs if _inside(emu, s)], emu.space)
+    idle = [0] * emu.ports
+    rng = random.Random(0)
+    for name, path in request["states"]:
+        print(json.dumps({"begin": name}), flush=True)
+        result: dict[str, Any] = {"name": name, "path": path}
+        try:
+            data = read_state(path)
+            state = _mint(data, emu.system.name)  # unchecked: finding out whether it is safe is this child's job
+            emu.set_state(state)
+            result["start"] = reader.read()
+            emu.run(idle, 1)  # one frame in: where validate checks the fields' declared ranges
+            result["first"] = reader.read()
+            emu.run(idle, max(frames - 1, 0))
+            result["after"] = reader.read()
+            emu.set_state(state)  # every reset() loads the state again: some crash only then
+            for _ in range(0, input_frames, 10):  # and some only under input
+                emu.run([rng.getrandbits(12) for _ in range(emu.ports)], 10)
             emu.get_state()
-    except (RetrokitError, ValueError) as exc:
-        print(str(exc).replace("\n", " "), file=sys.stderr)
-        return _REFUSED
+            result["loaded"] = True
+            result["detail"] = f"{state_format(data) or 'no core signature'}, {len(data)} bytes"
+        except (RetrokitError, MemoryError) as exc:
+            result["error"] = str(exc) if not isinstance(exc, MemoryError) else "the state needs too much memory"
+        print(json.dumps(result), flush=True)
+    emu.close()
     return 0
 
 
+def _inside(emu: Any, spec: Any) -> bool:
+    try:
+        emu.space.locate(spec.address, spec.field_type.width)
+    except RetrokitError:
+        return False
+    return True
+
+
 if __name__ == "__main__":
-    sys.exit(_child(sys.argv[1:]))
+    sys.exit(_child_main())

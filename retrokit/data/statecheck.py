@@ -1,52 +1,45 @@
-"""Deciding whether a save state may be loaded into an emulator in this process.
+"""Deciding whether a save state may be loaded into an emulator in this process: the checked load.
 
-A state is loaded only if it is for the game's ROM and cannot crash the core:
+Every state reaches a core as a :class:`~retrokit.host.emulator.VettedState`,
+and these functions are how one is made from a file or from bytes:
 
-- a state retrokit wrote records the game and the SHA-1 of its ROM
-  (:class:`~retrokit.data.states.StateRecord`); one recorded for a ROM the game
-  does not accept is refused, naming the game it is for; one without a record
-  that sits in another game's folder (where stable-retro keeps each game's
-  states) is refused too, unless the two games share a ROM;
-- a state that is exactly what retrokit recorded, or that ships with retrokit
-  or the stable-retro wheel, is trusted as it is;
-- any other state (a user's, stable-retro's, one changed since retrokit wrote
-  it) is first run in a child process, once per machine
-  (:func:`retrokit.data.probe.vet_state`).
+- a state retrokit recorded (:class:`~retrokit.data.states.StateRecord`) for a
+  ROM the game does not accept is refused, naming the game it is for; one
+  without a record that sits in another game's folder (where stable-retro keeps
+  each game's states) is refused too, unless the two games share a ROM. The
+  record only ever refuses: anyone can write one;
+- whether the state may crash the core is decided by :func:`retrokit.data.probe.vet_state`,
+  from what this machine wrote or probed and what the package ships, never
+  from the file itself.
 """
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
-from retrokit import paths
 from retrokit.data.games import Game, cached_rom_sha1, load_game
-from retrokit.data.probe import vet_state
+from retrokit.data.probe import remember
+from retrokit.data.probe import vet_state as _vet
 from retrokit.data.states import StateRecord, read_state_file
 from retrokit.errors import RetrokitError, StateError
-
-
-def is_shipped(path: Path) -> bool:
-    """Whether ``path`` is one of the states retrokit's ``games/`` or the stable-retro wheel ship."""
-    roots = [d for d in (paths.repo_games_dir(), *paths.wheel_data_dirs()) if d is not None]
-    try:
-        resolved = path.resolve()
-    except OSError:
-        return False
-    return any(resolved.is_relative_to(root.resolve()) for root in roots)
+from retrokit.host.emulator import VettedState
+from retrokit.host.systems import System, get_system
 
 
 def check_state(
-    game: Game, data: bytes, record: StateRecord | None, *, source: str, rom: Path | None = None, trusted: bool = False
-) -> None:
-    """Refuse a state that is for another game's ROM, or that crashes or hangs the core.
+    game: Game, data: bytes, record: StateRecord | None = None, *, source: str, rom: Path | None = None,
+    shipped: Path | None = None,
+) -> VettedState:
+    """Refuse a state that is for another game's ROM, or that crashes or hangs the core; return it checked.
 
     Args:
         game: The game the state is to be loaded for.
         data: The serialized state.
-        record: What retrokit recorded with the state, if anything.
+        record: What the file says retrokit recorded with the state, if anything (used only to refuse).
         source: What to call the state in errors (its path, or a movie's ``Core.bin``).
         rom: The ROM it will run on; by default the game's.
-        trusted: The state ships with retrokit or the wheel: no probe.
+        shipped: The file ``data`` was read from, which needs no probe if it is a shipped state file.
 
     Raises:
         StateError: The state is for another ROM, or the core cannot run it.
@@ -54,21 +47,17 @@ def check_state(
     """
     rom = rom if rom is not None else game.require_rom()
     rom_sha1 = cached_rom_sha1(rom, game.system)
-    if record is not None:
-        if record.rom_sha1 != rom_sha1 and record.rom_sha1 not in game.sha1s:
-            of = f", of {record.game}" if record.game != game.name else ""
-            raise StateError(
-                f"{source}: expected a state of {game.name} (ROM SHA-1 {rom_sha1}); found a state retrokit "
-                f"recorded on another ROM (SHA-1 {record.rom_sha1}{of}). Load it with the game of that ROM, "
-                f"or pick a state of {game.name}."
-            )
-        if record.rom_sha1 == rom_sha1 and record.describes(data):
-            return  # exactly what retrokit wrote for this ROM
-    if not trusted:
-        vet_state(data, game.system, rom, rom_sha1, source=source)
+    if record is not None and record.rom_sha1 != rom_sha1 and record.rom_sha1 not in game.sha1s:
+        of = f", of {record.game}" if record.game != game.name else ""
+        raise StateError(
+            f"{source}: expected a state of {game.name} (ROM SHA-1 {rom_sha1}); found a state retrokit "
+            f"recorded on another ROM (SHA-1 {record.rom_sha1}{of}). Load it with the game of that ROM, "
+            f"or pick a state of {game.name}."
+        )
+    return _vet(data, game.system, rom, rom_sha1, source=source, shipped=shipped)
 
 
-def load_state(game: Game, path: str | Path) -> bytes:
+def load_state(game: Game, path: str | os.PathLike[str]) -> VettedState:
     """Read a ``.state`` file for ``game`` and return the state, once it is known to be safe to load.
 
     Raises:
@@ -78,8 +67,32 @@ def load_state(game: Game, path: str | Path) -> bytes:
     state = read_state_file(path)
     if state.record is None:
         _check_folder(game, path)
-    check_state(game, state.data, state.record, source=str(path), trusted=is_shipped(path))
-    return state.data
+    return check_state(game, state.data, state.record, source=str(path), shipped=path)
+
+
+def vet_state(
+    data: bytes, system: str | System, rom: str | os.PathLike[str], *, source: str = "the state",
+    shipped: str | os.PathLike[str] | None = None,
+) -> VettedState:
+    """Check a state for a ROM of no known game (or any ROM): probe it unless this machine knows it is safe.
+
+    Args:
+        data: The serialized state.
+        system: The system (a name or descriptor).
+        rom: The ROM it will run on.
+        source: What to call it in errors.
+        shipped: The ``.state`` file ``data`` was read from: no probe if its bytes are a shipped file's.
+
+    Raises:
+        StateError: The core cannot run it.
+    """
+    system = get_system(system)
+    return _vet(data, system, rom, cached_rom_sha1(Path(rom), system), source=source, shipped=shipped)
+
+
+def remember_written(game: Game, state: VettedState, rom: Path | None = None) -> None:
+    """Note that retrokit wrote ``state`` (a core made it), so reading it back from its file needs no probe."""
+    remember(state, cached_rom_sha1(rom if rom is not None else game.require_rom(), game.system))
 
 
 def folder_game(path: Path) -> Game | None:

@@ -46,7 +46,10 @@ class StableRetroCompat:
         Raises:
             StateNotFoundError: The game has no state of that name.
         """
-        self.state_name, self._state = self._resolve_state(state)  # type: ignore[attr-defined]
+        from retrokit.data.resolve import resolve_state
+
+        start = resolve_state(self.game, state, players=self.players)  # type: ignore[attr-defined]
+        self.state_name, self._state = start.name, start.state
         self._first_frame = self._first_obs = None  # the first observation is the new state's
         old = self.movies  # type: ignore[attr-defined]
         if old is not None:  # later movies start from the new state, under its name

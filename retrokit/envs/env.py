@@ -9,7 +9,6 @@ as in Gym Retro.
 
 from __future__ import annotations
 
-import enum
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -20,7 +19,7 @@ import numpy as np
 from gymnasium import spaces
 
 from retrokit.data.games import Game, find_game
-from retrokit.data.statecheck import load_state
+from retrokit.data.resolve import Resolved, State, resolve
 from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
 from retrokit.envs.compat import StableRetroCompat
@@ -32,19 +31,16 @@ from retrokit.host.fields import out_of_range, ranged
 from retrokit.host.memory import FieldReader
 from retrokit.movie.recorder import EpisodeMovies
 
-
-class State(enum.Enum):
-    """Special start states, as in Gym Retro."""
-
-    DEFAULT = "default"  #: the game's default state
-    NONE = "none"  #: power on, no state
+__all__ = ["RetroEnv", "State", "make"]
 
 
 class RetroEnv(StableRetroCompat, gymnasium.Env):
     """A game as a Gymnasium environment.
 
     Args:
-        game: The game's name, e.g. ``"Airstriker-Genesis"``, or a loaded :class:`Game`.
+        game: The game's name, e.g. ``"Airstriker-Genesis"``, a loaded :class:`Game`, or a
+            :class:`~retrokit.data.resolve.Resolved` (game, ROM, checked state and scenario found
+            once; ``state`` and ``scenario`` are then not given).
         state: A state name, a ``.state`` path, or a :class:`State`.
         scenario: A scenario name of the game, a path to a ``.yaml`` or
             Gym Retro ``.json`` scenario, or ``None`` for the game's default.
@@ -69,7 +65,7 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
 
     def __init__(
         self,
-        game: str | Game,
+        game: str | Game | Resolved,
         state: str | os.PathLike[str] | State | None = State.DEFAULT,
         scenario: str | os.PathLike[str] | Mapping[str, Any] | None = None,
         *,
@@ -96,18 +92,19 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
         frameskip, sticky_prob, players = checked["frameskip"], checked["sticky_prob"], checked["players"]
         max_episode_steps, scenario_every_frame = checked["max_episode_steps"], checked["scenario_every_frame"]
         skip_video, options = checked["skip_video"], checked["options"]
-        self.game: Game = game if isinstance(game, Game) else find_game(game)
-        if players > max(self.game.players, 1):
-            raise InvalidArgumentError(
-                f"Expected 1 to {self.game.players} players for {self.game.name}, got {players}."
-            )
+        found = game.game if isinstance(game, Resolved) else find_game(game)
+        if players > max(found.players, 1):
+            raise InvalidArgumentError(f"Expected 1 to {found.players} players for {found.name}, got {players}.")
+        # Game, ROM, checked state and scenario are found once, in the data layer.
+        setup = game if isinstance(game, Resolved) else resolve(found, state, scenario, players=players)
+        self.game: Game = setup.game
         self.obs_type, self.frameskip, self.sticky_prob = obs_type, frameskip, float(sticky_prob)
         self.max_episode_steps, self.players, self.render_mode = max_episode_steps, players, render_mode
         self.scenario_every_frame = scenario_every_frame
 
-        self.state_name, self._state = self._resolve_state(state)
-        self.scenario = self._load_scenario(scenario)
-        self.emulator = Emulator(self.game.system, self.game.require_rom(), options=options, ports=max(players, 2))
+        self.state_name, self._state = setup.start.name, setup.start.state
+        self.scenario = self._compile_scenario(setup.scenario)
+        self.emulator = Emulator(self.game.system, setup.rom, options=options, ports=max(players, 2))
         self.reader = FieldReader(self.game.fields, self.emulator.space)
         self.actions = ActionMap(self.emulator.system, action_type, getattr(self.scenario, "actions", None), players)
         self.action_space = self.actions.space
@@ -157,32 +154,13 @@ class RetroEnv(StableRetroCompat, gymnasium.Env):
 
     # --- set-up -----------------------------------------------------------------------------------
 
-    def _resolve_state(self, state: str | os.PathLike[str] | State | None) -> tuple[str | None, bytes | None]:
-        if state is None or state is State.DEFAULT:
-            by_players = self.game.default_player_states
-            name = by_players[self.players - 1] if len(by_players) >= self.players else self.game.default_state
-            return (name, load_state(self.game, self.game.state_path(name))) if name else (None, None)
-        if state is State.NONE:
-            return None, None
-        path = Path(state)
-        if path.suffix == ".state" and path.is_file():
-            return path.stem, load_state(self.game, path)
-        return str(state), load_state(self.game, self.game.state_path(str(state)))
-
-    def _load_scenario(self, scenario: str | os.PathLike[str] | Mapping[str, Any] | None) -> Any:
+    def _compile_scenario(self, source: Path | Mapping[str, Any] | None) -> Any:
         from retrokit.dsl.scenario import load_scenario
 
-        fields = list(self.game.fields)
-        if isinstance(scenario, Mapping):
-            return load_scenario(scenario, fields, game_dir=self.game.folders[0], name="scenario")
-        if scenario is None:
-            if self.game.default_scenario is None:
-                return None
-            return load_scenario(self.game.scenario_path(), fields, game_dir=self.game.folders[0])
-        path = Path(scenario)
-        if path.suffix in (".yaml", ".yml", ".json") and path.is_file():
-            return load_scenario(path, fields, game_dir=self.game.folders[0])
-        return load_scenario(self.game.scenario_path(str(scenario)), fields, game_dir=self.game.folders[0])
+        if source is None:
+            return None
+        name = "scenario" if isinstance(source, Mapping) else None
+        return load_scenario(source, list(self.game.fields), game_dir=self.game.folders[0], name=name)
 
     def _first_frame_shape(self) -> tuple[int, int]:
         self._start()

@@ -20,7 +20,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from retrokit.data.games import Game
-from retrokit.data.states import read_state, write_state
+from retrokit.data.names import check_state_name
+from retrokit.data.statecheck import load_state, remember_written
+from retrokit.data.states import write_state
 from retrokit.errors import EnvError, install_extra
 from retrokit.host.emulator import Emulator
 from retrokit.movie.recorder import MovieRecorder, claim_movie_path
@@ -52,6 +54,7 @@ class PlaySession:
     """
 
     def __init__(self, game: Game, state: str | None, folder: Path, *, name: str = "Play", scale: int = 2) -> None:
+        check_state_name(name, what="name of saved states")  # F5 writes <folder>/<name>.state
         try:
             import pygame
         except ImportError:
@@ -65,7 +68,7 @@ class PlaySession:
         self.emulator = Emulator(game.system, game.require_rom())
         start = state or game.default_state
         if start is not None:
-            self.emulator.set_state(read_state(game.state_path(start)))
+            self.emulator.set_state(load_state(game, game.state_path(start)))  # checked: it may be any file
         self.held: set[int] = set()
         self.recorder: MovieRecorder | None = None
         self.saved: list[Path] = []
@@ -106,7 +109,9 @@ class PlaySession:
         while path.exists():
             n += 1
             path = self.folder / f"{self.name}.{n}.state"
-        write_state(path, self.emulator.get_state())
+        state = self.emulator.get_state()
+        write_state(path, state)
+        remember_written(self.game, state)  # this machine wrote it: loading it again needs no probe
         self.saved.append(path)
         print(f"saved {path}")
         return path

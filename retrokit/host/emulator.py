@@ -9,13 +9,14 @@ from __future__ import annotations
 
 import logging
 import os
-from collections.abc import Mapping, Sequence
+import zlib
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Self
 
 import numpy as np
 
-from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean
+from retrokit.errors import InvalidArgumentError, RetrokitError, StateError, UnknownNameError, did_you_mean
 from retrokit.host import primitives
 from retrokit.host.corecheck import vet_core
 from retrokit.host.cores import find_core
@@ -29,6 +30,89 @@ _LOG_LEVELS = (logging.DEBUG, logging.INFO, logging.WARNING, logging.ERROR)
 
 def _log_core(level: int, text: str) -> None:
     logger.log(_LOG_LEVELS[level] if 0 <= level < len(_LOG_LEVELS) else logging.INFO, "%s", text)
+
+
+class VettedState(bytes):
+    """A serialized core state that may be loaded into an emulator: the only kind :meth:`Emulator.set_state` takes.
+
+    Genesis Plus GX trusts a state's contents (a corrupt body kills the process
+    with SIGSEGV), so a state reaches a core only as a ``VettedState``. One is
+    made in two places only: by :meth:`Emulator.get_state` (the core wrote it,
+    in this process), and by the one checker of states in the data layer
+    (:mod:`retrokit.data.probe`, through :mod:`retrokit.data.statecheck`), which
+    claims the only other way to make one (:func:`claim_mint`) when it is
+    imported. It is ``bytes``: it is written, hashed and compared as any state.
+    A slice or a copy made with ``bytes(...)`` is plain bytes again, so an
+    edited state is never taken as vetted; it pickles as plain bytes too.
+
+    Attributes:
+        system: The system whose core the state is for.
+    """
+
+    system: str
+
+    def __new__(cls, data: bytes, system: str, *, seal: object = None) -> Self:
+        if seal is not _SEAL:
+            raise StateError(
+                "Expected a state checked by retrokit; found one made directly as VettedState(...). Load a file "
+                "with retrokit.data.statecheck.load_state(game, path), or check bytes with "
+                "retrokit.data.statecheck.vet_state(data, system, rom)."
+            )
+        state = super().__new__(cls, data)
+        state.system = system
+        return state
+
+    def __reduce__(self) -> tuple[type[bytes], tuple[bytes]]:
+        return bytes, (bytes(self),)  # what is read back from a pickle is unchecked bytes
+
+    def pack(self) -> PackedState:
+        """This state zlib-compressed (fast), to keep many in memory; :meth:`PackedState.unpack` gives it back checked."""
+        return PackedState(zlib.compress(self, 1), self.system, seal=_SEAL)
+
+
+class PackedState:
+    """A :class:`VettedState`, compressed (a search keeps thousands); made only by :meth:`VettedState.pack`.
+
+    Attributes:
+        system: The system whose core the state is for.
+    """
+
+    __slots__ = ("_blob", "system")
+
+    def __init__(self, blob: bytes, system: str, *, seal: object = None) -> None:
+        if seal is not _SEAL:
+            raise StateError("Expected a state packed by VettedState.pack(); found one made directly as PackedState(...).")
+        self._blob, self.system = bytes(blob), system
+
+    def unpack(self) -> VettedState:
+        """The state again, as checked as it was when packed."""
+        return VettedState(zlib.decompress(self._blob), self.system, seal=_SEAL)
+
+    def __len__(self) -> int:
+        return len(self._blob)
+
+
+_SEAL = object()
+_claimed = False
+
+
+def claim_mint() -> Callable[[bytes, str], VettedState]:
+    """Hand the one state checker the only way to make a :class:`VettedState` from bytes; a second claim raises.
+
+    :mod:`retrokit.data.probe` claims it when it is imported, so nothing else
+    can: a module that claimed it first would make that import fail, loudly.
+
+    Raises:
+        RetrokitError: The mint was claimed already.
+    """
+    global _claimed
+    if _claimed:
+        raise RetrokitError(
+            "Expected the state checker (retrokit.data.probe) to be the only holder of VettedState's mint; found it "
+            "claimed already. Load states through retrokit.data.statecheck instead of claiming the mint."
+        )
+    _claimed = True
+    return lambda data, system: VettedState(data, system, seal=_SEAL)
 
 
 class Emulator:
@@ -229,16 +313,32 @@ class Emulator:
 
     # --- states and information -------------------------------------------------------------
 
-    def get_state(self) -> bytes:
-        """Serialize the console's state."""
-        return self._emu.serialize()
+    def get_state(self) -> VettedState:
+        """Serialize the console's state (the core wrote it, so it may be loaded again as it is)."""
+        return VettedState(self._emu.serialize(), self.system.name, seal=_SEAL)
 
-    def set_state(self, state: bytes) -> None:
-        """Restore a state made by :meth:`get_state` (or a .state file's contents).
+    def set_state(self, state: VettedState) -> None:
+        """Restore a state made by :meth:`get_state`, or one the state checker passed.
+
+        A ``.state`` file's contents reach this only through the check:
+        ``retrokit.data.statecheck.load_state(game, path)`` (or ``vet_state``
+        for bytes), which refuses a state that would crash the core.
 
         Raises:
-            StateError: The state does not fit this core.
+            StateError: ``state`` was not checked, is for another system, or does not fit this core.
         """
+        if not isinstance(state, VettedState):
+            found = "None" if state is None else f"{type(state).__name__}"
+            raise StateError(
+                f"Expected a checked state (from get_state(), or retrokit.data.statecheck.load_state/vet_state) "
+                f"to load into the {self.system.name} emulator; found {found}. A state's bytes could crash the "
+                "core, so check them first: retrokit.data.statecheck.vet_state(data, system, rom)."
+            )
+        if state.system != self.system.name:
+            raise StateError(
+                f"Expected a state of a {self.system.name} core; found one checked for {state.system}. "
+                f"Load it into a {state.system} emulator."
+            )
         self._emu.unserialize(state)
 
     def av_info(self) -> dict[str, float | int]:

@@ -87,9 +87,14 @@ def read_bk2(path: str | os.PathLike[str]) -> Movie:
             f"{path}: expected a .bk2 movie, which is a zip file; found a file that is not a complete zip "
             f"({exc}). It may be truncated: record it again."
         ) from None
+    if state == b"":  # read as power-on, it would replay another game than the one recorded
+        raise MovieError(
+            f"{path}: expected {STATE!r} to hold the movie's start state; found 0 bytes. A movie that starts at "
+            f"power-on has no {STATE!r}: record it again, or copy the movie again if it was cut short."
+        )
     system, game, header = _parse_header(path, header_text)
     players, frames = _parse_log(path, log_text, layout(system))
-    return Movie(game, system, players, state or None, frames, header)
+    return Movie(game, system, players, state, frames, header)
 
 
 def _member(path: Path, archive: zipfile.ZipFile, member: str, limit: int) -> bytes:

@@ -23,7 +23,7 @@ from retrokit.errors import (
     RomError,
     install_extra,
 )
-from retrokit.host.emulator import Emulator
+from retrokit.host.emulator import Emulator, VettedState
 from retrokit.movie.bk2 import read_bk2
 from retrokit.movie.gif import GifWriter, gif_step
 from retrokit.movie.model import STATE_DIGEST, Movie
@@ -50,37 +50,73 @@ def open_emulator(movie: Movie) -> Emulator:
     return Emulator(movie.system, rom, ports=max(2, movie.players))
 
 
-def check_movie_state(movie: Movie, emu: Emulator, source: str) -> None:
-    """Refuse a movie's start state that is for another ROM, or that crashes or hangs the core.
+def check_movie_state(movie: Movie, emu: Emulator, source: str) -> VettedState:
+    """Refuse a movie's start state that is for another ROM, or that crashes or hangs the core; return it checked.
 
-    A movie retrokit recorded names its ROM's SHA-1 and its state's SHA-256 in
-    its header; one that does not (stable-retro's), or whose state changed
-    since, is probed in a child process first (see :mod:`retrokit.data.statecheck`).
+    A movie retrokit recorded names its ROM's SHA-1 in its header: one for a
+    ROM the game does not accept is refused. Whether the state may crash the
+    core is decided as for any state (see :mod:`retrokit.data.statecheck`),
+    never from the header.
 
     Raises:
         StateError: The state is for another ROM, or the core cannot run it.
     """
-    from retrokit.data.games import cached_rom_sha1, find_game
-    from retrokit.data.probe import vet_state
-    from retrokit.data.statecheck import check_state
+    from retrokit.data.games import find_game
+    from retrokit.data.statecheck import check_state, vet_state
 
+    if movie.state is None:
+        raise MovieError(f"{source}: expected a start state; found a movie that starts at power-on.")
     sha1 = movie.header.get("SHA1", "?").strip().lower()
     record = StateRecord(movie.game, sha1, movie.header.get(STATE_DIGEST, "")) if _SHA1.fullmatch(sha1) else None
     try:
         game = find_game(movie.game)
     except (GameNotFoundError, DataFileError):  # a movie of a game retrokit does not know: probe it all the same
-        vet_state(movie.state, emu.system.name, emu.rom, cached_rom_sha1(emu.rom, emu.system), source=source)
-        return
-    check_state(game, movie.state, record, source=source, rom=emu.rom)
+        return vet_state(movie.state, emu.system, emu.rom, source=source)
+    return check_state(game, movie.state, record, source=source, rom=emu.rom)
+
+
+def replay(movie: Movie, emu: Emulator, *, source: str, stop: int | None = None) -> Iterator[int]:
+    """Replay a movie on ``emu``: the one loop every replay uses, and the one place its start state is checked.
+
+    The emulator's sticky-action probability is set to 0 and it is put at the
+    movie's start state (checked first: :func:`check_movie_state`), or reset
+    to power-on if the movie has none; then it runs one frame per movie frame.
+
+    Args:
+        movie: The movie.
+        emu: An emulator of the movie's system with a port for every player.
+        source: What to call the movie's start state in errors.
+        stop: Replay only this many frames (all by default).
+
+    Yields:
+        0 once the console is at the movie's start, then the number of each
+        movie frame (1-based) once it has run.
+
+    Raises:
+        MovieError: ``emu`` runs another system or has too few ports.
+        StateError: The start state is for another ROM, or the core cannot run it.
+    """
+    if emu.system.name != movie.system or emu.ports < movie.players:
+        raise MovieError(
+            f"Expected an emulator of {movie.system} with at least {movie.players} port(s) to play "
+            f"{movie.game}; found one of {emu.system.name} with {emu.ports}."
+        )
+    emu.set_sticky(0.0, 0)
+    emu.forget_action()
+    if movie.state is not None:
+        emu.set_state(check_movie_state(movie, emu, source))
+    else:
+        emu.reset()
+    yield 0
+    for number, frame in enumerate(movie.frames[:stop] if stop is not None else movie.frames, start=1):
+        emu.run(frame, 1)
+        yield number
 
 
 def play(
     movie: Movie | str | os.PathLike[str], *, emulator: Emulator | None = None, source: str | None = None
 ) -> Iterator[np.ndarray]:
-    """Replay a movie, yielding the screen after each of its frames.
-
-    The emulator is set to the movie's start state (or reset to power-on if it
-    has none), then runs one frame per movie frame with that frame's buttons.
+    """Replay a movie, yielding the screen after each of its frames (see :func:`replay`).
 
     Args:
         movie: A movie, or the path of a ``.bk2`` file.
@@ -93,6 +129,7 @@ def play(
 
     Raises:
         MovieError: The movie is malformed, or ``emulator`` runs another system or has too few ports.
+        StateError: The movie's start state is for another ROM, or the core cannot run it.
     """
     if source is None:
         source = f"the start state (Core.bin) of the {movie.game} movie" if isinstance(movie, Movie) else f"{movie}: Core.bin"
@@ -101,21 +138,9 @@ def play(
     own = emulator is None
     emu = open_emulator(movie) if emulator is None else emulator
     try:
-        if emu.system.name != movie.system or emu.ports < movie.players:
-            raise MovieError(
-                f"Expected an emulator of {movie.system} with at least {movie.players} port(s) to play "
-                f"{movie.game}; found one of {emu.system.name} with {emu.ports}."
-            )
-        emu.set_sticky(0.0, 0)
-        emu.forget_action()
-        if movie.state is not None:
-            check_movie_state(movie, emu, source)
-            emu.set_state(movie.state)
-        else:
-            emu.reset()
-        for frame in movie.frames:
-            emu.run(frame, 1)
-            yield emu.screen()
+        for number in replay(movie, emu, source=source):
+            if number:
+                yield emu.screen()
     finally:
         if own:
             emu.close()
@@ -259,7 +284,7 @@ def _write_mp4(imageio, frames: Iterator[tuple[int, np.ndarray]], out: Path, fps
     return count
 
 
-def state_from_movie(game: Game, movie_path: str | os.PathLike[str], frame: int | None = None) -> bytes:
+def state_from_movie(game: Game, movie_path: str | os.PathLike[str], frame: int | None = None) -> VettedState:
     """Replay a movie of ``game`` for ``frame`` frames (all by default) and return the state it reaches.
 
     Raises:
@@ -275,13 +300,7 @@ def state_from_movie(game: Game, movie_path: str | os.PathLike[str], frame: int 
     frame = length if frame is None else frame
     if not 0 <= frame <= length:
         raise MovieError(f"Expected a frame from 0 to {length} (the movie's length) for --frame; found {frame}.")
-    movie.frames = movie.frames[:frame]
     with Emulator(game.system, game.require_rom(), ports=max(2, movie.players)) as emu:
-        for _ in play(movie, emulator=emu):
+        for _ in replay(movie, emu, source=f"{movie_path}: Core.bin", stop=frame):
             pass
-        if frame == 0:  # play() ran nothing: put the console at the movie's start
-            if movie.state is not None:
-                emu.set_state(movie.state)
-            else:
-                emu.reset()
         return emu.get_state()

@@ -118,11 +118,12 @@ class RamSearch:
         self.engine.candidates, self.engine.history, self.engine.redo_stack = data.candidates, data.history, data.redo
         self.labels, self.state = list(data.labels), data.state
         try:
-            # Trusted when it is the state this tool wrote (its SHA-256 is in the session);
-            # otherwise first run in a child process, so a state that crashes the core cannot.
+            # The record may refuse it (another ROM), never vouch for it: unless this machine
+            # wrote or probed the state, it is first run in a child process.
             record = StateRecord(data.game, data.rom_sha1, data.state_sha256)
-            statecheck.check_state(self.game, data.emulator_state, record, source=str(path), rom=self.rom)
-            self.emulator.set_state(data.emulator_state)
+            self.emulator.set_state(
+                statecheck.check_state(self.game, data.emulator_state, record, source=str(path), rom=self.rom)
+            )
         except StateError as exc:
             raise SessionError(
                 f"{path}: expected an emulator state of {data.game}; the core refused it ({exc})."
@@ -134,7 +135,9 @@ class RamSearch:
         Raises:
             FileConflictError: ``path`` exists and ``overwrite`` is false.
         """
-        write_session(path, self.session_data(), overwrite=overwrite)
+        data = self.session_data()
+        statecheck.remember_written(self.game, data.emulator_state, self.rom)  # resuming it needs no probe
+        write_session(path, data, overwrite=overwrite)
 
     def session_data(self) -> SessionData:
         """Everything a session file holds."""
@@ -219,7 +222,7 @@ class RamSearch:
             MovieError: The movie is malformed or of another game.
         """
         from retrokit.movie import read_bk2
-        from retrokit.movie.playback import check_movie_state
+        from retrokit.movie.playback import replay
 
         recorded = read_bk2(movie)
         if recorded.game != self.game.name:
@@ -235,14 +238,8 @@ class RamSearch:
             raise InvalidArgumentError(
                 f"Expected --until from 0 to the movie's {len(recorded.frames)} frames, got {until!r}."
             )
-        if recorded.state is not None:
-            check_movie_state(recorded, self.emulator, str(movie))  # a state that could crash the core is refused
-            self.emulator.set_state(recorded.state)
-        else:
-            self.emulator.reset()
-        self.emulator.forget_action()
-        for frame in recorded.frames[:end]:
-            self.emulator.run(list(frame), 1)
+        for _ in replay(recorded, self.emulator, source=str(movie), stop=end):  # its start state checked there
+            pass
         return self.snapshot(f"movie {Path(movie).name} to frame {end}")
 
     def poke(self, address: int, value: int, type_code: str = "|u1") -> None:

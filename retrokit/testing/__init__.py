@@ -6,9 +6,7 @@ The checks, one module each:
 
 - :mod:`~retrokit.testing.schema`: ``game.yaml`` and scenario files against the shipped JSON Schemas;
 - :mod:`~retrokit.testing.fields`: fields inside the system's RAM, usual type codes, overlaps;
-- :mod:`~retrokit.testing.states`: every state (shipped, in the user's data folder, and each solution
-  movie's start state) loads in a child process, is the game's own, holds its fields within their
-  declared ranges one frame in, decodes; the default state exists;
+- :mod:`~retrokit.testing.states`: every state loads (in a child process), is the game's own, decodes;
 - :mod:`~retrokit.testing.scenarios`: every scenario compiles, covers the states' table keys, and
   survives a deterministic smoke run on every state;
 - :mod:`~retrokit.testing.movies`: solution movies replay to their expected outcome.
@@ -60,13 +58,15 @@ def check_game(
     from retrokit.testing.movies import check_movies
     from retrokit.testing.scenarios import SMOKE_FRAMES, check_scenarios
     from retrokit.testing.schema import check_schemas
-    from retrokit.testing.states import check_movie_states, check_states
+    from retrokit.testing.states import check_states
 
     def step(stage: str, detail: str = "") -> None:
         if progress is not None:
             progress(stage, detail)
 
-    game = _resolve(game)
+    from retrokit.data.games import find_game
+
+    game = find_game(game, check=False)  # its data file is checked below, as a step of the report
     report = GameReport(game.name)
 
     step("schema")
@@ -99,7 +99,6 @@ def check_game(
     _check_fields(game, report, rom)
     step("states")
     probes = check_states(game, report, rom)
-    check_movie_states(game, report, rom)
     step("scenarios")
     starts = {name: probe.start for name, probe in probes.items() if probe.start}
     check_scenarios(game, report, starts, rom=rom is not None, frames=frames or SMOKE_FRAMES,
@@ -107,31 +106,6 @@ def check_game(
     step("movies")
     check_movies(game, report, rom)
     return report
-
-
-def _resolve(game: Game | str | os.PathLike[str]) -> Game:
-    """A Game from a Game, a name or a folder, without checking its files (that is a check of its own)."""
-    from retrokit import paths
-    from retrokit.data.games import Game, list_games, normalize_name
-    from retrokit.errors import GameNotFoundError
-
-    if isinstance(game, Game):
-        return game
-    text = os.fspath(game)
-    known = {g.name: g for g in list_games()}
-    if normalize_name(text) in known:
-        return known[normalize_name(text)]
-    folder = Path(text)
-    if folder.is_dir() and any((folder / m).is_file() for m in ("game.yaml", "data.json", "rom.sha")):
-        # The states that integrate and ramsearch savestate wrote into the data folder are the game's too.
-        name = normalize_name(folder.resolve().name)
-        made = paths.user_games_dir() / name
-        extra = (made,) if made.is_dir() and made.resolve() != folder.resolve() else ()
-        return Game(name, (folder, *extra))
-    from retrokit.data.games import find_game
-
-    find_game(text)  # raises the usual message, with did-you-mean
-    raise GameNotFoundError(f"Expected a game name or a game folder; found {text!r}.")  # pragma: no cover
 
 
 def _check_fields(game: Game, report: GameReport, rom: Path | None) -> None:

@@ -64,24 +64,19 @@ def replay(game: Game, movie_path: Path, scenario: str | None = None, rom: Path 
     from retrokit.host.emulator import Emulator
     from retrokit.host.memory import FieldReader
     from retrokit.movie import read_bk2
+    from retrokit.movie.playback import replay as frames_of
 
     movie = read_bk2(movie_path)
     path = game.scenario_path(scenario)
     compiled = load_scenario(path, list(game.fields), game_dir=path.parent)
     total, done_at = 0.0, None
     with Emulator(game.system, rom or game.require_rom(), ports=max(2, movie.players)) as emu:
-        # As retrokit.movie.playback.play does, without converting screens nobody looks at.
-        emu.set_sticky(0.0, 0)
-        emu.forget_action()
-        if movie.state is not None:
-            emu.set_state(movie.state)
-        else:
-            emu.reset()
         reader = FieldReader(game.fields, emu.space)
         run = compiled.start()
-        run.reset(reader.read())  # as an env's reset: the scenario starts from the movie's state
-        for frame, buttons in enumerate(movie.frames, start=1):
-            emu.run(buttons, 1)
+        for frame in frames_of(movie, emu, source=f"{movie_path}: Core.bin"):  # its start state checked there
+            if frame == 0:
+                run.reset(reader.read())  # as an env's reset: the scenario starts from the movie's state
+                continue
             rewards, done = run.step(reader.read(), frame, frame)
             total += sum(rewards)
             if done:

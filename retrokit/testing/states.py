@@ -1,6 +1,6 @@
 """Checking a game's save states: each loads, is the game's own, and its fields decode.
 
-States are loaded in a child process (``python -m retrokit.testing.states``),
+States are loaded in the crash probe's child process (:mod:`retrokit.data.probe`),
 so that a corrupt state that crashes or hangs the core costs one result, not
 the run: the parent sees the child die or time out, blames the state it was
 on, and starts a new child for the rest.
@@ -22,10 +22,7 @@ states of the solution movies are checked the same way.
 from __future__ import annotations
 
 import hashlib
-import json
 import os
-import subprocess
-import sys
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,9 +40,8 @@ if TYPE_CHECKING:
 __all__ = ["IDLE_FRAMES", "StateProbe", "check_states", "parse_states", "probe_states", "state_space"]
 
 IDLE_FRAMES = 60  # frames run after loading, so a state that breaks the core does so here
+INPUT_FRAMES = 300  # then, loaded again, frames of random input: some states crash only then
 CHILD_TIMEOUT = 30.0  # seconds a child may spend on one state
-CHILD_STARTUP = 120.0  # seconds a child may take to start (importing retrokit, loading the core) on a busy machine
-CHILD_MEMORY = 512 << 20  # bytes of address space a child may map: a gzip bomb fails there, the machine lives
 
 
 @dataclass
@@ -83,25 +79,23 @@ def probe_states(
 ) -> dict[str, StateProbe]:
     """Load each state in a child process with the game's ROM; return what each showed.
 
-    A child that dies or hangs marks the state it was loading as failed, and a
-    new child carries on with the states after it.
-
-    Args:
-        game: The game.
-        names: The states to load.
-        rom: The ROM to load them with.
-        frames: Idle frames run after loading.
-        files: The file of each name; by default the game's state of that name.
+    The child is the crash probe's (:func:`retrokit.data.probe.run_child`: a
+    memory cap, no core file, this retrokit). A child that dies or hangs marks
+    the state it was loading as failed, and a new child carries on with the
+    states after it: each state gets its own result, none is cached.
     """
+    from retrokit.data.probe import run_child
+
     paths = {name: str(files[name] if files is not None else game.state_path(name)) for name in names}
     fields = [{"name": f.name, "address": f.address, "type": f.type, "mask": f.mask} for f in game.fields.values()]
     probes: dict[str, StateProbe] = {}
     todo = list(names)
     while todo:
-        request = {"system": game.system.name, "rom": str(rom), "fields": fields, "frames": frames,
-                   "states": [[n, paths[n]] for n in todo]}
-        done, current, failure = _run_child(request)
-        probes.update(done)
+        done, current, failure = run_child(
+            game.system.name, rom, [(n, paths[n]) for n in todo], frames=frames, input_frames=INPUT_FRAMES,
+            fields=fields, timeout=CHILD_TIMEOUT,
+        )
+        probes.update({name: StateProbe(**vars(result)) for name, result in done.items()})
         todo = [n for n in todo if n not in probes]
         if current is not None and current in todo:  # the child died or hung on this one
             probes[current] = StateProbe(current, paths[current], error=failure)
@@ -111,67 +105,6 @@ def probe_states(
                 probes[name] = StateProbe(name, paths[name], error=failure or "the state loader stopped early")
             todo = []
     return {name: probes[name] for name in names}
-
-
-def _run_child(request: Mapping[str, Any]) -> tuple[dict[str, StateProbe], str | None, str]:
-    """Run one child; return the probes it finished, the state it was on when it stopped, and why it stopped.
-
-    The child prints a line before and after each state; a state that prints
-    nothing for :data:`CHILD_TIMEOUT` seconds has hung the core, and the child
-    is killed. Its log goes to a file, so a chatty core cannot fill a pipe.
-    """
-    import selectors
-    import tempfile
-
-    probes: dict[str, StateProbe] = {}
-    current, failure = None, ""
-    with tempfile.TemporaryFile("w+") as log:
-        proc = subprocess.Popen(
-            [sys.executable, "-m", "retrokit.testing.states"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-            stderr=log, bufsize=0,
-        )
-        try:
-            proc.stdin.write(json.dumps(request).encode())  # type: ignore[union-attr]
-            proc.stdin.close()  # type: ignore[union-attr]
-        except BrokenPipeError:  # it died at once; its status says why
-            pass
-        # Raw reads, split here: a buffered reader could hold a line that select() then waits for.
-        fd = proc.stdout.fileno()  # type: ignore[union-attr]
-        pending = b""
-        with selectors.DefaultSelector() as selector:
-            selector.register(fd, selectors.EVENT_READ)
-            wait = CHILD_STARTUP
-            while True:
-                if not selector.select(timeout=wait):
-                    proc.kill()
-                    failure = (f"the core hung: loading the state and running {request['frames']} frames "
-                               f"took over {CHILD_TIMEOUT:g} s")
-                    break
-                chunk = os.read(fd, 1 << 16)
-                if not chunk:
-                    break
-                wait = CHILD_TIMEOUT
-                *lines, pending = (pending + chunk).split(b"\n")
-                for line in lines:
-                    try:
-                        message = json.loads(line)
-                    except json.JSONDecodeError:
-                        continue
-                    if "begin" in message:
-                        current = message["begin"]
-                    else:
-                        probes[message["name"]] = StateProbe(**message)
-                        current = None
-        proc.stdout.close()  # type: ignore[union-attr]
-        status = proc.wait()
-        if not failure and status != 0:
-            if status < 0:
-                failure = f"the core crashed (signal {-status}) while loading or running the state"
-            else:
-                log.seek(0)
-                last = log.read().strip().splitlines()[-1:] or ["no message"]
-                failure = f"the state loader exited with status {status}: {last[0]}"
-    return probes, current, failure
 
 
 def state_space(game: Game, data: bytes) -> AddressSpace | None:
@@ -434,45 +367,3 @@ def _sha1(path: Path) -> str:
     return hashlib.sha1(path.read_bytes()).hexdigest()
 
 
-# --- Child side ------------------------------------------------------------------------------------
-
-
-def _child_main() -> int:
-    """Load the states a request names, one by one; print one JSON line per state (and one before each)."""
-    from retrokit.host.emulator import Emulator
-    from retrokit.host.fields import FieldSpec
-    from retrokit.host.memory import FieldReader
-
-    try:  # a gzip bomb or a core gone wild fails here with MemoryError, and the machine lives
-        import resource
-
-        resource.setrlimit(resource.RLIMIT_AS, (CHILD_MEMORY, CHILD_MEMORY))
-    except (ImportError, ValueError, OSError):  # not POSIX, or a lower hard limit already
-        pass
-    request = json.load(sys.stdin)
-    emu = Emulator(request["system"], request["rom"])
-    specs = [FieldSpec(f["name"], f["address"], f["type"], f["mask"]) for f in request["fields"]]
-    reader = FieldReader([s for s in specs if _inside(emu.space, s)], emu.space)
-    idle = [0] * emu.ports
-    for name, path in request["states"]:
-        print(json.dumps({"begin": name}), flush=True)
-        result: dict[str, Any] = {"name": name, "path": path}
-        try:
-            data = read_state(path)
-            emu.set_state(data)
-            result["start"] = reader.read()
-            emu.run(idle, 1)
-            result["first"] = reader.read()
-            emu.run(idle, max(request["frames"] - 1, 0))
-            result["after"] = reader.read()
-            result["loaded"] = True
-            result["detail"] = f"{state_format(data) or 'no core signature'}, {len(data)} bytes"
-        except (RetrokitError, MemoryError) as exc:
-            result["error"] = str(exc) if not isinstance(exc, MemoryError) else "the state needs too much memory"
-        print(json.dumps(result), flush=True)
-    emu.close()
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(_child_main())

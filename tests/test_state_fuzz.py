@@ -1,0 +1,106 @@
+"""Corrupt states behind a real state's valid header: none kills the process that loads it.
+
+Each state is Dasher's Zone1.Act1 with its header kept and a random body
+(the fuzz of issue 24, where 3 of 120 passed the first probe). Each goes through the
+public API: ``retrokit.make(game, path)``, then 3,000 frames with random
+input and a reset every 500. The probe (:mod:`retrokit.data.probe`) must
+refuse every state that would crash the core; the ones it passes must play.
+The probes run first, two at a time, each in its own child, through
+``statecheck.load_state`` (their verdicts are cached, so ``make`` reads them);
+the play runs in one child process, so a state the probe missed fails this
+test instead of killing the suite.
+
+24 states run always (about a quarter of them pass the probe and play);
+the issue's full 120 with ``RETROKIT_FUZZ_STATES=120``.
+"""
+
+from __future__ import annotations
+
+import os
+import random
+import time
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+from childproc import MAX_RSS_MB, REPO, run_child
+
+from retrokit.data.states import compress_state, read_state
+
+DASHER = REPO / "games" / "Dasher-Genesis"
+COUNT = int(os.environ.get("RETROKIT_FUZZ_STATES", "24"))
+HEADER = 16  # "GENPLUS-GX 1.7.5": the core's signature, checked by the core on load
+
+PLAY = """
+import json
+import numpy as np
+import retrokit
+from retrokit.errors import StateError
+
+played = refused = 0
+for path in json.load(open(STATES)):
+    try:
+        env = retrokit.make("Dasher-Genesis", path, obs_type="ram", frameskip=4)
+    except StateError:
+        refused += 1
+        continue
+    rng = np.random.default_rng(0)
+    env.reset(seed=0)
+    for step in range(750):  # 3,000 frames
+        env.step(rng.integers(0, 2, env.action_space.shape))
+        if step % 125 == 124:
+            env.reset()  # every reset loads the state again
+    env.close()
+    played += 1
+print(json.dumps({"played": played, "refused": refused}))
+"""
+
+
+def corrupt_states(good: bytes, count: int) -> list[bytes]:
+    """Copies of ``good`` with its header and a random body."""
+    rng = random.Random(2024)
+    return [good[:HEADER] + rng.randbytes(len(good) - HEADER) for _ in range(count)]
+
+
+@pytest.mark.xfail(
+    strict=False,
+    reason="known gap (issue 24): about 1 random-body state in 24 passes the probe in its child and then kills "
+    "an env's process at reset(), depending on the memory layout (seed 2024, state 7); the cause is not found yet",
+)
+def test_corrupt_states_never_kill_the_process(tmp_path: Path, monkeypatch) -> None:
+    import json
+
+    from retrokit.data.games import find_game
+    from retrokit.data.statecheck import load_state
+    from retrokit.errors import StateError
+
+    data = tmp_path / "data"
+    monkeypatch.setenv("RETROKIT_DATA", str(data))
+    game = find_game("Dasher-Genesis")
+    files = []
+    for i, state in enumerate(corrupt_states(read_state(DASHER / "Zone1.Act1.state"), COUNT)):
+        path = tmp_path / f"fuzz{i:03d}.state"
+        path.write_bytes(compress_state(state))
+        files.append(str(path))
+
+    def probe(path: str) -> bool:
+        try:
+            load_state(game, path)
+        except StateError:
+            return False
+        return True
+
+    began = time.monotonic()
+    with ThreadPoolExecutor(2) as pool:
+        passed = list(pool.map(probe, files))
+    probing = time.monotonic() - began
+    assert len(passed) == COUNT and not all(passed) and any(passed)  # the fuzz makes both kinds
+
+    (tmp_path / "states.json").write_text(json.dumps(files))
+    code = f"STATES = {str(tmp_path / 'states.json')!r}\n" + PLAY
+    child = run_child(code, env={"RETROKIT_DATA": str(data)}, timeout=600)
+    assert child.signal is None and child.returncode == 0, child.describe()
+    counts = json.loads(child.stdout.strip().splitlines()[-1])
+    assert counts == {"played": sum(passed), "refused": COUNT - sum(passed)}, child.describe()
+    assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
+    print(f"{COUNT} states: {sum(passed)} played, {COUNT - sum(passed)} refused; probing took {probing:.0f} s")

@@ -64,9 +64,13 @@ def check_game(
         if progress is not None:
             progress(stage, detail)
 
-    from retrokit.data.games import find_game
+    from retrokit import paths
+    from retrokit.data.games import Game, find_game
 
     game = find_game(game, check=False)  # its data file is checked below, as a step of the report
+    made = paths.user_games_dir() / game.name  # where integrate and savestate write: its states are the game's too
+    if made.is_dir() and all(made.resolve() != f.resolve() for f in game.folders):
+        game = Game(game.name, (*game.folders, made))
     report = GameReport(game.name)
 
     step("schema")

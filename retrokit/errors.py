@@ -10,14 +10,24 @@ from __future__ import annotations
 import difflib
 from collections.abc import Iterable
 
+MIN_PART = 3
+"""The shortest text that :func:`did_you_mean` also looks for inside the choices."""
+MAX_PARTS = 3
+
 
 def did_you_mean(name: str, choices: Iterable[str], *, n: int = 1) -> str:
-    """Return ``" Did you mean 'x'?"`` for the ``n`` choices closest to ``name``, or ``""``."""
+    """Return ``" Did you mean 'x'?"`` for the ``n`` choices closest to ``name``, or ``""``.
+
+    When no choice is close, up to three that contain ``name`` are suggested.
+    """
     choices = [str(c) for c in choices]
     close = difflib.get_close_matches(name, choices, n=n, cutoff=0.6)
     if not close:
         lowered = {c.lower(): c for c in choices}
         close = [lowered[c] for c in difflib.get_close_matches(name.lower(), list(lowered), n=n, cutoff=0.6)]
+    if not close and len(name) >= MIN_PART:
+        # A part of a long name ('Sonic' for 'SonicTheHedgehog-Genesis') is too short to be "close" to it.
+        close = [c for c in choices if name.lower() in c.lower()][:MAX_PARTS]
     if not close:
         return ""
     if len(close) == 1:

@@ -135,3 +135,30 @@ def test_a_closed_pipe_ends_the_command_quietly(command: list[str]) -> None:
     stderr = process.stderr.read().decode()
     process.wait(timeout=120)
     assert "Traceback" not in stderr and "BrokenPipeError" not in stderr
+
+
+def test_import_lists_unmatched_files_with_their_sha1_and_suggests_new(capsys, tmp_path):
+    from runner_rom import write_runner_rom
+
+    from retrokit.data.roms import rom_sha1
+
+    runner = write_runner_rom(tmp_path / "runner.bin")
+    status, out, _ = run(capsys, "import", str(runner))
+    assert status == 0
+    assert f"  {runner}  SHA-1 {rom_sha1(runner, 'Genesis')}  Genesis" in out
+    assert f"Start one with: retrokit new {runner} --name NAME-Genesis" in out
+
+
+def test_import_of_a_path_that_does_not_exist_exits_2(capsys, tmp_path, data_dir):
+    roms = tmp_path / "roms"
+    roms.mkdir()
+    (roms / "airstriker.md").write_bytes((AIRSTRIKER_DIR / "rom.md").read_bytes())
+    status, out, err = run(capsys, "import", str(roms), str(tmp_path / "romz"))
+    assert status == 2 and out == "" and "no such path" in err and "romz" in err
+    assert not (data_dir / "roms").exists()  # nothing imported: the typo is fixed first
+
+
+def test_import_game_with_part_of_a_name_suggests_the_games_holding_it(capsys):
+    status, out, err = run(capsys, "import", "--game", "Sonic")
+    assert status == 2 and out == ""
+    assert "Did you mean one of: 'Sonic" in err and err.count("\n") == 1

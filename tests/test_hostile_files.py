@@ -51,7 +51,8 @@ def _import_a_folder_named_rom_md(place: Path, monkeypatch: pytest.MonkeyPatch) 
 
 CASES = {
     "rom.md-is-a-folder": (_rom_md_a_folder, "ROM"),
-    "import-a-folder-named-rom.md": (_import_a_folder_named_rom_md, None),
+    # a path that does not exist (here under a file) is a one-line error, exit 2 (issue 20), before any is searched
+    "import-a-folder-named-rom.md": (_import_a_folder_named_rom_md, "no such path"),
     "data-folder-is-a-file": (lambda place, mp: mp.setenv("RETROKIT_DATA", str(place / "afile"))
                               or ["import", str(AIRSTRIKER_ROM)], "a file where one of its parent folders should be"),
     "output-without-suffix-is-a-file": (lambda place, mp: ["playback", "m.bk2", "afile"], "a file without a suffix"),

@@ -62,7 +62,7 @@ def test_an_address_outside_ram_names_the_field(tmp_path: Path, monkeypatch: pyt
 
 
 RECIPE_CASES = {
-    "recipe-is-a-list": ("[1, 2]", "expected a mapping with set, press, until"),
+    "recipe-is-a-list": ("[1, 2]", "expected a mapping with set, press, and until or frames"),
     "until-is-a-list": ("{press: [START], until: [game_mode]}", "expected 'until' to map field names"),
     "unknown-button": ("{press: [JUMP], until: {game_mode: 1}}", "found 'JUMP'"),
     "press-is-a-string": ("{press: START, until: {game_mode: 1}}", "expected press to list button names"),

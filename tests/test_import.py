@@ -52,7 +52,7 @@ def test_import_from_a_folder(src, data_dir):
     dest = imported(data_dir, "Airstriker-Genesis", "md")
     assert [(r.game, r.path) for r in report.imported] == [("Airstriker-Genesis", dest)]
     assert dest.read_bytes() == AIRSTRIKER_ROM.read_bytes()
-    assert report.unmatched == [str(src / "notes.txt")]
+    assert [u.source for u in report.unmatched] == [str(src / "notes.txt")]
     assert report.conflicts == [] and report.already_present == [] and report.broken_games == []
     assert sorted(p.name for p in dest.parent.iterdir()) == ["rom.md"]  # no temp file left
 
@@ -75,7 +75,7 @@ def test_import_from_a_zip(src, data_dir, nested):
     assert [r.game for r in report.imported] == ["Airstriker-Genesis"]
     assert report.imported[0].source.endswith("!Airstriker/Airstriker.md")
     assert imported(data_dir, "Airstriker-Genesis", "md").read_bytes() == AIRSTRIKER_ROM.read_bytes()
-    assert any(u.endswith("!readme.txt") for u in report.unmatched)
+    assert [u.source.rsplit("!", 1)[-1] for u in report.unmatched] == ["readme.txt"]
     assert not list(src.glob("**/*.md"))  # zip members are never extracted to disk
 
 
@@ -96,7 +96,7 @@ def test_nes_header_is_left_out_of_the_hash(src, data_dir):
     # Two games accept the same ROM: each gets its copy, stored with its header.
     assert sorted(r.game for r in report.imported) == ["FakeQuest-Nes", "FakeQuestTurbo-Nes"]
     assert imported(data_dir, "FakeQuest-Nes", "nes").read_bytes() == NES_ROM
-    assert str(src / "FakeQuest-headered.bin") in report.unmatched
+    assert str(src / "FakeQuest-headered.bin") in [u.source for u in report.unmatched]
     assert game.require_rom() == imported(data_dir, "FakeQuest-Nes", "nes")
 
 
@@ -145,3 +145,28 @@ def test_written_files_get_the_usual_permissions(tmp_path):
     finally:
         os.umask(umask)
     assert (tmp_path / "f.bin").stat().st_mode & 0o777 == 0o644
+
+
+def test_an_unmatched_file_has_its_sha1_and_likely_system(src, data_dir):
+    from runner_rom import write_runner_rom
+
+    runner = write_runner_rom(src / "runner.bin")
+    (src / "FakeQuest-headered.bin").write_bytes(NES_ROM)
+    report = import_roms([src])
+    by_source = {Path(u.source).name: u for u in report.unmatched}
+    assert by_source["runner.bin"].sha1 == hashlib.sha1(runner.read_bytes()).hexdigest()
+    assert by_source["runner.bin"].system == "Genesis"  # told by its header: .bin says nothing
+    assert by_source["FakeQuest-headered.bin"].system == "Nes"
+    assert by_source["notes.txt"].system is None
+
+
+@pytest.mark.parametrize("nested", [False, True], ids=["zip", "zip-in-zip"])
+def test_a_zip_holding_no_rom_is_listed_once(src, data_dir, nested):
+    archive = _zip({"readme.txt": b"hello"})
+    if nested:
+        archive = _zip({"inner.zip": archive})
+    (src / "docs.zip").write_bytes(archive)
+    (src / "empty.zip").write_bytes(_zip({}))
+    report = import_roms([src / "docs.zip", src / "empty.zip"])
+    inner = "!inner.zip" if nested else ""
+    assert [u.source for u in report.unmatched] == [f"{src / 'docs.zip'}{inner}!readme.txt", str(src / "empty.zip")]

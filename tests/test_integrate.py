@@ -89,10 +89,12 @@ def write_recipe(folder: Path, recipe: str) -> None:
     "recipe,message",
     [
         ("  Zone1.Act1: {set: {zon: 0}, until: {game_mode: 1}}\n", "Did you mean 'zone'"),
-        ("  Zone1.Act1: {set: {zone: 0}}\n", "expected 'until'"),
+        ("  Zone1.Act1: {set: {zone: 0}}\n", "expected 'until'.*or 'frames'.*found neither"),
+        ("  Zone1.Act1: {press: [START], until: {game_mode: 1}, frames: 60}\n", "found both. Keep one"),
+        ("  Zone1.Act1: {press: [START], frames: 0}\n", "expected frames to be a number of frames from 1"),
         ("  Zone1.Act1: {set: {zone: 0}, untill: {game_mode: 1}}\n", "Did you mean 'until'"),
     ],
-    ids=["unknown-field", "no-until", "unknown-key"],
+    ids=["unknown-field", "no-until-nor-frames", "until-and-frames", "zero-frames", "unknown-key"],
 )
 def test_bad_recipes_say_what_is_wrong(dasher_copy: Path, recipe: str, message: str) -> None:
     write_recipe(dasher_copy, recipe)
@@ -105,3 +107,22 @@ def test_a_recipe_that_never_arrives_is_a_clear_error(dasher_copy: Path) -> None
     game = load_game(dasher_copy)
     with pytest.raises(StateError, match=r"reach \{'game_mode': 3\} within 120 frames; it ended at \{'game_mode': 1\}"):
         make_state(game, recipes(game)["Zone1.Act1"])
+
+
+def test_a_press_and_frames_recipe_plays_that_many_frames(dasher_copy: Path) -> None:
+    """A game with no fields yet can make its first state: START, then a number of frames."""
+    write_recipe(dasher_copy, "  Zone1.Act1: {press: [START], frames: 100}\n  B: {press: [START], frames: 101}\n")
+    game = load_game(dasher_copy)
+    made = {name: fields_after(game, make_state(game, recipe)) for name, recipe in recipes(game).items()}
+    assert made["Zone1.Act1"]["game_mode"] == made["B"]["game_mode"] == 1  # in play
+    assert made["B"]["frame"] == made["Zone1.Act1"]["frame"] + 1  # exactly one frame more
+
+
+def test_a_frames_recipe_passes_the_schema(dasher_copy: Path) -> None:
+    from retrokit.data.schema import check_file
+
+    write_recipe(dasher_copy, "  Zone1.Act1: {press: [START], frames: 100}\n")
+    assert check_file(dasher_copy / "game.yaml", "game") == []
+    write_recipe(dasher_copy, "  Zone1.Act1: {press: [START], frames: 100, until: {game_mode: 1}}\n")
+    assert check_file(dasher_copy / "game.yaml", "game") != []
+

@@ -21,7 +21,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "each of its scenarios compiles ('ok', 'none', or 'refused:' and the names of those that do not).",
     )
     parser.add_argument("pattern", nargs="?", metavar="PATTERN",
-                        help="only games whose name matches this glob, or contains this text")
+                        help="only games whose name matches this glob, or contains this text; a game's exact name shows that game only")
     parser.add_argument("--imported", action="store_true", help="only games whose ROM is available")
     add_data_dir_option(parser)
     parser.set_defaults(run=run)
@@ -29,10 +29,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     """List the games."""
-    from retrokit.data.games import list_games
+    from retrokit.data.games import list_games, normalize_name
     from retrokit.errors import GameNotFoundError, RetrokitError, did_you_mean
 
-    games = list_games(args.pattern)
+    # A game's full name (or its -v0 name) shows that game, not every name that contains it.
+    exact = [g for g in list_games() if args.pattern is not None and g.name == normalize_name(args.pattern)]
+    games = exact or list_games(args.pattern)
     if not games:
         names = [g.name for g in list_games()]
         raise GameNotFoundError(

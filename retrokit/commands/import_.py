@@ -3,8 +3,14 @@
 from __future__ import annotations
 
 import argparse
+import os
+import shlex
+from typing import TYPE_CHECKING
 
 from retrokit.commands._common import add_data_dir_option, add_force_option, rom_status
+
+if TYPE_CHECKING:
+    from retrokit.data.importer import UnmatchedFile
 
 SHOWN = 10
 
@@ -38,11 +44,15 @@ def _section(title: str, lines: list[str], verbose: bool) -> None:
         print(f"  ... and {len(lines) - len(shown)} more (-v lists them all)")
 
 
+def _unmatched(entry: UnmatchedFile) -> str:
+    return f"{entry.source}  SHA-1 {entry.sha1}  {entry.system or 'system unknown'}"
+
+
 def run(args: argparse.Namespace) -> int:
     """Import ROMs, and/or show what a game expects."""
     from retrokit.data.games import find_game
     from retrokit.data.importer import import_roms
-    from retrokit.errors import InvalidArgumentError
+    from retrokit.errors import FileSystemError, InvalidArgumentError
 
     if not args.paths and not args.game:
         raise InvalidArgumentError(
@@ -50,6 +60,11 @@ def run(args: argparse.Namespace) -> int:
             "Run, for example: retrokit import ~/roms"
         )
     game = find_game(args.game) if args.game else None
+    for path in args.paths:  # checked before any is searched: a typo must not look like "nothing found"
+        if not os.path.lexists(path):
+            raise FileSystemError(
+                f"Expected a file, folder or zip file to search; found no such path: {path!r}. Check the path."
+            )
     status = 0
     if args.paths:
         report = import_roms(args.paths, data_dir=args.data_dir, overwrite=args.force, progress=True)
@@ -61,9 +76,13 @@ def run(args: argparse.Namespace) -> int:
             [f"{c.game}: {c.path} has SHA-1 {c.existing_sha1}; {c.source} has {c.sha1}" for c in report.conflicts],
             True,
         )
-        _section("Matched no known game", report.unmatched, args.verbose)
+        _section("Matched no known game (SHA-1, likely system)", [_unmatched(u) for u in report.unmatched], args.verbose)
         _section("Skipped", [f"{label}: {why}" for label, why in report.skipped], args.verbose)
         _section("Games whose data files cannot be read", [f"{n}: {e}" for n, e in report.broken_games], args.verbose)
+        likely = [u for u in report.unmatched if u.system is not None]
+        if likely:
+            print(f"A game nobody has integrated yet? Start one with: retrokit new {shlex.quote(likely[0].source)} "
+                  f"--name NAME-{likely[0].system} (retrokit docs integrate)")
         status = 1 if report.conflicts else 0
     if game is not None:
         where, path = rom_status(game, args.data_dir)

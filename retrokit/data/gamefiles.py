@@ -22,7 +22,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
-from retrokit.errors import DataFileError, FieldTypeError, FileSystemError, did_you_mean
+from retrokit.errors import DataFileError, FieldTypeError, FileSystemError, InvalidArgumentError, did_you_mean
 from retrokit.paths import read_regular_file
 
 if TYPE_CHECKING:
@@ -119,7 +119,7 @@ def _field(source: Path, name: str, entry: Any) -> FieldSpec:
     from retrokit.host.fields import FieldSpec
 
     where = f"field {name!r}"
-    entry = _expect(source, where, entry, Mapping, "a mapping with address, type and optionally mask")
+    entry = _expect(source, where, entry, Mapping, "a mapping with address, type and optionally mask and range")
     _check_keys(source, where, entry, _FIELD_KEYS)
     for key in ("address", "type"):
         if key not in entry:
@@ -139,10 +139,23 @@ def _field(source: Path, name: str, entry: Any) -> FieldSpec:
             )
         if mask >= 1 << 63:  # the same 64 bits as a signed number, as fields are decoded
             mask -= 1 << 64
+    bounds = _range(source, where, entry.get("range"))
     try:
-        return FieldSpec(name, address, code, mask)
+        return FieldSpec(name, address, code, mask, bounds)
     except FieldTypeError as exc:  # the type code; FieldSpec parses it
         raise FieldTypeError(f"{source}: {where}: {exc}") from exc
+    except InvalidArgumentError as exc:  # the range: FieldSpec checks it against the type
+        raise data_error(source, f"the range of {where} to fit it", str(exc), "fix the range") from exc
+
+
+def _range(source: Path, where: str, value: Any) -> tuple[int, int] | None:
+    """A field's ``range: [lo, hi]``: the values it takes in play (None when not given)."""
+    if value is None:
+        return None
+    pair = _expect(source, f"the range of {where}", value, list, "a list [lo, hi]")
+    if len(pair) != 2:
+        raise data_error(source, f"the range of {where} to be [lo, hi]", _describe(value), "write two numbers")
+    return _int(source, f"the range of {where}", pair[0]), _int(source, f"the range of {where}", pair[1])
 
 
 def _fields(source: Path, where: str, value: Any) -> Mapping[str, FieldSpec]:

@@ -74,6 +74,21 @@ class ImportConflict:
     existing_sha1: str
 
 
+@dataclass(frozen=True)
+class UnmatchedFile:
+    """A candidate whose SHA-1 matches no known game: perhaps a game nobody has integrated yet.
+
+    Attributes:
+        source: Where it was found (``archive.zip!member`` for zip members).
+        sha1: Its SHA-1 (by stable-retro's rules, for its likely system's form).
+        system: The system its header or extension suggests (``retrokit new`` takes it), or ``None``.
+    """
+
+    source: str
+    sha1: str
+    system: str | None
+
+
 @dataclass
 class ImportReport:
     """What :func:`import_roms` did.
@@ -92,7 +107,7 @@ class ImportReport:
     imported: list[ImportedRom] = field(default_factory=list)
     already_present: list[ImportedRom] = field(default_factory=list)
     conflicts: list[ImportConflict] = field(default_factory=list)
-    unmatched: list[str] = field(default_factory=list)
+    unmatched: list[UnmatchedFile] = field(default_factory=list)
     skipped: list[tuple[str, str]] = field(default_factory=list)
     broken_games: list[tuple[str, str]] = field(default_factory=list)
 
@@ -300,8 +315,22 @@ def import_roms(
                 continue
             matches = table.get(sha1)
             if not matches:
-                report.unmatched.append(label)
+                system, _ = roms.guess_system(data, label)
+                report.unmatched.append(UnmatchedFile(label, sha1, system.name if system is not None else None))
                 continue
             for game in matches:
                 _store(game, label, data, sha1, report, overwrite)
+    report.unmatched = _once_per_zip(report.unmatched)
     return report
+
+
+def _once_per_zip(unmatched: list[UnmatchedFile]) -> list[UnmatchedFile]:
+    """Leave out a zip whose members are listed: a zip is searched whole (an arcade set) and by member.
+
+    Listing both would show a zip holding no ROM twice; its members say more.
+    """
+    parents = set()
+    for entry in unmatched:
+        parts = entry.source.split("!")
+        parents.update("!".join(parts[:i]) for i in range(1, len(parts)))
+    return [entry for entry in unmatched if entry.source not in parents]

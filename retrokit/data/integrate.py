@@ -11,6 +11,9 @@ has a recipe for, and checks the ones already there::
         press: [START]                 # port 1; or {1: [START], 2: [START]}
         until: {game_mode: 1}          # every field equal: arrived
         settle: 0                      # frames to run after arrival
+      Level1:
+        press: [START]                 # a new game has no fields yet: press START
+        frames: 300                    # for 300 frames from power-on, then save
 
 States can also be made from a movie: the state a ``.bk2`` reaches at a
 frame (:func:`retrokit.movie.playback.state_from_movie`), placed with
@@ -65,6 +68,7 @@ class Recipe:
     until: Mapping[str, int] = field(default_factory=dict)
     settle: int = 0
     max_frames: int = 3000
+    frames: int | None = None  # instead of until: play exactly this many frames
 
 
 def recipes(game: Game) -> dict[str, Recipe]:
@@ -81,29 +85,40 @@ def recipes(game: Game) -> dict[str, Recipe]:
     return {str(name): _recipe(game, str(name), spec) for name, spec in raw.items()}
 
 
-_RECIPE_KEYS = ("set", "press", "until", "settle", "max_frames")
+_RECIPE_KEYS = ("set", "press", "until", "frames", "settle", "max_frames")
 MAX_RECIPE_FRAMES = 1_000_000  # about 4.6 hours of play: a recipe that needs more is a mistake
 
 
 def _recipe(game: Game, name: str, spec: Any) -> Recipe:
     where = f"{game.info.source}: the recipe of state {name!r}"
     if not isinstance(spec, Mapping):
-        raise DataFileError(f"{where}: expected a mapping with set, press, until; found {_show(spec)}.")
+        raise DataFileError(f"{where}: expected a mapping with set, press, and until or frames; found {_show(spec)}.")
     unknown = set(map(str, spec)) - set(_RECIPE_KEYS)
     if unknown:
         key = min(unknown)
         raise DataFileError(
             f"{where}: expected only the keys {', '.join(_RECIPE_KEYS)}; found {key!r}." + did_you_mean(key, _RECIPE_KEYS)
         )
-    if not spec.get("until"):
-        raise DataFileError(f"{where}: expected 'until', the field values that mark arrival, such as {{game_mode: 1}}.")
+    # A game with no fields yet can only say how long to play: 'frames'; 'until' needs fields to watch.
+    if spec.get("until") and "frames" in spec:
+        raise DataFileError(
+            f"{where}: expected either 'until' (field values that mark arrival) or 'frames' (how long to play); "
+            "found both. Keep one."
+        )
+    if not spec.get("until") and "frames" not in spec:
+        raise DataFileError(
+            f"{where}: expected 'until', the field values that mark arrival, such as {{game_mode: 1}}, or 'frames', "
+            "how many frames to play from power-on, such as 300 (for a game with no fields yet); found neither."
+        )
+    frames = _count(where, "frames", spec["frames"], 1) if "frames" in spec else None
     return Recipe(
         name=name,
         set=_values(game, where, "set", spec.get("set")),
         press=_press(game, where, spec.get("press")),
-        until=_values(game, where, "until", spec["until"]),
+        until=_values(game, where, "until", spec.get("until")),
         settle=_count(where, "settle", spec.get("settle", 0), 0),
         max_frames=_count(where, "max_frames", spec.get("max_frames", 3000), 1),
+        frames=frames,
     )
 
 
@@ -190,6 +205,11 @@ def _count(where: str, key: str, value: Any, least: int) -> int:
 def make_state(game: Game, recipe: Recipe) -> VettedState:
     """Play a recipe from power-on and return the state it reaches.
 
+    An ``until`` recipe plays until its fields hold their values (at most
+    ``max_frames``); a ``frames`` recipe plays exactly that many frames. Either
+    taps its buttons (held :data:`HOLD_FRAMES`, released as long) meanwhile,
+    then runs ``settle`` idle frames.
+
     Raises:
         StateError: The recipe did not arrive within its frame budget.
     """
@@ -200,20 +220,29 @@ def make_state(game: Game, recipe: Recipe) -> VettedState:
             if not 1 <= port <= emu.ports:
                 raise InvalidArgumentError(f"Expected ports 1 to {emu.ports} in the recipe of {recipe.name!r}, got {port}.")
             masks[port - 1] = emu.system.mask(buttons)
-        for frame in range(recipe.max_frames):
+        values: dict[str, int] = {}
+        for frame in range(recipe.frames if recipe.frames is not None else recipe.max_frames):
             for name, value in recipe.set.items():
                 reader.write(name, value)
             values = reader.read()
-            if all(values[k] == v for k, v in recipe.until.items()):
-                emu.run([0] * emu.ports, recipe.settle)
-                return emu.get_state()
+            if recipe.until and all(values[k] == v for k, v in recipe.until.items()):
+                break
             pressed = (frame // HOLD_FRAMES) % 2 == 0
             emu.run(masks if pressed else [0] * emu.ports, 1)
-        seen = {k: values[k] for k in recipe.until}
-        raise StateError(
-            f"Expected the recipe of {game.name} state {recipe.name!r} to reach {dict(recipe.until)} within "
-            f"{recipe.max_frames} frames; it ended at {seen}. Check its set, press and until in game.yaml."
-        )
+        else:
+            if recipe.frames is None:
+                _not_arrived(game, recipe, values)
+        emu.run([0] * emu.ports, recipe.settle)
+        return emu.get_state()
+
+
+def _not_arrived(game: Game, recipe: Recipe, values: Mapping[str, int]) -> None:
+    """Raise the error of an ``until`` recipe that did not arrive within ``max_frames``."""
+    seen = {k: values.get(k) for k in recipe.until}
+    raise StateError(
+        f"Expected the recipe of {game.name} state {recipe.name!r} to reach {dict(recipe.until)} within "
+        f"{recipe.max_frames} frames; it ended at {seen}. Check its set, press and until in game.yaml."
+    )
 
 
 def fingerprint(game: Game, state: VettedState) -> str:

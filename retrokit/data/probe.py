@@ -78,6 +78,7 @@ class ChildResult:
         loaded: It loaded, ran, loaded again and ran under input.
         error: Why it did not: retrokit's error, a signal, a hang (``""`` when it did).
         start: Every field's value right after the first load, by name.
+        first: Every field's value one idle frame in (what validate checks ranges on).
         after: Every field's value after the idle frames.
         detail: The core's signature and the state's size.
     """
@@ -87,6 +88,7 @@ class ChildResult:
     loaded: bool = False
     error: str = ""
     start: dict[str, int] = field(default_factory=dict)
+    first: dict[str, int] = field(default_factory=dict)
     after: dict[str, int] = field(default_factory=dict)
     detail: str = ""
 
@@ -352,7 +354,9 @@ def _child_main() -> int:
             state = _mint(data, emu.system.name)  # unchecked: finding out whether it is safe is this child's job
             emu.set_state(state)
             result["start"] = reader.read()
-            emu.run(idle, frames)
+            emu.run(idle, 1)  # one frame in: where validate checks the fields' declared ranges
+            result["first"] = reader.read()
+            emu.run(idle, max(frames - 1, 0))
             result["after"] = reader.read()
             emu.set_state(state)  # every reset() loads the state again: some crash only then
             for _ in range(0, input_frames, 10):  # and some only under input

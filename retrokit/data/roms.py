@@ -13,7 +13,8 @@ of the Gym Retro and stable-retro integrations matches:
 - Every other file is hashed whole, up to 32 MiB (the largest game supported).
 
 Which system a file extension belongs to is :mod:`retrokit.host.systems`'
-business; this module only hashes and grooms.
+business; this module hashes and grooms, and reads the headers that name a
+ROM's system (:func:`header_system`), for ROMs no game knows yet.
 """
 
 from __future__ import annotations
@@ -23,7 +24,14 @@ import os
 from pathlib import Path
 
 from retrokit.errors import InvalidArgumentError, RomError
-from retrokit.host.systems import System, extension_of, get_system, system_for_extension, systems_by_extension
+from retrokit.host.systems import (
+    System,
+    all_systems,
+    extension_of,
+    get_system,
+    system_for_extension,
+    systems_by_extension,
+)
 
 MAX_ROM_SIZE = 32 * 1024 * 1024
 """The largest ROM hashed or imported, as in stable-retro."""
@@ -129,3 +137,58 @@ def _rule(form: System | str) -> str:
         system_for_extension(ext)  # an unknown extension raises, with a suggestion
         return ext
     return get_system(form).extensions[0]
+
+
+# Header signatures: (system, offset, bytes). A match names the system whatever the file's extension,
+# so a Genesis ROM dumped as .bin (an extension N64 dumps use too) is still a Genesis ROM.
+_SIGNATURES: tuple[tuple[str, int, bytes], ...] = (
+    ("32x", 0x100, b"SEGA 32X"),
+    ("Genesis", 0x100, b"SEGA"),
+    ("Genesis", 0x101, b"SEGA"),  # " SEGA MEGA DRIVE": some headers start with a space
+    ("Nes", 0, b"NES\x1a"),
+    ("N64", 0, bytes.fromhex("80371240")),
+    ("GbAdvance", 0xB2, b"\x96"),  # the fixed byte of every GBA header; checked with the logo below
+)
+_GB_LOGO = bytes.fromhex("CEED6666CC0D000B03730083000C000D0008111F8889000E")  # the start of the Nintendo logo at 0x104
+_SMS_MARK = b"TMR SEGA"
+_SMS_MARK_OFFSETS = (0x7FF0, 0x3FF0, 0x1FF0)
+_GG_REGIONS = (5, 6, 7)  # the region nibble of a Game Gear header
+_GBA_LOGO = bytes.fromhex("24FFAE51699AA2213D84820A")  # the start of the GBA's logo at 0x04
+
+
+def header_system(data: bytes) -> str | None:
+    """The system a ROM's header names, or ``None`` if no header retrokit knows is there.
+
+    Args:
+        data: The ROM, in its stored form (an ``.smd`` dump de-interleaved).
+    """
+    for system, offset, mark in _SIGNATURES:
+        if system == "GbAdvance":
+            if data[0x04 : 0x04 + len(_GBA_LOGO)] == _GBA_LOGO and data[offset : offset + 1] == mark:
+                return system
+            continue
+        if data[offset : offset + len(mark)] == mark:
+            return system
+    if data[0x104 : 0x104 + len(_GB_LOGO)] == _GB_LOGO:
+        return "GbColor" if len(data) > 0x143 and data[0x143] in (0x80, 0xC0) else "GameBoy"
+    for offset in _SMS_MARK_OFFSETS:
+        if data[offset : offset + len(_SMS_MARK)] == _SMS_MARK:
+            region = data[offset + 0xF] >> 4 if len(data) > offset + 0xF else 0
+            return "GameGear" if region in _GG_REGIONS else "Sms"
+    return None
+
+
+def guess_system(data: bytes, filename: str | os.PathLike[str]) -> tuple[System | None, str]:
+    """The likely system of a file: from its header, else its extension; and how it was told.
+
+    Returns:
+        The system (``None`` if neither tells it) and ``"header"``, ``"extension"`` or ``""``.
+    """
+    named = header_system(data)
+    if named is not None and named in all_systems():
+        return get_system(named), "header"
+    ext = extension_of(filename)
+    known = systems_by_extension()
+    if ext in known and ext != "bin":  # .bin is any dump: only a header tells what it is
+        return known[ext], "extension"
+    return None, ""

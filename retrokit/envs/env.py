@@ -27,8 +27,9 @@ from retrokit.envs.options import check_crop, check_options, check_seed, make_ar
 from retrokit.envs.pickling import PicklesAsArguments
 from retrokit.envs.stepper import Stepper, drive
 from retrokit.envs.viewer import render_modes
-from retrokit.errors import InvalidArgumentError
+from retrokit.errors import InvalidArgumentError, StateError
 from retrokit.host.emulator import Emulator
+from retrokit.host.fields import out_of_range, ranged
 from retrokit.host.memory import FieldReader
 from retrokit.movie.recorder import EpisodeMovies
 
@@ -149,6 +150,16 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         self._at_start = False
         seen = "last" if obs_type == "rgb" or render_mode is not None else "none"
         self.emulator.set_video_frames(seen if skip_video else "all")
+        if self._state is not None and ranged(self.game.fields.values()):
+            # The start state's first frame is emulated once anyway (the first observation): do it now,
+            # so that a state whose fields are out of their ranges (another game's) is refused at make().
+            try:
+                self._start()
+                self.emulator.forget_action()
+                self._initial_observation()
+            except StateError:
+                self.close()
+                raise
 
     @property
     def direct_screen(self) -> bool:
@@ -179,6 +190,7 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         """
         if self._first_frame is None:
             self.emulator.run(0, 1)
+            self._check_ranges()
             self._first_frame = self.emulator.screen()
             self._first_obs = self.observe()
             self._start()
@@ -186,6 +198,23 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         if self.obs_type == "ram":
             return self.observe()
         return self._first_obs.copy()  # type: ignore[union-attr]
+
+    def _check_ranges(self) -> None:
+        """Refuse a start state whose fields, one frame in, are outside the ranges game.yaml declares.
+
+        Raises:
+            StateError: Some field is out of its range: the state is another game's, or broken.
+        """
+        specs = ranged(self.game.fields.values())
+        if not specs or self._state is None:
+            return
+        wrong = out_of_range(specs, FieldReader(specs, self.emulator.space).read())
+        if wrong:
+            raise StateError(
+                f"Expected the state {self.state_name!r} of {self.game.name} to hold its fields within the ranges "
+                f"its game.yaml declares; found, one frame in, {', '.join(wrong)}. The state is another game's or "
+                f"broken: pick another, or remake it (retrokit integrate, or ramsearch savestate)."
+            )
 
     def _make_observation_space(self) -> spaces.Box:
         if self.obs_type == "ram":

@@ -59,15 +59,19 @@ def check_game(
     from retrokit.testing.movies import check_movies
     from retrokit.testing.scenarios import SMOKE_FRAMES, check_scenarios
     from retrokit.testing.schema import check_schemas
-    from retrokit.testing.states import check_states
+    from retrokit.testing.states import check_movie_states, check_states
 
     def step(stage: str, detail: str = "") -> None:
         if progress is not None:
             progress(stage, detail)
 
-    from retrokit.data.games import find_game
+    from retrokit import paths
+    from retrokit.data.games import Game, find_game
 
     game = find_game(game, check=False)  # its data file is checked below, as a step of the report
+    made = paths.user_games_dir() / game.name  # where integrate and savestate write: its states are the game's too
+    if made.is_dir() and all(made.resolve() != f.resolve() for f in game.folders):
+        game = Game(game.name, (*game.folders, made))
     report = GameReport(game.name)
 
     step("schema")
@@ -100,6 +104,7 @@ def check_game(
     _check_fields(game, report, rom)
     step("states")
     probes = check_states(game, report, rom)
+    check_movie_states(game, report, rom)
     step("scenarios")
     starts = {name: probe.start for name, probe in probes.items() if probe.start}
     check_scenarios(game, report, starts, rom=rom is not None, frames=frames or SMOKE_FRAMES,

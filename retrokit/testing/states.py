@@ -11,8 +11,12 @@ gzip stream, the core's signature and, where the layout is known
 
 A state is flagged as not the game's own when retrokit recorded it on another
 ROM (:class:`~retrokit.data.states.StateRecord`), when it is a copy of another
-game's state file, or when it does not reach what its recipe in ``game.yaml``
-(``integrate``) says it should: the recipe's ``set`` and ``until`` values.
+game's state file, when it does not reach what its recipe in ``game.yaml``
+(``integrate``) says it should (the recipe's ``set`` and ``until`` values), or
+when, one frame in, a field is outside the ``range`` game.yaml declares for it:
+that is how another game's state is caught however it was copied (re-gzipped,
+or saved on the other game's ROM by a tool that records nothing). The start
+states of the solution movies are checked the same way.
 """
 
 from __future__ import annotations
@@ -50,6 +54,7 @@ class StateProbe:
         loaded: Whether a core loaded it (``False`` also when it was only parsed).
         error: Why it could not be loaded or parsed, or ``""``.
         start: Every field's value right after loading (or read from the file), by name.
+        first: Every field's value after one idle frame (empty when parsed).
         after: Every field's value after :data:`IDLE_FRAMES` idle frames (empty when parsed).
         parsed_only: No core was run: the values come from the file.
         detail: A short description, e.g. the core's signature and the size.
@@ -60,6 +65,7 @@ class StateProbe:
     loaded: bool = False
     error: str = ""
     start: dict[str, int] = field(default_factory=dict)
+    first: dict[str, int] = field(default_factory=dict)
     after: dict[str, int] = field(default_factory=dict)
     parsed_only: bool = False
     detail: str = ""
@@ -68,7 +74,9 @@ class StateProbe:
 # --- Parent side ---------------------------------------------------------------------------------
 
 
-def probe_states(game: Game, names: Sequence[str], rom: Path, *, frames: int = IDLE_FRAMES) -> dict[str, StateProbe]:
+def probe_states(
+    game: Game, names: Sequence[str], rom: Path, *, frames: int = IDLE_FRAMES, files: Mapping[str, Path] | None = None,
+) -> dict[str, StateProbe]:
     """Load each state in a child process with the game's ROM; return what each showed.
 
     The child is the crash probe's (:func:`retrokit.data.probe.run_child`: a
@@ -78,7 +86,7 @@ def probe_states(game: Game, names: Sequence[str], rom: Path, *, frames: int = I
     """
     from retrokit.data.probe import run_child
 
-    paths = {name: str(game.state_path(name)) for name in names}
+    paths = {name: str(files[name] if files is not None else game.state_path(name)) for name in names}
     fields = [{"name": f.name, "address": f.address, "type": f.type, "mask": f.mask} for f in game.fields.values()]
     probes: dict[str, StateProbe] = {}
     todo = list(names)
@@ -145,6 +153,7 @@ def _inside(space: AddressSpace, spec: FieldSpec) -> bool:
 
 def check_states(game: Game, report: GameReport, rom: Path | None) -> dict[str, StateProbe]:
     """Check every state of the game; add the results to ``report``; return the probes of those that loaded."""
+    _check_default(game, report)
     names = []
     for name in game.states:
         try:
@@ -180,7 +189,7 @@ def check_states(game: Game, report: GameReport, rom: Path | None) -> dict[str, 
                        "Replace the file with one made for this game (retrokit integrate, or retrokit play).",
                        state=name)
             continue
-        if name in recipes and probe.start:
+        if name in recipes and probe.start and _expected_values(recipes[name]):
             mismatch = _recipe_mismatch(recipes[name], probe.start)
             if mismatch:
                 report.add("state is the game's", FAIL,
@@ -191,8 +200,10 @@ def check_states(game: Game, report: GameReport, rom: Path | None) -> dict[str, 
                 continue
             report.add("state is the game's", PASS, f"reaches its recipe's {_recipe_text(recipes[name])}", state=name)
         else:
-            report.add("state is the game's", PASS, "not a copy of another game's state (no recipe to compare with)",
+            report.add("state is the game's", PASS, "not a copy of another game's state (no recipe values to compare with)",
                        state=name)
+        if not check_ranges(game, report, probe, name):
+            continue
         if probe.start:
             report.add("fields decode", PASS, f"{len(probe.start)} fields: " + _sample(probe.start), state=name)
         elif game.fields:
@@ -200,6 +211,74 @@ def check_states(game: Game, report: GameReport, rom: Path | None) -> dict[str, 
                        state=name)
         good[name] = probe
     return good
+
+
+def _check_default(game: Game, report: GameReport) -> None:
+    """Flag a default state (``states: default:``, or one per player count) that names no state file."""
+    defaults = [name for name in (game.default_state, *game.default_player_states) if name]
+    for name in dict.fromkeys(defaults):
+        try:
+            path = game.state_path(name)
+        except RetrokitError as exc:
+            report.add("default state", FAIL, f"game.yaml's default names no state file: {exc}", state=name)
+            continue
+        report.add("default state", PASS, f"{path}", state=name)
+
+
+def check_ranges(game: Game, report: GameReport, probe: StateProbe, label: str) -> bool:
+    """Report whether the state's fields, one frame in, are within their declared ranges; return whether they are.
+
+    A parsed state (no ROM) is judged by the values in its file.
+    """
+    from retrokit.host.fields import out_of_range, ranged
+
+    specs = ranged(game.fields.values())
+    values = probe.first or probe.start
+    if not specs or not values:
+        return True
+    wrong = out_of_range(specs, values)
+    when = "one frame in" if probe.first else "in the file"
+    if wrong:
+        report.add("fields in range", FAIL,
+                   f"expected every field within the range game.yaml declares; found, {when}, {', '.join(wrong)}: "
+                   "the state is another game's, made with another ROM, or broken. Replace it with one made for "
+                   f"this game (retrokit integrate {game.name} NAME, or ramsearch savestate).", state=label)
+        return False
+    checked = [s.name for s in specs if s.name in values]
+    report.add("fields in range", PASS, f"{len(checked)} ranged fields {when}: " + _sample({k: values[k] for k in checked}),
+               state=label)
+    return True
+
+
+def check_movie_states(game: Game, report: GameReport, rom: Path | None) -> None:
+    """Check the start state of each solution movie as a state of the game: it loads, and its fields are in range."""
+    import tempfile
+
+    from retrokit.data.states import write_state
+    from retrokit.movie import read_bk2
+    from retrokit.testing.movies import movie_files
+
+    if rom is None:
+        return
+    with tempfile.TemporaryDirectory(prefix="retrokit-movie-states-") as scratch:
+        files = {}
+        for name, path in movie_files(game).items():
+            label = f"{path.name} start"
+            try:
+                state = read_bk2(path).state
+            except RetrokitError:  # the movies stage says why it cannot be read
+                continue
+            if state is None:  # a movie from power-on: nothing to check
+                continue
+            files[label] = Path(scratch) / f"{name}.state"
+            write_state(files[label], state)
+        for label, probe in probe_states(game, list(files), rom, files=files).items():
+            if probe.error:
+                report.add("movie start state", FAIL, probe.error, state=label)
+            else:
+                report.add("movie start state", PASS, f"loaded and ran {IDLE_FRAMES} frames in a child process",
+                           state=label)
+                check_ranges(game, report, probe, label)
 
 
 def _recorded_elsewhere(game: Game, path: Path) -> str:

@@ -1,0 +1,183 @@
+"""A new game from a bare ROM: telling its system, and making its folder in the user's games.
+
+``retrokit new ROM --name NAME-SYSTEM`` is the first step of integrating a
+game nobody has integrated: the ROM's system is told from its header (a
+Genesis cartridge says ``SEGA`` at 0x100 whatever the file is called) or else
+from its file extension; a folder ``<data>/games/NAME-SYSTEM/`` is made in
+the user's games folder (:func:`retrokit.paths.user_games_dir`, searched by
+every command) with a ``game.yaml`` that holds the system and the ROM's SHA-1
+and no fields yet; and the ROM is imported into ``<data>/roms/NAME-SYSTEM/``
+as ``retrokit import`` would.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from retrokit import paths
+from retrokit.data import roms
+from retrokit.data.games import Game, list_games, normalize_name
+from retrokit.errors import (
+    FileConflictError,
+    InvalidArgumentError,
+    RomError,
+    did_you_mean,
+)
+from retrokit.host.systems import System, all_systems, extension_of, get_system
+
+__all__ = ["NewGame", "check_new_name", "new_game", "read_rom"]
+
+_NAME = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_]*-[A-Za-z0-9]+$")
+
+def check_new_name(name: str, system: System) -> str:
+    """Return ``name`` if it is a valid name for a new game of ``system``: ``<Name>-<System>``, unused.
+
+    Raises:
+        InvalidArgumentError: The name is not ``<Name>-<System>`` with ``system``'s name.
+        FileConflictError: A game of that name (whatever its case) is known already.
+    """
+    example = f"{re.sub(r'[^A-Za-z0-9_]', '', name.rsplit('-', 1)[0]) or 'MyGame'}-{system.name}"
+    if not isinstance(name, str) or not _NAME.match(name) or normalize_name(name) != name:
+        raise InvalidArgumentError(
+            f"Expected the game's name as <Name>-<System>, letters, digits and underscores then the system "
+            f"(e.g. {example}); found {name!r}. Pass --name {example}."
+        )
+    suffix = name.rsplit("-", 1)[1]
+    if suffix != system.name:
+        hint = did_you_mean(suffix, all_systems()) if suffix not in all_systems() else ""
+        raise InvalidArgumentError(
+            f"Expected the name to end with the ROM's system, -{system.name}; found -{suffix} in {name!r}. "
+            f"Pass --name {example}" + (", or --system to say the ROM's system." if suffix in all_systems() else ".")
+            + hint
+        )
+    known = [g.name for g in list_games()]
+    same = [k for k in known if k.lower() == name.lower()]
+    if same:
+        raise FileConflictError(
+            f"Expected a name no game has; found {same[0]!r}, a known game. Choose another name (retrokit games "
+            "lists the taken ones), or work on that game."
+        )
+    return name
+
+
+@dataclass(frozen=True)
+class NewGame:
+    """What :func:`new_game` made.
+
+    Attributes:
+        game: The new game (its only folder is the new one).
+        folder: Its folder in the user's games, holding ``game.yaml``.
+        rom: Where its ROM was imported.
+        sha1: The ROM's SHA-1 (by stable-retro's rules).
+        told_by: How the system was told: ``"header"``, ``"extension"`` or ``"--system"``.
+    """
+
+    game: Game
+    folder: Path
+    rom: Path
+    sha1: str
+    told_by: str
+
+
+def read_rom(path: str | os.PathLike[str]) -> bytes:
+    """Read a ROM file: a regular file, not empty, at most :data:`retrokit.data.roms.MAX_FILE_SIZE` bytes.
+
+    Raises:
+        FileSystemError: The path is missing or not a regular file.
+        RomError: The file is empty or too big.
+    """
+    path = paths.require_regular_file(path, "a ROM file")
+    if path.stat().st_size > roms.MAX_FILE_SIZE:
+        raise RomError(
+            f"Expected a ROM of at most {roms.MAX_ROM_SIZE // 2**20} MiB; found {path.stat().st_size} bytes in "
+            f"{str(path)!r}. This file is not a ROM retrokit supports."
+        )
+    with open(path, "rb") as f:
+        data = f.read(roms.MAX_FILE_SIZE + 1)
+    if not data or len(data) > roms.MAX_FILE_SIZE:
+        raise RomError(f"Expected a ROM in {str(path)!r}; found {'an empty file' if not data else 'a file that grew'}.")
+    return data
+
+
+def new_game(
+    rom: str | os.PathLike[str],
+    name: str,
+    *,
+    system: str | None = None,
+    data_dir: str | os.PathLike[str] | None = None,
+) -> NewGame:
+    """Make a new game from a ROM in the user's games folder, and import its ROM.
+
+    Args:
+        rom: The ROM file.
+        name: The new game's name, ``<Name>-<System>`` (e.g. ``"Runner-Genesis"``).
+        system: The ROM's system, when neither its header nor its extension tells it.
+        data_dir: The data folder; by default :func:`retrokit.paths.data_dir`.
+
+    Returns:
+        The game, its folder, its imported ROM and SHA-1.
+
+    Raises:
+        RomError: The file is not a ROM of a system retrokit knows (or is empty, or too big).
+        InvalidArgumentError: ``name`` is not ``<Name>-<System>`` for the ROM's system.
+        FileConflictError: A game of that name is known, or its folder exists; or the ROM is a known game's.
+        UnsupportedSystemError: ``system`` names no system.
+    """
+    from retrokit.data.importer import import_roms, known_hashes
+
+    data = read_rom(rom)
+    told_by = "--system"
+    if system is not None:
+        chosen = get_system(system)
+    else:
+        chosen, told_by = roms.guess_system(roms.deinterleave_smd(data) if extension_of(rom) == "smd" else data, rom)
+        if chosen is None:
+            raise RomError(
+                f"Expected a ROM whose header or file extension tells its system; found neither in {str(rom)!r} "
+                f"(extension {'.' + extension_of(rom) if extension_of(rom) else 'none'}, no known header). If it "
+                f"is a ROM, pass its system: --system {'|'.join(all_systems())}."
+            )
+    _, sha1 = roms.groom_rom(data, extension_of(rom) if extension_of(rom) == "smd" else chosen.extensions[0])
+    check_new_name(name, chosen)
+    owners = known_hashes()[0].get(sha1, [])
+    if owners:
+        raise FileConflictError(
+            f"Expected a ROM no game knows; found that {str(rom)!r} (SHA-1 {sha1}) is the ROM of "
+            f"{', '.join(g.name for g in owners)}. Import it with: retrokit import {rom}"
+        )
+    folder = paths.user_games_dir(data_dir) / name
+    if folder.exists():
+        raise FileConflictError(
+            f"Expected no folder at {folder} for the new game; found one. Move it away, or pick another name."
+        )
+    paths.atomic_write(folder / "game.yaml", game_yaml(name, chosen, sha1, Path(rom).name).encode(),
+                       hint="Pick another name, or work on that game.")
+    game = Game(name, (folder,))
+    report = import_roms([rom], data_dir=data_dir, games=[game])
+    stored = [r.path for r in (*report.imported, *report.already_present)]
+    if not stored:
+        why = "; ".join(f"{c.path} has SHA-1 {c.existing_sha1}" for c in report.conflicts) or "nothing was imported"
+        raise RomError(
+            f"Expected the ROM imported into {game.imported_rom_path(data_dir)}; found {why}. "
+            f"Move that file away, then run: retrokit import {rom}"
+        )
+    return NewGame(game, folder, stored[0], sha1, told_by)
+
+
+def game_yaml(name: str, system: System, sha1: str, source: str) -> str:
+    """The ``game.yaml`` of a new game: its system and ROM, and room for the fields ramsearch finds."""
+    return (
+        f"# {name}: made by `retrokit new`. Fields come from ramsearch\n"
+        "# (retrokit ramsearch save NAME ADDRESS TYPE), states from recipes or\n"
+        "# ramsearch savestate; the format: retrokit docs integrate.\n"
+        f"system: {system.name}\n"
+        f"title: {name.rsplit('-', 1)[0]}\n"
+        "roms:\n"
+        f"  - sha1: {sha1}\n"
+        f"    label: {json.dumps(source)}\n"  # a JSON string is a YAML one, whatever the file name holds
+    )
+

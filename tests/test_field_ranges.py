@@ -1,0 +1,150 @@
+"""Field ranges in game.yaml: read, checked by ``retrokit validate`` on every state, and by ``make(state=...)``.
+
+Another game's state, dropped into a game's folder (re-gzipped, so no byte-for-byte
+copy is found) plays garbage: Dasher's fields read out of their ranges one frame in.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import gzip
+import shutil
+from pathlib import Path
+
+import pytest
+
+import retrokit
+from retrokit.data.gamefiles import read_game_yaml
+from retrokit.data.games import find_game
+from retrokit.data.states import StateRecord, read_state, write_state
+from retrokit.errors import DataFileError, StateError
+from retrokit.host.fields import FieldSpec, out_of_range
+from retrokit.paths import repo_games_dir
+from retrokit.testing import check_game
+from retrokit.testing.report import FAIL, PASS
+
+DASHER = repo_games_dir() / "Dasher-Genesis"
+GAME = "Dashcopy-Genesis"
+
+
+@pytest.fixture
+def data(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    return tmp_path / "data"
+
+
+@pytest.fixture
+def copy(tmp_path: Path, data: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """Dasher under another name, with its ROM, its Zone1.Act1 state and its ranges (no recipes, no movies)."""
+    folder = tmp_path / "games" / GAME
+    folder.mkdir(parents=True)
+    text = (DASHER / "game.yaml").read_text()
+    (folder / "game.yaml").write_text(text[: text.index("integrate:")].replace("by_players: [Zone1.Act1, Zone1.Act1.2P]", ""))
+    for name in ("rom.md", "scenario.yaml"):
+        shutil.copy(DASHER / name, folder / name)
+    # re-gzipped: the game's own state, not a byte-for-byte copy of Dasher's (which validate flags)
+    (folder / "Zone1.Act1.state").write_bytes(gzip.compress(read_state(DASHER / "Zone1.Act1.state"), 1, mtime=0))
+    monkeypatch.setenv("RETROKIT_GAMES", str(folder.parent))
+    return folder
+
+
+def airstriker_regzipped(airstriker_dir: Path) -> bytes:
+    return gzip.compress(gzip.decompress((airstriker_dir / "Level1.state").read_bytes()), mtime=0)
+
+
+def results(report, check: str) -> dict[str, tuple[str, str]]:
+    return {r.state: (r.status, r.message) for r in report.results if r.check == check}
+
+
+def test_ranges_are_read_from_game_yaml_and_checked_against_the_type(tmp_path):
+    game = find_game("Dasher-Genesis")
+    assert game.fields["p1_lives"].range == (0, 9) and game.fields["zone"].range == (0, 2)
+    assert game.fields["p1_x"].range is None
+    spec = FieldSpec("lives", 0xFF002B, "|u1", range=(0, 9))
+    assert out_of_range([spec], {"lives": 26}) == ["lives=26 (range 0 to 9)"]
+    assert out_of_range([spec], {"lives": 9}) == [] and out_of_range([spec], {}) == []
+    for bad, message in [("[9, 0]", "lo <= hi"), ("[0, 300]", "0 to 255"), ("[0]", "to be \\[lo, hi\\]"),
+                         ("5", "a list \\[lo, hi\\]"), ("[0, x]", "an integer")]:
+        path = tmp_path / "game.yaml"
+        path.write_text(f"system: Genesis\nfields:\n  lives: {{address: 0xFF002B, type: '|u1', range: {bad}}}\n")
+        with pytest.raises(DataFileError, match=message):
+            read_game_yaml(path)
+    path.write_text("system: Genesis\nfields:\n  lives: {address: 0xFF002B, type: '|u1', range: ['0x0', '0x09']}\n")
+    assert read_game_yaml(path).fields["lives"].range == (0, 9)
+
+
+def test_make_refuses_another_games_state_with_a_state_error(copy, airstriker_dir):
+    (copy / "Level1.state").write_bytes(airstriker_regzipped(airstriker_dir))
+    with pytest.raises(StateError, match=r"found, one frame in, .*game_mode=\d+ \(range 0 to 3\)"):
+        retrokit.make(GAME, state="Level1")
+    env = retrokit.make(GAME, state="Zone1.Act1", obs_type="ram")  # the game's own state is fine
+    try:
+        obs, info = env.reset(seed=0)
+        assert info["game_mode"] == 1 and obs.shape == env.observation_space.shape
+    finally:
+        env.close()
+
+
+def test_validate_names_the_fields_of_another_games_state_out_of_range(copy, airstriker_dir):
+    (copy / "Level1.state").write_bytes(airstriker_regzipped(airstriker_dir))
+    report = check_game(GAME, frames=30)
+    ranges = results(report, "fields in range")
+    assert ranges["Zone1.Act1"][0] == PASS
+    status, message = ranges["Level1"]
+    assert status == FAIL and "game_mode=" in message and "(range 0 to 3)" in message
+    assert results(report, "state is the game's")["Level1"][0] == PASS  # no other check sees it
+    assert not report.passed
+
+
+def test_validate_catches_a_state_saved_on_another_games_rom(copy, airstriker_dir, airstriker_rom):
+    """Saved with Airstriker's ROM by a tool that records nothing: only the ranges can tell."""
+    with retrokit.Emulator("Genesis", airstriker_rom) as emu:
+        from retrokit.data.statecheck import load_state
+
+        emu.set_state(load_state(find_game("Airstriker-Genesis"), airstriker_dir / "Level1.state"))
+        emu.run([0, 0], 10)
+        write_state(copy / "Saved.state", emu.get_state())
+    report = check_game(GAME, frames=30)
+    assert results(report, "fields in range")["Saved"][0] == FAIL
+
+
+def test_validate_covers_the_states_in_the_data_folder_of_a_game_given_by_folder(copy, data, airstriker_dir):
+    made = data / "games" / GAME
+    made.mkdir(parents=True)
+    (made / "Dropped.state").write_bytes(airstriker_regzipped(airstriker_dir))
+    report = check_game(copy, frames=30)  # validate FOLDER, as docs/integrate.md runs it in the game's folder
+    assert results(report, "fields in range")["Dropped"][0] == FAIL
+    assert results(report, "state loads")["Dropped"][0] == PASS
+
+
+def test_validate_flags_a_default_that_names_no_state(copy):
+    text = (copy / "game.yaml").read_text()
+    (copy / "game.yaml").write_text(text + "integrate:\n  Zone2.Act1: {set: {zone: 1, act: 0}, press: [START], "
+                                    "until: {game_mode: 1}}\n")
+    (copy / "game.yaml").write_text((copy / "game.yaml").read_text().replace("default: Zone1.Act1", "default: Zone2.Act1"))
+    report = check_game(GAME, frames=30)
+    status, message = results(report, "default state")["Zone2.Act1"]
+    assert status == FAIL and f"retrokit integrate {GAME} Zone2.Act1" in message
+
+
+def test_validate_checks_each_movies_start_state(copy, airstriker_dir):
+    from retrokit.movie import read_bk2, write_bk2
+
+    movie = read_bk2(DASHER / "movies" / "Zone1.Act1.bk2")
+    (copy / "movies").mkdir()
+    write_bk2(copy / "movies" / "Good.bk2", movie)
+    foreign = gzip.decompress((airstriker_dir / "Level1.state").read_bytes())
+    write_bk2(copy / "movies" / "Foreign.bk2", dataclasses.replace(movie, state=foreign))
+    report = check_game(GAME, frames=30)
+    ranges = results(report, "fields in range")
+    assert ranges["Good.bk2 start"][0] == PASS and ranges["Foreign.bk2 start"][0] == FAIL
+
+
+def test_a_state_recorded_on_this_rom_in_range_is_trusted_as_before(copy):
+    """The range check adds no refusal of the game's own states (make() and validate agree)."""
+    state = read_state(copy / "Zone1.Act1.state")
+    record = StateRecord.of(GAME, find_game(GAME).sha1s[0], state)
+    write_state(copy / "Mine.state", state, record=record)
+    env = retrokit.make(GAME, state="Mine")
+    env.close()
+    assert results(check_game(GAME, frames=30), "fields in range")["Mine"][0] == PASS

@@ -1,0 +1,183 @@
+"""``retrokit new ROM --name NAME-SYSTEM``: a game nobody integrated, from a bare ROM, seen by every command."""
+
+from __future__ import annotations
+
+import os
+import shutil
+from pathlib import Path
+
+import pytest
+from runner_rom import DASHER_ROM, write_runner_rom
+
+import retrokit
+from retrokit.cli import main
+from retrokit.data import roms
+from retrokit.data.games import find_game
+from retrokit.data.yamlfile import load_yaml
+from retrokit.host.emulator import Emulator
+
+
+@pytest.fixture
+def data(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """An empty per-user data folder, and no RETROKIT_GAMES."""
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    monkeypatch.delenv("RETROKIT_GAMES", raising=False)
+    return tmp_path / "data"
+
+
+@pytest.fixture
+def runner(tmp_path: Path) -> Path:
+    return write_runner_rom(tmp_path / "runner.bin")
+
+
+def cli(capsys: pytest.CaptureFixture[str], *argv: str) -> tuple[int, str, str]:
+    status = main(list(argv))
+    out, err = capsys.readouterr()
+    return status, out, err
+
+
+def test_new_makes_the_game_in_the_users_games_folder_and_imports_its_rom(data, runner, capsys):
+    status, out, err = cli(capsys, "new", str(runner), "--name", "Runner-Genesis")
+    assert status == 0, err
+    folder = data / "games" / "Runner-Genesis"
+    sha1 = roms.rom_sha1(runner, "Genesis")
+    assert f"Made Runner-Genesis (Genesis, told by its header; ROM SHA-1 {sha1})" in out
+    assert "retrokit ramsearch new Runner-Genesis" in out and "retrokit validate Runner-Genesis" in out
+    doc = load_yaml((folder / "game.yaml").read_text())
+    assert doc["system"] == "Genesis" and [r["sha1"] for r in doc["roms"]] == [sha1]
+    assert "fields" not in doc and "states" not in doc
+    assert sorted(p.name for p in folder.iterdir()) == ["game.yaml"]  # no temporary file left
+    assert (data / "roms" / "Runner-Genesis" / "rom.md").read_bytes() == runner.read_bytes()
+    game = find_game("Runner-Genesis")
+    assert game.folders == (folder,) and dict(game.fields) == {} and game.require_rom() == data / "roms" / "Runner-Genesis" / "rom.md"
+
+
+def test_the_header_tells_the_system_whatever_the_extension(tmp_path):
+    dasher = DASHER_ROM.read_bytes()
+    nes = b"NES\x1a" + bytes(12) + bytes(16384)
+    assert roms.guess_system(dasher, "x.bin")[0].name == "Genesis"  # .bin is also an N64 extension
+    assert roms.guess_system(dasher, "x.nes") == (roms.get_system("Genesis"), "header")
+    assert roms.guess_system(nes, "x.rom") == (roms.get_system("Nes"), "header")
+    sms = bytearray(0x8000)
+    sms[0x7FF0:0x7FF8], sms[0x7FFF] = b"TMR SEGA", 0x4C
+    assert roms.header_system(bytes(sms)) == "Sms"
+    sms[0x7FFF] = 0x6C
+    assert roms.header_system(bytes(sms)) == "GameGear"
+    assert roms.guess_system(bytes(100), "x.sfc") == (roms.get_system("Snes"), "extension")
+    assert roms.guess_system(bytes(100), "x.bin") == (None, "")
+    assert roms.guess_system(b"just some notes\n", "notes.txt") == (None, "")
+
+
+def test_system_passed_when_nothing_tells_it(data, tmp_path, capsys):
+    blob = tmp_path / "mystery.rom"
+    blob.write_bytes(bytes(range(256)) * 64)
+    status, _, err = cli(capsys, "new", str(blob), "--name", "Mystery-Snes")
+    assert status == 2 and "found neither in" in err and "--system" in err
+    status, out, err = cli(capsys, "new", str(blob), "--name", "Mystery-Snes", "--system", "Snes")
+    assert status == 0, err
+    assert "told by its --system" in out and find_game("Mystery-Snes").system.name == "Snes"
+
+
+@pytest.mark.parametrize(
+    ("name", "message"),
+    [
+        ("Runner", "Expected the game's name as <Name>-<System>"),
+        ("Runner-Genesis-v0", "Expected the game's name as <Name>-<System>"),
+        ("../Runner-Genesis", "Expected the game's name as <Name>-<System>"),
+        ("Runner-Gensis", "Did you mean 'Genesis'?"),
+        ("Runner-Nes", "Expected the name to end with the ROM's system, -Genesis; found -Nes"),
+        ("Dasher-Genesis", "found 'Dasher-Genesis', a known game"),
+        ("dasher-Genesis", "found 'Dasher-Genesis', a known game"),
+    ],
+    ids=["no-system", "version-suffix", "a-path", "misspelt-system", "another-system", "taken", "taken-in-another-case"],
+)
+def test_a_bad_or_taken_name_is_refused(data, runner, capsys, name, message):
+    status, _, err = cli(capsys, "new", str(runner), "--name", name)
+    assert status == 2 and message in err, err
+    assert err.count("\n") == 1  # one line, no traceback
+    assert not (data / "games").exists() and not (data / "roms").exists()
+
+
+def test_a_known_rom_or_a_file_that_is_no_rom_is_refused(data, tmp_path, capsys):
+    status, _, err = cli(capsys, "new", str(DASHER_ROM), "--name", "Dasher2-Genesis")
+    assert status == 2 and "is the ROM of Dasher-Genesis. Import it with: retrokit import" in err
+    notes = tmp_path / "notes.txt"
+    notes.write_text("not a rom\n")
+    empty = tmp_path / "empty.md"
+    empty.write_bytes(b"")
+    fifo = tmp_path / "pipe.md"
+    os.mkfifo(fifo)
+    zero = tmp_path / "zero.md"
+    zero.symlink_to("/dev/zero")
+    huge = tmp_path / "huge.md"
+    with open(huge, "wb") as f:  # sparse: 40 MiB on paper, nothing on disk
+        f.truncate(40 * 2**20)
+    for path, message in [(notes, "found neither"), (empty, "found an empty file"), (fifo, "found a FIFO"),
+                          (zero, "found a device"), (huge, "at most 32 MiB"),
+                          (tmp_path / "missing.md", "No such file"), (tmp_path, "found a folder")]:
+        status, _, err = cli(capsys, "new", str(path), "--name", "Junk-Genesis")
+        assert status == 2 and message in err, err
+    assert not (data / "games").exists()
+
+
+def test_an_existing_folder_is_never_overwritten(data, runner, capsys):
+    folder = data / "games" / "Runner-Genesis"
+    folder.mkdir(parents=True)  # the user's states of a game not made yet: a known (broken) game
+    (folder / "Level1.state").write_bytes(b"mine")
+    status, _, err = cli(capsys, "new", str(runner), "--name", "Runner-Genesis")
+    assert status == 2 and "a known game" in err
+    assert sorted(p.name for p in folder.iterdir()) == ["Level1.state"]
+
+
+@pytest.mark.parametrize("where", ["data folder", "RETROKIT_GAMES"])
+def test_the_new_game_is_seen_by_every_command(data, runner, tmp_path, monkeypatch, capsys, where):
+    assert cli(capsys, "new", str(runner), "--name", "Runner-Genesis")[0] == 0
+    folder = data / "games" / "Runner-Genesis"
+    if where == "RETROKIT_GAMES":  # a game folder kept elsewhere, e.g. in the user's own repository
+        mine = tmp_path / "my games"
+        mine.mkdir()
+        folder = Path(shutil.move(folder, mine / "Runner-Genesis"))
+        monkeypatch.setenv("RETROKIT_GAMES", str(mine))
+    with open(folder / "game.yaml", "a", encoding="utf-8") as f:
+        f.write("integrate:\n  Level1: {press: [START], frames: 30}\n")
+
+    status, out, _ = cli(capsys, "games", "Runner-Genesis")  # an exact name: that game only
+    assert status == 0 and out.splitlines()[0].split() == ["Runner-Genesis", "ROM", "imported", "scenarios", "none",
+                                                           "states:", "(none)"]
+    assert out.splitlines()[1].startswith("1 game shown")
+
+    status, out, err = cli(capsys, "integrate", "Runner-Genesis")
+    assert status == 0, err
+    state = data / "games" / "Runner-Genesis" / "Level1.state"
+    assert out.split() == ["Level1", "made", str(state)]
+
+    env = retrokit.make("Runner-Genesis", state="Level1", obs_type="ram")
+    try:
+        env.reset(seed=0)
+        with Emulator("Genesis", DASHER_ROM) as emu:  # the state is in play: Dasher's game_mode byte is 1
+            emu.set_state(env.emulator.get_state())
+            assert emu.peek(0xFF0002, "|u1") == 1
+    finally:
+        env.close()
+
+    status, out, err = cli(capsys, "validate", "Runner-Genesis")
+    assert status == 0, out + err
+    assert "Level1  PASS    loaded" in out
+
+    session = tmp_path / "s.session"
+    status, out, err = cli(capsys, "ramsearch", "new", "Runner-Genesis", "--state", "Level1", "--session", str(session))
+    assert status == 0 and "New search of Runner-Genesis" in out, err
+
+
+def test_games_with_an_exact_name_shows_that_game_only(capsys):
+    status, out, _ = cli(capsys, "games", "Airstriker-Genesis")
+    assert status == 0 and len(out.splitlines()) == 2 and out.startswith("Airstriker-Genesis ")
+    status, out, _ = cli(capsys, "games", "Airstriker-Genesis-v0")
+    assert status == 0 and len(out.splitlines()) == 2
+    status, out, _ = cli(capsys, "games", "SonicTheHedgehog")  # a part of names: every game containing it
+    assert status == 0 and len(out.splitlines()) > 2
+
+
+def test_new_help_shows_examples(capsys):
+    status, out, _ = cli(capsys, "new", "--help")
+    assert status == 0 and "retrokit new ~/roms/runner.bin --name Runner-Genesis" in out

@@ -126,3 +126,12 @@ def test_a_frames_recipe_passes_the_schema(dasher_copy: Path) -> None:
     write_recipe(dasher_copy, "  Zone1.Act1: {press: [START], frames: 100, until: {game_mode: 1}}\n")
     assert check_file(dasher_copy / "game.yaml", "game") != []
 
+
+
+def test_a_state_name_inside_a_game_folder_is_that_games(dasher_copy: Path, tmp_path: Path, monkeypatch, capsys) -> None:
+    """Level1 is a state of hundreds of games; run inside a game's folder, it is that game's."""
+    write_recipe(dasher_copy, "  Zone1.Act1: {press: [START], frames: 100}\n  Level1: {press: [START], frames: 100}\n")
+    monkeypatch.chdir(dasher_copy)
+    assert main(["integrate", "Level1", "--out", str(tmp_path / "out")]) == 0
+    assert capsys.readouterr().out.split()[:2] == ["Level1", "made"]
+    assert (tmp_path / "out" / "Level1.state").is_file()

@@ -90,11 +90,12 @@ def resolve(first: str, second: str | None = None, *, cwd: Path | None = None): 
     """Which game and states ``retrokit integrate FIRST [SECOND]`` means.
 
     ``GAME STATE`` is that state of that game; ``GAME`` alone is all its recipes.
-    A lone ``STATE`` belongs to the one known game that has a state file or a
-    recipe of that name, else to the game.yaml in ``cwd``.
+    A lone ``STATE`` belongs to the game whose game.yaml is in ``cwd`` (run
+    inside a game's folder, as docs/integrate.md shows), else to the one known
+    game that has a state file or a recipe of that name.
 
     Raises:
-        UnknownNameError: Several games have that state, or none does and ``cwd`` has no game.yaml.
+        UnknownNameError: ``cwd`` holds no game.yaml, and several games or none have that state.
     """
     from retrokit.data.games import find_game, list_games, normalize_name
     from retrokit.data.integrate import games_with_state
@@ -106,6 +107,8 @@ def resolve(first: str, second: str | None = None, *, cwd: Path | None = None): 
     names = {g.name for g in list_games()}
     if normalize_name(first) in names:
         return find_game(first), None
+    if (cwd / "game.yaml").is_file():  # inside a game's folder, a state is that game's (Level1 is hundreds')
+        return find_game(cwd), [first]
     owners = games_with_state(first)
     if len(owners) == 1:
         return find_game(owners[0]), [first]
@@ -114,8 +117,6 @@ def resolve(first: str, second: str | None = None, *, cwd: Path | None = None): 
             f"Expected one game with a state or recipe named {first!r}; found {len(owners)}: {', '.join(owners)}. "
             f"Name the game: retrokit integrate {owners[0]} {first}"
         )
-    if (cwd / "game.yaml").is_file():
-        return find_game(cwd), [first]
     raise GameNotFoundError(
         f"Expected a game name, or a state or recipe that one known game has; found {first!r}, which no game "
         f"has, and no game.yaml in {cwd} to make it for. Name the game: retrokit integrate GAME {first}"

@@ -6,6 +6,8 @@ folder shown in the text as ``~/.local/share/retrokit``:
 - a ``python`` block is executed (it builds the header-patched ROM);
 - a ``yaml`` block whose first line is ``# file: PATH`` is that file's text,
   written by hand; ``# append to: PATH`` is text added at its end;
+- any other block is shown, not run (the test checks the ``game.yaml`` the
+  commands wrote against its block);
 - a ``console`` block holds ``$ retrokit ...`` commands, each followed by
   what it prints (standard output, then any ``retrokit: error:`` line).
 

@@ -36,11 +36,11 @@ def run(args: argparse.Namespace) -> int:
     print(f"Made {name} ({made.game.system}, told by its {made.told_by}; ROM SHA-1 {made.sha1}):")
     print(f"  game file  {made.folder / 'game.yaml'}")
     print(f"  ROM        {made.rom}")
-    print("Next: a first state, from a recipe in game.yaml (retrokit docs integrate: \"Your own game, from a ROM\"), such as")
-    print("  integrate:")
-    print("    Level1: {press: [START], frames: 120}")
-    print(f"then: retrokit integrate {name}")
-    print(f"      retrokit ramsearch new {name} --state Level1    # find its fields (retrokit docs ramsearch)")
+    print("Next: a first state, saved from a RAM search session (retrokit docs integrate: \"Your own game, from a ROM\"):")
+    print(f"  retrokit ramsearch new {name}    # from power-on")
+    print("  retrokit ramsearch run --script '_*20 START*2 _*98'    # for example: play on to the first level")
+    print("  retrokit ramsearch savestate Level1 --default")
+    print(f"then: retrokit ramsearch new {name} --state Level1 --force    # find its fields (retrokit docs ramsearch)")
     print(f"      retrokit validate {name}")
     return 0
 

@@ -137,19 +137,7 @@ def add_field(
         DataFileError: The file is missing, is not YAML, or its ``fields`` is not a mapping.
     """
     check_field_name(name)
-    path, text = _read(path)
-    doc = _load(text, path)
-    if doc is None:
-        doc, text = {}, ""
-    if not isinstance(doc, dict):
-        raise DataFileError(
-            f"{path}: expected a mapping at the top of the file; found {type(doc).__name__}. Fix the file first."
-        )
-    fields = doc.get("fields")
-    if fields is not None and not isinstance(fields, dict):
-        raise DataFileError(
-            f"{path}: expected 'fields' to be a mapping; found {type(fields).__name__}. Fix the file first."
-        )
+    path, text, doc, fields = _open_section(path, "fields")
     replaced = bool(fields) and name in fields
     if replaced and not force:
         line = text.splitlines()[fields.lc.key(name)[0]].strip()
@@ -184,6 +172,28 @@ class _Entry:
         return out
 
 
+def _open_section(path: str | os.PathLike[str], key: str) -> tuple[Path, str, Any, Any]:
+    """Read a game.yaml for a one-line edit of its ``key`` mapping: the path, text, document and that mapping.
+
+    Raises:
+        DataFileError: The file is missing or not YAML, or its top or its ``key`` is not a mapping.
+    """
+    path, text = _read(path)
+    doc = _load(text, path)
+    if doc is None:
+        doc, text = {}, ""
+    if not isinstance(doc, dict):
+        raise DataFileError(
+            f"{path}: expected a mapping at the top of the file; found {type(doc).__name__}. Fix the file first."
+        )
+    section = doc.get(key)
+    if section is not None and not isinstance(section, dict):
+        raise DataFileError(
+            f"{path}: expected {key!r} to be a mapping; found {type(section).__name__}. Fix the file first."
+        )
+    return path, text, doc, section
+
+
 def _read(path: str | os.PathLike[str]) -> tuple[Path, str]:
     """The game.yaml a path names (a symlink's target, written through it) and its text.
 
@@ -215,19 +225,7 @@ def set_default_state(path: str | os.PathLike[str], name: str) -> None:
         DataFileError: The file is missing or not YAML, its ``states`` is not a mapping, or its
             layout defeats a one-line edit.
     """
-    path, text = _read(path)
-    doc = _load(text, path)
-    if doc is None:
-        doc, text = {}, ""
-    if not isinstance(doc, dict):
-        raise DataFileError(
-            f"{path}: expected a mapping at the top of the file; found {type(doc).__name__}. Fix the file first."
-        )
-    states = doc.get("states")
-    if states is not None and not isinstance(states, dict):
-        raise DataFileError(
-            f"{path}: expected 'states' to be a mapping; found {type(states).__name__}. Fix the file first."
-        )
+    path, text, doc, states = _open_section(path, "states")
     value = _scalar(name)
     lines = text.splitlines(keepends=True)
     nl = "\r\n" if lines and lines[0].endswith("\r\n") else "\n"

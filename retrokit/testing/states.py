@@ -24,11 +24,12 @@ from __future__ import annotations
 import hashlib
 import os
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from retrokit.data.games import Game, list_games
+from retrokit.data.probe import ChildResult
 from retrokit.data.states import read_state, state_format, state_ram
 from retrokit.errors import RetrokitError
 from retrokit.testing.report import FAIL, PASS, SKIP, WARN, GameReport
@@ -45,30 +46,15 @@ CHILD_TIMEOUT = 30.0  # seconds a child may spend on one state
 
 
 @dataclass
-class StateProbe:
-    """What loading (or parsing) one state showed.
+class StateProbe(ChildResult):
+    """What loading (or parsing) one state showed: the probe child's result (see
+    :class:`~retrokit.data.probe.ChildResult` for the values), or what a state's file alone tells.
 
     Attributes:
-        name: The state's name.
-        path: Its file.
-        loaded: Whether a core loaded it (``False`` also when it was only parsed).
-        error: Why it could not be loaded or parsed, or ``""``.
-        start: Every field's value right after loading (or read from the file), by name.
-        first: Every field's value after one idle frame (empty when parsed).
-        after: Every field's value after :data:`IDLE_FRAMES` idle frames (empty when parsed).
         parsed_only: No core was run: the values come from the file.
-        detail: A short description, e.g. the core's signature and the size.
     """
 
-    name: str
-    path: str
-    loaded: bool = False
-    error: str = ""
-    start: dict[str, int] = field(default_factory=dict)
-    first: dict[str, int] = field(default_factory=dict)
-    after: dict[str, int] = field(default_factory=dict)
     parsed_only: bool = False
-    detail: str = ""
 
 
 # --- Parent side ---------------------------------------------------------------------------------

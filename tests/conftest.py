@@ -60,3 +60,19 @@ def airstriker(airstriker_rom: Path, airstriker_state: bytes):
 def dasher_rom() -> Path:
     """Dasher, our own test cartridge (built from tools/testcart, committed as a free ROM)."""
     return REPO / "games" / "Dasher-Genesis" / "rom.md"
+
+
+@pytest.fixture(scope="session")
+def good_state(dasher_rom: Path) -> bytes:
+    """Dasher's Zone1.Act1 state, uncompressed."""
+    from retrokit.data.states import read_state
+
+    return read_state(dasher_rom.parent / "Zone1.Act1.state")
+
+
+@pytest.fixture(scope="session")
+def corrupt_state(good_state: bytes) -> bytes:
+    """The right size and a valid header (GENPLUS-GX 1.7.5), then random bytes: it crashes the core."""
+    import random
+
+    return good_state[:16] + random.Random(1).randbytes(len(good_state) - 16)

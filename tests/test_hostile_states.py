@@ -8,7 +8,6 @@ killing the suite.
 from __future__ import annotations
 
 import gzip
-import random
 import shutil
 import zipfile
 from pathlib import Path
@@ -24,18 +23,6 @@ from retrokit.errors import StateError
 from retrokit.movie import Movie, write_bk2
 
 DASHER = REPO / "games" / "Dasher-Genesis"
-
-
-@pytest.fixture(scope="module")
-def good_state() -> bytes:
-    return read_state(DASHER / "Zone1.Act1.state")
-
-
-@pytest.fixture(scope="module")
-def corrupt_state(good_state: bytes) -> bytes:
-    """The right size and a valid header (GENPLUS-GX 1.7.5), then random bytes: it crashes the core."""
-    rng = random.Random(1)
-    return good_state[:16] + rng.randbytes(len(good_state) - 16)
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,6 @@ killing the suite.
 
 from __future__ import annotations
 
-import random
 import shutil
 import zipfile
 from pathlib import Path
@@ -25,17 +24,6 @@ from retrokit.movie import Movie, write_bk2
 from retrokit.movie.model import STATE_DIGEST
 
 DASHER = REPO / "games" / "Dasher-Genesis"
-
-
-@pytest.fixture(scope="module")
-def good_state() -> bytes:
-    return read_state(DASHER / "Zone1.Act1.state")
-
-
-@pytest.fixture(scope="module")
-def corrupt_state(good_state: bytes) -> bytes:
-    """The right size and a valid header (GENPLUS-GX 1.7.5), then random bytes: it crashes the core."""
-    return good_state[:16] + random.Random(1).randbytes(len(good_state) - 16)
 
 
 @pytest.fixture(scope="module")

@@ -75,17 +75,22 @@ def wheel_data_dirs() -> list[Path]:
     return [root / "data" / kind for kind in WHEEL_DATA_KINDS if (root / "data" / kind).is_dir()]
 
 
+def _bundled(copy: str, checkout: str) -> Path | None:
+    """The package's copy of a top-level folder (an installed retrokit), else the checkout's folder, if either exists."""
+    package = Path(__file__).resolve().parent
+    for path in (package / copy, package.parent / checkout):
+        if path.is_dir():
+            return path
+    return None
+
+
 BUNDLED_GAMES = "_games"
 """The package folder an installed retrokit keeps the bundled ``games/`` in (``setup.py`` copies it there)."""
 
 
 def repo_games_dir() -> Path | None:
     """Return the bundled integrations: ``games/`` of a checkout, or the copy inside an installed package."""
-    package = Path(__file__).resolve().parent
-    for path in (package / BUNDLED_GAMES, package.parent / "games"):
-        if path.is_dir():
-            return path
-    return None
+    return _bundled(BUNDLED_GAMES, "games")
 
 
 BUNDLED_DOCS = "_docs"
@@ -94,11 +99,7 @@ BUNDLED_DOCS = "_docs"
 
 def docs_dir() -> Path | None:
     """Return the user guides: ``docs/`` of a checkout, or the copy inside an installed package."""
-    package = Path(__file__).resolve().parent
-    for path in (package / BUNDLED_DOCS, package.parent / "docs"):
-        if path.is_dir():
-            return path
-    return None
+    return _bundled(BUNDLED_DOCS, "docs")
 
 
 def doc_topics() -> list[str]:

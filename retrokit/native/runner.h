@@ -24,24 +24,29 @@ typedef struct {
     pthread_t thread;
     sem_t wake;            /* posted only when the worker said it sleeps */
     struct rk_runner *runner;
-    atomic_uint start;     /* bumped by the caller: a call has tasks to share */
-    atomic_uint done;      /* set to start by the worker: it takes no more of them */
     atomic_int sleeping;
-    atomic_int quit;
 } rk_worker;
+
+/* The most tasks one call may have: a call's tasks left are counted in the low 32 bits of `work`. */
+#define RK_MAX_TASKS 0x7fffffff
 
 typedef struct rk_runner {
     rk_worker *workers;
     int n_workers;
     rk_task *tasks;        /* the current call's tasks */
     int n_tasks;
-    atomic_int next;       /* the next task nobody has taken */
+    /* The call's number (high 32 bits) and how many of its tasks nobody took yet (low 32 bits), in one word:
+     * a task is taken by one compare-and-swap that also checks the call, so a thread that wakes late can
+     * never take a task of a call other than the one it saw. */
+    _Atomic uint64_t work;
+    atomic_int finished;   /* tasks of the current call done */
+    atomic_int quit;
 } rk_runner;
 
 /* Start `threads` workers; 0 on success. */
 int rk_runner_init(rk_runner *r, int threads);
-/* Run n tasks, any number, shared among the calling thread and the workers;
- * wait for all. Call without the GIL. */
+/* Run n tasks (at most RK_MAX_TASKS), shared among the calling thread and whichever workers are free;
+ * return once all are done. Call without the GIL. */
 void rk_runner_run(rk_runner *r, rk_task *tasks, int n);
 /* Stop and join the workers. */
 void rk_runner_close(rk_runner *r);

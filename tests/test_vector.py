@@ -29,7 +29,7 @@ def test_vector_equals_single_envs_through_autoreset(n: int, threads: int | None
     options = {**OPTIONS, "scenario_every_frame": every_frame, "scenario": MID_STEP if every_frame else None}
     vec = retrokit.make_vec("Airstriker-Genesis", n, threads=threads, **options)
     assert vec.threads == min(n, threads or available_cpus())
-    assert vec._runner is not None  # both kinds run on the native runner
+    assert vec.native  # both kinds run on the native runner
     singles = [retrokit.make("Airstriker-Genesis", **options) for _ in range(n)]
     obs, infos = vec.reset(seed=seed)
     single_obs = [env.reset(seed=seed + i)[0] for i, env in enumerate(singles)]
@@ -89,7 +89,7 @@ def test_vector_infos_are_batched_as_gymnasium_batches_them(wrapped: bool) -> No
     make = lambda: retrokit.make("Airstriker-Genesis", **OPTIONS)
     fns = [(lambda: gymnasium.wrappers.RecordEpisodeStatistics(make())) if wrapped else make for _ in range(n)]
     vec = ThreadedVectorEnv(fns, threads=2)  # more envs than threads
-    assert (vec._runner is None) == wrapped
+    assert vec.native != wrapped
     singles = [fn() for fn in fns]
     vec.reset(seed=3)
     for i, env in enumerate(singles):

@@ -25,7 +25,7 @@ from retrokit.envs.buffers import BufferPool
 from retrokit.envs.compat import StableRetroCompat
 from retrokit.envs.options import check_crop, check_options, check_seed, make_arguments
 from retrokit.envs.pickling import PicklesAsArguments
-from retrokit.envs.stepper import Stepper, drive
+from retrokit.envs.stepper import Stepper, Stepping
 from retrokit.envs.viewer import render_modes
 from retrokit.errors import InvalidArgumentError, StateError
 from retrokit.host.emulator import Emulator
@@ -250,16 +250,16 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         return obs, values
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        stepper = self.stepper
-        stepper.begin(action)
-        out = self._buffers.take() if self.direct_screen else None
-        run = self.emulator.run
+        return self.stepping.step(action, self._buffers.take() if self.direct_screen else None)
 
-        def frames(live: list[int], count: int, last: bool) -> tuple[bool | None]:
-            return (run(stepper.masks, count, out if last else None),)
+    @property
+    def stepping(self) -> Stepping:
+        """This env's steps as a vector env runs them with others' (see :class:`~retrokit.envs.stepper.Stepping`).
 
-        converted = drive((stepper,), frames)[0]
-        return self.finish_step(out if converted else None)
+        Made anew on each access, so that the env holds no reference to itself.
+        """
+        reader = self.reader if self.players == 1 and self.reader.fits_int64 else None
+        return Stepping(self.stepper, self.emulator, self.direct_screen, self.finish_step, reader)
 
     def finish_step(self, obs: np.ndarray | None = None) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         """End a step once its frames ran (see :func:`~retrokit.envs.stepper.drive`): the step's 5-tuple.

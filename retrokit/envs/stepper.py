@@ -17,6 +17,7 @@ recorder) registers as an observer.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
@@ -145,6 +146,56 @@ class Stepper:
         if done:
             self.done = True
             self._left = 0
+
+
+#: A step's outcome, as ``gymnasium.Env.step`` returns it: observation, reward, terminated, truncated, info.
+StepResult = tuple[Any, float, bool, bool, dict[str, Any]]
+
+
+@dataclass(frozen=True)
+class Stepping:
+    """How an env's steps run together with other envs': the one stepping interface of env and vector env.
+
+    An env offers one (``RetroEnv.stepping``) and steps itself through it; a
+    vector env whose envs all offer one of the same :attr:`kind` begins every
+    env's step (``stepper.begin``), runs all their frames in one native call
+    per :func:`drive` round, and ends each with :attr:`finish`.
+
+    Attributes:
+        stepper: The env's episode logic.
+        emulator: Its console.
+        direct_screen: Whether an observation is the whole screen, so the last
+            frame can be converted straight into a buffer of the observation's shape.
+        finish: Ends a step once its frames ran: given the observation if the
+            frames were converted straight into it (else ``None``), returns the step's 5-tuple.
+        fields: The reader whose decoded values (``fields.values``, in
+            ``fields.names``' order, all fitting int64) are exactly the step's
+            info, or ``None`` when the info holds more (several players) or
+            other values.
+    """
+
+    stepper: Stepper
+    emulator: Emulator
+    direct_screen: bool
+    finish: Callable[[np.ndarray | None], StepResult]
+    fields: FieldReader | None
+
+    @property
+    def kind(self) -> tuple[int, int, bool]:
+        """Envs can share native calls when this is the same: frame skip, ports, scenario every frame."""
+        return self.stepper.frameskip, self.emulator.ports, self.stepper.every_frame
+
+    def step(self, action: Any, out: np.ndarray | None) -> StepResult:
+        """One whole step of this env alone: ``out``, if given, receives the observation straight from the core."""
+        stepper = self.stepper
+        stepper.begin(action)
+        run = self.emulator.run
+
+        def frames(live: list[int], count: int, last: bool) -> tuple[bool | None]:
+            return (run(stepper.masks, count, out if last else None),)
+
+        converted = drive((stepper,), frames)[0]
+        return self.finish(out if converted else None)
 
 
 #: ``run(live, frames, last)``: run ``frames`` frames of the steppers at indices ``live``,

@@ -1,0 +1,170 @@
+"""Steps in flight: the bookkeeping of a vector env's asynchronous mode (``send`` / ``recv``).
+
+``send`` hands some envs' actions to a pool of threads and returns at once;
+each thread runs one env's whole step (its frames with the GIL released,
+then its fields and scenario), and whichever thread is free takes the next
+env waiting, so a descheduled thread holds up only the step it is running.
+``recv`` returns the first steps that are done, as many as the vector env's
+``batch_size`` (or all in flight, if fewer), in the order they finished.
+
+An env is in flight from its ``send`` to the ``recv`` that returns it; it
+cannot be sent again in between, and every misuse (``recv`` with nothing in
+flight, an env sent twice, an id out of range) is a one-line
+:class:`~retrokit.errors.EnvError` or
+:class:`~retrokit.errors.InvalidArgumentError`.
+"""
+
+from __future__ import annotations
+
+import numbers
+import queue
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any
+
+import numpy as np
+from gymnasium.vector import VectorEnv
+
+from retrokit.errors import EnvError, InvalidArgumentError, shown
+
+#: Runs one env's step: ``step(env_id, action)`` returns its 5-tuple.
+StepOne = Callable[[int, Any], tuple]
+
+
+class InFlight:
+    """Envs whose steps were sent and not yet received.
+
+    Args:
+        num_envs: The vector env's envs; ids go from 0 to ``num_envs - 1``.
+        threads: Threads that run the steps (the caller is not one of them: it is free while they run).
+    """
+
+    def __init__(self, num_envs: int, threads: int) -> None:
+        self.num_envs, self.threads = num_envs, threads
+        self._pool: ThreadPoolExecutor | None = None  # started at the first send: a sync-only user needs no threads
+        self._sent: set[int] = set()
+        self._done: queue.SimpleQueue[tuple[int, tuple | None, BaseException | None]] = queue.SimpleQueue()
+
+    @property
+    def busy(self) -> bool:
+        """Whether some env is in flight."""
+        return bool(self._sent)
+
+    def check_ids(self, env_ids: Any) -> list[int]:
+        """The env ids a ``send`` names, checked: whole numbers in range, each once, none in flight.
+
+        Raises:
+            InvalidArgumentError: An id is not a whole number, out of range, or named twice.
+            EnvError: An env is still in flight (sent and not received).
+        """
+        if env_ids is None:
+            ids = list(range(self.num_envs))
+        else:
+            try:
+                ids = list(np.asarray(env_ids).reshape(-1)) if not isinstance(env_ids, (str, bytes)) else None
+            except (TypeError, ValueError):
+                ids = None
+            if ids is None or np.ndim(env_ids) > 1:
+                raise InvalidArgumentError(
+                    f"Expected env_ids to be a sequence of env indices (0 to {self.num_envs - 1}), or None for all; "
+                    f"found {shown(env_ids)}."
+                )
+        checked = []
+        for value in ids:
+            if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
+                raise InvalidArgumentError(
+                    f"Expected env ids to be whole numbers from 0 to {self.num_envs - 1}; found {shown(value)}."
+                )
+            if not 0 <= int(value) < self.num_envs:
+                raise InvalidArgumentError(
+                    f"Expected env ids from 0 to {self.num_envs - 1} (the vector env has {self.num_envs} envs); "
+                    f"found {int(value)}."
+                )
+            checked.append(int(value))
+        if len(set(checked)) != len(checked):
+            twice = sorted({i for i in checked if checked.count(i) > 1})
+            raise InvalidArgumentError(
+                f"Expected each env id at most once in a send; found {twice} more than once. Send one action per env."
+            )
+        if not checked:
+            raise InvalidArgumentError("Expected at least one env id in a send; found none.")
+        busy = sorted(self._sent.intersection(checked))
+        if busy:
+            raise EnvError(
+                f"Expected envs that are not in flight; envs {busy} were sent and not yet received. "
+                f"Call recv() until they come back before sending them again."
+            )
+        return checked
+
+    def send(self, env_ids: Sequence[int], actions: Sequence[Any], step: StepOne) -> None:
+        """Start the steps of ``env_ids`` (checked by :meth:`check_ids`), ``actions[k]`` for ``env_ids[k]``.
+
+        ``step`` runs one env's step; it is given per call, not kept, so that
+        the vector env (whose method it is) and this object make no cycle:
+        closing the vector env frees its emulators without waiting for the
+        garbage collector.
+        """
+        if self._pool is None:
+            self._pool = ThreadPoolExecutor(max_workers=self.threads, thread_name_prefix="retrokit-async")
+        for env_id, action in zip(env_ids, actions):
+            self._sent.add(env_id)
+            self._pool.submit(self._run, step, env_id, action)
+
+    def _run(self, step: StepOne, env_id: int, action: Any) -> None:
+        try:
+            self._done.put((env_id, step(env_id, action), None))
+        except BaseException as exc:  # noqa: BLE001 - any failure, raised by recv() in the caller's thread: never a hang
+            self._done.put((env_id, None, exc))
+
+    def recv(self, batch_size: int) -> list[tuple[int, tuple]]:
+        """Wait for the first ``batch_size`` steps to finish (all in flight, if fewer); return ``(env_id, result)``s.
+
+        Raises:
+            EnvError: Nothing is in flight (no ``send`` since the last ``recv`` of every env).
+            RetrokitError: A step failed; its error is raised once the batch is in (the failed env is no
+                longer in flight).
+        """
+        if not self._sent:
+            raise EnvError(
+                "Expected a send() before recv(): no env is in flight. Call vec.send(actions) (or "
+                "vec.send(actions, env_ids)) first, then recv()."
+            )
+        want = min(batch_size, len(self._sent))
+        got: list[tuple[int, tuple]] = []
+        error: BaseException | None = None
+        for _ in range(want):
+            env_id, result, exc = self._done.get()
+            self._sent.discard(env_id)
+            if exc is not None:
+                error = error or exc
+            else:
+                got.append((env_id, result))  # type: ignore[arg-type]
+        if error is not None:
+            raise error
+        return got
+
+    def close(self) -> None:
+        """Let the steps in flight finish, and stop the threads."""
+        if self._pool is not None:
+            self._pool.shutdown(wait=True)
+            self._pool = None
+        self._sent.clear()
+
+
+class _Rows(VectorEnv):
+    """Only Gymnasium's info batching, for a batch of ``num_envs`` rows (a ``recv``'s, not the vector env's)."""
+
+    def __init__(self, num_envs: int) -> None:  # no spaces: it batches infos, nothing else
+        self.num_envs = num_envs
+
+    def add(self, batched: dict[str, Any], info: dict[str, Any], row: int) -> dict[str, Any]:
+        return self._add_info(batched, info, row)
+
+
+def batch_infos(infos: Sequence[dict[str, Any]]) -> dict[str, Any]:
+    """The infos of a batch's rows, batched as Gymnasium's vector envs batch them (with ``_key`` masks)."""
+    rows = _Rows(len(infos))
+    batched: dict[str, Any] = {}
+    for k, info in enumerate(infos):
+        batched = rows.add(batched, info, k)
+    return batched

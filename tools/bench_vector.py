@@ -1,0 +1,214 @@
+#!/usr/bin/env python3
+"""Vector env throughput: retrokit against stable-retro-turbo, and under a busy CPU.
+
+Env steps per second on Airstriker, frame skip 4, sticky 0.25, no-op actions,
+median of ``--rounds`` rounds; each config of each round runs in a fresh
+process (so no config inherits another's caches, threads or heap), and the
+rounds interleave the configs so that a drift of the machine's speed hits
+them all alike.
+
+Configs: 1, 2 and 4 envs, with RGB observations and with gray 84x84 stack 4
+ones (natively when ``make_vec`` takes ``grayscale``/``resize``/``frame_stack``,
+else through Gymnasium's wrappers, as a user would), plus 1 env and the 2-env
+vector with a third process burning one core (``while True: pass``, as a
+learner would).
+
+stable-retro-turbo's ``RetroVecEnv`` runs the same configs side by side when
+``--turbo-python`` names an interpreter that imports it (install it in a
+venv of its own: it is a fork of stable-retro, which retrokit's venv holds
+for its cores), and the ratios retrokit/turbo are printed beside the
+targets: >= 1.5 at 2 and 4 envs, RGB and gray; under load, the 2-env vector
+>= 1.2x the 1-env rate.
+
+Usage: python tools/bench_vector.py [--rounds 3] [--seconds 3] [--turbo-python PATH] [--check]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+GAME = "Airstriker-Genesis"
+FRAMESKIP, STICKY = 4, 0.25
+#: (envs, observation, loaded): every config measured, in this order.
+CONFIGS = [(n, obs, False) for obs in ("rgb", "gray") for n in (1, 2, 4)] + [(1, "rgb", True), (2, "rgb", True)]
+RATIO_TARGET = 1.5  # retrokit/turbo at 2 and 4 envs
+LOAD_TARGET = 1.2  # 2-env vector / 1 env, both under load
+
+
+def label(config: tuple[int, str, bool]) -> str:
+    n, obs, loaded = config
+    shape = "RGB" if obs == "rgb" else "gray 84x84 stack 4"
+    return f"{n} env{'s' if n > 1 else ''}, {shape}{', 1 core busy' if loaded else ''}"
+
+
+# --- the measuring child ------------------------------------------------------------------------
+
+
+def retrokit_vec(n: int, obs: str):
+    """retrokit's vector env of ``n`` envs; gray natively if make_vec can, else through Gymnasium's wrappers."""
+    import functools
+
+    import retrokit
+    from retrokit.envs.options import OPTIONS
+    from retrokit.envs.vector import ThreadedVectorEnv
+
+    options = {"frameskip": FRAMESKIP, "sticky_prob": STICKY}
+    if obs == "rgb":
+        return retrokit.make_vec(GAME, n, **options), "native"
+    if {"grayscale", "resize", "frame_stack"} <= set(OPTIONS):
+        return retrokit.make_vec(GAME, n, grayscale=True, resize=(84, 84), frame_stack=4, **options), "native"
+    return ThreadedVectorEnv([functools.partial(wrapped_gray, options)] * n), "Gymnasium wrappers"
+
+
+def wrapped_gray(options: dict):
+    """One env preprocessed by Gymnasium's wrappers (cv2's area resize as a PIL box filter: no cv2 here)."""
+    import gymnasium
+    import numpy as np
+    from gymnasium.wrappers import FrameStackObservation, GrayscaleObservation, TransformObservation
+    from PIL import Image
+
+    import retrokit
+
+    env = GrayscaleObservation(retrokit.make(GAME, **options))
+    space = gymnasium.spaces.Box(0, 255, (84, 84), np.uint8)
+
+    def resize(frame):
+        return np.asarray(Image.fromarray(frame).resize((84, 84), Image.BOX))
+
+    return FrameStackObservation(TransformObservation(env, resize, space), 4)
+
+
+def turbo_vec(n: int, obs: str):
+    import stable_retro
+
+    gray = {"obs_grayscale": True, "obs_resize": (84, 84), "obs_resize_algorithm": "area", "frame_stack": 4}
+    vec = stable_retro.RetroVecEnv(
+        GAME, num_envs=n, num_threads=min(n, len(os.sched_getaffinity(0))), render_mode="rgb_array",
+        frame_skip=FRAMESKIP, sticky_action_prob=STICKY, **(gray if obs == "gray" else {}),
+    )
+    return vec, "native"
+
+
+def measure(kind: str, n: int, obs: str, seconds: float) -> dict:
+    """Env steps/s of one vector env stepping no-op actions for about ``seconds``."""
+    import numpy as np
+
+    vec, how = (retrokit_vec if kind == "retrokit" else turbo_vec)(n, obs)
+    space = vec.single_action_space
+    actions = np.zeros((n,) + space.shape, dtype=space.dtype)
+    vec.reset(seed=0)
+    for _ in range(30):  # warm the caches and the threads
+        vec.step(actions)
+    steps, start = 0, time.perf_counter()
+    while (elapsed := time.perf_counter() - start) < seconds:
+        for _ in range(10):
+            vec.step(actions)
+        steps += 10
+    vec.close()
+    return {"rate": steps * n / elapsed, "how": how}
+
+
+# --- the parent ---------------------------------------------------------------------------------
+
+
+def run_config(python: str, kind: str, config: tuple[int, str, bool], seconds: float) -> dict | None:
+    """Measure one config in a fresh process, beside a core burner if the config says; None if it failed."""
+    n, obs, loaded = config
+    burner = subprocess.Popen([sys.executable, "-c", "while True: pass"]) if loaded else None
+    try:
+        proc = subprocess.run(
+            [python, os.path.abspath(__file__), "--child", kind, str(n), obs, "--seconds", str(seconds)],
+            capture_output=True, text=True, timeout=120 + 10 * seconds, check=False,
+        )
+    except subprocess.TimeoutExpired:
+        print(f"  {kind} {label(config)}: timed out", file=sys.stderr)
+        return None
+    finally:
+        if burner is not None:
+            burner.kill()
+            burner.wait()
+    if proc.returncode != 0:
+        print(f"  {kind} {label(config)} failed: {proc.stderr.strip().splitlines()[-1:]}", file=sys.stderr)
+        return None
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def turbo_importable(python: str | None) -> bool:
+    if python is None:
+        return False
+    probe = subprocess.run([python, "-c", "import stable_retro; stable_retro.RetroVecEnv"], capture_output=True, check=False)
+    return probe.returncode == 0
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rounds", type=int, default=3, help="rounds (the median is reported)")
+    parser.add_argument("--seconds", type=float, default=3.0, help="measured seconds per config per round")
+    parser.add_argument("--turbo-python", help="an interpreter that imports stable-retro-turbo's stable_retro")
+    parser.add_argument("--check", action="store_true", help="exit 1 if a target is missed")
+    parser.add_argument("--child", nargs=3, metavar=("KIND", "N", "OBS"), help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.child:
+        kind, n, obs = args.child
+        print(json.dumps(measure(kind, int(n), obs, args.seconds)))
+        return 0
+
+    kinds = {"retrokit": sys.executable}
+    if turbo_importable(args.turbo_python):
+        kinds["turbo"] = args.turbo_python
+    else:
+        print("stable-retro-turbo: not measured (pass --turbo-python, an interpreter that imports it)")
+    print(f"{len(os.sched_getaffinity(0))} CPUs, load average {os.getloadavg()[0]:.1f} at the start")
+    rates: dict[tuple[str, tuple], list[float]] = {}
+    hows: dict[tuple[str, tuple], str] = {}
+    for round_ in range(args.rounds):
+        for config in CONFIGS:
+            for kind, python in kinds.items():
+                got = run_config(python, kind, config, args.seconds)
+                if got is not None:
+                    rates.setdefault((kind, config), []).append(got["rate"])
+                    hows[kind, config] = got["how"]
+        print(f"round {round_ + 1}/{args.rounds} done, load average {os.getloadavg()[0]:.1f}", flush=True)
+
+    def median(kind: str, config: tuple) -> float | None:
+        values = rates.get((kind, config))
+        return statistics.median(values) if values else None
+
+    missed = []
+    print(f"\nenv steps/s, median of {args.rounds}:")
+    print(f"{'config':<40} {'retrokit':>9} {'turbo':>9} {'ratio':>7}  target")
+    for config in CONFIGS:
+        ours, theirs = median("retrokit", config), median("turbo", config)
+        ratio = ours / theirs if ours and theirs else None
+        target = RATIO_TARGET if config[0] >= 2 and not config[2] else None
+        mark = "" if ratio is None or target is None else ("ok" if ratio >= target else "MISSED")
+        if mark == "MISSED":
+            missed.append(label(config))
+        how = f" ({hows['retrokit', config]})" if config[1] == "gray" and ("retrokit", config) in hows else ""
+        print(
+            f"{label(config):<40} {fmt(ours):>9} {fmt(theirs):>9} {fmt(ratio, 2):>7}  "
+            f"{f'>= {target} {mark}' if target else ''}{how}"
+        )
+    print("\nunder load (one core kept busy), 2-env vector / 1 env:")
+    for kind in kinds:
+        one, two = median(kind, (1, "rgb", True)), median(kind, (2, "rgb", True))
+        ratio = two / one if one and two else None
+        mark = "" if kind != "retrokit" or ratio is None else ("ok" if ratio >= LOAD_TARGET else "MISSED")
+        if mark == "MISSED":
+            missed.append("2-env vector under load")
+        print(f"  {kind:<9} {fmt(ratio, 2):>6}  {f'>= {LOAD_TARGET} {mark}' if kind == 'retrokit' else ''}")
+    return 1 if args.check and missed else 0
+
+
+def fmt(value: float | None, digits: int = 0) -> str:
+    return "-" if value is None else f"{value:.{digits}f}"
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -103,8 +103,9 @@ class Runner:
 
         Any number of emulators: the threads take them one at a time until
         none is left. ``actions`` has one row of port masks per emulator. Each
-        screen is converted into its buffer when its shape fits the frame; the
-        result says, per emulator, whether it was.
+        screen is converted into its buffer when its shape fits the frame (or,
+        for an emulator with a preprocessing, its observation is made into it:
+        always); the result says, per emulator, whether it was.
         """
 
 def pack_buttons(

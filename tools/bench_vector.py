@@ -84,22 +84,31 @@ def wrapped_gray(options: dict):
     return FrameStackObservation(TransformObservation(env, resize, space), 4)
 
 
-def turbo_vec(n: int, obs: str):
+def turbo_vec(n: int, obs: str, rom: str):
+    """stable-retro-turbo's vector env, on the ROM retrokit plays (turbo's wheel ships no Airstriker ROM)."""
     import stable_retro
 
     gray = {"obs_grayscale": True, "obs_resize": (84, 84), "obs_resize_algorithm": "area", "frame_stack": 4}
     vec = stable_retro.RetroVecEnv(
-        GAME, num_envs=n, num_threads=min(n, len(os.sched_getaffinity(0))), render_mode="rgb_array",
+        f"{GAME}-v0", num_envs=n, num_threads=min(n, len(os.sched_getaffinity(0))), render_mode="rgb_array",
+        rom_path=rom,
         frame_skip=FRAMESKIP, sticky_action_prob=STICKY, **(gray if obs == "gray" else {}),
     )
     return vec, "native"
 
 
-def measure(kind: str, n: int, obs: str, seconds: float) -> dict:
+def game_rom() -> str:
+    """The path of the ROM retrokit's env plays."""
+    from retrokit.data.games import find_game
+
+    return str(find_game(GAME).rom_path())
+
+
+def measure(kind: str, n: int, obs: str, seconds: float, rom: str) -> dict:
     """Env steps/s of one vector env stepping no-op actions for about ``seconds``."""
     import numpy as np
 
-    vec, how = (retrokit_vec if kind == "retrokit" else turbo_vec)(n, obs)
+    vec, how = retrokit_vec(n, obs) if kind == "retrokit" else turbo_vec(n, obs, rom)
     space = vec.single_action_space
     actions = np.zeros((n,) + space.shape, dtype=space.dtype)
     vec.reset(seed=0)
@@ -117,13 +126,13 @@ def measure(kind: str, n: int, obs: str, seconds: float) -> dict:
 # --- the parent ---------------------------------------------------------------------------------
 
 
-def run_config(python: str, kind: str, config: tuple[int, str, bool], seconds: float) -> dict | None:
+def run_config(python: str, kind: str, config: tuple[int, str, bool], seconds: float, rom: str) -> dict | None:
     """Measure one config in a fresh process, beside a core burner if the config says; None if it failed."""
     n, obs, loaded = config
     burner = subprocess.Popen([sys.executable, "-c", "while True: pass"]) if loaded else None
     try:
         proc = subprocess.run(
-            [python, os.path.abspath(__file__), "--child", kind, str(n), obs, "--seconds", str(seconds)],
+            [python, os.path.abspath(__file__), "--child", kind, str(n), obs, "--seconds", str(seconds), "--rom", rom],
             capture_output=True, text=True, timeout=120 + 10 * seconds, check=False,
         )
     except subprocess.TimeoutExpired:
@@ -153,11 +162,13 @@ def main() -> int:
     parser.add_argument("--turbo-python", help="an interpreter that imports stable-retro-turbo's stable_retro")
     parser.add_argument("--check", action="store_true", help="exit 1 if a target is missed")
     parser.add_argument("--child", nargs=3, metavar=("KIND", "N", "OBS"), help=argparse.SUPPRESS)
+    parser.add_argument("--rom", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         kind, n, obs = args.child
-        print(json.dumps(measure(kind, int(n), obs, args.seconds)))
+        print(json.dumps(measure(kind, int(n), obs, args.seconds, args.rom)))
         return 0
+    rom = game_rom()
 
     kinds = {"retrokit": sys.executable}
     if turbo_importable(args.turbo_python):
@@ -170,7 +181,7 @@ def main() -> int:
     for round_ in range(args.rounds):
         for config in CONFIGS:
             for kind, python in kinds.items():
-                got = run_config(python, kind, config, args.seconds)
+                got = run_config(python, kind, config, args.seconds, rom)
                 if got is not None:
                     rates.setdefault((kind, config), []).append(got["rate"])
                     hows[kind, config] = got["how"]

@@ -168,17 +168,17 @@ class Stepping:
             frame can be converted straight into a buffer of the observation's shape.
         finish: Ends a step once its frames ran: given the observation if the
             frames were converted straight into it (else ``None``), returns the step's 5-tuple.
-        fields: The reader whose decoded values (``fields.values``, in
-            ``fields.names``' order, all fitting int64) are exactly the step's
-            info, or ``None`` when the info holds more (several players) or
-            other values.
+        info: The names of the fields a step's info holds, and a view of
+            their values (int64, in that order) as of the last step, when the
+            info is exactly these; ``None`` when it holds more (several
+            players) or values that do not fit int64.
     """
 
     stepper: Stepper
     emulator: Emulator
     direct_screen: bool
     finish: Callable[[np.ndarray | None], StepResult]
-    fields: FieldReader | None
+    info: tuple[tuple[str, ...], memoryview] | None
 
     @property
     def kind(self) -> tuple[int, int, bool]:

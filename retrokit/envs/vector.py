@@ -42,6 +42,7 @@ from retrokit.envs.inflight import InFlight, batch_infos
 from retrokit.envs.memory import MIN_ENV_BYTES, build_envs, check_fits
 from retrokit.envs.options import check_num_envs, check_seed
 from retrokit.envs.pickling import PicklesAsArguments
+from retrokit.envs.starts import per_env_states
 from retrokit.envs.stepper import Stepping, StepResult, drive
 from retrokit.errors import EnvError, InvalidArgumentError, shown
 from retrokit.host.runner import Runner
@@ -131,13 +132,13 @@ class ThreadedVectorEnv(PicklesAsArguments, VectorEnv):
         for i, stepper in enumerate(self._steppers):
             stepper.use_masks(self._actions[i])
         self._direct_screens = all(s.direct_screen for s in self._steppings) and self._batches is not None
-        readers = [s.fields for s in self._steppings]
-        names = {tuple(r.names) for r in readers if r is not None}
-        if len(names) == 1 and all(r is not None for r in readers):
+        infos = [s.info for s in self._steppings]
+        names = {info[0] for info in infos if info is not None}
+        if len(names) == 1 and all(info is not None for info in infos):
             keys = names.pop()
             num_envs = self.num_envs  # not self: a closure over self would keep the envs alive until GC
             self._step_arrays = Pool(lambda: StepArrays(num_envs, keys))
-            self._field_values = [memoryview(r.values) for r in readers]  # type: ignore[union-attr]
+            self._field_values = [info[1] for info in infos]  # type: ignore[index]
         return Runner([s.emulator for s in self._steppings], self.threads - 1)
 
     def _each(self, job: Callable[[int], Any]) -> list[Any]:
@@ -300,7 +301,7 @@ class ThreadedVectorEnv(PicklesAsArguments, VectorEnv):
         for i, result in enumerate(results):
             rewards[i], terminations[i], truncations[i] = result[1], result[2], result[3]
         for row, values in zip(arrays.rows, self._field_values):
-            row[:] = values  # the env's reader decoded this step's fields into it
+            row[:] = values  # the env's reader decoded this step's fields (its info's) into it
         arrays.refill_masks()
         return observations, arrays.rewards, arrays.terminations, arrays.truncations, dict(arrays.info)
 
@@ -376,8 +377,8 @@ def make_vec(
 
     num_envs = check_num_envs(num_envs)
     check_fits(num_envs, (MIN_ENV_BYTES, MIN_ENV_BYTES), at_least=True)  # before a list of num_envs functions
-    start = State.DEFAULT if state is None else state
+    starts = [State.DEFAULT if s is None else s for s in per_env_states(state, num_envs)]  # a list: one per env
     # partials, not lambdas: the vector env pickles as its env functions
     return ThreadedVectorEnv(
-        [functools.partial(make, game, start, scenario, **options)] * num_envs, threads, batch_size
+        [functools.partial(make, game, s, scenario, **options) for s in starts], threads, batch_size
     )

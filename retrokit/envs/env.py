@@ -23,7 +23,7 @@ from retrokit.data.resolve import Resolved, StartState, State, resolve, resolve_
 from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
 from retrokit.envs.compat import StableRetroCompat
-from retrokit.envs.options import check_crop, check_options, check_seed, make_arguments
+from retrokit.envs.options import OPTIONS, check_crop, check_options, check_seed, make_arguments
 from retrokit.envs.pickling import PicklesAsArguments
 from retrokit.envs.preprocessing import OBSERVATION_OPTIONS, Preprocessing, preprocessing
 from retrokit.envs.starts import check_weights, probabilities
@@ -108,24 +108,11 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         reward_clip: bool | float = False,
         info_keys: list[str] | None = None,
     ) -> None:
-        PicklesAsArguments.__init__(
-            self, game, state, scenario, obs_type=obs_type, action_type=action_type, frameskip=frameskip,
-            sticky_prob=sticky_prob, max_episode_steps=max_episode_steps, players=players, render_mode=render_mode,
-            record=record, scenario_every_frame=scenario_every_frame, options=options, skip_video=skip_video,
-            grayscale=grayscale, resize=resize, resize_method=resize_method, crop=crop, frame_stack=frame_stack,
-            channels_first=channels_first, max_pool=max_pool, noop_max=noop_max, reward_clip=reward_clip,
-            info_keys=info_keys,
-        )
-        checked = check_options(
-            {
-                "obs_type": obs_type, "action_type": action_type, "frameskip": frameskip, "sticky_prob": sticky_prob,
-                "max_episode_steps": max_episode_steps, "players": players, "render_mode": render_mode,
-                "record": record, "scenario_every_frame": scenario_every_frame, "options": options,
-                "skip_video": skip_video, "grayscale": grayscale, "resize": resize, "resize_method": resize_method,
-                "crop": crop, "frame_stack": frame_stack, "channels_first": channels_first, "max_pool": max_pool,
-                "noop_max": noop_max, "reward_clip": reward_clip, "info_keys": info_keys,
-            }
-        )  # the same rules as retrokit.make's, whichever way the env is made
+        # The keyword options are declared once, by this signature (names and defaults); OPTIONS holds
+        # their checks, and a test keeps the two the same. Here they are taken as given, by name.
+        given = {name: value for name, value in locals().items() if name in OPTIONS}
+        PicklesAsArguments.__init__(self, game, state, scenario, **given)
+        checked = check_options(given)  # the same rules as retrokit.make's, whichever way the env is made
         self.noop_max, self.reward_clip = checked["noop_max"], checked["reward_clip"]
         frameskip, sticky_prob, players = checked["frameskip"], checked["sticky_prob"], checked["players"]
         max_episode_steps, scenario_every_frame = checked["max_episode_steps"], checked["scenario_every_frame"]

@@ -97,11 +97,14 @@ def test_recv_returns_the_first_done_and_keeps_the_rest_in_flight() -> None:
     vec = retrokit.make_vec(GAME, 4, batch_size=3, **OPTIONS)
     vec.reset(seed=1)
     vec.send(np.zeros(4, dtype=np.int64))
+    assert vec.in_flight == 4
     first = vec.recv()
     assert len(first[5]) == 3 and first[0].shape == (3, 224, 320, 3)
+    assert vec.in_flight == 1
     with pytest.raises(EnvError, match="in flight"):
         vec.send(np.zeros(4, dtype=np.int64))  # one is still out
     rest = vec.recv()  # fewer than batch_size left: all of them
+    assert vec.in_flight == 0
     assert sorted([*first[5], *rest[5]]) == [0, 1, 2, 3]
     vec.send(np.zeros(4, dtype=np.int64))  # everything came back: all may go again
     again = vec.recv()[5]

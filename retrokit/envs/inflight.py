@@ -46,9 +46,9 @@ class InFlight:
         self._done: queue.SimpleQueue[tuple[int, tuple | None, BaseException | None]] = queue.SimpleQueue()
 
     @property
-    def busy(self) -> bool:
-        """Whether some env is in flight."""
-        return bool(self._sent)
+    def count(self) -> int:
+        """How many envs are in flight."""
+        return len(self._sent)
 
     def check_ids(self, env_ids: Any) -> list[int]:
         """The env ids a ``send`` names, checked: whole numbers in range, each once, none in flight.

@@ -182,7 +182,7 @@ class ThreadedVectorEnv(PicklesAsArguments, VectorEnv):
         Raises:
             EnvError: Some env was sent and not received.
         """
-        if self._in_flight.busy:
+        if self._in_flight.count:
             raise EnvError(
                 f"Expected no env in flight at {call}(); some were sent and not received. Call recv() until "
                 f"every env sent came back, then {call}()."
@@ -256,6 +256,11 @@ class ThreadedVectorEnv(PicklesAsArguments, VectorEnv):
         ids = self._in_flight.check_ids(env_ids)
         rows = self._action_rows(actions, len(ids))
         self._in_flight.send(ids, rows, self._step_one)
+
+    @property
+    def in_flight(self) -> int:
+        """How many envs were sent and not yet received (:meth:`recv` returns them)."""
+        return self._in_flight.count
 
     def recv(self) -> tuple[Any, np.ndarray, np.ndarray, np.ndarray, dict[str, Any], np.ndarray]:
         """The first steps done of the envs sent: up to ``batch_size`` of them, in the order they finished.
@@ -368,10 +373,15 @@ def make_vec(
 ) -> ThreadedVectorEnv:
     """Make ``num_envs`` copies of a game's env stepped on threads (one per CPU unless ``threads`` says).
 
-    ``batch_size`` is how many envs' steps the asynchronous mode's ``recv``
-    returns at most (see :meth:`ThreadedVectorEnv.send`). The vector env
-    pickles as these arguments: unpickled, it is a fresh one made from them
-    (no emulator state or episode carried over).
+    ``step`` runs every env's frames in one native call shared by the
+    threads (the caller's included); a thread the machine deschedules holds
+    up nobody, since the emulators it has not started are run by whichever
+    thread is free. The asynchronous mode, ``send(actions, env_ids)`` then
+    ``recv()`` (see :meth:`ThreadedVectorEnv.send`), runs each env's whole
+    step on ``threads`` threads while the caller goes on; ``batch_size`` is
+    how many envs' steps ``recv`` returns at most (the first done). The
+    vector env pickles as these arguments: unpickled, it is a fresh one made
+    from them (no emulator state or episode carried over).
     """
     from retrokit.envs.env import State, make
 

@@ -423,6 +423,28 @@ def test_runner_steps_match_single_runs_and_screens_land_in_the_batch(
         emu.close()
 
 
+def test_runner_calls_of_changing_subsets_run_each_task_once(airstriker_rom: Path, airstriker_state: bytes) -> None:
+    """Workers that wake late, or find nothing left, never run a task of another call, nor one twice."""
+    count = 4
+    emus = [Emulator("Genesis", airstriker_rom) for _ in range(count)]
+    solo = [Emulator("Genesis", airstriker_rom) for _ in range(count)]
+    for emu in emus + solo:
+        emu.set_state(airstriker_state)
+    runner = _host.Runner(3)  # more workers than most calls' tasks: some always find none
+    rng = np.random.default_rng(7)
+    for step in range(150):
+        which = sorted(rng.choice(count, size=int(rng.integers(1, count + 1)), replace=False))
+        actions = rng.integers(0, 256, (len(which), 2)).astype(np.uint16)
+        frames = int(rng.integers(1, 5))
+        runner.run([emus[i].handle for i in which], actions, frames)
+        for i, row in zip(which, actions):
+            solo[i].run(row, frames)
+    for emu, alone in zip(emus, solo):
+        assert emu.ram.tobytes() == alone.ram.tobytes()
+    for emu in emus + solo:
+        emu.close()
+
+
 def test_runner_checks_its_arguments_first(airstriker: Emulator) -> None:
     runner = _host.Runner(1)
     actions = np.zeros((1, 2), dtype=np.uint16)

@@ -18,22 +18,30 @@
  * changed and takes nothing, and the caller may return as soon as the count
  * of finished tasks is complete.
  *
- * Between calls a worker waits a little before it sleeps: a step's Python
- * part is short, and waking a sleeping thread (on a virtual machine, a halted
- * vCPU) costs more than the step gains. It waits by yielding the CPU, not by
- * spinning on it, so that on a busy machine the waiting costs the caller's
- * thread (or a learner) nothing. The caller posts a worker's semaphore only
- * if the worker says it sleeps; both sides write their word before reading
- * the other's, so no wake-up is lost.
+ * Between calls a worker spins a while (up to a millisecond) before it
+ * sleeps: a step's Python part is short, and waking a sleeping thread (on a
+ * virtual machine, a halted vCPU) costs more than the step gains. But only
+ * while spinning is cheap: a worker that finds it lost the CPU while it spun
+ * (a gap in its clock) knows the machine is oversubscribed (a learner, other
+ * processes), and for the next calls it sleeps at once, since there a
+ * spinning thread only takes a core from the others and, having used up its
+ * share, is woken late, while a sleeping one is woken first. The caller posts
+ * a worker's semaphore only if the worker says it sleeps; both sides write
+ * their word before reading the other's, so no wake-up is lost. A caller that
+ * waits for a task in progress yields its CPU after a few microseconds.
  */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime under -std=c11 */
 #include "runner.h"
 
 #include <sched.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
-#define RK_PAUSES 200  /* a few microseconds of pause instructions before the first yield */
-#define RK_YIELDS 2000 /* about a millisecond of yields on an idle machine before a worker sleeps */
+#define RK_PAUSES 200              /* a few microseconds of pause instructions before a caller yields */
+#define RK_SPIN_NS 1000000         /* how long an idle worker spins before it sleeps, on a quiet machine */
+#define RK_PREEMPTED_NS 200000     /* a gap this long in a spinning worker's clock: it lost the CPU */
+#define RK_BUSY_CALLS 256          /* calls for which a worker that lost the CPU sleeps at once */
 
 static inline void cpu_relax(void) {
 #if defined(__x86_64__) || defined(__i386__)
@@ -51,6 +59,12 @@ static inline void wait_turn(int turn) {
 
 static inline uint32_t call_of(uint64_t work) { return (uint32_t)(work >> 32); }
 
+static inline uint64_t now_ns(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (uint64_t)t.tv_sec * 1000000000u + (uint64_t)t.tv_nsec;
+}
+
 /* Take and run the tasks of call `call` until none is left; tasks go from the last to the first. */
 static void take_tasks(rk_runner *r, uint32_t call) {
     uint64_t work = atomic_load(&r->work);
@@ -65,25 +79,33 @@ static void take_tasks(rk_runner *r, uint32_t call) {
     }
 }
 
+/* Whether a worker waiting for call `seen` should still spin: up to RK_SPIN_NS since `start`, unless the
+ * machine is busy (the worker lost the CPU lately, or now: a gap since `*last`). */
+static int keep_spinning(rk_worker *w, uint64_t start, uint64_t *last) {
+    uint64_t t = now_ns();
+    if (t - *last > RK_PREEMPTED_NS) w->busy_calls = RK_BUSY_CALLS;
+    *last = t;
+    return w->busy_calls == 0 && t - start < RK_SPIN_NS;
+}
+
 static void *worker_main(void *arg) {
     rk_worker *w = arg;
     rk_runner *r = w->runner;
     uint32_t seen = call_of(atomic_load(&r->work));
     for (;;) {
-        int turn = 0;
-        uint64_t work;
+        uint64_t start = now_ns(), last = start, work;
+        unsigned turn = 0;
         while (call_of(work = atomic_load(&r->work)) == seen && !atomic_load(&r->quit)) {
-            if (++turn < RK_PAUSES + RK_YIELDS) {
-                wait_turn(turn);
-                continue;
-            }
+            cpu_relax();
+            if (++turn % 64 || keep_spinning(w, start, &last)) continue; /* the clock, once per 64 pauses */
             atomic_store(&w->sleeping, 1);
             if (call_of(atomic_load(&r->work)) == seen && !atomic_load(&r->quit)) sem_wait(&w->wake);
             atomic_store(&w->sleeping, 0);
-            turn = 0;
+            start = last = now_ns();
         }
         if (atomic_load(&r->quit)) return NULL;
         seen = call_of(work);
+        if (w->busy_calls > 0) w->busy_calls--;
         take_tasks(r, seen);
     }
 }

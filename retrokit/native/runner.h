@@ -25,6 +25,7 @@ typedef struct {
     sem_t wake;            /* posted only when the worker said it sleeps */
     struct rk_runner *runner;
     atomic_int sleeping;
+    int busy_calls;        /* calls left for which this worker sleeps at once: it lost the CPU while spinning */
 } rk_worker;
 
 /* The most tasks one call may have: a call's tasks left are counted in the low 32 bits of `work`. */

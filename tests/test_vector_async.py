@@ -210,3 +210,11 @@ def test_a_failing_step_is_raised_by_recv_and_leaves_the_env_usable() -> None:
     vec.send([1], env_ids=[0])  # the failed env is no longer in flight, nor is the one beside it
     assert list(vec.recv()[5]) == [0]
     vec.close()
+
+
+def test_close_with_envs_in_flight_waits_for_them() -> None:
+    vec = retrokit.make_vec(GAME, 2, **OPTIONS)
+    vec.reset(seed=0)
+    vec.send([1, 2])
+    vec.close()  # the steps in flight finish before the emulators close: no crash, no hang
+    assert vec.in_flight == 0

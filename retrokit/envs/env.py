@@ -27,7 +27,7 @@ from retrokit.envs.options import OPTIONS, check_crop, check_options, check_seed
 from retrokit.envs.pickling import PicklesAsArguments
 from retrokit.envs.preprocessing import OBSERVATION_OPTIONS, Preprocessing, preprocessing
 from retrokit.envs.starts import check_weights, probabilities
-from retrokit.envs.stepper import Stepper, Stepping
+from retrokit.envs.stepper import Stepper, Stepping, step_alone
 from retrokit.envs.viewer import render_modes
 from retrokit.errors import InvalidArgumentError, StateError, UnknownNameError, did_you_mean
 from retrokit.host.emulator import Emulator
@@ -339,7 +339,9 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         return obs, values
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        return self.stepping.step(action, self._buffers.take() if self.direct_screen else None)
+        out = self._buffers.take() if self.direct_screen else None
+        # What Stepping.step does, without making a Stepping each step.
+        return self.finish_step(out if step_alone(self.stepper, self.emulator, action, out) else None)
 
     @property
     def stepping(self) -> Stepping:

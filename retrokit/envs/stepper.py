@@ -156,10 +156,11 @@ StepResult = tuple[Any, float, bool, bool, dict[str, Any]]
 class Stepping:
     """How an env's steps run together with other envs': the one stepping interface of env and vector env.
 
-    An env offers one (``RetroEnv.stepping``) and steps itself through it; a
-    vector env whose envs all offer one of the same :attr:`kind` begins every
-    env's step (``stepper.begin``), runs all their frames in one native call
-    per :func:`drive` round, and ends each with :attr:`finish`.
+    An env offers one (``RetroEnv.stepping``). Alone, it runs its step's
+    frames with :func:`step_alone` and ends it with :attr:`finish`; a vector
+    env whose envs all offer one of the same :attr:`kind` begins every env's
+    step (``stepper.begin``), runs all their frames in one native call per
+    :func:`drive` round, and ends each with :attr:`finish`.
 
     Attributes:
         stepper: The env's episode logic.
@@ -185,17 +186,16 @@ class Stepping:
         """Envs can share native calls when this is the same: frame skip, ports, scenario every frame."""
         return self.stepper.frameskip, self.emulator.ports, self.stepper.every_frame
 
-    def step(self, action: Any, out: np.ndarray | None) -> StepResult:
-        """One whole step of this env alone: ``out``, if given, receives the observation straight from the core."""
-        stepper = self.stepper
-        stepper.begin(action)
-        run = self.emulator.run
 
-        def frames(live: list[int], count: int, last: bool) -> tuple[bool | None]:
-            return (run(stepper.masks, count, out if last else None),)
+def step_alone(stepper: Stepper, emulator: Emulator, action: Any, out: np.ndarray | None) -> bool:
+    """Run one env's step's frames on its own emulator; return whether its screen was converted into ``out``."""
+    stepper.begin(action)
+    run = emulator.run
 
-        converted = drive((stepper,), frames)[0]
-        return self.finish(out if converted else None)
+    def frames(live: list[int], count: int, last: bool) -> tuple[bool | None]:
+        return (run(stepper.masks, count, out if last else None),)
+
+    return drive((stepper,), frames)[0]
 
 
 #: ``run(live, frames, last)``: run ``frames`` frames of the steppers at indices ``live``,

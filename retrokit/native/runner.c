@@ -27,21 +27,20 @@
  * spinning thread only takes a core from the others and, having used up its
  * share, is woken late, while a sleeping one is woken first. The caller posts
  * a worker's semaphore only if the worker says it sleeps; both sides write
- * their word before reading the other's, so no wake-up is lost. A caller that
- * waits for a task in progress yields its CPU after a few microseconds.
+ * their word before reading the other's, so no wake-up is lost. A caller
+ * that waits for tasks in progress does the same: it spins while that is
+ * cheap, then sleeps until the worker that finishes the last task wakes it.
  */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime under -std=c11 */
 #include "runner.h"
 
-#include <sched.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
-#define RK_PAUSES 200              /* a few microseconds of pause instructions before a caller yields */
-#define RK_SPIN_NS 1000000         /* how long an idle worker spins before it sleeps, on a quiet machine */
-#define RK_PREEMPTED_NS 200000     /* a gap this long in a spinning worker's clock: it lost the CPU */
-#define RK_BUSY_CALLS 256          /* calls for which a worker that lost the CPU sleeps at once */
+#define RK_SPIN_NS 1000000     /* how long a waiting thread spins before it sleeps, on a quiet machine */
+#define RK_PREEMPTED_NS 200000 /* a gap this long in a spinning thread's clock: it lost the CPU */
+#define RK_BUSY_CALLS 256      /* calls for which a thread that lost the CPU while spinning sleeps at once */
 
 static inline void cpu_relax(void) {
 #if defined(__x86_64__) || defined(__i386__)
@@ -49,12 +48,6 @@ static inline void cpu_relax(void) {
 #elif defined(__aarch64__)
     __asm__ volatile("yield");
 #endif
-}
-
-/* One more turn of waiting: pause first, then give the CPU to whoever else wants it. */
-static inline void wait_turn(int turn) {
-    if (turn < RK_PAUSES) cpu_relax();
-    else sched_yield();
 }
 
 static inline uint32_t call_of(uint64_t work) { return (uint32_t)(work >> 32); }
@@ -71,21 +64,24 @@ static void take_tasks(rk_runner *r, uint32_t call) {
     while (call_of(work) == call && (uint32_t)work > 0) {
         if (!atomic_compare_exchange_weak(&r->work, &work, work - 1)) continue; /* `work` now holds the new word */
         rk_task *task = &r->tasks[(uint32_t)work - 1]; /* the call cannot end while one of its tasks runs */
+        int n = r->n_tasks;                            /* (so this is still the call's) */
         rk_core_run(task->core, task->actions, task->core->n_ports, task->frames);
         task->converted =
             task->screen && rk_core_screen_into(task->core, task->screen, task->screen_width, task->screen_height);
-        atomic_fetch_add(&r->finished, 1);
+        /* The last task done wakes a caller that sleeps; a post that comes late is a spurious wake-up the
+         * caller's loop absorbs. */
+        if (atomic_fetch_add(&r->finished, 1) + 1 == n && atomic_load(&r->caller_sleeping)) sem_post(&r->done);
         work = atomic_load(&r->work);
     }
 }
 
-/* Whether a worker waiting for call `seen` should still spin: up to RK_SPIN_NS since `start`, unless the
- * machine is busy (the worker lost the CPU lately, or now: a gap since `*last`). */
-static int keep_spinning(rk_worker *w, uint64_t start, uint64_t *last) {
+/* Whether a thread waiting since `start` should still spin: up to RK_SPIN_NS, unless the machine is busy
+ * (the thread lost the CPU lately, `*busy_calls`, or now: a gap in its clock since `*last`). */
+static int keep_spinning(int *busy_calls, uint64_t start, uint64_t *last) {
     uint64_t t = now_ns();
-    if (t - *last > RK_PREEMPTED_NS) w->busy_calls = RK_BUSY_CALLS;
+    if (t - *last > RK_PREEMPTED_NS) *busy_calls = RK_BUSY_CALLS;
     *last = t;
-    return w->busy_calls == 0 && t - start < RK_SPIN_NS;
+    return *busy_calls == 0 && t - start < RK_SPIN_NS;
 }
 
 static void *worker_main(void *arg) {
@@ -97,7 +93,7 @@ static void *worker_main(void *arg) {
         unsigned turn = 0;
         while (call_of(work = atomic_load(&r->work)) == seen && !atomic_load(&r->quit)) {
             cpu_relax();
-            if (++turn % 64 || keep_spinning(w, start, &last)) continue; /* the clock, once per 64 pauses */
+            if (++turn % 64 || keep_spinning(&w->busy_calls, start, &last)) continue; /* clock: every 64 */
             atomic_store(&w->sleeping, 1);
             if (call_of(atomic_load(&r->work)) == seen && !atomic_load(&r->quit)) sem_wait(&w->wake);
             atomic_store(&w->sleeping, 0);
@@ -114,6 +110,7 @@ int rk_runner_init(rk_runner *r, int threads) {
     memset(r, 0, sizeof *r);
     r->workers = calloc((size_t)(threads > 0 ? threads : 1), sizeof(rk_worker));
     if (!r->workers) return -1;
+    sem_init(&r->done, 0, 0);
     for (int i = 0; i < threads; i++) {
         rk_worker *w = &r->workers[i];
         w->runner = r;
@@ -142,8 +139,17 @@ void rk_runner_run(rk_runner *r, rk_task *tasks, int n) {
         if (atomic_load(&w->sleeping)) sem_post(&w->wake);
     }
     take_tasks(r, call);
-    /* Only tasks that some worker took and is still running are left to wait for. */
-    for (int turn = 0; atomic_load(&r->finished) != n; turn++) wait_turn(turn);
+    /* Only tasks that some worker took and is still running are left to wait for: spin while it is cheap,
+     * then sleep until the last one is done. */
+    uint64_t start = now_ns(), last = start;
+    for (unsigned turn = 1; atomic_load(&r->finished) != n; turn++) {
+        cpu_relax();
+        if (turn % 64 || keep_spinning(&r->busy_calls, start, &last)) continue;
+        atomic_store(&r->caller_sleeping, 1);
+        while (atomic_load(&r->finished) != n) sem_wait(&r->done);
+        atomic_store(&r->caller_sleeping, 0);
+    }
+    if (r->busy_calls > 0) r->busy_calls--;
 }
 
 void rk_runner_close(rk_runner *r) {
@@ -156,4 +162,5 @@ void rk_runner_close(rk_runner *r) {
     free(r->workers);
     r->workers = NULL;
     r->n_workers = 0;
+    sem_destroy(&r->done);
 }

@@ -41,6 +41,9 @@ typedef struct rk_runner {
      * never take a task of a call other than the one it saw. */
     _Atomic uint64_t work;
     atomic_int finished;   /* tasks of the current call done */
+    sem_t done;            /* posted by the worker that finishes a call's last task, if the caller sleeps */
+    atomic_int caller_sleeping;
+    int busy_calls;        /* calls left for which the caller sleeps at once: it lost the CPU while spinning */
     atomic_int quit;
 } rk_runner;
 

@@ -190,6 +190,7 @@ HOSTILE = {
     "frame-stack-zero": {"frame_stack": 0},
     "frame-stack-huge": {"frame_stack": 10**6},
     "frame-stack-float": {"frame_stack": 4.0},
+    "observation-too-large": {"resize": (4096, 4096), "frame_stack": 64},
     "channels-first-none": {"channels_first": None},
     "max-pool-every-frame": {"max_pool": True, "scenario_every_frame": True},
     "preprocessing-ram": {"grayscale": True, "obs_type": "ram"},
@@ -322,3 +323,29 @@ def test_make_vec_takes_one_state_per_env() -> None:
     assert [env.state_name for env in vec.envs] == ["Zone1.Act1", "Zone2.Act1", "Zone3.Act1"]
     assert list(info["zone"]) == [0, 1, 2]
     vec.close()
+
+
+NATIVE_HOSTILE = {
+    "crop-wrapping-around": (224, 320, 2**32 - 1, 1, 0, 0, 84, 84, 1, 1, 0, 1, 0),
+    "crop-everything": (224, 320, 112, 112, 0, 0, 84, 84, 1, 1, 0, 1, 0),
+    "zero-stack": (224, 320, 0, 0, 0, 0, 84, 84, 1, 1, 0, 0, 0),
+    "unknown-method": (224, 320, 0, 0, 0, 0, 84, 84, 9, 1, 0, 1, 0),
+    "no-resize-yet-another-size": (224, 320, 0, 0, 0, 0, 84, 84, 0, 1, 0, 1, 0),
+    "huge-screen": (2**20, 320, 0, 0, 0, 0, 84, 84, 1, 1, 0, 1, 0),
+}
+
+
+@pytest.mark.parametrize("name", NATIVE_HOSTILE, ids=list(NATIVE_HOSTILE))
+def test_the_native_host_checks_a_preprocessing_again(airstriker, name: str) -> None:
+    with pytest.raises(InvalidArgumentError):
+        airstriker.set_preprocess(NATIVE_HOSTILE[name])
+    airstriker.run(0, 1)  # still the plain RGB screen
+    assert airstriker.run(0, 1, np.zeros((224, 320, 3), np.uint8)) is True
+
+
+def test_a_wrong_observation_buffer_is_refused(airstriker) -> None:
+    airstriker.set_preprocess((224, 320, 0, 0, 0, 0, 84, 84, 1, 1, 0, 4, 0))
+    with pytest.raises(InvalidArgumentError, match="observation buffer"):
+        airstriker.run(0, 1, np.zeros((224, 320, 3), np.uint8))
+    out = np.zeros((84, 84, 4), np.uint8)
+    assert airstriker.run(0, 4, out) is True and out.any()

@@ -129,23 +129,31 @@ def test_native_preprocessing_equals_gymnasiums_wrappers(config: str) -> None:
 
 
 def test_a_vector_env_gets_the_same_preprocessed_observations_as_single_envs() -> None:
+    """Through autoresets too (max_episode_steps ends episodes): each episode's stack starts anew."""
     options = {"frameskip": SKIP, "sticky_prob": 0.25, "grayscale": True, "resize": (84, 84), "frame_stack": 4,
-               "max_pool": True}  # fmt: skip
-    vec = retrokit.make_vec(AIRSTRIKER, 2, **options)
-    singles = [retrokit.make(AIRSTRIKER, **options) for _ in range(2)]
+               "max_pool": True, "noop_max": 5, "max_episode_steps": 20}  # fmt: skip
+    vec = retrokit.make_vec(DASHER, 2, **options)
+    singles = [retrokit.make(DASHER, **options) for _ in range(2)]
     assert vec.single_observation_space == singles[0].observation_space
     obs, _ = vec.reset(seed=5)
     for i, env in enumerate(singles):
         assert (obs[i] == env.reset(seed=5 + i)[0]).all()
     vec.action_space.seed(5)
-    for _ in range(60):
+    ended, resets = [False, False], 0
+    for _ in range(50):
         actions = vec.action_space.sample()
         obs, rewards, terminated, truncated, _ = vec.step(actions)
         for i, env in enumerate(singles):
-            single = env.step(actions[i])
-            assert (obs[i] == single[0]).all() and rewards[i] == single[1]
-        if terminated.any() or truncated.any():
-            break
+            if ended[i]:  # the vector's next-step autoreset
+                expected, reward, done = env.reset()[0], 0.0, False
+                resets += 1
+            else:
+                expected, reward, *flags, _ = env.step(actions[i])
+                done = any(flags)
+            assert (obs[i] == expected).all() and rewards[i] == reward
+            assert bool(terminated[i] or truncated[i]) == done
+            ended[i] = done
+    assert resets >= 2
     vec.close()
     for env in singles:
         env.close()
@@ -298,7 +306,11 @@ def test_info_keys_choose_what_crosses_into_python() -> None:
     vec.reset(seed=0)
     info = vec.step(vec.action_space.sample())[4]
     assert set(info) == {"lives", "_lives"} and list(info["lives"]) == [none.reader.read()["lives"]] * 2
-    for env in (none, score, vec):
+    quiet = retrokit.make_vec(AIRSTRIKER, 2, frameskip=SKIP, info_keys=[])
+    assert quiet.reset(seed=0)[1] == {}
+    for _ in range(3):
+        assert quiet.step(quiet.action_space.sample())[4] == {}
+    for env in (none, score, vec, quiet):
         env.close()
 
 

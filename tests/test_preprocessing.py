@@ -129,23 +129,31 @@ def test_native_preprocessing_equals_gymnasiums_wrappers(config: str) -> None:
 
 
 def test_a_vector_env_gets_the_same_preprocessed_observations_as_single_envs() -> None:
+    """Through autoresets too (max_episode_steps ends episodes): each episode's stack starts anew."""
     options = {"frameskip": SKIP, "sticky_prob": 0.25, "grayscale": True, "resize": (84, 84), "frame_stack": 4,
-               "max_pool": True}  # fmt: skip
-    vec = retrokit.make_vec(AIRSTRIKER, 2, **options)
-    singles = [retrokit.make(AIRSTRIKER, **options) for _ in range(2)]
+               "max_pool": True, "noop_max": 5, "max_episode_steps": 20}  # fmt: skip
+    vec = retrokit.make_vec(DASHER, 2, **options)
+    singles = [retrokit.make(DASHER, **options) for _ in range(2)]
     assert vec.single_observation_space == singles[0].observation_space
     obs, _ = vec.reset(seed=5)
     for i, env in enumerate(singles):
         assert (obs[i] == env.reset(seed=5 + i)[0]).all()
     vec.action_space.seed(5)
-    for _ in range(60):
+    ended, resets = [False, False], 0
+    for _ in range(50):
         actions = vec.action_space.sample()
         obs, rewards, terminated, truncated, _ = vec.step(actions)
         for i, env in enumerate(singles):
-            single = env.step(actions[i])
-            assert (obs[i] == single[0]).all() and rewards[i] == single[1]
-        if terminated.any() or truncated.any():
-            break
+            if ended[i]:  # the vector's next-step autoreset
+                expected, reward, done = env.reset()[0], 0.0, False
+                resets += 1
+            else:
+                expected, reward, *flags, _ = env.step(actions[i])
+                done = any(flags)
+            assert (obs[i] == expected).all() and rewards[i] == reward
+            assert bool(terminated[i] or truncated[i]) == done
+            ended[i] = done
+    assert resets >= 2
     vec.close()
     for env in singles:
         env.close()
@@ -190,6 +198,7 @@ HOSTILE = {
     "frame-stack-zero": {"frame_stack": 0},
     "frame-stack-huge": {"frame_stack": 10**6},
     "frame-stack-float": {"frame_stack": 4.0},
+    "observation-too-large": {"resize": (4096, 4096), "frame_stack": 64},
     "channels-first-none": {"channels_first": None},
     "max-pool-every-frame": {"max_pool": True, "scenario_every_frame": True},
     "preprocessing-ram": {"grayscale": True, "obs_type": "ram"},
@@ -297,7 +306,11 @@ def test_info_keys_choose_what_crosses_into_python() -> None:
     vec.reset(seed=0)
     info = vec.step(vec.action_space.sample())[4]
     assert set(info) == {"lives", "_lives"} and list(info["lives"]) == [none.reader.read()["lives"]] * 2
-    for env in (none, score, vec):
+    quiet = retrokit.make_vec(AIRSTRIKER, 2, frameskip=SKIP, info_keys=[])
+    assert quiet.reset(seed=0)[1] == {}
+    for _ in range(3):
+        assert quiet.step(quiet.action_space.sample())[4] == {}
+    for env in (none, score, vec, quiet):
         env.close()
 
 
@@ -322,3 +335,29 @@ def test_make_vec_takes_one_state_per_env() -> None:
     assert [env.state_name for env in vec.envs] == ["Zone1.Act1", "Zone2.Act1", "Zone3.Act1"]
     assert list(info["zone"]) == [0, 1, 2]
     vec.close()
+
+
+NATIVE_HOSTILE = {
+    "crop-wrapping-around": (224, 320, 2**32 - 1, 1, 0, 0, 84, 84, 1, 1, 0, 1, 0),
+    "crop-everything": (224, 320, 112, 112, 0, 0, 84, 84, 1, 1, 0, 1, 0),
+    "zero-stack": (224, 320, 0, 0, 0, 0, 84, 84, 1, 1, 0, 0, 0),
+    "unknown-method": (224, 320, 0, 0, 0, 0, 84, 84, 9, 1, 0, 1, 0),
+    "no-resize-yet-another-size": (224, 320, 0, 0, 0, 0, 84, 84, 0, 1, 0, 1, 0),
+    "huge-screen": (2**20, 320, 0, 0, 0, 0, 84, 84, 1, 1, 0, 1, 0),
+}
+
+
+@pytest.mark.parametrize("name", NATIVE_HOSTILE, ids=list(NATIVE_HOSTILE))
+def test_the_native_host_checks_a_preprocessing_again(airstriker, name: str) -> None:
+    with pytest.raises(InvalidArgumentError):
+        airstriker.set_preprocess(NATIVE_HOSTILE[name])
+    airstriker.run(0, 1)  # still the plain RGB screen
+    assert airstriker.run(0, 1, np.zeros((224, 320, 3), np.uint8)) is True
+
+
+def test_a_wrong_observation_buffer_is_refused(airstriker) -> None:
+    airstriker.set_preprocess((224, 320, 0, 0, 0, 0, 84, 84, 1, 1, 0, 4, 0))
+    with pytest.raises(InvalidArgumentError, match="observation buffer"):
+        airstriker.run(0, 1, np.zeros((224, 320, 3), np.uint8))
+    out = np.zeros((84, 84, 4), np.uint8)
+    assert airstriker.run(0, 4, out) is True and out.any()

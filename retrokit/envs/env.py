@@ -318,7 +318,6 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         self.emulator.set_sticky(self.sticky_prob, int(self.np_random.integers(0, 2**63)))
         noops = int(self.np_random.integers(1, self.noop_max + 1)) if self.noop_max else 0
         if noops:
-            self._first_obs = None
             self.emulator.run(self._noop, noops * self.frameskip)  # one call: only its last frame is drawn
             self.emulator.forget_action()
             values = self.stepper.start()
@@ -375,10 +374,14 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
             self.movies.end()
         if self.render_mode == "human":
             self.render()
-        reward = float(sum(rewards))
-        if self.reward_clip is not False:
-            reward = float(np.sign(reward)) if self.reward_clip is True else min(max(reward, -self.reward_clip), self.reward_clip)
-        return obs, reward, done, truncated, values
+        return obs, self._clipped(float(sum(rewards))), done, truncated, values
+
+    def _clipped(self, reward: float) -> float:
+        """The reward as ``reward_clip`` says: itself (False), its sign (True), or within ``[-c, c]``."""
+        clip = self.reward_clip
+        if clip is False:
+            return reward
+        return float(np.sign(reward)) if clip is True else min(max(reward, -clip), clip)
 
     def observe(self) -> np.ndarray:
         """The observation now: the screen (cropped as the scenario says, in the fixed shape, or preprocessed) or the RAM."""

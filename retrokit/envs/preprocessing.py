@@ -41,6 +41,8 @@ DEFAULTS: dict[str, Any] = {
     "grayscale": False, "resize": None, "resize_method": "area", "crop": None, "frame_stack": 1,
     "channels_first": False, "max_pool": False,
 }  # fmt: skip
+#: The largest observation: a step writes all of it, and a vector env holds a batch of them.
+MAX_OBSERVATION_BYTES = 32 << 20
 #: The native method codes (``RK_RESIZE_*`` in ``native/preprocess.h``).
 _METHODS = {None: 0, "area": 1, "bilinear": 2, "nearest": 3}
 
@@ -150,8 +152,15 @@ def preprocessing(
             f"Expected crop=(top, bottom, left, right) to leave part of the {height}x{width} (height x width) "
             f"screen, got {crop}; keep top + bottom below {height} and left + right below {width}."
         )
-    return Preprocessing(
+    made = Preprocessing(
         screen=(height, width), crop=crop, resize=given["resize"], method=given["resize_method"],
         grayscale=given["grayscale"], max_pool=given["max_pool"], frame_stack=given["frame_stack"],
         channels_first=given["channels_first"],
     )  # fmt: skip
+    size = int(np.prod(made.shape))
+    if size > MAX_OBSERVATION_BYTES:
+        raise InvalidArgumentError(
+            f"Expected an observation of at most {MAX_OBSERVATION_BYTES >> 20} MiB, got {made.shape} "
+            f"({size / 2**20:.0f} MiB) from {asked}; resize it smaller or stack fewer frames."
+        )
+    return made

@@ -9,7 +9,7 @@
  *
  * A resize is separable: each output column (row) is a weighted sum of a few
  * input columns (rows), so the taps are computed once, and an observation is
- * a horizontal pass into floats and a vertical pass into bytes, rounded to
+ * a vertical pass into floats and a horizontal pass into bytes, rounded to
  * nearest-even as OpenCV's saturate_cast does.
  */
 #include "preprocess.h"
@@ -35,7 +35,9 @@ struct rk_prep {
     uint8_t *row;             /* one cropped row as RGB */
     uint8_t *cur, *kept;      /* crop_h x crop_w x ch: this frame, and the step's next-to-last */
     int have_kept;
-    float *pass;              /* crop_h x width x ch: the horizontal pass */
+    float *pass;              /* height x crop_w x ch: the vertical pass */
+    uint8_t *gray16;          /* the luma of every 16-bit pixel, for gray16_format */
+    int gray16_format;
     rk_taps tx, ty;
     uint8_t *frames;          /* stack x height x width x ch: a ring of the last frames */
     unsigned head;            /* the slot of the newest frame */
@@ -124,6 +126,7 @@ void rk_prep_free(rk_prep *p) {
     free(p->cur);
     free(p->kept);
     free(p->pass);
+    free(p->gray16);
     free(p->frames);
     taps_free(&p->tx);
     taps_free(&p->ty);
@@ -133,6 +136,7 @@ void rk_prep_free(rk_prep *p) {
 rk_prep *rk_prep_new(const rk_prep_spec *s, char *error, size_t error_size) {
     const unsigned limit = 1u << 14; /* no console screen, nor a sensible observation, is larger */
     if (!s->screen_height || !s->screen_width || s->screen_height > limit || s->screen_width > limit ||
+        s->top > limit || s->bottom > limit || s->left > limit || s->right > limit || /* sums cannot wrap */
         s->top + s->bottom >= s->screen_height || s->left + s->right >= s->screen_width || !s->height ||
         !s->width || s->height > limit || s->width > limit || s->stack < 1 || s->stack > 256 ||
         s->method < RK_RESIZE_NONE || s->method > RK_RESIZE_NEAREST) {
@@ -160,12 +164,13 @@ rk_prep *rk_prep_new(const rk_prep_spec *s, char *error, size_t error_size) {
     if (!p->row || !p->cur || !p->kept || !p->frames) goto nomem;
     if (s->method != RK_RESIZE_NONE) {
         int area_up = s->method == RK_RESIZE_AREA && (s->height > p->crop_h || s->width > p->crop_w);
-        p->pass = malloc((size_t)p->crop_h * s->width * p->ch * sizeof(float));
+        p->pass = malloc((size_t)s->height * p->crop_w * p->ch * sizeof(float));
         if (!p->pass || taps_make(&p->tx, s->method, (int)p->crop_w, (int)s->width, area_up) ||
             taps_make(&p->ty, s->method, (int)p->crop_h, (int)s->height, area_up))
             goto nomem;
     }
     p->fresh = 1;
+    p->gray16_format = -1;
     return p;
 nomem:
     snprintf(error, error_size, "out of memory for the preprocessing of a %ux%u screen", s->screen_width,
@@ -185,7 +190,7 @@ void rk_prep_restart(rk_prep *p) {
 
 /* ---- one frame -------------------------------------------------------------------------------- */
 
-/* The cropped frame into `out` (crop_h x crop_w x ch): the rows come from `row_of(y)`, RGB. */
+/* Row y of the core's frame, cropped, into p->row as RGB. */
 static void load_row_core(rk_prep *p, const rk_core *core, unsigned y) {
     const unsigned w = p->crop_w;
     unsigned have = 0;
@@ -211,21 +216,59 @@ static void load_row_rgb(rk_prep *p, const uint8_t *rgb, unsigned width, unsigne
 
 /* The loaded row into `dst`: RGB as it is, or GrayscaleObservation's luma, summed left to right in
  * doubles and truncated, exactly as numpy computes it. */
+static uint8_t luma(const uint8_t *rgb);
+
 static void store_row(const rk_prep *p, uint8_t *dst) {
     const unsigned w = p->crop_w;
     if (!p->s.gray) {
         memcpy(dst, p->row, (size_t)w * 3);
         return;
     }
-    const uint8_t *src = p->row;
-    for (unsigned x = 0; x < w; x++, src += 3) dst[x] = (uint8_t)(src[0] * 0.2125 + src[1] * 0.7154 + src[2] * 0.0721);
+    for (unsigned x = 0; x < w; x++) dst[x] = luma(p->row + 3 * x);
+}
+
+static uint8_t luma(const uint8_t *rgb) { return (uint8_t)(rgb[0] * 0.2125 + rgb[1] * 0.7154 + rgb[2] * 0.0721); }
+
+/* For a 16-bit pixel format, the luma of each of its 65536 pixels, made once through the same RGB
+ * conversion as the screen's (video.c), so a gray frame is one table lookup per pixel; NULL for
+ * another format (or short of memory: then the rows go through RGB). */
+static const uint8_t *gray_table(rk_prep *p, int format) {
+    if (format != RK_RETRO_PIXEL_FORMAT_RGB565 && format != RK_RETRO_PIXEL_FORMAT_0RGB1555) return NULL;
+    if (p->gray16_format == format) return p->gray16;
+    uint16_t *all = malloc(65536 * sizeof(uint16_t));
+    uint8_t *rgb = malloc(65536 * 3);
+    if (!p->gray16) p->gray16 = malloc(65536);
+    int ok = all && rgb && p->gray16;
+    if (ok) {
+        for (unsigned v = 0; v < 65536; v++) all[v] = (uint16_t)v;
+        ok = rk_frame_to_rgb(all, 65536 * sizeof(uint16_t), 65536, 1, format, rgb) == 0;
+    }
+    for (unsigned v = 0; ok && v < 65536; v++) p->gray16[v] = luma(rgb + 3 * v);
+    free(all);
+    free(rgb);
+    p->gray16_format = ok ? format : -1;
+    return ok ? p->gray16 : NULL;
 }
 
 static void take_core_frame(rk_prep *p, const rk_core *core, uint8_t *out) {
-    size_t stride = (size_t)p->crop_w * p->ch;
+    const size_t stride = (size_t)p->crop_w * p->ch;
+    const uint8_t *table = p->s.gray && core->frame_data ? gray_table(p, core->pixel_format) : NULL;
     for (unsigned j = 0; j < p->crop_h; j++) {
-        load_row_core(p, core, p->s.top + j);
-        store_row(p, out + j * stride);
+        const unsigned y = p->s.top + j;
+        uint8_t *dst = out + j * stride;
+        if (table) {
+            unsigned have = 0;
+            if (y < core->frame_height && p->s.left < core->frame_width) {
+                have = core->frame_width - p->s.left < p->crop_w ? core->frame_width - p->s.left : p->crop_w;
+                const uint16_t *src = (const uint16_t *)((const uint8_t *)core->frame_data + y * core->frame_pitch) +
+                                      p->s.left;
+                for (unsigned x = 0; x < have; x++) dst[x] = table[src[x]];
+            }
+            memset(dst + have, 0, p->crop_w - have);
+            continue;
+        }
+        load_row_core(p, core, y);
+        store_row(p, dst);
     }
 }
 
@@ -236,28 +279,31 @@ void rk_prep_keep(rk_prep *p, const rk_core *core) {
 
 /* ---- resize, stack, output ---------------------------------------------------------------------- */
 
+/* Rows first, over contiguous bytes (the compiler vectorises it), then columns, on the fewer rows left.
+ * OpenCV sums columns first: the same weights in another order, so a pixel may round the other way. */
 static void resize(rk_prep *p, const uint8_t *src, uint8_t *dst) {
-    const unsigned ch = p->ch, in_w = p->crop_w, out_w = p->s.width, out_h = p->s.height;
+    const unsigned ch = p->ch, out_w = p->s.width, out_h = p->s.height;
+    const size_t in_stride = (size_t)p->crop_w * ch;
     const rk_taps *tx = &p->tx, *ty = &p->ty;
-    for (unsigned y = 0; y < p->crop_h; y++) {
-        const uint8_t *row = src + (size_t)y * in_w * ch;
-        float *out = p->pass + (size_t)y * out_w * ch;
+    for (unsigned y = 0; y < out_h; y++) {
+        float *restrict acc = p->pass + y * in_stride;
+        memset(acc, 0, in_stride * sizeof(float));
+        for (int t = ty->first[y]; t < ty->first[y + 1]; t++) {
+            const float w = ty->weight[t];
+            const uint8_t *restrict row = src + (size_t)ty->index[t] * in_stride;
+            for (size_t i = 0; i < in_stride; i++) acc[i] += w * row[i];
+        }
+    }
+    for (unsigned y = 0; y < out_h; y++) {
+        const float *row = p->pass + y * in_stride;
+        uint8_t *out = dst + (size_t)y * out_w * ch;
         for (unsigned x = 0; x < out_w; x++)
             for (unsigned c = 0; c < ch; c++) {
                 float sum = 0;
                 for (int t = tx->first[x]; t < tx->first[x + 1]; t++) sum += tx->weight[t] * row[tx->index[t] * ch + c];
-                out[x * ch + c] = sum;
+                long v = lrintf(sum); /* round half to even, as OpenCV's saturate_cast */
+                out[x * ch + c] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
             }
-    }
-    const size_t stride = (size_t)out_w * ch;
-    for (unsigned y = 0; y < out_h; y++) {
-        uint8_t *out = dst + y * stride;
-        for (size_t i = 0; i < stride; i++) {
-            float sum = 0;
-            for (int t = ty->first[y]; t < ty->first[y + 1]; t++) sum += ty->weight[t] * p->pass[ty->index[t] * stride + i];
-            long v = lrintf(sum); /* round half to even, as OpenCV's saturate_cast */
-            out[i] = (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v);
-        }
     }
 }
 
@@ -289,9 +335,11 @@ static void finish(rk_prep *p, uint8_t *dst) {
             }
         } else if (n == 1) {
             memcpy(dst, f, frame);
-        } else {
+        } else { /* interleaved: each pixel's channels of every frame side by side */
             uint8_t *out = dst + k * ch;
-            for (size_t i = 0; i < pixels; i++, out += n * ch) memcpy(out, f + i * ch, ch);
+            const size_t step = n * ch;
+            for (size_t i = 0; i < pixels; i++, out += step, f += ch)
+                for (size_t c = 0; c < ch; c++) out[c] = f[c];
         }
     }
 }

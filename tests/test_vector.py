@@ -165,3 +165,24 @@ def test_vector_movies_replay_what_each_env_saw(tmp_path, every_frame: bool) -> 
     replays = {movie: list(play(movie)) for movie in written}
     assert all(len(replays[movie]) == count for movie, count in frames_in.items())
     assert all((replays[movie][index] == frame).all() for movie, index, frame in seen)
+
+
+class CountingEnv(retrokit.RetroEnv):
+    """A user's subclass whose step does more than RetroEnv's."""
+
+    def step(self, action):
+        self.counted = getattr(self, "counted", 0) + 1
+        return super().step(action)
+
+
+def test_a_subclass_that_overrides_step_is_stepped_through_its_own_step() -> None:
+    vec = ThreadedVectorEnv([lambda: CountingEnv("Airstriker-Genesis", **OPTIONS)] * 2)
+    plain = retrokit.make("Airstriker-Genesis", **OPTIONS)
+    assert plain.stepping is not None and vec.envs[0].stepping is None
+    assert not vec.native  # the native runner would bypass the override
+    vec.reset(seed=0)
+    for step in range(3):
+        vec.step(actions_for(step, 2))
+    assert [env.counted for env in vec.envs] == [3, 3]
+    vec.close()
+    plain.close()

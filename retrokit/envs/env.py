@@ -343,11 +343,15 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         return self.finish_step(out if step_alone(self.stepper, self.emulator, action, out) else None)
 
     @property
-    def stepping(self) -> Stepping:
+    def stepping(self) -> Stepping | None:
         """This env's steps as a vector env runs them with others' (see :class:`~retrokit.envs.stepper.Stepping`).
 
-        Made anew on each access, so that the env holds no reference to itself.
+        ``None`` for a subclass that overrides :meth:`step`: its steps are its
+        own, so a vector env calls them. Made anew on each access, so that the
+        env holds no reference to itself.
         """
+        if type(self).step is not RetroEnv.step:
+            return None
         info = (self.info_names, self.info_values) if self.players == 1 and self.reader.fits_int64 else None
         return Stepping(self.stepper, self.emulator, self.direct_screen, self.finish_step, info)
 

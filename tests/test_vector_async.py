@@ -148,6 +148,13 @@ def test_send_refuses_wrong_env_ids(env_ids: object, match: str) -> None:
     vec.close()
 
 
+def test_a_huge_list_of_repeated_ids_is_refused_at_once() -> None:
+    vec = retrokit.make_vec(GAME, 2, **OPTIONS)
+    with pytest.raises(InvalidArgumentError, match="at most 2; found 400000 ids"):
+        vec.send(np.zeros(400_000, dtype=np.int64), env_ids=[0, 1] * 200_000)  # no quadratic count: no hang
+    vec.close()
+
+
 def test_send_refuses_actions_that_do_not_match_the_ids() -> None:
     vec = retrokit.make_vec(GAME, 3, **OPTIONS)
     vec.reset(seed=0)

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import numbers
 import queue
+from collections import Counter
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
@@ -69,6 +70,11 @@ class InFlight:
                     f"Expected env_ids to be a sequence of env indices (0 to {self.num_envs - 1}), or None for all; "
                     f"found {shown(env_ids)}."
                 )
+        if len(ids) > self.num_envs:  # some id is repeated: say so before looking at each
+            raise InvalidArgumentError(
+                f"Expected each env id at most once in a send, so at most {self.num_envs}; found {len(ids)} ids. "
+                f"Send one action per env."
+            )
         checked = []
         for value in ids:
             if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral):
@@ -82,7 +88,7 @@ class InFlight:
                 )
             checked.append(int(value))
         if len(set(checked)) != len(checked):
-            twice = sorted({i for i in checked if checked.count(i) > 1})
+            twice = sorted(i for i, times in Counter(checked).items() if times > 1)
             raise InvalidArgumentError(
                 f"Expected each env id at most once in a send; found {twice} more than once. Send one action per env."
             )

@@ -20,7 +20,15 @@ from typing import Any
 from retrokit.benchmark import plots
 from retrokit.benchmark.agents import resolve_agent
 from retrokit.benchmark.definition import Benchmark, Level
-from retrokit.benchmark.level import EpisodeEnded, LevelDone, LevelFailed, LevelTask, Message, Progress
+from retrokit.benchmark.level import (
+    EpisodeEnded,
+    LevelDone,
+    LevelFailed,
+    LevelRestarted,
+    LevelTask,
+    Message,
+    Progress,
+)
 from retrokit.benchmark.paper import PaperScores, has_paper_scores, load_paper
 from retrokit.benchmark.progress import LevelProgress
 from retrokit.benchmark.report import paper_column, render_report, write_report, write_summary
@@ -173,6 +181,9 @@ def _run(ev: Evaluation, tasks: list[LevelTask], run: RunDir, progress: LevelPro
             ev.played[message.level] = (message.timesteps, message.seconds)
             score = level_score(run.episodes.get(message.level, []), run.finished[message.level])
             progress.end(message.level, f"done, {score.episodes} episode(s), score {score.mean_score:,.1f}")
+        elif isinstance(message, LevelRestarted):
+            run.restart(message.level)
+            progress.restart(message.level, message.reason)
         elif isinstance(message, LevelFailed):
             ev.failed[message.level] = message.error
             run.fail(message.level, message.error)

@@ -96,7 +96,19 @@ class LevelFailed:
     timesteps: int
 
 
-Message = Started | Progress | EpisodeEnded | LevelDone | LevelFailed
+@dataclass(frozen=True)
+class LevelRestarted:
+    """``level``'s play was lost with the machine playing it, and starts again from its beginning elsewhere.
+
+    Its episodes so far are dropped, as ``--resume`` drops an unfinished level's: the level's result depends only
+    on its seed, so the replay ends as an uninterrupted run does.
+    """
+
+    level: str
+    reason: str
+
+
+Message = Started | Progress | EpisodeEnded | LevelDone | LevelFailed | LevelRestarted
 
 
 def run_level(task: LevelTask, emit: Callable[[Message], None]) -> None:

@@ -359,7 +359,10 @@ def test_validate_reports_as_json_while_the_game_plays_on(client, session):
         played = session.frame - start
         reader.join(timeout=30)
     post(client, "/api/play/pause")
-    assert report["game"] == "Dasher-Genesis" and report["passed"] is True, report
+    assert report["game"] == "Dasher-Genesis" and report["counts"]["pass"] > 10
+    failed = [r for r in report["results"] if r["status"] == "fail"]
+    # Only what the tests above broke on purpose (a corrupt state, a junk movie) may fail.
+    assert all("Broken" in r["state"] + r["message"] or "junk" in r["message"] for r in failed), failed
     assert {"schema", "state loads"} <= {r["check"] for r in report["results"]}
     assert played > 0  # the session kept playing while the check ran
     assert "done" in stages

@@ -149,9 +149,6 @@ async def _send(websocket: WebSocket, subscriber: Subscriber) -> None:
     try:
         while True:
             await subscriber.wait()
-            screen, subscriber.screen = subscriber.screen, None
-            if screen is not None:
-                await websocket.send_bytes(pack_screen(screen))
             now = loop.time()
             later = []
             for kind, message in list(subscriber.messages.items()):
@@ -161,6 +158,9 @@ async def _send(websocket: WebSocket, subscriber: Subscriber) -> None:
                 subscriber.messages.pop(kind, None)
                 sent_at[kind] = now
                 await websocket.send_text(json.dumps(message, default=_plain))
+            screen, subscriber.screen = subscriber.screen, None  # after the messages: the status comes first
+            if screen is not None:
+                await websocket.send_bytes(pack_screen(screen))
             if later:  # come back for them when their period is over
                 loop.call_later(MESSAGE_PERIOD, subscriber.wake)
     except (WebSocketDisconnect, RuntimeError, ConnectionError):

@@ -310,3 +310,12 @@ def test_an_unknown_game_is_one_line_before_anything_listens():
                           check=False, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 2 and proc.stdout == ""
     assert proc.stderr.count("\n") == 1 and "Did you mean 'Dasher-Genesis'" in proc.stderr
+
+
+def test_a_state_symlinked_out_of_the_game_is_refused(client, session, folder, tmp_path):
+    outside = tmp_path / "outside.state"
+    shutil.copy(folder / "Zone1.Act2.state", outside)
+    (folder / "Linked.state").symlink_to(outside)
+    session.call_blocking(lambda s: s.refresh_game())
+    assert "symlink" in refused(client.post("/api/states/load", json={"name": "Linked"}))
+    assert "symlink" in refused(client.post("/api/play/reset", json={"state": "Linked"}))

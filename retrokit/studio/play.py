@@ -106,6 +106,7 @@ def reset(session: Session, state: str | None) -> None:
         check_inside(path, game_roots(search.game), what="state")
         search.load_state(name)
         search.state = name
+    session.mark_loaded()
     session.send_screen()
     session.publish(session.status())
 
@@ -178,7 +179,7 @@ def _png(session: Session) -> bytes:
     from PIL import Image
 
     buffer = io.BytesIO()
-    Image.fromarray(session.search.emulator.screen()).save(buffer, format="PNG")
+    Image.fromarray(session.screen()).save(buffer, format="PNG")
     return buffer.getvalue()
 
 

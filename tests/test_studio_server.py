@@ -406,3 +406,11 @@ def test_a_studio_nobody_opened_does_not_run_the_emulator():
             assert not idle.running and idle.frame == 0
     finally:
         idle.close()
+
+
+def test_a_reset_while_paused_shows_the_state_it_loaded(client, session):
+    screens = []
+    for state in ("Zone1.Act1", "Zone3.Act1", "Zone1.Act1"):
+        paused_at(client, state)
+        screens.append(client.get("/api/screen.png").content)
+    assert screens[0] != screens[1] and screens[0] == screens[2]

@@ -144,6 +144,7 @@ def _replay(session: Session, path: Path) -> dict[str, Any]:
         return True
 
     session.recording = False
+    session.mark_loaded()
     session.play_frames(next_frame)
     session.paused = False
     session.send_screen()

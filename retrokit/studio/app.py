@@ -163,7 +163,7 @@ async def _send(websocket: WebSocket, subscriber: Subscriber) -> None:
                 await websocket.send_bytes(pack_screen(screen))
             if later:  # come back for them when their period is over
                 loop.call_later(MESSAGE_PERIOD, subscriber.wake)
-    except (WebSocketDisconnect, RuntimeError, ConnectionError):
+    except (WebSocketDisconnect, RuntimeError, OSError):  # the page went (uvicorn's ClientDisconnected is an OSError)
         pass
 
 

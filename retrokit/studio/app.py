@@ -33,8 +33,9 @@ from starlette.staticfiles import StaticFiles
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from retrokit import errors
+from retrokit.studio.push import Screen, Subscriber
 from retrokit.studio.security import Guard
-from retrokit.studio.session import Screen, Session, Subscriber
+from retrokit.studio.session import Session
 
 ROUTE_MODULES: tuple[str, ...] = ("play", "states", "authoring")
 """The modules of :mod:`retrokit.studio` whose ``routes`` are mounted under ``/api``."""

@@ -404,6 +404,10 @@ def test_new_game_from_a_rom_file_then_the_session_plays_it(tmp_path, monkeypatc
         assert made["info"]["game"] == "Runner-Genesis" and made["info"]["states"] == []
         status = post(client, "/api/play/step", {"frames": 3})
         assert status["game"] == "Runner-Genesis"
+        post(client, "/api/play/reset", {})  # no states: power-on, and a movie recorded from there starts there
+        post(client, "/api/movies/record")
+        post(client, "/api/play/step", {"frames": 4})
+        assert read_bk2(post(client, "/api/movies/stop", {"name": "boot"})["path"]).frames == [(0,)] * 4  # one player
         again = post(client, "/api/newgame", {"rom": str(rom), "name": "Runner-Genesis"}, status=409)
         assert again["kind"] == "FileConflictError"
         back = client.post("/api/game", json={"game": "Dasher-Genesis", "state": "Zone2.Act1"}).json()

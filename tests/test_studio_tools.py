@@ -14,14 +14,11 @@ import time
 from pathlib import Path
 
 import pytest
+from starlette.testclient import TestClient
 
-pytest.importorskip("starlette")
-
-from starlette.testclient import TestClient  # noqa: E402
-
-from retrokit import paths  # noqa: E402
-from retrokit.studio.app import create_app  # noqa: E402
-from retrokit.studio.session import Session  # noqa: E402
+from retrokit import paths
+from retrokit.studio.app import create_app
+from retrokit.studio.session import Session
 
 DASHER = Path(__file__).resolve().parent.parent / "games" / "Dasher-Genesis"
 TOKEN, PORT = "tools-token", 8765

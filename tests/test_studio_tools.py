@@ -222,6 +222,19 @@ def test_compile_errors_carry_the_line_and_column_the_language_reports(client, g
     assert good == {"ok": True, "name": "scenario", "players": 1, "fields": ["p1_x"]}
 
 
+def test_editor_text_includes_only_files_of_the_games_folders(client, game, tmp_path):
+    (game.parent / "parts.yaml").write_text("define:\n  gain: delta(p1_x)\n")
+    good = ok(client.post("/api/scenario/compile", json={"text": "include: [parts.yaml]\nreward: gain\n"}))
+    assert good["ok"] and good["fields"] == ["p1_x"]
+    secret = tmp_path / "secret.yaml"
+    secret.write_text("define:\n  gain: 1\n")
+    (game.parent / "link.yaml").symlink_to(secret)
+    for name in (str(secret), "../../secret.yaml", "%2e%2e/%2e%2e/secret.yaml", "link.yaml"):
+        refused_ = ok(client.post("/api/scenario/compile", json={"text": f"include: [{name!r}]\nreward: 1\n"}))
+        assert not refused_["ok"] and "inside the game's folders" in refused_["error"], refused_
+        assert (refused_["line"], refused_["column"]) == (1, 11)
+
+
 def test_the_draft_survives_a_restart_and_only_compiling_text_is_saved(game, data):
     scenario = game.parent / "scenario.yaml"
     saved = scenario.read_text()
@@ -302,6 +315,16 @@ def run_job(client: TestClient, body: dict, timeout: float = 60.0) -> dict:
     raise AssertionError(f"click to find did not finish in {timeout} s: {job}")
 
 
+def future(session: Session) -> tuple[bytes, bytes]:
+    """The RAM and the screen 10 frames from now (run on a copy of the state: the game stays where it is)."""
+    emulator = session.search.emulator
+    now = emulator.get_state()
+    emulator.run(0, 10)
+    seen = session.search.layout.read(emulator.space).tobytes(), emulator.screen().tobytes()
+    emulator.set_state(now)
+    return seen
+
+
 SPAWN_BLINK = 70  # frames: a player blinks for its first 60 (tools/testcart/src/player.c SPAWN_INVULN)
 
 
@@ -311,13 +334,13 @@ def test_click_on_the_player_finds_its_position_without_disturbing_the_game(clie
     assert values["p1_invuln"]["value"] == 0
     x, y = values["p1_x"]["value"] - values["camera_x"]["value"], values["p1_y"]["value"] - 8  # the sprite's middle
     session = client.app.state.session
-    before = session.call_blocking(lambda s: s.search.emulator.get_state())
+    before = session.call_blocking(future)
     job = run_job(client, {"x": x, "y": y, "region": {"start": "0xFF0020", "length": 32}})
     assert job["done"] == job["total"] == 32 and not job["error"]
     found = {hit["address"]: hit for hit in job["hits"]}
     assert P1_X in found and found[P1_X]["fields"] == ["p1_x"]  # its high byte moves it off the point
     assert LIVES not in found  # the HUD's lives are drawn elsewhere
-    assert session.call_blocking(lambda s: s.search.emulator.get_state()) == before  # the game is where it was
+    assert session.call_blocking(future) == before  # the game is where it was, and goes on the same
 
 
 def screen(client: TestClient):
@@ -423,6 +446,10 @@ def test_hostile_requests_get_one_line_json_errors(client, method, url, body, st
 
 
 def test_a_body_that_is_not_json_or_too_big_is_refused(client):
+    lone = b'{"text": "reward: 1 # \\ud800"}'  # JSON may carry half a UTF-16 pair; no file can hold it
+    for route in ("/api/scenario/compile", "/api/scenario/save", "/api/scenario/live"):
+        assert "UTF-16" in refused(client.post(route, content=lone))["error"]
+    assert "UTF-16" in refused(client.put("/api/scenario/draft", content=lone))["error"]
     refused(client.post("/api/search/filter", content=b"{not json", headers={"Content-Type": "application/json"}))
     refused(client.post("/api/search/filter", content=b"[1, 2]"))
     huge = "reward: " + "1 + " * 400_000 + "1\n"

@@ -165,7 +165,11 @@ def begin(session: Any, x: object, y: object, region: object, frames: object) ->
 
 
 def work(session: Any, job: Job, seconds: float = CHUNK_SECONDS) -> None:
-    """Try cells for about ``seconds``, then put the game back as it was (emulator thread)."""
+    """Try cells for about ``seconds``, then put the game back as it was (emulator thread).
+
+    The job's progress changes only once the game is back, so whoever reads it from another thread
+    never sees a job finished while its last chunk still holds the emulator.
+    """
     if session.search is not job.search:
         job.error = "Expected the game that was clicked; the session plays another one now. Click again."
         return
@@ -173,9 +177,10 @@ def work(session: Any, job: Job, seconds: float = CHUNK_SECONDS) -> None:
     now = emulator.get_state()
     started = time.perf_counter()
     names = _field_names(session)
+    done, hits = job.done, []
     try:
-        while not job.finished and time.perf_counter() - started < seconds:
-            address = job.addresses[job.done]
+        while done < len(job.addresses) and not job.cancelled and time.perf_counter() - started < seconds:
+            address = job.addresses[done]
             value = job.base_ram[address]
             changed = []
             for poked in ((value + 1) & 0xFF, value ^ 0xFF):
@@ -185,13 +190,15 @@ def work(session: Any, job: Job, seconds: float = CHUNK_SECONDS) -> None:
                 if color != job.color:
                     changed.append({"value": poked, "color": list(color)})
             if changed:
-                job.hits.append(
+                hits.append(
                     {"address": address, "hex": session.search.layout.format(address), "value": value,
                      "fields": names.get(address, []), "pokes": changed}
                 )
-            job.done += 1
+            done += 1
     finally:
         emulator.set_state(now)
+        job.hits.extend(hits)
+        job.done = done
         job.seconds += time.perf_counter() - started
 
 

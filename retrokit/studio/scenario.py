@@ -40,11 +40,11 @@ from retrokit import paths
 from retrokit.data.names import check_state_name
 from retrokit.dsl.scenario import Run, Scenario, scenario_from_text
 from retrokit.dsl.source import read_source
-from retrokit.errors import DataFileError, ScenarioError, ScenarioRuntimeError
+from retrokit.errors import DataFileError, InvalidArgumentError, ScenarioError, ScenarioRuntimeError
 from retrokit.studio.app import session_of
 from retrokit.studio.fields import field_reader
 from retrokit.studio.search import Pacer
-from retrokit.studio.security import expect, json_body
+from retrokit.studio.security import expect, json_body, resolve_path
 
 HISTORY = 600
 """Frames of reward kept for the plot: 10 seconds at 60 fps."""
@@ -108,7 +108,13 @@ def compile_text(place: Where, text: str) -> Scenario:
         ScenarioError: It does not compile (with ``line`` and ``column`` where the language gives them).
     """
     game = place.game
-    return scenario_from_text(text, list(game.fields), source=place.source, name=place.name, game_dir=game.folders[0])
+
+    def include(base: Path, name: str) -> Path:  # the text is a request's: what it includes stays in the game's folders
+        return resolve_path(name, base, game.folders, what="scenario file to include")
+
+    return scenario_from_text(
+        text, list(game.fields), source=place.source, name=place.name, game_dir=game.folders[0], resolve_include=include
+    )
 
 
 def _compile_saved(place: Where) -> Scenario:
@@ -287,9 +293,25 @@ def _saved(session: Any, place: Where, scenario: Scenario) -> None:
         _go_live(session, place.name, scenario)
 
 
+def _utf8(text: str) -> str:
+    """``text`` if it can be saved as UTF-8 (JSON can carry a lone surrogate, which no file holds).
+
+    Raises:
+        InvalidArgumentError: It cannot.
+    """
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError as exc:
+        raise InvalidArgumentError(
+            f"Expected the scenario's text as Unicode text; found {exc.object[exc.start]!r} at character {exc.start}, "
+            "half of a UTF-16 pair, which no file can hold. Remove it."
+        ) from None
+    return text
+
+
 async def _text(request: Request) -> tuple[Where, str]:
     body = await json_body(request)
-    text, name = expect(body, "text", str), expect(body, "name", str, None)
+    text, name = _utf8(expect(body, "text", str)), expect(body, "name", str, None)
     return await session_of(request).call(where, name), text
 
 
@@ -327,6 +349,7 @@ async def save(request: Request) -> JSONResponse:
 async def live_start(request: Request) -> JSONResponse:
     body = await json_body(request)
     text, name = expect(body, "text", str, None), expect(body, "name", str, None)
+    text = None if text is None else _utf8(text)
     session = session_of(request)
     place = await session.call(where, name)
     try:

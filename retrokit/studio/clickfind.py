@@ -29,7 +29,7 @@ import itertools
 import time
 import weakref
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from starlette.requests import Request
 from starlette.responses import JSONResponse
@@ -40,6 +40,9 @@ from retrokit.host.typecodes import parse_type
 from retrokit.studio.app import session_of
 from retrokit.studio.search import address_of, integer_of
 from retrokit.studio.security import json_body
+
+if TYPE_CHECKING:
+    from retrokit.studio.session import Session
 
 MAX_CELLS = 8192
 """The most cells one job pokes: two tries of ~3 ms each per cell, about a minute at most."""
@@ -93,10 +96,10 @@ class Job:
         }
 
 
-_jobs: weakref.WeakKeyDictionary[Any, Job] = weakref.WeakKeyDictionary()  # each session's newest job
+_jobs: weakref.WeakKeyDictionary[Session, Job] = weakref.WeakKeyDictionary()  # each session's newest job
 
 
-def _cells(session: Any, region: object) -> list[int]:
+def _cells(session: Session, region: object) -> list[int]:
     """The byte addresses a job pokes (on the emulator thread: the candidates live there).
 
     Raises:
@@ -138,7 +141,7 @@ def _pixel(emulator: Any, job: Job) -> tuple[int, ...]:
     return tuple(int(c) for c in emulator.screen()[job.y, job.x])
 
 
-def begin(session: Any, x: object, y: object, region: object, frames: object) -> Job:
+def begin(session: Session, x: object, y: object, region: object, frames: object) -> Job:
     """Start a job at pixel (x, y): keep the moment, and the pixel's color a few frames on (emulator thread).
 
     Raises:
@@ -164,7 +167,7 @@ def begin(session: Any, x: object, y: object, region: object, frames: object) ->
     return job
 
 
-def work(session: Any, job: Job, seconds: float = CHUNK_SECONDS) -> None:
+def work(session: Session, job: Job, seconds: float = CHUNK_SECONDS) -> None:
     """Try cells for about ``seconds``, then put the game back as it was (emulator thread).
 
     The job's progress changes only once the game is back, so whoever reads it from another thread
@@ -202,7 +205,7 @@ def work(session: Any, job: Job, seconds: float = CHUNK_SECONDS) -> None:
         job.seconds += time.perf_counter() - started
 
 
-def _field_names(session: Any) -> dict[int, list[str]]:
+def _field_names(session: Session) -> dict[int, list[str]]:
     """The game's fields over each byte address, so a hit names the variable it is part of."""
     names: dict[int, list[str]] = {}
     for spec in session.search.game.fields.values():
@@ -211,7 +214,7 @@ def _field_names(session: Any) -> dict[int, list[str]]:
     return names
 
 
-async def _run(session: Any, job: Job) -> None:
+async def _run(session: Session, job: Job) -> None:
     """Drive a job to its end a chunk at a time, publishing its progress."""
     try:
         while not job.finished:

@@ -30,7 +30,7 @@ import collections
 import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from starlette.requests import Request
 from starlette.responses import JSONResponse
@@ -45,6 +45,9 @@ from retrokit.studio.app import session_of
 from retrokit.studio.fields import field_reader
 from retrokit.studio.search import Pacer
 from retrokit.studio.security import expect, json_body, resolve_path
+
+if TYPE_CHECKING:
+    from retrokit.studio.session import Session
 
 HISTORY = 600
 """Frames of reward kept for the plot: 10 seconds at 60 fps."""
@@ -83,7 +86,7 @@ class Where:
         return draft_path(self.game.name, self.name)
 
 
-def where(session: Any, name: object) -> Where:
+def where(session: Session, name: object) -> Where:
     """Scenario ``name`` (the default one if none) of the session's game (emulator thread: the game may change)."""
     search = session.search
     game = search.game
@@ -160,7 +163,7 @@ class _Live:
     pacer: Pacer = field(default_factory=Pacer)
     remove: Any = None
 
-    def restart(self, session: Any) -> None:
+    def restart(self, session: Session) -> None:
         """A new episode from the game's moment now (a run-time error of the scenario is kept in ``error``)."""
         self.search, self.start_state = session.search, session.search.start_state
         self.episode_frame, self.total, self.done, self.error = 0, 0.0, False, None
@@ -170,7 +173,7 @@ class _Live:
         except ScenarioRuntimeError as exc:  # the scenario's fault, told to the page; the game goes on
             self.error = error_json(exc)
 
-    def step(self, session: Any) -> None:
+    def step(self, session: Session) -> None:
         """Evaluate the scenario on this frame's fields."""
         self.episode_frame += 1
         try:
@@ -198,10 +201,10 @@ class _Live:
         }
 
 
-_live: weakref.WeakKeyDictionary[Any, _Live] = weakref.WeakKeyDictionary()
+_live: weakref.WeakKeyDictionary[Session, _Live] = weakref.WeakKeyDictionary()
 
 
-def _on_frame(session: Any) -> None:
+def _on_frame(session: Session) -> None:
     """Frame hook: step the live scenario on this frame's fields; push the reward 20 times a second."""
     live = _live.get(session)
     if live is None:
@@ -215,7 +218,7 @@ def _on_frame(session: Any) -> None:
         live.unsent = 0
 
 
-def _go_live(session: Any, name: str, scenario: Scenario) -> dict[str, Any]:
+def _go_live(session: Session, name: str, scenario: Scenario) -> dict[str, Any]:
     old = _live.get(session)
     live = _Live(name, scenario, remove=old.remove if old is not None else None)
     live.restart(session)
@@ -225,14 +228,14 @@ def _go_live(session: Any, name: str, scenario: Scenario) -> dict[str, Any]:
     return live.report()
 
 
-def _stop(session: Any) -> dict[str, Any]:
+def _stop(session: Session) -> dict[str, Any]:
     live = _live.pop(session, None)
     if live is not None and live.remove is not None:
         live.remove()
     return {"live": False}
 
 
-def _live_report(session: Any) -> dict[str, Any]:
+def _live_report(session: Session) -> dict[str, Any]:
     live = _live.get(session)
     return {"live": False} if live is None else {"live": True, **live.report()}
 
@@ -285,7 +288,7 @@ def _save(place: Where, text: str) -> Scenario:
     return scenario
 
 
-def _saved(session: Any, place: Where, scenario: Scenario) -> None:
+def _saved(session: Session, place: Where, scenario: Scenario) -> None:
     """After a save: the game's scenarios listed afresh, and the live one replaced if it is this one."""
     session.search.reload_game()
     live = _live.get(session)

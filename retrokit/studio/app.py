@@ -78,7 +78,7 @@ def session_of(request: Request | WebSocket) -> Session:
 def create_app(session: Session, *, token: str, port: int) -> Starlette:
     """The studio's application for ``session``, guarded by ``token`` (the server listens on ``port``).
 
-    The session's thread starts with the application and the session is closed when it shuts down.
+    The session's thread starts with the first page or request, and the session is closed when the app shuts down.
     """
     routes: list[BaseRoute] = []
     for name in ROUTE_MODULES:
@@ -86,7 +86,7 @@ def create_app(session: Session, *, token: str, port: int) -> Starlette:
 
     @contextlib.asynccontextmanager
     async def lifespan(_app: Starlette) -> AsyncIterator[None]:
-        session.start()
+        # The emulator thread starts with the first page or request, not here: a studio nobody opened stays idle.
         try:
             yield
         finally:
@@ -151,9 +151,6 @@ async def _send(websocket: WebSocket, subscriber: Subscriber) -> None:
     try:
         while True:
             await subscriber.wait()
-            screen, subscriber.screen = subscriber.screen, None
-            if screen is not None:
-                await websocket.send_bytes(pack_screen(screen))
             now = loop.time()
             later = []
             for kind, message in list(subscriber.messages.items()):
@@ -163,6 +160,9 @@ async def _send(websocket: WebSocket, subscriber: Subscriber) -> None:
                 subscriber.messages.pop(kind, None)
                 sent_at[kind] = now
                 await websocket.send_text(json.dumps(message, default=_plain))
+            screen, subscriber.screen = subscriber.screen, None  # after the messages: the status comes first
+            if screen is not None:
+                await websocket.send_bytes(pack_screen(screen))
             if later:  # come back for them when their period is over
                 loop.call_later(MESSAGE_PERIOD, subscriber.wake)
     except (WebSocketDisconnect, RuntimeError, ConnectionError):

@@ -200,6 +200,7 @@ def work(session: Session, job: Job, seconds: float = CHUNK_SECONDS) -> None:
             done += 1
     finally:
         emulator.set_state(now)
+        session.mark_loaded()  # the video buffer holds the last try: a paused page is shown the game's own picture
         job.hits.extend(hits)
         job.done = done
         job.seconds += time.perf_counter() - started

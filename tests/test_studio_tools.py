@@ -182,6 +182,9 @@ def test_a_field_is_edited_in_place_and_the_session_reads_it_again(client, game)
     assert changed[1].startswith('  ring_count:  {address: 0xFF00C2, type: "|i1"}')
     rows = fields(client)
     assert rows["p1_lives"]["range"] == [0, 5] and rows["ring_count"]["hex"] == "0xFF00C2"
+    ok(client.patch("/api/fields/game_mode", json={"range": [0, 4]}))  # its comment stays
+    assert '  game_mode:   {address: 0xFF0002, type: "|u1", range: [0, 4]}   # 0 title, 1 play, 2 act clear' in (
+        game.read_text())
     ok(client.patch("/api/fields/p1_lives", json={"range": None}))  # a range can be dropped
     assert "range" not in next(line for line in game.read_text().splitlines() if "p1_lives:" in line)
 

@@ -114,7 +114,7 @@ def test_search_finds_lives_and_adds_it_as_a_field(client, game):
 def test_filters_take_every_form_of_than_and_scales(client):
     ok(client.post("/api/search/new", json={"types": ["|u1", ">u2"]}))
     scaled = ok(client.post("/api/search/filter", json={"op": "equal", "value": 30}))  # 3 lives, shown x10
-    rows = ok(client.get("/api/search/candidates?limit=500"))["rows"]
+    rows = ok(client.get("/api/search/candidates?limit=100"))["rows"]
     assert any(r["address"] == LIVES and "x10" in r["scales"] for r in rows), scaled
     ok(client.post("/api/search/new", json={"types": ["|u1"]}))
     step(client, 20, ["RIGHT"])
@@ -132,6 +132,43 @@ def test_filters_take_every_form_of_than_and_scales(client):
     bad = refused(client.post("/api/search/filter", json={"op": "changed", "than": "prevous"}))
     assert "Did you mean 'previous'?" in bad["error"]
     refused(client.post("/api/search/filter", json={"op": "increased", "than": "7"}))  # no snapshot 7
+
+
+def test_a_search_takes_at_most_64_snapshots(client):
+    from retrokit.studio.search import MAX_SNAPSHOTS
+
+    ok(client.post("/api/search/new"))
+    for _ in range(MAX_SNAPSHOTS - 1):
+        ok(client.post("/api/search/snapshot"))
+    full = refused(client.post("/api/search/snapshot"))
+    assert "at most 64 snapshots" in full["error"] and full["kind"] == "RamSearchError"
+    assert len(ok(client.post("/api/search/new"))["snapshots"]) == 1
+
+
+def test_the_longest_listing_stays_in_bounded_memory(game):
+    from childproc import MAX_RSS_MB, run_child
+
+    child = run_child(
+        f"""
+        from starlette.testclient import TestClient
+        from retrokit.studio.app import create_app
+        from retrokit.studio.session import Session
+
+        session = Session("Dasher-Genesis", "Zone1.Act1")
+        session.paused = True
+        app = create_app(session, token="{TOKEN}", port={PORT})
+        with TestClient(app, base_url="http://127.0.0.1:{PORT}", headers={{"X-Retrokit-Token": "{TOKEN}"}}) as client:
+            client.post("/api/play/buttons", json={{"buttons": ["RIGHT"]}})
+            for _ in range(63):  # a fresh search: every type at every address, with a value at each snapshot
+                client.post("/api/play/step", json={{"frames": 1}})
+                assert client.post("/api/search/snapshot").status_code == 200
+            rows = client.get("/api/search/candidates?limit=100").json()["rows"]
+            print(len(rows), len(rows[0]["values"]))
+        """,
+        timeout=300,
+    )
+    assert child.returncode == 0 and child.stdout.split() == ["100", "64"], child.describe()
+    assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
 
 
 def test_candidate_values_are_pushed_live_over_the_socket(client):
@@ -422,6 +459,7 @@ def test_ram_view_marks_what_changed_since_the_last_frame_and_a_snapshot(client)
         ("post", "/api/search/new", {"types": ["|q7"]}, 400),
         ("post", "/api/search/snapshot", {"label": "x" * 1000}, 400),
         ("get", "/api/search/candidates?limit=0", None, 400),
+        ("get", "/api/search/candidates?limit=101", None, 400),
         ("get", "/api/search/candidates?limit=99999999999999999999", None, 400),
         ("post", "/api/search/poke", {"address": "0xFF002B", "value": 300}, 400),
         ("post", "/api/search/poke", {"address": -1, "value": 1}, 400),

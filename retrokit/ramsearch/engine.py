@@ -337,16 +337,16 @@ def list_candidates(engine: Engine, limit: int | None = None) -> list[Candidate]
     positions, kinds = positions[order], kinds[order]
     if not len(positions):
         return []
-    values = np.empty((len(positions), len(engine.snapshots)), dtype=object)  # Python ints: any width fits
+    values = np.empty((len(positions), len(engine.snapshots)), dtype=np.int64)  # what decode_all gives fits
     present = [(t, kinds == t) for t in np.unique(kinds).tolist()]
     for index in range(len(engine.snapshots)):
         decoded = engine.decoded(index)
         for t, rows in present:
-            values[rows, index] = decoded[t][positions[rows]].tolist()
+            values[rows, index] = decoded[t][positions[rows]]
     addresses = engine.layout.addresses(positions).tolist()
     out = []
-    for row, (position, t, address) in enumerate(zip(positions.tolist(), kinds.tolist(), addresses)):
-        seen = tuple(values[row])
+    for row, position, t, address in zip(values.tolist(), positions.tolist(), kinds.tolist(), addresses):
+        seen = tuple(row)
         changes = sum(a != b for a, b in pairwise(seen))
         mask = int(cands.scale[t][position])
         out.append(Candidate(int(address), engine.types[t].code, seen, scale_label(mask), changes, scale_labels(mask)))

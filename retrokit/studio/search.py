@@ -33,7 +33,7 @@ from starlette.requests import Request
 from starlette.responses import JSONResponse
 from starlette.routing import Route
 
-from retrokit.errors import InvalidArgumentError, shown
+from retrokit.errors import InvalidArgumentError, RamSearchError, shown
 from retrokit.ramsearch.candidates import Candidate, list_groups
 from retrokit.ramsearch.filters import OPS, THAN_FORMS
 from retrokit.studio.app import session_of
@@ -42,8 +42,12 @@ from retrokit.studio.security import expect, json_body
 if TYPE_CHECKING:
     from retrokit.studio.session import Session
 
-MAX_ROWS = 500
-"""The most candidate groups one listing returns (and whose live values are pushed)."""
+MAX_ROWS = 100
+"""The most candidate groups one listing returns (and whose live values are pushed): a listing fetches up to
+256 candidates a group, each with its value at every snapshot, on the emulator thread."""
+MAX_SNAPSHOTS = 64
+"""The most snapshots one search of the studio takes: with 100 rows listed, a listing then peaks under 200 MB
+(at 256 snapshots it took 750 MB for 500 rows). A new search starts again from one."""
 PUSH_PERIOD = 0.05
 """Seconds between two pushes of a tool's live values: 20 a second, whatever the game's speed."""
 
@@ -174,6 +178,11 @@ def _filter(session: Session, op: str, value: object, than: object) -> dict[str,
 def _snapshot(session: Session, label: str) -> dict[str, Any]:
     if len(label) > 200:
         raise InvalidArgumentError(f"Expected a snapshot label of at most 200 characters; got {shown(label)}.")
+    if len(session.search.labels) >= MAX_SNAPSHOTS:
+        raise RamSearchError(
+            f"Expected at most {MAX_SNAPSHOTS} snapshots in one search; this one has them all. Filter with what "
+            "you have, or start a new search (POST /api/search/new) from the game now."
+        )
     index = session.search.snapshot(label)
     return {"snapshot": index, **_status(session)}
 

@@ -37,7 +37,9 @@ from retrokit.studio.push import Screen, Subscriber
 from retrokit.studio.security import Guard
 from retrokit.studio.session import Session
 
-ROUTE_MODULES: tuple[str, ...] = ("play", "states", "authoring")
+ROUTE_MODULES: tuple[str, ...] = (
+    "play", "states", "authoring", "search", "fields", "scenario", "clickfind", "ramview",
+)
 """The modules of :mod:`retrokit.studio` whose ``routes`` are mounted under ``/api``."""
 
 STATIC = Path(__file__).parent / "static"

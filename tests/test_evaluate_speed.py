@@ -107,7 +107,7 @@ def test_a_free_worker_takes_the_next_level_while_a_long_one_plays(tmp_path, cap
     assert short["ended"] <= last["began"] < long["ended"]  # the free worker took the last level at once
     assert len({t["pid"] for t in times.values()}) == 3  # each level in a process of its own
     assert (tmp_path / "one" / "summary.json").read_bytes() == (tmp_path / "two" / "summary.json").read_bytes()
-    last_line = capsys.readouterr().out.strip().splitlines()[-1]
+    last_line = capsys.readouterr().err.strip().splitlines()[-1]  # after the results, with the progress
     assert last_line.startswith("speed: ") and "with 2 level(s) at once" in last_line
     assert "the Sonic protocol (11 test levels x 1,000,000 timesteps) would take about" in last_line
     assert "--workers 2 (6 round(s) of levels)" in last_line

@@ -107,10 +107,10 @@ def run(args: argparse.Namespace) -> int:
     print(f"wrote {args.out}/: " + ("episodes.jsonl, summary.json, summary.csv, report.md, learning-curves.png, "
                                     "scores.png" if len(agents) == 1 else
                                     "report.md, scores.png, and a run folder per agent"))
-    for evaluation in made:
+    for evaluation in made:  # on stderr, beside the progress: stdout is the results, the same on every machine
         speed = evaluation.speed()
         if speed is not None:
-            print(("" if len(made) == 1 else f"{evaluation.agent}: ") + estimate_line(speed))
+            print(("" if len(made) == 1 else f"{evaluation.agent}: ") + estimate_line(speed), file=sys.stderr)
     return 0
 
 

@@ -72,7 +72,16 @@ def good_state(dasher_rom: Path) -> bytes:
 
 @pytest.fixture(scope="session")
 def corrupt_state(good_state: bytes) -> bytes:
-    """The right size and a valid header (GENPLUS-GX 1.7.5), then random bytes: it crashes the core."""
+    """The right size and a valid header (GENPLUS-GX 1.7.5), then random bytes: it crashes the core.
+
+    The real state's cartridge memory map is kept, so only the probe can tell (a random map is refused before
+    any probe: :mod:`retrokit.host.statelayout`).
+    """
     import random
 
-    return good_state[:16] + random.Random(1).randbytes(len(good_state) - 16)
+    from retrokit.host.statelayout import GENESIS_BANK_MAP, GENESIS_BANKS
+
+    state = bytearray(good_state[:16] + random.Random(1).randbytes(len(good_state) - 16))
+    where = slice(GENESIS_BANK_MAP, GENESIS_BANK_MAP + GENESIS_BANKS)
+    state[where] = good_state[where]
+    return bytes(state)

@@ -86,6 +86,50 @@ def test_a_probe_verdict_is_cached_by_sha256(tmp_path: Path, corrupt_state: byte
         probe.vet_state(corrupt_state, "Genesis", rom, sha1, source="x")
 
 
+def wild_map(good_state: bytes, value: int = 0xF3) -> bytes:
+    """``good_state`` with bank 0 of its cartridge memory map pointing ``value`` banks into the ROM area."""
+    from retrokit.host.statelayout import GENESIS_BANK_MAP
+
+    state = bytearray(good_state)
+    state[GENESIS_BANK_MAP] = value
+    return bytes(state)
+
+
+def test_a_memory_map_outside_the_rom_area_is_refused_before_any_probe_or_record(
+    tmp_path: Path, good_state: bytes, monkeypatch
+) -> None:
+    # Such a state crashes or not by the process's memory layout (issue 24's fuzz, state 7): no probe can vouch.
+    from retrokit.data import probe
+    from retrokit.host.statelayout import state_layout_problem
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    rom = DASHER / "rom.md"
+    sha1 = cached_rom_sha1(rom, "Genesis")
+    state = wild_map(good_state)
+    probe._remember(probe_key(state, "Genesis", sha1), probe.ProbeVerdict(True))  # an old probe's lucky verdict
+    monkeypatch.setattr(probe, "probe_state", lambda *a, **k: pytest.fail("probed"))
+    with pytest.raises(StateError, match=r"points 1 of the 68000's 64 banks outside the core's ROM area \(bank 0x00 at"):
+        probe.vet_state(state, "Genesis", rom, sha1, source="x")
+    for edge in (0x9F, 0xFF):  # the last ROM bank, and the battery RAM: what a core writes
+        assert state_layout_problem("Genesis", wild_map(good_state, edge)) == ""
+    assert "0xa0" in state_layout_problem("Genesis", wild_map(good_state, 0xA0))
+
+
+def test_the_probe_child_refuses_a_wild_memory_map_too(good_state: bytes) -> None:
+    verdict = probe_state(wild_map(good_state, 0xA0), "Genesis", DASHER / "rom.md", frames=1, input_frames=0)
+    assert not verdict.safe and "outside the core's ROM area" in verdict.reason, verdict
+
+
+def test_every_shipped_genesis_state_has_its_memory_map_inside_the_rom_area() -> None:
+    from retrokit.host.statelayout import state_layout_problem
+    from retrokit.paths import wheel_dir
+
+    files = sorted((wheel_dir() / "data" / "stable").glob("*-Genesis*/*.state")) + sorted(DASHER.glob("*.state"))
+    assert len(files) > 900
+    problems = {f.name: state_layout_problem("Genesis", gzip.decompress(f.read_bytes())) for f in files}
+    assert not any(problems.values()), {k: v for k, v in problems.items() if v}
+
+
 def test_shipped_and_recorded_states_need_no_probe(tmp_path: Path, good_state: bytes, monkeypatch) -> None:
     from retrokit.data import probe, statecheck
 

@@ -94,6 +94,7 @@ def unranged_dasher(folder: Path) -> Path:
     return game
 
 
+@pytest.mark.timeout(120 + 10 * COUNT)  # a probe takes a few seconds a state on a busy machine
 @pytest.mark.parametrize("keep_map", [False, True], ids=["random-body", "random-body-real-memory-map"])
 def test_corrupt_states_never_kill_the_process(tmp_path: Path, monkeypatch, keep_map: bool) -> None:
     import json

@@ -74,14 +74,10 @@ def good_state(dasher_rom: Path) -> bytes:
 def corrupt_state(good_state: bytes) -> bytes:
     """The right size and a valid header (GENPLUS-GX 1.7.5), then random bytes: it crashes the core.
 
-    The real state's cartridge memory map is kept, so only the probe can tell (a random map is refused before
-    any probe: :mod:`retrokit.host.statelayout`).
+    The real state's pointer bytes are kept (tests/corrupt.py), so only the probe can tell.
     """
     import random
 
-    from retrokit.host.statelayout import GENESIS_BANK_MAP, GENESIS_BANKS
+    from corrupt import random_body
 
-    state = bytearray(good_state[:16] + random.Random(1).randbytes(len(good_state) - 16))
-    where = slice(GENESIS_BANK_MAP, GENESIS_BANK_MAP + GENESIS_BANKS)
-    state[where] = good_state[where]
-    return bytes(state)
+    return random_body(good_state, random.Random(1), keep_pointers=True)

@@ -8,8 +8,10 @@ input and a reset every 500. Two fuzzes:
 - the issue's: the whole body random. Its random cartridge memory map points
   banks past the core's ROM area, which crashes the core or not by the process's
   memory layout (one such state passed the probe and killed an env at reset()
-  about one run in two): :mod:`retrokit.host.statelayout` refuses every one, before any probe;
-- a harder one: the same, with the real state's memory map kept, so the probe
+  about one run in two), and so does a random Z80 bank address:
+  :mod:`retrokit.host.statelayout` refuses every one, before any probe;
+- a harder one: the same, with the real state's memory map and Z80 bank kept
+  (tests/corrupt.py), so the probe
   (:mod:`retrokit.data.probe`) decides: it must refuse every state that would
   crash the core, and the ones it passes must play.
 
@@ -35,13 +37,12 @@ from pathlib import Path
 import pytest
 import yaml
 from childproc import MAX_RSS_MB, REPO, run_child
+from corrupt import random_body
 
 from retrokit.data.states import compress_state, read_state
-from retrokit.host.statelayout import GENESIS_BANK_MAP, GENESIS_BANKS
 
 DASHER = REPO / "games" / "Dasher-Genesis"
 COUNT = int(os.environ.get("RETROKIT_FUZZ_STATES", "24"))
-HEADER = 16  # "GENPLUS-GX 1.7.5": the core's signature, checked by the core on load
 
 PLAY = """
 import json
@@ -68,17 +69,10 @@ print(json.dumps({"played": played, "refused": refused}))
 """
 
 
-def corrupt_states(good: bytes, count: int, *, keep_map: bool) -> list[bytes]:
-    """Copies of ``good`` with its header and a random body (and its cartridge memory map, with ``keep_map``)."""
+def corrupt_states(good: bytes, count: int, *, keep_pointers: bool) -> list[bytes]:
+    """Copies of ``good`` with its header and a random body (and its pointer bytes, with ``keep_pointers``)."""
     rng = random.Random(2024)
-    states = []
-    for _ in range(count):
-        state = bytearray(good[:HEADER] + rng.randbytes(len(good) - HEADER))
-        if keep_map:
-            where = slice(GENESIS_BANK_MAP, GENESIS_BANK_MAP + GENESIS_BANKS)
-            state[where] = good[where]
-        states.append(bytes(state))
-    return states
+    return [random_body(good, rng, keep_pointers=keep_pointers) for _ in range(count)]
 
 
 def unranged_dasher(folder: Path) -> Path:
@@ -95,8 +89,8 @@ def unranged_dasher(folder: Path) -> Path:
 
 
 @pytest.mark.timeout(120 + 10 * COUNT)  # a probe takes a few seconds a state on a busy machine
-@pytest.mark.parametrize("keep_map", [False, True], ids=["random-body", "random-body-real-memory-map"])
-def test_corrupt_states_never_kill_the_process(tmp_path: Path, monkeypatch, keep_map: bool) -> None:
+@pytest.mark.parametrize("keep_pointers", [False, True], ids=["random-body", "random-body-real-pointers"])
+def test_corrupt_states_never_kill_the_process(tmp_path: Path, monkeypatch, keep_pointers: bool) -> None:
     import json
 
     from retrokit.data.games import find_game
@@ -108,7 +102,7 @@ def test_corrupt_states_never_kill_the_process(tmp_path: Path, monkeypatch, keep
     folder = unranged_dasher(tmp_path)
     game = find_game(folder)
     files = []
-    for i, state in enumerate(corrupt_states(read_state(DASHER / "Zone1.Act1.state"), COUNT, keep_map=keep_map)):
+    for i, state in enumerate(corrupt_states(read_state(DASHER / "Zone1.Act1.state"), COUNT, keep_pointers=keep_pointers)):
         path = tmp_path / f"fuzz{i:03d}.state"
         path.write_bytes(compress_state(state))
         files.append(str(path))
@@ -125,7 +119,7 @@ def test_corrupt_states_never_kill_the_process(tmp_path: Path, monkeypatch, keep
         passed = list(pool.map(probe, files))
     probing = time.monotonic() - began
     assert len(passed) == COUNT
-    if keep_map:
+    if keep_pointers:
         assert not all(passed) and any(passed)  # the probe decides, and the fuzz makes both kinds
     else:
         assert not any(passed)  # every random memory map points outside the ROM area

@@ -17,7 +17,8 @@ one when:
   memory (:mod:`retrokit.host.statelayout`): whether that crashes depends on
   the process's memory layout, so no probe or record can vouch for it;
 - otherwise, once it has passed the probe: loaded into a fresh emulator in a
-  child process, run, loaded again, and run 3,000 frames under random input. The child
+  child process, run, loaded again, run 3,000 frames under random input, and
+  loaded twice more around one frame (as an env's reset() does). The child
   dying by a signal, running out of memory, or hanging marks it unsafe.
 
 Nothing inside the file (retrokit's ``RK`` record, a movie's header) makes a
@@ -377,6 +378,11 @@ def _child_main() -> int:
             emu.set_state(state)  # every reset() loads the state again: some crash only then
             for _ in range(0, input_frames, 10):  # and some only under input
                 emu.run([rng.getrandbits(12) for _ in range(emu.ports)], 10)
+            # An env's reset(): load, one scratch frame (its first observation), load again. Loading
+            # resets the console from the state that ran before, so a load after one frame differs.
+            emu.set_state(state)
+            emu.run(idle, 1)
+            emu.set_state(state)
             emu.get_state()
             result["loaded"] = True
             result["detail"] = f"{state_format(data) or 'no core signature'}, {len(data)} bytes"

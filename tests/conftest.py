@@ -72,7 +72,12 @@ def good_state(dasher_rom: Path) -> bytes:
 
 @pytest.fixture(scope="session")
 def corrupt_state(good_state: bytes) -> bytes:
-    """The right size and a valid header (GENPLUS-GX 1.7.5), then random bytes: it crashes the core."""
+    """The right size and a valid header (GENPLUS-GX 1.7.5), then random bytes: it crashes the core.
+
+    The real state's pointer bytes are kept (tests/corrupt.py), so only the probe can tell.
+    """
     import random
 
-    return good_state[:16] + random.Random(1).randbytes(len(good_state) - 16)
+    from corrupt import random_body
+
+    return random_body(good_state, random.Random(1), keep_pointers=True)

@@ -86,6 +86,70 @@ def test_a_probe_verdict_is_cached_by_sha256(tmp_path: Path, corrupt_state: byte
         probe.vet_state(corrupt_state, "Genesis", rom, sha1, source="x")
 
 
+def wild_map(good_state: bytes, value: int = 0xF3) -> bytes:
+    """``good_state`` with bank 0 of its cartridge memory map pointing ``value`` banks into the ROM area."""
+    from retrokit.host.statelayout import GENESIS_BANK_MAP
+
+    state = bytearray(good_state)
+    state[GENESIS_BANK_MAP] = value
+    return bytes(state)
+
+
+def test_a_memory_map_outside_the_rom_area_is_refused_before_any_probe_or_record(
+    tmp_path: Path, good_state: bytes, monkeypatch
+) -> None:
+    # Such a state crashes or not by the process's memory layout (issue 24's fuzz, state 7): no probe can vouch.
+    from retrokit.data import probe
+    from retrokit.host.statelayout import state_layout_problem
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    rom = DASHER / "rom.md"
+    sha1 = cached_rom_sha1(rom, "Genesis")
+    state = wild_map(good_state)
+    probe._remember(probe_key(state, "Genesis", sha1), probe.ProbeVerdict(True))  # an old probe's lucky verdict
+    monkeypatch.setattr(probe, "probe_state", lambda *a, **k: pytest.fail("probed"))
+    with pytest.raises(StateError, match=r"points 1 of the 68000's 64 banks outside the core's ROM area \(bank 0x00 at"):
+        probe.vet_state(state, "Genesis", rom, sha1, source="x")
+    for edge in (0x9F, 0xFF):  # the last ROM bank, and the battery RAM: what a core writes
+        assert state_layout_problem("Genesis", wild_map(good_state, edge)) == ""
+    assert "0xa0" in state_layout_problem("Genesis", wild_map(good_state, 0xA0))
+
+
+def test_a_z80_bank_outside_the_68000s_space_is_refused(good_state: bytes) -> None:
+    import struct
+
+    from retrokit.host.statelayout import GENESIS_Z80_BANK, state_layout_problem
+
+    state = bytearray(good_state)
+    struct.pack_into("<I", state, GENESIS_Z80_BANK, 0x7F8000)  # the highest bank a core writes
+    assert state_layout_problem("Genesis", bytes(state)) == ""
+    struct.pack_into("<I", state, GENESIS_Z80_BANK, 0x1FF8000)
+    assert "Z80 bank address is 0x1ff8000" in state_layout_problem("Genesis", bytes(state))
+
+
+def test_the_probe_child_refuses_a_wild_memory_map_too(good_state: bytes) -> None:
+    verdict = probe_state(wild_map(good_state, 0xA0), "Genesis", DASHER / "rom.md", frames=1, input_frames=0)
+    assert not verdict.safe and "outside the core's ROM area" in verdict.reason, verdict
+
+
+def test_shipped_genesis_states_have_their_memory_map_inside_the_rom_area() -> None:
+    from retrokit.host.statelayout import GENESIS_BANK_MAP, GENESIS_BANKS, GENESIS_STATE_SIZE, state_layout_problem
+    from retrokit.paths import wheel_dir
+
+    def head(path: Path) -> bytes:
+        """The state up to its memory map (all the check reads), padded to a state's size: 7 times less to inflate."""
+        with gzip.open(path) as f:
+            data = f.read(GENESIS_BANK_MAP + GENESIS_BANKS)
+        return data + bytes(GENESIS_STATE_SIZE - len(data))
+
+    # One state of each game (all 928 pass too; every game has its own cartridge and mapper), and all of Dasher's.
+    games = sorted((wheel_dir() / "data" / "stable").glob("*-Genesis*"))
+    files = [f for g in games for f in sorted(g.glob("*.state"))[:1]] + sorted(DASHER.glob("*.state"))
+    assert len(files) > 100
+    problems = {f"{f.parent.name}/{f.name}": state_layout_problem("Genesis", head(f)) for f in files}
+    assert not any(problems.values()), {k: v for k, v in problems.items() if v}
+
+
 def test_shipped_and_recorded_states_need_no_probe(tmp_path: Path, good_state: bytes, monkeypatch) -> None:
     from retrokit.data import probe, statecheck
 

@@ -13,6 +13,7 @@ import shutil
 from pathlib import Path
 
 import pytest
+from corrupt import random_body
 
 from retrokit.cli import main
 from retrokit.data.games import list_games
@@ -136,9 +137,7 @@ def test_a_corrupt_state_fails_without_stopping_the_run(dasher: Path, kind: str)
     if kind == "truncated":
         path.write_bytes(path.read_bytes()[:300])
     else:  # right size and signature, random inside (seed 1: the core dies of SIGSEGV on it, in the child)
-        garbage = bytearray(random.Random(1).randbytes(len(data)))
-        garbage[:16] = data[:16]
-        path.write_bytes(gzip.compress(bytes(garbage)))
+        path.write_bytes(gzip.compress(random_body(data, random.Random(1), keep_pointers=True)))
     report = check_game(dasher, frames=FRAMES)
     assert failed(report) == {("state loads", "Zone2.Act1")}, render(report)
     message = report.failures[0].message

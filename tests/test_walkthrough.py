@@ -22,6 +22,9 @@ def folders(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> tuple[Path, Path
     work.mkdir()
     monkeypatch.setenv("RETROKIT_DATA", str(data))
     monkeypatch.delenv("RETROKIT_GAMES", raising=False)
+    # validate's table fits the terminal's width, 120 columns when there is none (as in the text); a pytest-xdist
+    # worker's inherited terminal would make it another.
+    monkeypatch.setenv("COLUMNS", "120")
     monkeypatch.chdir(work)
     return work, data
 

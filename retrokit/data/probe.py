@@ -13,8 +13,12 @@ one when:
   it from a core (:func:`remember`): verdicts are kept in the data folder
   (``<data>/state-probes/``) under the SHA-256 of the system, the ROM's SHA-1
   and the state;
+- never when its bytes would make the core build a pointer outside its own
+  memory (:mod:`retrokit.host.statelayout`): whether that crashes depends on
+  the process's memory layout, so no probe or record can vouch for it;
 - otherwise, once it has passed the probe: loaded into a fresh emulator in a
-  child process, run, loaded again, and run 3,000 frames under random input. The child
+  child process, run, loaded again, run 3,000 frames under random input, and
+  loaded twice more around one frame (as an env's reset() does). The child
   dying by a signal, running out of memory, or hanging marks it unsafe.
 
 Nothing inside the file (retrokit's ``RK`` record, a movie's header) makes a
@@ -47,6 +51,7 @@ from retrokit.data.shipped import is_shipped_blob
 from retrokit.data.states import MAX_STATE_FILE_SIZE, decompress_state
 from retrokit.errors import RetrokitError, StateError
 from retrokit.host.emulator import VettedState, claim_mint
+from retrokit.host.statelayout import state_layout_problem
 from retrokit.host.systems import System, get_system
 
 _mint = claim_mint()
@@ -294,6 +299,11 @@ def vet_state(
     if isinstance(state, VettedState) and state.system == system:
         return state
     state = bytes(state)
+    # Before any record or probe: a state the core would map outside its memory crashes or not by the
+    # process's layout, so a probe's verdict on it (or an old record of one) proves nothing.
+    problem = state_layout_problem(system, state)
+    if problem:
+        raise _unrunnable(source, system, problem)
     key = probe_key(state, system, rom_sha1)
     if shipped is not None and _ships(Path(shipped), state):
         if _cached(key) is None:  # a movie that starts from it (Core.bin) is then known too
@@ -304,11 +314,15 @@ def vet_state(
         verdict = probe_state(state, system, rom)
         _remember(key, verdict)
     if not verdict.safe:
-        raise StateError(
-            f"{source}: expected a save state the {system} core can run; found one that it cannot: "
-            f"{verdict.reason}. The file is corrupt or was made by something else; record or copy it again."
-        )
+        raise _unrunnable(source, system, verdict.reason)
     return _mint(state, system)
+
+
+def _unrunnable(source: str, system: str, reason: str) -> StateError:
+    return StateError(
+        f"{source}: expected a save state the {system} core can run; found one that it cannot: "
+        f"{reason}. The file is corrupt or was made by something else; record or copy it again."
+    )
 
 
 def _ships(path: Path, state: bytes) -> bool:
@@ -351,6 +365,9 @@ def _child_main() -> int:
         result: dict[str, Any] = {"name": name, "path": path}
         try:
             data = read_state(path)
+            problem = state_layout_problem(emu.system.name, data)
+            if problem:  # the core would read memory it does not own: a crash here or not is luck
+                raise StateError(f"the core cannot run the state: {problem}")
             state = _mint(data, emu.system.name)  # unchecked: finding out whether it is safe is this child's job
             emu.set_state(state)
             result["start"] = reader.read()
@@ -361,6 +378,11 @@ def _child_main() -> int:
             emu.set_state(state)  # every reset() loads the state again: some crash only then
             for _ in range(0, input_frames, 10):  # and some only under input
                 emu.run([rng.getrandbits(12) for _ in range(emu.ports)], 10)
+            # An env's reset(): load, one scratch frame (its first observation), load again. Loading
+            # resets the console from the state that ran before, so a load after one frame differs.
+            emu.set_state(state)
+            emu.run(idle, 1)
+            emu.set_state(state)
             emu.get_state()
             result["loaded"] = True
             result["detail"] = f"{state_format(data) or 'no core signature'}, {len(data)} bytes"

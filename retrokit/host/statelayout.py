@@ -1,0 +1,77 @@
+"""What a core would do with a state's bytes that no probe can see: pointers built from them, unchecked.
+
+Genesis Plus GX restores the cartridge's memory map from a state (its
+``md_cart_context_load``): for each of the 68000's 64 banks of 64 KiB the
+state holds one byte, ``0xFF`` for the battery RAM, else the bank of the ROM
+area to map there, and the core sets the bank's pointer to
+``cart.rom + (byte << 16)``. Its ROM area holds ``MAXROMSIZE`` (10 MiB, 160
+banks), and the core does not check the byte: a state whose byte is 0xA0 to
+0xFE maps a bank up to 6 MiB past the end of that array. Reading the bank
+then reads whatever this process happens to have there: nothing (SIGSEGV), or
+another library's memory. Whether anything is mapped there depends on the
+process's memory layout, so a probe in a child may pass such a state while the
+same state kills the user's process (a corrupt state of the fuzz of issue 24
+did this about one run in two, at its third load, in ``system_reset``).
+
+The Z80's window into the 68000's space is the same: its base address
+(``zbank``) is restored from the state as 4 bytes, and the core indexes its
+256-entry table of handlers with ``(zbank | offset) >> 16``, so a base above
+24 bits (the core itself only ever writes ``& 0xFF8000``) calls a function
+pointer read from past the table.
+
+So such a state is refused by reading those bytes, before any probe: the
+verdict does not depend on luck. No state a core writes has such a byte (the
+core maps banks only inside its ROM area): the 928 Genesis states that
+stable-retro ships all pass.
+"""
+
+from __future__ import annotations
+
+import struct
+
+GENESIS_STATE_SIZE = 1036288
+"""Bytes of a Genesis Plus GX 1.7.5 state (its ``STATE_SIZE``, 0xFD000)."""
+GENESIS_SIGNATURE = b"GENPLUS-GX 1.7.5"
+"""The 16 bytes every Genesis Plus GX 1.7.5 state begins with."""
+GENESIS_BANK_MAP = 144613
+"""Where a Mega Drive state's 64 bank bytes begin: after the work RAM, Z80 RAM, I/O, VDP, sound, 68000 and Z80
+contexts, whose sizes are fixed for a Mega Drive cartridge (the bytes of a plain ROM's state there read 0, 1, ..., 63)."""
+GENESIS_Z80_BANK = 16 + 0x10000 + 0x2000 + 1
+"""Where a Mega Drive state's Z80 bank address (4 bytes, little-endian) is: after the signature, the 68000's
+work RAM, the Z80's RAM and the Z80's bus state."""
+GENESIS_Z80_BANK_BITS = 0xFF8000
+"""The bits a Z80 bank address may have: 9 bits of bank, in the 68000's 24-bit space."""
+GENESIS_BANKS = 0x40
+GENESIS_ROM_BANKS = 10485760 >> 16
+"""Banks of 64 KiB in the core's ROM area (``MAXROMSIZE``, 10 MiB): a bank byte must be below this, or 0xFF."""
+_SRAM = 0xFF
+
+
+def state_layout_problem(system: str, state: bytes) -> str:
+    """Why the core would build a pointer outside its own memory from ``state`` (``""`` when it would not).
+
+    Only what is known of a core's layout is checked: a Genesis state in
+    Genesis Plus GX 1.7.5's format. Anything else is left to the probe.
+
+    Args:
+        system: The system's name (``"Genesis"``).
+        state: The serialized state.
+    """
+    if system != "Genesis" or len(state) != GENESIS_STATE_SIZE or not state.startswith(GENESIS_SIGNATURE):
+        return ""
+    (z80_bank,) = struct.unpack_from("<I", state, GENESIS_Z80_BANK)
+    if z80_bank & ~GENESIS_Z80_BANK_BITS:
+        return (
+            f"its Z80 bank address is {z80_bank:#x}, outside the 68000's 24-bit space (a core writes only "
+            f"addresses within {GENESIS_Z80_BANK_BITS:#x}), which reads memory the core does not own"
+        )
+    banks = state[GENESIS_BANK_MAP : GENESIS_BANK_MAP + GENESIS_BANKS]
+    wild = [(i, b) for i, b in enumerate(banks) if GENESIS_ROM_BANKS <= b < _SRAM]
+    if not wild:
+        return ""
+    bank, value = wild[0]
+    return (
+        f"its cartridge memory map points {len(wild)} of the 68000's {GENESIS_BANKS} banks outside the core's ROM "
+        f"area (bank {bank:#04x} at ROM bank {value:#04x}; the area holds {GENESIS_ROM_BANKS:#04x}), which reads "
+        "memory the core does not own"
+    )

@@ -212,3 +212,22 @@ class RamSearchError(RetrokitError, ValueError):
 
 class SessionError(RamSearchError):
     """A RAM search session file is missing, corrupt, not a session, or from another game."""
+
+
+# --- The studio ----------------------------------------------------------------------------------
+
+
+class StudioError(RetrokitError):
+    """The studio's server was asked for something it cannot do: a malformed request, a port in use."""
+
+
+class PortInUseError(StudioError, OSError):
+    """Another program (often another studio) already listens on the port the studio was asked to use."""
+
+
+class AccessDeniedError(StudioError, PermissionError):
+    """A request named a file outside the game's folders and the data folder, or came without the studio's token."""
+
+
+class RequestTooLargeError(StudioError):
+    """A request's body is larger than the studio accepts."""

@@ -20,12 +20,12 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 from retrokit.dsl.compiler import Program
-from retrokit.dsl.document import document_from_dict, load_document, plain_scenario_dict
+from retrokit.dsl.document import DocumentLoader, document_from_dict, load_document, plain_scenario_dict
 from retrokit.dsl.gymretro import is_gym_retro, spec_from_json, spec_from_json_dict
 from retrokit.dsl.spec import ScenarioSpec
 from retrokit.errors import InvalidArgumentError, ScenarioError, shown
 
-__all__ = ["Run", "Scenario", "load_scenario"]
+__all__ = ["Run", "Scenario", "load_scenario", "scenario_from_text"]
 
 
 class Scenario:
@@ -158,3 +158,39 @@ def load_scenario(
     else:
         raise ScenarioError(f"{str(path)!r}: a scenario is a .yaml file (retrokit) or a .json file (Gym Retro); got {suffix or 'no suffix'!r}")
     return Scenario(spec, fields)
+
+
+def scenario_from_text(
+    text: str,
+    fields: Sequence[str],
+    *,
+    source: str,
+    name: str,
+    game_dir: str | os.PathLike[str] | None = None,
+) -> Scenario:
+    """Compile scenario YAML given as text, such as an editor's unsaved buffer.
+
+    It is read exactly as the file ``source`` would be: its errors name
+    ``source`` and carry the same ``line`` and ``column`` attributes.
+
+    Args:
+        text: The scenario, in retrokit's YAML format.
+        fields: The names of the game's RAM fields.
+        source: What the text's errors call it, e.g. the path it will be saved to.
+        name: The scenario's name unless the text gives one (``name:``).
+        game_dir: Where its ``include`` files are looked up.
+
+    Raises:
+        ScenarioError: The text is too large, or malformed (and its subclasses, as :func:`load_scenario`).
+    """
+    from retrokit.data.yamlfile import MAX_YAML_BYTES
+
+    if not isinstance(text, str):
+        raise InvalidArgumentError(f"Expected a scenario as text, got {type(text).__name__}.")
+    if len(text) > MAX_YAML_BYTES:
+        raise ScenarioError(
+            f"{source}: expected a scenario of at most {MAX_YAML_BYTES >> 20} MiB; got {len(text):,} characters."
+        )
+    loader = DocumentLoader(name)
+    loader.load_text(text.removeprefix("\ufeff"), source, Path(game_dir) if game_dir is not None else None)
+    return Scenario(loader.spec, fields)

@@ -353,6 +353,23 @@ class RamSearch:
 
     # --- searching ------------------------------------------------------------------------------
 
+    def new_search(self, types: Sequence[str] | None = None) -> int:
+        """Start the search afresh from the game's moment now: every candidate back, one snapshot; return it.
+
+        The game, its state and the inputs played stay as they are (a long-running session, such as
+        the studio's, looks for one variable after another).
+
+        Raises:
+            FieldTypeError: A type code is unknown, or given twice.
+        """
+        self.engine = Engine(self.layout, parse_search_types(types if types is not None else self.types))
+        self.labels = []
+        return self.snapshot("new search")
+
+    def reload_game(self) -> None:
+        """Read the game's data files again, after its game.yaml was written (a field added or edited)."""
+        self.game = Game(self.game.name, self.game.folders).check()
+
     def filter(self, op: str, value: int | None = None, than: str | int | None = None) -> int:
         """Keep the candidates that pass a filter (see :mod:`retrokit.ramsearch.engine`); return how many are left."""
         return self.engine.filter(op, value, than)

@@ -1,0 +1,176 @@
+"""RAM view: a grid of a RAM region's bytes, live, with what changed.
+
+The region is given in console addresses and read as the RAM search reads
+it (:class:`~retrokit.ramsearch.ram.RamLayout`: console byte order, whatever
+the core's), so a cell shows what the console's CPU sees. While a region is
+watched, a frame hook compares it with the frame before and pushes
+``{"type": "ram", "start", "frame", "values", "changed", "differs"}`` every
+few frames: ``changed`` lists the offsets that changed in any frame since the
+last push, ``differs`` those that differ from the chosen snapshot of the RAM
+search (``null`` without one).
+
+Routes (under ``/api``):
+
+- ``GET /ram?start=ADDRESS&length=N&snapshot=K``: the region's bytes now, and the same lists.
+- ``POST /ram/watch`` ``{"start", "length", "snapshot"?}``: push the region live; ``DELETE /ram/watch`` stops.
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from starlette.requests import Request
+from starlette.responses import JSONResponse
+from starlette.routing import Route
+
+from retrokit.errors import RamSearchError
+from retrokit.studio.app import session_of
+from retrokit.studio.search import PUSH_EVERY, address_of, integer_of
+from retrokit.studio.security import json_body
+
+MAX_LENGTH = 4096
+"""The most bytes a view shows: 256 rows of 16, more than a page can draw live."""
+
+
+@dataclass
+class _View:
+    """A region of RAM watched frame by frame."""
+
+    start: int
+    length: int
+    position: int  # where the region starts in a RamLayout snapshot
+    buffer: int  # which of the core's memory buffers holds it
+    offsets: np.ndarray  # the buffer offset of each byte, in console order
+    snapshot: int | None
+    search: Any
+    last: np.ndarray
+    changed: np.ndarray
+    countdown: int = 0
+    remove: Any = None
+
+
+_views: weakref.WeakKeyDictionary[Any, _View] = weakref.WeakKeyDictionary()
+
+
+def _region(session: Any, start: object, length: object, snapshot: object) -> tuple[int, int, int, int | None]:
+    """The region's start, length, snapshot position, and snapshot index, checked (emulator thread).
+
+    Raises:
+        InvalidArgumentError: It is not inside one RAM region, or too long.
+        RamSearchError: The snapshot does not exist.
+    """
+    search = session.search
+    begin = address_of(start, "start")
+    count = integer_of(length, "length", 1, MAX_LENGTH)
+    position = search.layout.position(begin, count)
+    index = None
+    if snapshot is not None:
+        taken = len(search.engine.snapshots)
+        index = integer_of(snapshot, "snapshot", 0, None)
+        if index >= taken:
+            raise RamSearchError(
+                f"Expected a snapshot from 0 to {taken - 1} of the RAM search; got {index}. Take one first."
+            )
+    return begin, count, position, index
+
+
+def _where(session: Any, start: int, length: int) -> tuple[int, np.ndarray]:
+    """The buffer holding a region, and the offset of each of its bytes there (in console order)."""
+    index, offsets = session.search.emulator.space.offsets(start, length)
+    return index, np.array(offsets, dtype=np.intp)
+
+
+def _bytes(session: Any, buffer: int, offsets: np.ndarray) -> np.ndarray:
+    """The region's bytes now: only those (the whole RAM's console-order copy costs half a frame)."""
+    return np.frombuffer(session.search.emulator.space.buffers[buffer], dtype=np.uint8)[offsets]
+
+
+def _differs(session: Any, view: _View, now: np.ndarray) -> list[int] | None:
+    if view.snapshot is None or view.snapshot >= len(session.search.engine.snapshots):
+        return None
+    then = session.search.engine.snapshots[view.snapshot][view.position : view.position + view.length]
+    return np.flatnonzero(then != now).tolist()
+
+
+def _report(session: Any, view: _View, now: np.ndarray) -> dict[str, Any]:
+    return {
+        "type": "ram",
+        "start": view.start,
+        "hex": session.search.layout.format(view.start),
+        "length": view.length,
+        "frame": session.frame,
+        "snapshot": view.snapshot,
+        "values": now.tolist(),
+        "changed": np.flatnonzero(view.changed).tolist(),
+        "differs": _differs(session, view, now),
+    }
+
+
+def _on_frame(session: Any) -> None:
+    """Frame hook: note what changed since the frame before; push every few frames."""
+    view = _views.get(session)
+    if view is None or view.search is not session.search:
+        return
+    now = _bytes(session, view.buffer, view.offsets)
+    view.changed |= now != view.last
+    view.last = now
+    view.countdown -= 1
+    if view.countdown <= 0:
+        view.countdown = PUSH_EVERY
+        session.publish(_report(session, view, now))
+        view.changed[:] = False
+
+
+def _view(session: Any, start: object, length: object, snapshot: object, watch: bool) -> dict[str, Any]:
+    begin, count, position, index = _region(session, start, length, snapshot)
+    buffer, offsets = _where(session, begin, count)
+    now = _bytes(session, buffer, offsets)
+    old = _views.get(session)
+    same = old is not None and old.search is session.search and (old.start, old.length) == (begin, count)
+    view = _View(begin, count, position, buffer, offsets, index, session.search, now, np.zeros(count, dtype=bool))
+    if same:  # what changed since the last frame the hook saw
+        view.changed = old.changed | (now != old.last)
+        view.last, view.remove = old.last, old.remove
+    elif old is not None:
+        view.remove = old.remove
+    if watch or same:
+        _views[session] = view
+        if view.remove is None:
+            view.remove = session.on_frame(_on_frame)
+    return _report(session, view, now)
+
+
+def _unwatch(session: Any) -> dict[str, Any]:
+    view = _views.pop(session, None)
+    if view is not None and view.remove is not None:
+        view.remove()
+    return {"watching": False}
+
+
+async def ram(request: Request) -> JSONResponse:
+    query = request.query_params
+    start, length = query.get("start"), query.get("length", "256")
+    result = await session_of(request).call(_view, start, length, query.get("snapshot"), False)
+    return JSONResponse(result)
+
+
+async def watch(request: Request) -> JSONResponse:
+    body = await json_body(request)
+    result = await session_of(request).call(
+        _view, body.get("start"), body.get("length", 256), body.get("snapshot"), True
+    )
+    return JSONResponse(result)
+
+
+async def unwatch(request: Request) -> JSONResponse:
+    return JSONResponse(await session_of(request).call(_unwatch))
+
+
+routes = [
+    Route("/ram", ram, methods=["GET"]),
+    Route("/ram/watch", watch, methods=["POST"]),
+    Route("/ram/watch", unwatch, methods=["DELETE"]),
+]

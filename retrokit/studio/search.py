@@ -1,0 +1,256 @@
+"""RAM search routes: the session's :class:`~retrokit.ramsearch.RamSearch`, over HTTP.
+
+Every move goes through ``session.call``, so it runs on the emulator thread
+between frames, and through the same :class:`RamSearch` methods as
+``retrokit ramsearch``: the filters (every operation, type, ``than`` and
+scale), snapshots, undo and redo, poke, and ``save_field`` (the one game.yaml
+writer, range included). The candidate table lists groups of candidates as
+``ramsearch show`` does; the rows listed last are watched, and their live
+values are pushed to the page (``{"type": "candidates", ...}``) every few frames.
+
+Routes (under ``/api``):
+
+- ``GET /search``: count, snapshots, filters applied, types, whether undo/redo can.
+- ``POST /search/new`` ``{"types"?}``: start afresh from the game's moment now.
+- ``POST /search/snapshot`` ``{"label"?}``; ``POST /search/filter`` ``{"op", "value"?, "than"?}``.
+- ``POST /search/undo``, ``POST /search/redo``.
+- ``GET /search/candidates?limit=N``: groups of candidates, with values per snapshot and live.
+- ``POST /search/poke`` ``{"address", "value", "type"?}``.
+- ``POST /search/field`` ``{"name", "address", "type", "range"?, "force"?}``: add a field to game.yaml.
+
+This module also holds the number helpers the other tool modules share:
+:func:`integer_of` and :func:`address_of` (JSON numbers, or hex text as the game files write addresses).
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass, field
+from typing import Any
+
+from starlette.requests import Request
+from starlette.responses import JSONResponse
+from starlette.routing import Route
+
+from retrokit.errors import InvalidArgumentError, shown
+from retrokit.ramsearch.candidates import Candidate, list_groups
+from retrokit.ramsearch.filters import OPS, THAN_FORMS
+from retrokit.studio.app import session_of
+from retrokit.studio.security import expect, json_body
+
+MAX_ROWS = 500
+"""The most candidate groups one listing returns (and whose live values are pushed)."""
+PUSH_EVERY = 3
+"""Frames between two pushes of live values: 20 a second at 60 fps."""
+
+
+def integer_of(value: object, what: str, low: int | None = None, high: int | None = None) -> int:
+    """A whole number given as JSON (a number, or text such as ``"0x2B"``), within ``[low, high]``.
+
+    Raises:
+        InvalidArgumentError: It is not a whole number, or out of range.
+    """
+    number = value
+    if isinstance(value, str) and len(value) <= 40:
+        try:
+            number = int(value, 0)
+        except ValueError:
+            pass
+    if not isinstance(number, int) or isinstance(number, bool):
+        raise InvalidArgumentError(f"Expected {what} as a whole number (decimal, or hex as 0xFF002B); got {shown(value)}.")
+    if (low is not None and number < low) or (high is not None and number > high):
+        raise InvalidArgumentError(f"Expected {what} from {low} to {high}; got {number}.")
+    return number
+
+
+def address_of(value: object, what: str = "address") -> int:
+    """A console address given as JSON: a number, or hex text such as ``"0xFF002B"``."""
+    return integer_of(value, what, 0, (1 << 48) - 1)
+
+
+def _than(value: object) -> str | int | None:
+    """``than`` as :meth:`RamSearch.filter` takes it: hex text is an address, digits a snapshot's number."""
+    if value is None or isinstance(value, int) and not isinstance(value, bool) and value >= 0:
+        return None if value is None else str(value)
+    if isinstance(value, str) and value.lower().startswith("0x"):
+        return address_of(value, "than")
+    if isinstance(value, str):
+        return value
+    raise InvalidArgumentError(f"Expected than as {THAN_FORMS}; got {shown(value)}.")
+
+
+@dataclass
+class _Watch:
+    """The candidate rows a page shows, whose live values are pushed."""
+
+    rows: list[tuple[int, str]] = field(default_factory=list)  # (address, type)
+    search: Any = None  # the RamSearch they were listed from (a new game lists afresh)
+    countdown: int = 0
+    remove: Any = None
+
+
+_watches: weakref.WeakKeyDictionary[Any, _Watch] = weakref.WeakKeyDictionary()
+
+
+def _push_live(session: Any) -> None:
+    """Frame hook: push the watched rows' values every :data:`PUSH_EVERY` frames."""
+    watch = _watches.get(session)
+    if watch is None or not watch.rows or watch.search is not session.search:
+        return
+    watch.countdown -= 1
+    if watch.countdown > 0:
+        return
+    watch.countdown = PUSH_EVERY
+    space = session.search.emulator.space
+    values = [[address, code, space.peek(address, code)] for address, code in watch.rows]
+    session.publish({"type": "candidates", "frame": session.frame, "values": values})
+
+
+def _status(session: Any) -> dict[str, Any]:
+    search = session.search
+    return {
+        "count": search.count,
+        "snapshots": list(search.labels),
+        "history": search.history,
+        "types": list(search.types),
+        "can_undo": bool(search.engine.history),
+        "can_redo": bool(search.engine.redo_stack),
+        "ops": list(OPS),
+    }
+
+
+def _row(session: Any, group: list[Candidate]) -> dict[str, Any]:
+    first = group[0]
+    return {
+        "address": first.address,
+        "hex": session.search.layout.format(first.address),
+        "type": first.type,
+        "also": [c.type for c in group[1:]],
+        "values": list(first.values),
+        "value": session.search.emulator.space.peek(first.address, first.type),
+        "scale": first.scale,
+        "scales": list(first.scales),
+        "changes": first.changes,
+    }
+
+
+def _candidates(session: Any, limit: int) -> dict[str, Any]:
+    search = session.search
+    groups = list_groups(search.count, search.candidates, limit, len(search.types))
+    rows = [_row(session, g) for g in groups.groups]
+    watch = _watches.setdefault(session, _Watch())
+    watch.rows, watch.search = [(r["address"], r["type"]) for r in rows], search
+    if watch.remove is None:
+        watch.remove = session.on_frame(_push_live)
+    return {"total": groups.total, "groups": groups.count, "more": groups.more, "rows": rows}
+
+
+def _filter(session: Any, op: str, value: object, than: object) -> dict[str, Any]:
+    number = None if value is None else integer_of(value, "the filter's number")
+    before = session.search.count
+    session.search.filter(op, number, _than(than))
+    return {"before": before, "filter": session.search.history[-1], **_status(session)}
+
+
+def _snapshot(session: Any, label: str) -> dict[str, Any]:
+    if len(label) > 200:
+        raise InvalidArgumentError(f"Expected a snapshot label of at most 200 characters; got {shown(label)}.")
+    index = session.search.snapshot(label)
+    return {"snapshot": index, **_status(session)}
+
+
+def _poke(session: Any, address: int | str, value: int | str, type_code: str) -> dict[str, Any]:
+    where = address_of(address)
+    session.search.poke(where, integer_of(value, "the value to poke"), type_code)
+    return {"address": where, "type": type_code, "value": session.search.emulator.space.peek(where, type_code)}
+
+
+def save_field(session: Any, name: object, address: object, type_code: object, value_range: object, force: bool) -> dict:
+    """Write a field into the game's game.yaml through :meth:`RamSearch.save_field`, then reload the game's fields."""
+    if not isinstance(type_code, str):
+        raise InvalidArgumentError(f"Expected a type code such as \"|u1\"; got {shown(type_code)}.")
+    if value_range is not None:
+        if not isinstance(value_range, list) or len(value_range) != 2:
+            raise InvalidArgumentError(f"Expected range as [LO, HI]; got {shown(value_range)}.")
+        value_range = tuple(integer_of(v, "range") for v in value_range)
+    search = session.search
+    where = address_of(address)
+    path = search.save_field(name, where, type_code, force=force, value_range=value_range)
+    search.reload_game()
+    spec = search.game.fields[name]
+    return {"name": name, "address": spec.address, "hex": search.layout.format(spec.address), "type": spec.type,
+            "range": list(spec.range) if spec.range else None, "path": str(path)}
+
+
+async def status(request: Request) -> JSONResponse:
+    return JSONResponse(await session_of(request).call(_status))
+
+
+async def new(request: Request) -> JSONResponse:
+    types = expect(await json_body(request), "types", list, None)
+    if types is not None and not all(isinstance(t, str) for t in types):
+        raise InvalidArgumentError(f'Expected types as a list of type codes such as ["|u1", ">u2"]; got {shown(types)}.')
+
+    def restart(session: Any) -> dict[str, Any]:
+        session.search.new_search(types)
+        return _status(session)
+
+    return JSONResponse(await session_of(request).call(restart))
+
+
+async def snapshot(request: Request) -> JSONResponse:
+    label = expect(await json_body(request), "label", str, "snapshot")
+    return JSONResponse(await session_of(request).call(_snapshot, label))
+
+
+async def filter_(request: Request) -> JSONResponse:
+    body = await json_body(request)
+    op = expect(body, "op", str)
+    return JSONResponse(await session_of(request).call(_filter, op, body.get("value"), body.get("than")))
+
+
+async def undo(request: Request) -> JSONResponse:
+    def step(session: Any) -> dict[str, Any]:
+        return {"undone": session.search.undo(), **_status(session)}
+
+    return JSONResponse(await session_of(request).call(step))
+
+
+async def redo(request: Request) -> JSONResponse:
+    def step(session: Any) -> dict[str, Any]:
+        return {"redone": session.search.redo(), **_status(session)}
+
+    return JSONResponse(await session_of(request).call(step))
+
+
+async def candidates(request: Request) -> JSONResponse:
+    limit = integer_of(request.query_params.get("limit", "100"), "limit", 1, MAX_ROWS)
+    return JSONResponse(await session_of(request).call(_candidates, limit))
+
+
+async def poke(request: Request) -> JSONResponse:
+    body = await json_body(request)
+    address, value = expect(body, "address", (int, str)), expect(body, "value", (int, str))
+    type_code = expect(body, "type", str, "|u1")
+    return JSONResponse(await session_of(request).call(_poke, address, value, type_code))
+
+
+async def add_field(request: Request) -> JSONResponse:
+    body = await json_body(request)
+    name, address, type_code = expect(body, "name", str), expect(body, "address", (int, str)), expect(body, "type", str)
+    value_range, force = expect(body, "range", list, None), expect(body, "force", bool, False)
+    result = await session_of(request).call(save_field, name, address, type_code, value_range, force)
+    return JSONResponse(result)
+
+
+routes = [
+    Route("/search", status, methods=["GET"]),
+    Route("/search/new", new, methods=["POST"]),
+    Route("/search/snapshot", snapshot, methods=["POST"]),
+    Route("/search/filter", filter_, methods=["POST"]),
+    Route("/search/undo", undo, methods=["POST"]),
+    Route("/search/redo", redo, methods=["POST"]),
+    Route("/search/candidates", candidates, methods=["GET"]),
+    Route("/search/poke", poke, methods=["POST"]),
+    Route("/search/field", add_field, methods=["POST"]),
+]

@@ -1,0 +1,270 @@
+"""The studio's guards: the token every request shows, the Origin a WebSocket comes from, and the one path resolver.
+
+The server listens on 127.0.0.1 only, but any web page the user opens can
+send requests to it; so, as Jupyter does, every HTTP request and WebSocket
+must carry a random token that only the printed URL holds: in the query
+(``?token=``), in the ``X-Retrokit-Token`` header (what the page's scripts
+send), or in the cookie the server sets when the URL's token is first seen
+(so the page's ``<script>`` and ``<img>`` requests carry it; ``SameSite=Strict``
+keeps other sites' pages from sending it). WebSockets must also come from
+the studio's own origin, and the ``Host`` header must name 127.0.0.1 or
+localhost, which stops DNS rebinding.
+
+:func:`resolve_path` is the one function through which a request may name a
+file: it refuses whatever would leave the game's folders and the data folder.
+The request helpers (:func:`json_body`, :func:`expect`) cap bodies and check
+types, so hostile input ends in a 4xx JSON error, never a 500.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import secrets
+from collections.abc import Iterable, Sequence
+from http.cookies import SimpleCookie
+from pathlib import Path
+from typing import Any
+from urllib.parse import parse_qs, unquote
+
+from starlette.requests import Request
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from retrokit.errors import AccessDeniedError, InvalidArgumentError, RequestTooLargeError, shown
+
+TOKEN_HEADER = "x-retrokit-token"
+MAX_BODY = 1 << 20
+"""The largest request body, in bytes: a scenario or a game.yaml is far smaller."""
+_HOSTS = ("127.0.0.1", "localhost")
+
+
+def new_token() -> str:
+    """A fresh random token (URL-safe)."""
+    return secrets.token_urlsafe(24)
+
+
+def cookie_name(port: int) -> str:
+    """The token cookie's name: one per port, as browsers share cookies between a host's ports."""
+    return f"retrokit-studio-{port}"
+
+
+def allowed_origins(port: int) -> tuple[str, ...]:
+    """The origins a WebSocket may come from: the studio's own page."""
+    return tuple(f"http://{host}:{port}" for host in _HOSTS)
+
+
+class Guard:
+    """ASGI middleware that refuses a request without the token, from another origin, or with a body too large.
+
+    Args:
+        app: The application it guards.
+        token: The token the printed URL holds.
+        port: The port the server listens on (for the Origin and Host checks, and the cookie's name).
+    """
+
+    def __init__(self, app: ASGIApp, token: str, port: int) -> None:
+        self.app = app
+        self.token = token
+        self.port = port
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] not in ("http", "websocket"):
+            await self.app(scope, receive, send)
+            return
+        headers = {k.decode("latin-1").lower(): v.decode("latin-1") for k, v in scope.get("headers", [])}
+        problem = self._problem(scope, headers)
+        if problem:
+            await _refuse(scope, receive, send, 403, problem, "AccessDeniedError")
+            return
+        if scope["type"] == "websocket":
+            await self.app(scope, receive, send)
+            return
+        length = headers.get("content-length", "0")
+        if not length.isdigit() or int(length) > MAX_BODY:
+            await _refuse(scope, receive, send, 413, _too_large(length), "RequestTooLargeError")
+            return
+        query_token = _query_token(scope)
+        await self.app(scope, _capped(receive), self._with_cookie(send) if query_token else send)
+
+    def _problem(self, scope: Scope, headers: dict[str, str]) -> str:
+        host = headers.get("host", "")
+        if host.rpartition(":")[0] not in _HOSTS and host not in _HOSTS:
+            return f"Expected a request to 127.0.0.1 or localhost; found Host {shown(host)}. Open the URL the studio printed."
+        given = _query_token(scope) or headers.get(TOKEN_HEADER) or _cookie_token(headers, cookie_name(self.port))
+        if not given or not secrets.compare_digest(given.encode(), self.token.encode()):
+            what = "a wrong token" if given else "no token"
+            return (
+                f"Expected the studio's token (?token= in the URL it printed, or the {TOKEN_HEADER} header); "
+                f"found {what}. Open the URL that `retrokit studio` printed."
+            )
+        origin = headers.get("origin")
+        if scope["type"] == "websocket" and origin is not None and origin not in allowed_origins(self.port):
+            return (
+                f"Expected a WebSocket from the studio's page ({' or '.join(allowed_origins(self.port))}); "
+                f"found Origin {shown(origin)}."
+            )
+        return ""
+
+    def _with_cookie(self, send: Send) -> Send:
+        cookie = f"{cookie_name(self.port)}={self.token}; Path=/; HttpOnly; SameSite=Strict".encode()
+
+        async def sending(message: Message) -> None:
+            if message["type"] == "http.response.start":
+                message = {**message, "headers": [*message.get("headers", []), (b"set-cookie", cookie)]}
+            await send(message)
+
+        return sending
+
+
+def _query_token(scope: Scope) -> str | None:
+    values = parse_qs(scope.get("query_string", b"").decode("latin-1")).get("token")
+    return values[0] if values else None
+
+
+def _cookie_token(headers: dict[str, str], name: str) -> str | None:
+    cookie = SimpleCookie()
+    try:
+        cookie.load(headers.get("cookie", ""))
+    except Exception:  # a malformed Cookie header is no token  # noqa: BLE001
+        return None
+    return cookie[name].value if name in cookie else None
+
+
+def _too_large(length: str) -> str:
+    return (
+        f"Expected a request body of at most {MAX_BODY:,} bytes with a Content-Length; found {shown(length)}. "
+        "Send less."
+    )
+
+
+def _capped(receive: Receive) -> Receive:
+    """``receive`` that refuses a body growing past :data:`MAX_BODY` (a chunked one has no Content-Length)."""
+    seen = 0
+
+    async def receiving() -> Message:
+        nonlocal seen
+        message = await receive()
+        if message["type"] == "http.request":
+            seen += len(message.get("body", b""))
+            if seen > MAX_BODY:
+                raise RequestTooLargeError(_too_large(f"{seen:,} bytes and more"))
+        return message
+
+    return receiving
+
+
+async def _refuse(scope: Scope, receive: Receive, send: Send, status: int, error: str, kind: str) -> None:
+    if scope["type"] == "websocket":
+        await receive()  # websocket.connect
+        await send({"type": "websocket.close", "code": 1008, "reason": error[:120]})
+        return
+    body = json.dumps({"error": error, "kind": kind}).encode()
+    await send({"type": "http.response.start", "status": status,
+                "headers": [(b"content-type", b"application/json"), (b"content-length", str(len(body)).encode())]})
+    await send({"type": "http.response.body", "body": body})
+
+
+# --- request bodies ---------------------------------------------------------------------------------
+
+
+async def json_body(request: Request) -> dict[str, Any]:
+    """The request's JSON object (an empty body is ``{}``).
+
+    Raises:
+        InvalidArgumentError: The body is not JSON, or not an object.
+        RequestTooLargeError: It is larger than :data:`MAX_BODY`.
+    """
+    raw = await request.body()
+    if not raw.strip():
+        return {}
+    try:
+        body = json.loads(raw)
+    except (ValueError, RecursionError) as exc:
+        raise InvalidArgumentError(
+            f"Expected a JSON object as the request body; found text that is not JSON ({exc}). Send JSON."
+        ) from None
+    if not isinstance(body, dict):
+        raise InvalidArgumentError(f"Expected a JSON object as the request body; found a {type(body).__name__}.")
+    return body
+
+
+def expect(body: dict[str, Any], key: str, kind: type | tuple[type, ...], default: Any = ...) -> Any:
+    """``body[key]``, checked to be of ``kind`` (a bool is not an int); ``default`` if it is missing or null.
+
+    Raises:
+        InvalidArgumentError: It is missing (and has no default) or of another type.
+    """
+    value = body.get(key)
+    if value is None:
+        if default is ...:
+            raise InvalidArgumentError(f"Expected {key!r} in the request's JSON object; found none.")
+        return default
+    kinds = kind if isinstance(kind, tuple) else (kind,)
+    if isinstance(value, bool) and bool not in kinds or not isinstance(value, kinds):
+        names = " or ".join(_JSON_NAMES.get(k, k.__name__) for k in kinds)
+        raise InvalidArgumentError(f"Expected {key!r} to be {names}; got {shown(value)}.")
+    return value
+
+
+_JSON_NAMES = {str: "a string", int: "a whole number", float: "a number", bool: "true or false", list: "a list"}
+
+
+# --- paths ---------------------------------------------------------------------------------------------
+
+
+def resolve_path(name: str, base: Path, roots: Iterable[Path], *, what: str = "file") -> Path:
+    """The file a request names, relative to ``base``, if it stays inside one of ``roots``: the one check of them all.
+
+    The name is percent-decoded until it no longer changes (``%2e%2e``, ``%252e%252e``), then
+    refused if it holds a NUL or a control character, is absolute, or climbs with ``..``; the
+    path is then resolved, symlinks followed, and must still lie inside a root (a symlink out of
+    the folder is refused too).
+
+    Args:
+        name: The relative path the request gave.
+        base: The folder it is relative to (inside a root).
+        roots: The folders a request may reach: the game's folders and the data folder.
+        what: What the file is, for the message.
+
+    Raises:
+        AccessDeniedError: The path leaves every root, however it is written.
+        InvalidArgumentError: ``name`` is not a non-empty string.
+    """
+    if not isinstance(name, str) or not name:
+        raise InvalidArgumentError(f"Expected a {what} name as a non-empty string, got {shown(name)}.")
+    decoded = name
+    for _ in range(8):  # %25 nests: decode until the text is stable
+        step = unquote(decoded, errors="strict") if "%" in decoded else decoded
+        if step == decoded:
+            break
+        decoded = step
+    problem = _path_problem(decoded)
+    allowed = [Path(os.path.realpath(r)) for r in roots]
+    if not problem:
+        target = Path(os.path.realpath(base / decoded))
+        if not any(target.is_relative_to(root) for root in allowed):
+            problem = "leads outside the game's folders and the data folder (through a symlink)"
+    if problem:
+        raise AccessDeniedError(
+            f"Expected a {what} inside the game's folders or the data folder; got {shown(name)}, which {problem}. "
+            "Name a file by its plain name."
+        )
+    return target
+
+
+def _path_problem(text: str) -> str:
+    if "%" in text:
+        return "is still percent-encoded after 8 rounds of decoding"
+    if any(ord(c) < 32 or ord(c) == 127 for c in text):
+        return "holds a NUL or a control character"
+    if text.startswith(("/", "\\", "~")) or (len(text) > 1 and text[1] == ":"):
+        return "is an absolute path"
+    if any(part == ".." for part in text.replace("\\", "/").split("/")):
+        return "climbs out of its folder with '..'"
+    return ""
+
+
+def under_any(path: Path, roots: Sequence[Path]) -> bool:
+    """Whether ``path`` (resolved) is inside one of ``roots`` (resolved)."""
+    real = Path(os.path.realpath(path))
+    return any(real.is_relative_to(Path(os.path.realpath(root))) for root in roots)

@@ -51,6 +51,7 @@ async function boot() {
   }
   for (const tab of byId("tabs").querySelectorAll("button")) tab.addEventListener("click", () => showTab(tab.dataset.panel));
   showTab(location.hash.slice(1));
+  window.addEventListener("hashchange", () => showTab(location.hash.slice(1))); // a link or Back to #watch
   socket.on("error", (message) => say(message.error, "error"));
   socket.connect();
   document.body.dataset.ready = "true"; // the browser tests wait for this

@@ -14,8 +14,12 @@ export function say(message, kind = "ok") {
   if (kind === "ok") timer = setTimeout(() => { if (line.textContent === message) line.textContent = ""; }, 6000);
 }
 
-/** Run an async action from a button, reporting its error (an ApiError carries the server's line). */
+/** Run an async action from a button, reporting its error (an ApiError carries the server's line). The line is
+ * cleared first, so what it shows afterwards is this action's outcome, not an older one's. */
 export async function attempt(action, done) {
+  const line = byId("message");
+  line.textContent = "";
+  line.className = "";
   try {
     const result = await action();
     if (done) say(typeof done === "function" ? done(result) : done);

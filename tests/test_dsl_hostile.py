@@ -56,6 +56,7 @@ TOO_DEEP = [
     pytest.param(_nested("clip(x, 0, {})", 99), ScenarioCompileError, "brackets deep", id="99_nested_clip"),
     pytest.param(_nested("t[{}]", 99), ScenarioCompileError, "brackets deep", id="99_nested_lookups"),
     pytest.param(_nested("min(x, {})", 10_000), ScenarioSyntaxError, "nesting at most 100", id="10000_nested_min"),
+    pytest.param("(" * 50_000 + "x" + ")" * 50_000, ScenarioSyntaxError, "brackets at most 1000", id="50000_parentheses"),
 ]
 
 

@@ -32,6 +32,10 @@ _GRAMMAR = Path(__file__).with_name("grammar.lark")
 #: formulas are split into definitions (``define:``), which have no such limit.
 MAX_DEPTH = 100
 
+#: How deep brackets may nest, redundant ones included: far more than :data:`MAX_DEPTH`
+#: operations use, few enough that the parser stays fast on hostile text.
+MAX_BRACKETS = 10 * MAX_DEPTH
+
 #: The largest integer literal: the console's values are at most 64 bits wide.
 MAX_INT = 2**64 - 1
 
@@ -169,6 +173,7 @@ def parse(snippet: Snippet) -> n.Node:
     """
     if not snippet.text.strip():
         raise snippet.error(ScenarioSyntaxError, 0, len(snippet.text), "the expression is empty")
+    _check_brackets(snippet)
     try:
         tree = _lark().parse(snippet.text)
     except UnexpectedInput as exc:
@@ -180,6 +185,26 @@ def parse(snippet: Snippet) -> n.Node:
         if isinstance(exc.orig_exc, ScenarioError):
             raise exc.orig_exc from None
         raise
+
+
+def _check_brackets(snippet: Snippet) -> None:
+    """Refuse brackets nested more than :data:`MAX_BRACKETS` deep, before lark parses them.
+
+    Redundant brackets are no operation, so :func:`_check_depth` does not count them, but lark's
+    parser slows down faster than their number grows: 32,000 nested ``(`` took it seconds.
+    """
+    depth = 0
+    for index, char in enumerate(snippet.text):
+        if char in "([":
+            depth += 1
+            if depth > MAX_BRACKETS:
+                raise snippet.error(
+                    ScenarioSyntaxError, index, index + 1,
+                    f"expected an expression nesting at most {MAX_DEPTH} operations, and brackets at most "
+                    f"{MAX_BRACKETS} deep; got deeper brackets; split it into definitions under 'define:'",
+                )
+        elif char in ")]":
+            depth -= 1
 
 
 def _check_depth(snippet: Snippet, tree: Tree) -> None:

@@ -46,8 +46,9 @@ class _View:
     offsets: np.ndarray  # the buffer offset of each byte, in console order
     snapshot: int | None
     search: Any
-    last: np.ndarray
-    changed: np.ndarray
+    last: np.ndarray  # the bytes after the newest frame
+    before: np.ndarray  # and after the frame before it
+    changed: np.ndarray  # which changed in any frame since the last push
     countdown: int = 0
     remove: Any = None
 
@@ -88,24 +89,26 @@ def _bytes(session: Any, buffer: int, offsets: np.ndarray) -> np.ndarray:
     return np.frombuffer(session.search.emulator.space.buffers[buffer], dtype=np.uint8)[offsets]
 
 
-def _differs(session: Any, view: _View, now: np.ndarray) -> list[int] | None:
-    if view.snapshot is None or view.snapshot >= len(session.search.engine.snapshots):
+def _differs(session: Any, view: _View, now: np.ndarray, snapshot: int | None) -> list[int] | None:
+    if snapshot is None or snapshot >= len(session.search.engine.snapshots):  # a new search has fewer
         return None
-    then = session.search.engine.snapshots[view.snapshot][view.position : view.position + view.length]
+    then = session.search.engine.snapshots[snapshot][view.position : view.position + view.length]
     return np.flatnonzero(then != now).tolist()
 
 
-def _report(session: Any, view: _View, now: np.ndarray) -> dict[str, Any]:
+def _report(
+    session: Any, view: _View, now: np.ndarray, changed: np.ndarray, snapshot: int | None
+) -> dict[str, Any]:
     return {
         "type": "ram",
         "start": view.start,
         "hex": session.search.layout.format(view.start),
         "length": view.length,
         "frame": session.frame,
-        "snapshot": view.snapshot,
+        "snapshot": snapshot,
         "values": now.tolist(),
-        "changed": np.flatnonzero(view.changed).tolist(),
-        "differs": _differs(session, view, now),
+        "changed": np.flatnonzero(changed).tolist(),
+        "differs": _differs(session, view, now, snapshot),
     }
 
 
@@ -116,31 +119,35 @@ def _on_frame(session: Any) -> None:
         return
     now = _bytes(session, view.buffer, view.offsets)
     view.changed |= now != view.last
-    view.last = now
+    view.before, view.last = view.last, now
     view.countdown -= 1
     if view.countdown <= 0:
         view.countdown = PUSH_EVERY
-        session.publish(_report(session, view, now))
+        session.publish(_report(session, view, now, view.changed, view.snapshot))
         view.changed[:] = False
 
 
 def _view(session: Any, start: object, length: object, snapshot: object, watch: bool) -> dict[str, Any]:
+    """The region now; with ``watch``, watched from now on. ``changed``: what the last frame changed."""
     begin, count, position, index = _region(session, start, length, snapshot)
     buffer, offsets = _where(session, begin, count)
     now = _bytes(session, buffer, offsets)
     old = _views.get(session)
     same = old is not None and old.search is session.search and (old.start, old.length) == (begin, count)
-    view = _View(begin, count, position, buffer, offsets, index, session.search, now, np.zeros(count, dtype=bool))
-    if same:  # what changed since the last frame the hook saw
-        view.changed = old.changed | (now != old.last)
-        view.last, view.remove = old.last, old.remove
-    elif old is not None:
-        view.remove = old.remove
-    if watch or same:
+    if same:  # the hook saw the frames: what the last one changed (and any poke since)
+        view = old
+        changed = now != view.before
+        if watch:
+            view.snapshot = index
+    else:  # no frame seen yet: nothing known to have changed
+        view = _View(begin, count, position, buffer, offsets, index, session.search, now, now,
+                     np.zeros(count, dtype=bool), remove=old.remove if old is not None else None)
+        changed = view.changed
+    if watch and not same:
         _views[session] = view
-        if view.remove is None:
-            view.remove = session.on_frame(_on_frame)
-    return _report(session, view, now)
+    if watch and view.remove is None:
+        view.remove = session.on_frame(_on_frame)
+    return _report(session, view, now, changed, index)
 
 
 def _unwatch(session: Any) -> dict[str, Any]:

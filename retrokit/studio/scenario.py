@@ -25,6 +25,7 @@ Routes (under ``/api``): ``GET /scenario?name=``, ``POST /scenario/compile``
 
 from __future__ import annotations
 
+import asyncio
 import collections
 import weakref
 from dataclasses import dataclass, field
@@ -39,7 +40,7 @@ from retrokit import paths
 from retrokit.data.names import check_state_name
 from retrokit.dsl.scenario import Run, Scenario, scenario_from_text
 from retrokit.dsl.source import read_source
-from retrokit.errors import DataFileError, InvalidArgumentError, ScenarioError, ScenarioRuntimeError, shown
+from retrokit.errors import DataFileError, ScenarioError, ScenarioRuntimeError
 from retrokit.studio.app import session_of
 from retrokit.studio.fields import field_reader
 from retrokit.studio.search import PUSH_EVERY
@@ -57,34 +58,67 @@ def _name(value: object, game: Any) -> str:
     return check_state_name(value, what="scenario name")
 
 
-def _target(search: Any, name: str) -> Path:
-    """Where scenario ``name`` is saved: beside the game's own game.yaml (never inside an installed package)."""
-    return search.default_game_file().parent / f"{name}.yaml"
-
-
 def draft_path(game: str, name: str) -> Path:
     """The draft of a game's scenario in the data folder."""
     return paths.data_dir() / "studio" / "drafts" / game / f"{name}.yaml"
+
+
+@dataclass(frozen=True)
+class Where:
+    """A scenario of the session's game: its name, its file, where it is saved, and its draft."""
+
+    game: Any
+    name: str
+    path: Path | None  # the file the game reads it from, if it has one
+    target: Path | None  # where saving writes it: beside the game's own game.yaml
+    why_not: str | None  # why it cannot be saved (a game inside an installed package)
+
+    @property
+    def source(self) -> str:
+        """What its errors call it: the file saving writes (or reads)."""
+        return str(self.target or self.path or f"{self.name}.yaml")
+
+    @property
+    def draft(self) -> Path:
+        return draft_path(self.game.name, self.name)
+
+
+def where(session: Any, name: object) -> Where:
+    """Scenario ``name`` (the default one if none) of the session's game (emulator thread: the game may change)."""
+    search = session.search
+    game = search.game
+    name = _name(name, game)
+    try:
+        target, why_not = search.default_game_file().parent / f"{name}.yaml", None
+    except DataFileError as exc:  # a shipped game: its scenarios compile and run, and are not saved
+        target, why_not = None, str(exc)
+    return Where(game, name, game.scenarios.get(name), target, why_not)
 
 
 def _read_text(path: Path) -> str:
     return read_source(path).text
 
 
-def compile_text(search: Any, name: str, text: object) -> Scenario:
-    """Compile ``text`` as scenario ``name`` of the game, its errors located in the file it is saved to.
+def compile_text(place: Where, text: str) -> Scenario:
+    """Compile ``text`` as scenario ``place``, its errors located in the file it is saved to.
+
+    It runs off the emulator thread: it reads no RAM, and hostile text may take a second or two.
 
     Raises:
         ScenarioError: It does not compile (with ``line`` and ``column`` where the language gives them).
     """
-    if not isinstance(text, str):
-        raise InvalidArgumentError(f"Expected the scenario's text as a string; got {shown(text)}.")
-    game = search.game
-    try:
-        source = str(_target(search, name))
-    except DataFileError:  # a game the studio cannot write to still compiles, under its own file's name
-        source = str(game.scenarios.get(name, f"{name}.yaml"))
-    return scenario_from_text(text, list(game.fields), source=source, name=name, game_dir=game.folders[0])
+    game = place.game
+    return scenario_from_text(text, list(game.fields), source=place.source, name=place.name, game_dir=game.folders[0])
+
+
+def _compile_saved(place: Where) -> Scenario:
+    """The scenario as its file holds it (a Gym Retro ``.json`` one too)."""
+    from retrokit.dsl.scenario import load_scenario
+
+    path = place.game.scenario_path(place.name)  # none of that name: UnknownNameError, with a did-you-mean
+    if path.suffix.lower() == ".json":
+        return load_scenario(path, list(place.game.fields), game_dir=path.parent, name=place.name)
+    return compile_text(place, _read_text(path))
 
 
 def error_json(exc: Exception) -> dict[str, Any]:
@@ -168,19 +202,7 @@ def _on_frame(session: Any) -> None:
         session.publish(live.report(_OVERLAP))
 
 
-def _go_live(session: Any, name: object, text: object) -> dict[str, Any]:
-    search = session.search
-    name = _name(name, search.game)
-    if text is None:
-        path = search.game.scenario_path(name)
-        if path.suffix.lower() != ".yaml":
-            from retrokit.dsl.scenario import load_scenario
-
-            scenario = load_scenario(path, list(search.game.fields), game_dir=path.parent, name=name)
-        else:
-            scenario = compile_text(search, name, _read_text(path))
-    else:
-        scenario = compile_text(search, name, text)
+def _go_live(session: Any, name: str, scenario: Scenario) -> dict[str, Any]:
     old = _live.get(session)
     live = _Live(name, scenario, remove=old.remove if old is not None else None)
     live.restart(session)
@@ -205,106 +227,109 @@ def _live_report(session: Any) -> dict[str, Any]:
 # --- the text, drafts and saving -------------------------------------------------------------------
 
 
-def _get(session: Any, name: object) -> dict[str, Any]:
-    search = session.search
-    game = search.game
-    name = _name(name, game)
-    path = game.scenarios.get(name)
-    text = _read_text(path) if path is not None else ""
-    draft = draft_path(game.name, name)
-    kept = _read_text(draft) if draft.is_file() else None
-    try:
-        target, writable = str(_target(search, name)), True
-    except DataFileError as exc:  # a shipped game: shown, not saved
-        target, writable = str(exc), False
+def _get(place: Where) -> dict[str, Any]:
+    text = _read_text(place.path) if place.path is not None else ""
+    kept = _read_text(place.draft) if place.draft.is_file() else None
     return {
-        "name": name,
-        "names": list(game.scenarios),
-        "path": str(path) if path is not None else None,
+        "name": place.name,
+        "names": list(place.game.scenarios),
+        "path": str(place.path) if place.path is not None else None,
         "text": text,
         "draft": kept if kept != text else None,
-        "save_to": target if writable else None,
-        "writable": writable,
-        "why_not": None if writable else target,
+        "save_to": str(place.target) if place.target is not None else None,
+        "writable": place.target is not None,
+        "why_not": place.why_not,
     }
 
 
-def _compile(session: Any, name: object, text: object) -> dict[str, Any]:
-    name = _name(name, session.search.game)
+def _checked(place: Where, text: str) -> dict[str, Any]:
+    """Compile ``text``: ``{"ok": true, ...}``, or ``{"ok": false, ...}`` with the error where it is."""
     try:
-        scenario = compile_text(session.search, name, text)
+        scenario = compile_text(place, text)
     except ScenarioError as exc:
         return {"ok": False, **error_json(exc)}
-    return {"ok": True, "name": name, "players": scenario.players, "fields": list(scenario.fields)}
+    return {"ok": True, "name": place.name, "players": scenario.players, "fields": list(scenario.fields)}
 
 
-def _put_draft(session: Any, name: object, text: object) -> dict[str, Any]:
-    name = _name(name, session.search.game)
-    if not isinstance(text, str):
-        raise InvalidArgumentError(f"Expected the scenario's text as a string; got {shown(text)}.")
-    path = draft_path(session.search.game.name, name)
-    paths.ensure_folder(path.parent, "the studio's scenario drafts")
-    paths.atomic_write(path, text.encode("utf-8"), overwrite=True)  # the studio's own file, replaced at each edit
-    return {"draft": str(path), **_compile(session, name, text)}
+def _put_draft(place: Where, text: str) -> dict[str, Any]:
+    paths.ensure_folder(place.draft.parent, "the studio's scenario drafts")
+    paths.atomic_write(place.draft, text.encode("utf-8"), overwrite=True)  # the studio's own file, replaced at each edit
+    return {"draft": str(place.draft), **_checked(place, text)}
 
 
-def _drop_draft(session: Any, name: object) -> dict[str, Any]:
-    name = _name(name, session.search.game)
-    path = draft_path(session.search.game.name, name)
-    path.unlink(missing_ok=True)
-    return {"draft": None, "name": name}
+def _save(place: Where, text: str) -> Scenario:
+    """Compile, then write the file and drop the draft; nothing is written unless it compiles.
+
+    Raises:
+        DataFileError: The game's folder is inside an installed package.
+        ScenarioError: The text does not compile.
+    """
+    if place.target is None:
+        raise DataFileError(place.why_not)
+    scenario = compile_text(place, text)
+    paths.atomic_write(place.target, text.encode("utf-8"), overwrite=True)  # the user asked to save over it
+    place.draft.unlink(missing_ok=True)
+    return scenario
 
 
-def _save(session: Any, name: object, text: object) -> dict[str, Any]:
-    search = session.search
-    name = _name(name, search.game)
-    scenario = compile_text(search, name, text)  # raises where it does not compile: nothing written
-    target = _target(search, name)
-    paths.atomic_write(target, text.encode("utf-8"), overwrite=True)  # the user asked to save over it
-    draft_path(search.game.name, name).unlink(missing_ok=True)
-    search.reload_game()  # its scenarios are listed afresh (a new name is one now)
+def _saved(session: Any, place: Where, scenario: Scenario) -> None:
+    """After a save: the game's scenarios listed afresh, and the live one replaced if it is this one."""
+    session.search.reload_game()
     live = _live.get(session)
-    if live is not None and live.name == name:
-        _go_live(session, name, None)
-    return {"saved": str(target), "name": name, "players": scenario.players}
+    if live is not None and live.name == place.name:
+        _go_live(session, place.name, scenario)
+
+
+async def _text(request: Request) -> tuple[Where, str]:
+    body = await json_body(request)
+    text, name = expect(body, "text", str), expect(body, "name", str, None)
+    return await session_of(request).call(where, name), text
 
 
 async def get(request: Request) -> JSONResponse:
-    return JSONResponse(await session_of(request).call(_get, request.query_params.get("name")))
+    place = await session_of(request).call(where, request.query_params.get("name"))
+    return JSONResponse(await asyncio.to_thread(_get, place))
 
 
 async def compile_(request: Request) -> JSONResponse:
-    body = await json_body(request)
-    text, name = expect(body, "text", str), expect(body, "name", str, None)
-    return JSONResponse(await session_of(request).call(_compile, name, text))
+    place, text = await _text(request)
+    return JSONResponse(await asyncio.to_thread(_checked, place, text))
 
 
 async def put_draft(request: Request) -> JSONResponse:
-    body = await json_body(request)
-    text, name = expect(body, "text", str), expect(body, "name", str, None)
-    return JSONResponse(await session_of(request).call(_put_draft, name, text))
+    place, text = await _text(request)
+    return JSONResponse(await asyncio.to_thread(_put_draft, place, text))
 
 
 async def drop_draft(request: Request) -> JSONResponse:
-    return JSONResponse(await session_of(request).call(_drop_draft, request.query_params.get("name")))
+    place = await session_of(request).call(where, request.query_params.get("name"))
+    place.draft.unlink(missing_ok=True)
+    return JSONResponse({"draft": None, "name": place.name})
 
 
 async def save(request: Request) -> JSONResponse:
-    body = await json_body(request)
-    text, name = expect(body, "text", str), expect(body, "name", str, None)
+    place, text = await _text(request)
     try:
-        return JSONResponse(await session_of(request).call(_save, name, text))
+        scenario = await asyncio.to_thread(_save, place, text)
     except ScenarioError as exc:
         return JSONResponse(error_json(exc), status_code=400)
+    await session_of(request).call(_saved, place, scenario)
+    return JSONResponse({"saved": str(place.target), "name": place.name, "players": scenario.players})
 
 
 async def live_start(request: Request) -> JSONResponse:
     body = await json_body(request)
     text, name = expect(body, "text", str, None), expect(body, "name", str, None)
+    session = session_of(request)
+    place = await session.call(where, name)
     try:
-        return JSONResponse(await session_of(request).call(_go_live, name, text))
+        if text is None:
+            scenario = await asyncio.to_thread(_compile_saved, place)
+        else:
+            scenario = await asyncio.to_thread(compile_text, place, text)
     except ScenarioError as exc:
         return JSONResponse(error_json(exc), status_code=400)
+    return JSONResponse(await session.call(_go_live, place.name, scenario))
 
 
 async def live_get(request: Request) -> JSONResponse:

@@ -1,0 +1,423 @@
+"""The studio's tools (RAM search, watch, scenario, click to find, RAM view) on a real Dasher session.
+
+Each test runs the studio's application through Starlette's TestClient on a
+copy of Dasher's folder (anything written lands there) and a data folder of
+its own (scenario drafts), with the session paused so that only what a test
+does moves the game.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+import time
+from pathlib import Path
+
+import pytest
+from starlette.testclient import TestClient
+
+from retrokit import paths
+from retrokit.studio.app import create_app
+from retrokit.studio.session import Session
+
+DASHER = Path(__file__).resolve().parent.parent / "games" / "Dasher-Genesis"
+TOKEN, PORT = "tools-token", 8765
+LIVES, P1_X = 0xFF002B, 0xFF0020
+
+
+@pytest.fixture(scope="module")
+def data(tmp_path_factory) -> Path:
+    """A data folder of the module's own, using the installed data folder's cores (state probes kept across tests)."""
+    folder = tmp_path_factory.mktemp("data")
+    cores = paths.data_dir() / "cores"
+    if cores.is_dir():
+        (folder / "cores").symlink_to(cores)
+    return folder
+
+
+@pytest.fixture
+def game(tmp_path, data, monkeypatch) -> Path:
+    """A copy of Dasher's folder, found first by name; returns its game.yaml."""
+    games = tmp_path / "games"
+    shutil.copytree(DASHER, games / "Dasher-Genesis", ignore=shutil.ignore_patterns("movies"))
+    monkeypatch.setenv(paths.GAMES_ENV, str(games))
+    monkeypatch.setenv(paths.DATA_ENV, str(data))
+    return games / "Dasher-Genesis" / "game.yaml"
+
+
+def open_studio(session: Session) -> TestClient:
+    session.paused = True  # only the tests move the game
+    app = create_app(session, token=TOKEN, port=PORT)
+    return TestClient(app, base_url=f"http://127.0.0.1:{PORT}", headers={"X-Retrokit-Token": TOKEN})
+
+
+@pytest.fixture
+def client(game):
+    with open_studio(Session("Dasher-Genesis", "Zone1.Act1")) as client:
+        yield client
+
+
+def ok(response) -> dict:
+    assert response.status_code in (200, 202), response.text
+    return response.json()
+
+
+def refused(response, status: int = 400) -> dict:
+    """A 4xx JSON error of one line (and a RetrokitError's class)."""
+    assert response.status_code == status, response.text
+    body = response.json()
+    assert body["error"] and "\n" not in body["error"] and body["kind"].endswith("Error"), body
+    return body
+
+
+def step(client: TestClient, frames: int, buttons: list[str] | None = None) -> None:
+    ok(client.post("/api/play/buttons", json={"buttons": buttons or []}))
+    ok(client.post("/api/play/step", json={"frames": frames}))
+    ok(client.post("/api/play/buttons", json={"buttons": []}))
+
+
+def fields(client: TestClient) -> dict[str, dict]:
+    return {row["name"]: row for row in ok(client.get("/api/fields"))["fields"]}
+
+
+# --- RAM search -----------------------------------------------------------------------------------
+
+
+def test_search_finds_lives_and_adds_it_as_a_field(client, game):
+    ok(client.post("/api/search/new"))
+    threes = ok(client.post("/api/search/filter", json={"op": "equal", "value": 3}))["count"]
+    ok(client.post("/api/search/poke", json={"address": "0xFF002B", "value": 2}))  # a life lost
+    ok(client.post("/api/search/snapshot", json={"label": "a life lost"}))
+    found = ok(client.post("/api/search/filter", json={"op": "decreased"}))
+    assert found["filter"] == "decreased --than previous" and found["snapshots"][-1] == "a life lost"
+    assert found["before"] == threes > found["count"]
+    rows = ok(client.get("/api/search/candidates?limit=50"))["rows"]
+    lives = next(r for r in rows if r["address"] == LIVES and r["type"] == "|u1")
+    assert lives["values"] == [3, 2] and lives["value"] == 2 and lives["hex"] == "0xFF002B"
+    assert "|i1" in lives["also"]  # the types that read the same byte alike are one row
+
+    undone = ok(client.post("/api/search/undo"))
+    assert undone["undone"] == "decreased --than previous" and undone["count"] == threes and undone["can_redo"]
+    assert ok(client.post("/api/search/redo"))["count"] == found["count"]
+    refused(client.post("/api/search/redo"))  # nothing left to redo
+
+    added = ok(client.post("/api/search/field", json={"name": "lives_found", "address": LIVES, "type": "|u1",
+                                                       "range": [0, 9]}))
+    assert added["path"] == str(game.resolve()) and added["range"] == [0, 9]
+    assert re.search(r'\n  lives_found: +\{address: 0xFF002B, type: "\|u1", range: \[0, 9\]\}\n', game.read_text())
+    assert fields(client)["lives_found"]["value"] == 2  # the session reads the new field at once
+    again = refused(client.post("/api/search/field", json={"name": "lives_found", "address": LIVES, "type": "|u1"}),
+                    409)
+    assert again["kind"] == "FileConflictError"
+
+
+def test_filters_take_every_form_of_than_and_scales(client):
+    ok(client.post("/api/search/new", json={"types": ["|u1", ">u2"]}))
+    scaled = ok(client.post("/api/search/filter", json={"op": "equal", "value": 30}))  # 3 lives, shown x10
+    rows = ok(client.get("/api/search/candidates?limit=500"))["rows"]
+    assert any(r["address"] == LIVES and "x10" in r["scales"] for r in rows), scaled
+    ok(client.post("/api/search/new", json={"types": ["|u1"]}))
+    step(client, 20, ["RIGHT"])
+    ok(client.post("/api/search/snapshot"))
+    step(client, 20, ["RIGHT"])
+    ok(client.post("/api/search/snapshot"))
+    status = ok(client.get("/api/search"))
+    assert len(status["snapshots"]) == 3 and status["types"] == ["|u1"]
+    for than in ("first", 0, "1", "previous"):
+        ok(client.post("/api/search/filter", json={"op": "increased", "than": than}))
+    ok(client.post("/api/search/filter", json={"op": "greater", "value": 1, "than": "changes"}))
+    ok(client.post("/api/search/filter", json={"op": "not-equal", "than": "0xFF0004"}))
+    rows = ok(client.get("/api/search/candidates"))["rows"]
+    assert P1_X + 1 in {r["address"] for r in rows}  # the player's x ran right twice
+    bad = refused(client.post("/api/search/filter", json={"op": "changed", "than": "prevous"}))
+    assert "Did you mean 'previous'?" in bad["error"]
+    refused(client.post("/api/search/filter", json={"op": "increased", "than": "7"}))  # no snapshot 7
+
+
+def test_candidate_values_are_pushed_live_over_the_socket(client):
+    ok(client.post("/api/search/new", json={"types": ["|u1"]}))
+    ok(client.post("/api/search/filter", json={"op": "equal", "value": 3}))
+    assert any(r["address"] == LIVES for r in ok(client.get("/api/search/candidates?limit=100"))["rows"])
+    ok(client.post("/api/search/poke", json={"address": LIVES, "value": 7}))
+    url = f"ws://127.0.0.1:{PORT}/ws?token={TOKEN}"
+    with client.websocket_connect(url, headers={"Origin": f"http://127.0.0.1:{PORT}"}) as ws:
+        ok(client.post("/api/play/step", json={"frames": 6}))
+        values = None
+        for _ in range(200):
+            message = ws.receive()
+            if message.get("text") and '"candidates"' in message["text"]:
+                import json
+
+                values = {(a, t): v for a, t, v in json.loads(message["text"])["values"]}
+                break
+        assert values is not None and values[(LIVES, "|u1")] == 7
+
+
+# --- watch and field edits ----------------------------------------------------------------------
+
+
+def test_watch_lists_every_field_with_its_value_as_the_env_reads_it(client):
+    import retrokit
+
+    rows = fields(client)
+    env = retrokit.make("Dasher-Genesis", "Zone1.Act1")
+    try:
+        _, info = env.reset()
+    finally:
+        env.close()
+    assert set(rows) == set(info) - {"rewards", "dones"}
+    assert rows["p1_lives"]["value"] == 3 and rows["p1_lives"]["range"] == [0, 9]
+    assert rows["p1_x"] == {**rows["p1_x"], "hex": "0xFF0020", "type": ">i2", "value": info["p1_x"]}
+
+
+def test_a_field_is_edited_in_place_and_the_session_reads_it_again(client, game):
+    before = game.read_text().splitlines()
+    edited = ok(client.patch("/api/fields/p1_lives", json={"range": [0, 5]}))
+    assert edited["range"] == [0, 5] and edited["type"] == "|u1"
+    ok(client.patch("/api/fields/ring_count", json={"address": "0xFF00C2", "type": "|i1"}))
+    after = game.read_text().splitlines()
+    changed = sorted(b for a, b in zip(before, after) if a != b)
+    assert len(before) == len(after) and len(changed) == 2, changed
+    assert changed[0] == '  p1_lives:    {address: 0xFF002B, type: "|u1", range: [0, 5]}'
+    assert changed[1].startswith('  ring_count:  {address: 0xFF00C2, type: "|i1"}')
+    rows = fields(client)
+    assert rows["p1_lives"]["range"] == [0, 5] and rows["ring_count"]["hex"] == "0xFF00C2"
+    ok(client.patch("/api/fields/p1_lives", json={"range": None}))  # a range can be dropped
+    assert "range" not in next(line for line in game.read_text().splitlines() if "p1_lives:" in line)
+
+    text = game.read_text()
+    unknown = refused(client.patch("/api/fields/p1_livs", json={"range": [0, 9]}), 404)
+    assert "Did you mean 'p1_lives'?" in unknown["error"]
+    refused(client.patch("/api/fields/p1_lives", json={"range": [9, 0]}))
+    refused(client.patch("/api/fields/p1_lives", json={"type": "|x9"}))
+    refused(client.patch("/api/fields/p1_lives", json={"address": "0x10"}))  # outside RAM
+    refused(client.patch("/api/fields/p1_lives", json={"colour": "red"}))
+    assert game.read_text() == text  # a refused edit writes nothing
+
+
+# --- scenario -----------------------------------------------------------------------------------
+
+
+BROKEN = "description: a typo\ndefine:\n  gone: p1_lives < initial(p1_lives)\nreward: delta(p1_xx)\ndone: gone\n"
+
+
+def test_compile_errors_carry_the_line_and_column_the_language_reports(client, game, tmp_path):
+    from retrokit.dsl.scenario import load_scenario
+    from retrokit.errors import ScenarioCompileError
+
+    result = ok(client.post("/api/scenario/compile", json={"text": BROKEN}))
+    path = game.parent / "scenario.yaml"
+    (tmp_path / "copy").mkdir()
+    file = tmp_path / "copy" / "scenario.yaml"
+    file.write_text(BROKEN)
+    with pytest.raises(ScenarioCompileError) as raised:
+        load_scenario(file, list(fields(client)))
+    assert (result["ok"], result["line"], result["column"]) == (False, raised.value.line, raised.value.column) == (
+        False, 4, 15)
+    assert result["message"] == str(raised.value).replace(str(file), str(path.resolve()))
+    assert result["error"] == result["message"].splitlines()[0] and "Did you mean 'p1_x'?" in result["error"]
+    syntax = ok(client.post("/api/scenario/compile", json={"text": "reward: (p1_x +\n"}))
+    assert (syntax["kind"], syntax["line"], syntax["column"]) == ("ScenarioSyntaxError", 1, 16)
+    good = ok(client.post("/api/scenario/compile", json={"text": "reward: delta(p1_x)\n"}))
+    assert good == {"ok": True, "name": "scenario", "players": 1, "fields": ["p1_x"]}
+
+
+def test_the_draft_survives_a_restart_and_only_compiling_text_is_saved(game, data):
+    scenario = game.parent / "scenario.yaml"
+    saved = scenario.read_text()
+    with open_studio(Session("Dasher-Genesis", "Zone1.Act1")) as client:
+        assert ok(client.get("/api/scenario"))["draft"] is None
+        kept = ok(client.put("/api/scenario/draft", json={"text": BROKEN}))
+        assert kept["ok"] is False and kept["line"] == 4 and Path(kept["draft"]).is_relative_to(data)
+    with open_studio(Session("Dasher-Genesis", "Zone1.Act1")) as client:  # a new server, as after Ctrl-C
+        shown = ok(client.get("/api/scenario"))
+        assert shown["text"] == saved and shown["draft"] == BROKEN and shown["writable"]
+        error = refused(client.post("/api/scenario/save", json={"text": BROKEN}))
+        assert (error["line"], error["column"], error["kind"]) == (4, 15, "ScenarioCompileError")
+        assert scenario.read_text() == saved and ok(client.get("/api/scenario"))["draft"] == BROKEN
+        fixed = BROKEN.replace("p1_xx", "p1_x")
+        assert ok(client.post("/api/scenario/save", json={"text": fixed}))["saved"] == str(scenario.resolve())
+        assert scenario.read_text() == fixed
+        assert ok(client.get("/api/scenario"))["draft"] is None
+        made = ok(client.post("/api/scenario/save", json={"name": "speedrun", "text": "reward: delta(p1_x)\n"}))
+        assert made["saved"] == str((game.parent / "speedrun.yaml").resolve())
+        assert "speedrun" in ok(client.get("/api/scenario?name=speedrun"))["names"]
+        ok(client.put("/api/scenario/draft", json={"name": "speedrun", "text": "reward: 1\n"}))
+        assert ok(client.delete("/api/scenario/draft?name=speedrun"))["draft"] is None
+        assert ok(client.get("/api/scenario?name=speedrun"))["draft"] is None
+
+
+def test_live_reward_is_the_scenarios_every_frame(client):
+    text = "reward: p1_x - prev(p1_x)\ndone: p1_x >= initial(p1_x) + 40\n"
+    live = ok(client.post("/api/scenario/live", json={"text": text}))
+    assert live["players"] == 1 and live["total"] == 0 and not live["done"]
+    start = fields(client)["p1_x"]["value"]
+    step(client, 30, ["RIGHT"])
+    report = ok(client.get("/api/scenario/live"))
+    moved = fields(client)["p1_x"]["value"] - start
+    assert len(report["samples"]) == 30 and report["total"] == sum(s[1] for s in report["samples"]) == moved > 0
+    assert [s[0] for s in report["samples"]] == list(range(report["frame"] - 29, report["frame"] + 1))
+    step(client, 90, ["RIGHT"])
+    report = ok(client.get("/api/scenario/live"))
+    assert report["done"] and report["total"] >= 40 and report["samples"][-1][3] is True
+    ok(client.post("/api/play/reset", json={"state": "Zone1.Act1"}))  # a state loaded: a new episode
+    step(client, 2)
+    report = ok(client.get("/api/scenario/live"))
+    assert not report["done"] and report["total"] == 0
+    assert ok(client.delete("/api/scenario/live")) == {"live": False}
+    assert ok(client.get("/api/scenario/live")) == {"live": False}
+    error = refused(client.post("/api/scenario/live", json={"text": "reward: nope\n"}))
+    assert (error["line"], error["column"]) == (1, 9)
+
+
+def test_the_games_own_scenario_goes_live_by_name(client):
+    live = ok(client.post("/api/scenario/live", json={}))
+    assert live["name"] == "scenario" and live["players"] == 2
+    step(client, 10, ["RIGHT"])
+    assert ok(client.get("/api/scenario/live"))["total"] > 0
+    refused(client.post("/api/scenario/live", json={"name": "nosuch"}), 404)
+
+
+# --- click to find ------------------------------------------------------------------------------
+
+
+def run_job(client: TestClient, body: dict, timeout: float = 60.0) -> dict:
+    ok(client.post("/api/clickfind", json=body))
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        job = ok(client.get("/api/clickfind"))
+        if job["finished"]:
+            return job
+        time.sleep(0.05)
+    raise AssertionError(f"click to find did not finish in {timeout} s: {job}")
+
+
+SPAWN_BLINK = 70  # frames: a player blinks for its first 60 (tools/testcart/src/player.c SPAWN_INVULN)
+
+
+def test_click_on_the_player_finds_its_position_without_disturbing_the_game(client):
+    step(client, SPAWN_BLINK)
+    values = fields(client)
+    assert values["p1_invuln"]["value"] == 0
+    x, y = values["p1_x"]["value"] - values["camera_x"]["value"], values["p1_y"]["value"] - 8  # the sprite's middle
+    session = client.app.state.session
+    before = session.call_blocking(lambda s: s.search.emulator.get_state())
+    job = run_job(client, {"x": x, "y": y, "region": {"start": "0xFF0020", "length": 32}})
+    assert job["done"] == job["total"] == 32 and not job["error"]
+    found = {hit["address"]: hit for hit in job["hits"]}
+    assert P1_X in found and found[P1_X]["fields"] == ["p1_x"]  # its high byte moves it off the point
+    assert LIVES not in found  # the HUD's lives are drawn elsewhere
+    assert session.call_blocking(lambda s: s.search.emulator.get_state()) == before  # the game is where it was
+
+
+def screen(client: TestClient):
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    return np.asarray(Image.open(io.BytesIO(client.get("/api/screen.png").content)).convert("RGB"))
+
+
+def test_click_on_the_hud_finds_lives_among_the_candidates(client):
+    import numpy as np
+
+    step(client, SPAWN_BLINK + 2)
+    shown = screen(client)
+    ok(client.post("/api/play/reset", json={"state": "Zone1.Act1"}))
+    step(client, SPAWN_BLINK)
+    ok(client.post("/api/search/poke", json={"address": LIVES, "value": 4}))  # as the job's first try will
+    step(client, 2)
+    y, x = np.argwhere((screen(client) != shown).any(axis=-1))[0]  # a pixel where the HUD's 3 and 4 differ
+    ok(client.post("/api/play/reset", json={"state": "Zone1.Act1"}))
+    step(client, SPAWN_BLINK)
+    ok(client.post("/api/search/new", json={"types": ["|u1"]}))
+    ok(client.post("/api/search/filter", json={"op": "equal", "value": 3}))
+    job = run_job(client, {"x": int(x), "y": int(y), "region": "candidates"})
+    assert job["total"] == ok(client.get("/api/search"))["count"] and not job["error"]
+    assert LIVES in {hit["address"] for hit in job["hits"]}
+    assert next(h for h in job["hits"] if h["address"] == LIVES)["fields"] == ["p1_lives"]
+
+
+def test_a_job_is_capped_and_cancelled(client):
+    big = refused(client.post("/api/clickfind", json={"x": 10, "y": 10, "region": {"start": "0xFF0000",
+                                                                                      "length": 65536}}))
+    assert "at most 8,192 cells" in big["error"]
+    refused(client.post("/api/clickfind", json={"x": 400, "y": 10, "region": {"start": "0xFF0000"}}))
+    refused(client.post("/api/clickfind", json={"x": 10, "y": 10, "region": {"start": "0x10", "length": 4}}))
+    refused(client.post("/api/clickfind", json={"x": 10, "y": 10, "region": "everything"}))
+    ok(client.post("/api/clickfind", json={"x": 10, "y": 10, "region": {"start": "0xFF0000", "length": 8192}}))
+    cancelled = ok(client.post("/api/clickfind/cancel"))
+    assert cancelled["cancelled"] and cancelled["finished"]
+    time.sleep(0.2)
+    job = ok(client.get("/api/clickfind"))
+    assert job["done"] < job["total"] == 8192
+
+
+# --- RAM view -----------------------------------------------------------------------------------
+
+
+def test_ram_view_marks_what_changed_since_the_last_frame_and_a_snapshot(client):
+    ok(client.post("/api/search/new"))  # snapshot 0: now
+    view = ok(client.post("/api/ram/watch", json={"start": "0xFF0000", "length": 64, "snapshot": 0}))
+    assert view["hex"] == "0xFF0000" and len(view["values"]) == 64 and view["differs"] == []
+    ok(client.post("/api/search/poke", json={"address": "0xFF0030", "value": 99}))
+    step(client, 1)
+    view = ok(client.get("/api/ram?start=0xFF0000&length=64&snapshot=0"))
+    assert 7 in view["changed"]  # the frame counter's low byte (0xFF0004, >u4) changes every frame
+    assert {7, 0x30} <= set(view["differs"]) and view["values"][0x30] == 99
+    ok(client.delete("/api/ram/watch"))
+    refused(client.get("/api/ram?start=0xFF0000&length=100000"))
+    refused(client.get("/api/ram?start=0x10&length=4"))
+    refused(client.get("/api/ram?start=0xFF0000&length=4&snapshot=9"))
+
+
+# --- hostile input ------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("method", "url", "body", "status"),
+    [
+        ("post", "/api/search/filter", {"op": 3}, 400),
+        ("post", "/api/search/filter", {"op": "equal", "value": "three"}, 400),
+        ("post", "/api/search/filter", {"op": "equal", "value": 3, "than": "previous"}, 400),
+        ("post", "/api/search/filter", {"op": "equal", "than": ["x"]}, 400),
+        ("post", "/api/search/filter", {"op": "greater", "than": "0xFFFFFFFFFF"}, 400),
+        ("post", "/api/search/new", {"types": ["|q7"]}, 400),
+        ("post", "/api/search/snapshot", {"label": "x" * 1000}, 400),
+        ("get", "/api/search/candidates?limit=0", None, 400),
+        ("get", "/api/search/candidates?limit=99999999999999999999", None, 400),
+        ("post", "/api/search/poke", {"address": "0xFF002B", "value": 300}, 400),
+        ("post", "/api/search/poke", {"address": -1, "value": 1}, 400),
+        ("post", "/api/search/poke", {"address": "0xFF002B", "value": 1, "type": "|zz"}, 400),
+        ("post", "/api/search/field", {"name": "9lives", "address": LIVES, "type": "|u1"}, 400),
+        ("post", "/api/search/field", {"name": "ok", "address": LIVES, "type": "|u1", "range": [0, 1, 2]}, 400),
+        ("patch", "/api/fields/p1_lives", {}, 400),
+        ("post", "/api/scenario/compile", {"text": 7}, 400),
+        ("post", "/api/scenario/compile", {"name": "../../etc/passwd", "text": "reward: 1"}, 400),
+        ("put", "/api/scenario/draft", {"name": "a/b", "text": "reward: 1"}, 400),
+        ("post", "/api/scenario/save", {"text": "reward: [1\n"}, 400),
+        ("post", "/api/scenario/save", {"text": "&a [*a]"}, 400),
+        ("get", "/api/scenario?name=..", None, 400),
+        ("post", "/api/clickfind", {"x": "left", "y": 0}, 400),
+        ("post", "/api/clickfind", {"x": 1, "y": 1, "frames": 1000}, 400),
+        ("get", "/api/clickfind", None, 400),
+        ("get", "/api/ram?start=nowhere", None, 400),
+        ("post", "/api/ram/watch", {"start": "0xFF0000", "length": -5}, 400),
+    ],
+    ids=lambda v: v if isinstance(v, str) else None,
+)
+def test_hostile_requests_get_one_line_json_errors(client, method, url, body, status):
+    response = getattr(client, method)(url, **({} if body is None else {"json": body}))
+    refused(response, status)
+
+
+def test_a_body_that_is_not_json_or_too_big_is_refused(client):
+    refused(client.post("/api/search/filter", content=b"{not json", headers={"Content-Type": "application/json"}))
+    refused(client.post("/api/search/filter", content=b"[1, 2]"))
+    huge = "reward: " + "1 + " * 400_000 + "1\n"
+    assert client.post("/api/scenario/compile", json={"text": huge}).status_code == 413
+    started = time.monotonic()
+    deep = ok(client.post("/api/scenario/compile", json={"text": "reward: " + "(" * 400_000 + "1" + ")" * 400_000}))
+    assert deep["ok"] is False and (deep["line"], deep["column"]) == (1, 1009) and "brackets" in deep["error"]
+    assert time.monotonic() - started < 30  # lark alone took minutes over so many

@@ -222,7 +222,8 @@ class Page:
 
     def field(self, name: str) -> str:
         """A field's live value in the Watch panel."""
-        return self.driver.find_element(By.CSS_SELECTOR, f'#watch-rows tr[data-field="{name}"] td.live').text
+        cell = self.driver.find_element(By.CSS_SELECTOR, f'#watch-rows tr[data-field="{name}"] td.live')
+        return cell.get_attribute("textContent")  # also while the Watch tab is hidden
 
     def shot(self, name: str) -> None:
         """Write docs/images/studio-NAME.png, only when asked (RETROKIT_SCREENSHOTS=1)."""
@@ -333,6 +334,18 @@ def test_find_the_lives_with_the_search_and_add_the_field(page, studio):
     page.tab("watch")
     until("the new field in Watch", lambda: page.field("lives") == "1")
 
+    # Undo and redo step through the filters; a poke shows in the live values.
+    page.tab("search")
+    page.click("search-undo")
+    assert page.said("Undid decreased --than previous: ").endswith(" candidates.")
+    assert page.text("search-count") != "12 candidates"
+    page.click("search-redo")
+    page.said("Redid decreased --than previous: 12 candidates.")
+    page.type("poke-value", "9")
+    page.click("poke")
+    page.said("Poked 0xFF002B (|u1): it now reads 9.")
+    until("9 lives in Watch", lambda: page.field("lives") == "9")
+
 
 def test_save_a_state(page, studio):
     from retrokit.data.states import read_state_file
@@ -389,6 +402,12 @@ def test_write_a_scenario_and_watch_its_reward_live(page, studio):
     assert not page.el("scenario-unsaved").get_attribute("hidden")
     page.shot("scenario-error")
 
+    # A message quoting the user's text is shown as text, never parsed as HTML.
+    type_scenario(page, "reward: delta(p1_x)\n<img src=x onerror=window.pwned=1>: 1\n")
+    until("the unknown key", lambda: "unknown key '<img src=x onerror=window.pwned=1>'" in page.text("scenario-errors"))
+    assert not page.driver.find_elements(By.CSS_SELECTOR, "#scenario-errors img")
+    assert page.driver.execute_script("return window.pwned === undefined")
+
     # Fixed: it compiles; the server keeps the unsaved edit as a draft, and a reload restores it.
     type_scenario(page, "description: run right\nreward: delta(p1_x)\n")
     until("it to compile", lambda: page.text("scenario-state").startswith("compiles"))
@@ -435,3 +454,107 @@ def test_validate(page):
     statuses = {row.get_attribute("class") for row in rows}
     assert statuses <= {"pass", "warn", "fail", "skip"} and "pass" in statuses
     page.shot("validate")
+
+
+# --- the other panels ------------------------------------------------------------------------------------
+
+
+def test_watch_edits_a_field(page, studio):
+    page.open("watch")
+    row = until("the field p1_deaths", lambda: page.driver.find_element(By.CSS_SELECTOR, '#watch-rows tr[data-field="p1_deaths"]'))
+    row.find_element(By.TAG_NAME, "button").click()
+    for label, value in (("range low", "0"), ("range high", "99")):
+        box = row.find_element(By.CSS_SELECTOR, f'input[aria-label="{label}"]')
+        box.clear()
+        box.send_keys(value)
+    row.find_element(By.CSS_SELECTOR, 'button[type="submit"]').click()
+    page.said("Wrote field p1_deaths (0xFF0038, |u1) into ")
+    fields = yaml.safe_load((studio.game / "game.yaml").read_text())["fields"]
+    assert fields["p1_deaths"] == {"address": 0xFF0038, "type": "|u1", "range": [0, 99]}
+    until("the row back, with its range", lambda: "[0, 99]" in page.driver.find_element(
+        By.CSS_SELECTOR, '#watch-rows tr[data-field="p1_deaths"]').text)  # fmt: skip
+
+
+def hud_lives_pixel() -> tuple[int, int]:
+    """A pixel of Dasher's HUD lives digit that a poke of the lives changes (3 -> 4), 2 frames after Zone1.Act1."""
+    import numpy as np
+
+    from retrokit.ramsearch import RamSearch
+
+    with RamSearch("Dasher-Genesis", "Zone1.Act1") as search:
+        start = search.emulator.get_state()
+        search.step([], 2)
+        before = search.screen().copy()
+        search.emulator.set_state(start)
+        search.poke(0xFF002B, 4)
+        search.step([], 2)
+        ys, xs = np.nonzero((search.screen() != before).any(axis=2))
+    return int(xs[0]), int(ys[0])
+
+
+def click_pixel(page: Page, x: int, y: int) -> None:
+    """Click the console pixel (x, y) of the screen, wherever and however large the canvas is drawn."""
+    canvas = page.el("screen")
+    size = canvas.size
+    scale = size["width"] / int(canvas.get_attribute("width"))
+    dx = round((x + 0.5) * scale - size["width"] / 2)  # Selenium's offsets are from the element's centre
+    dy = round((y + 0.5) * scale - size["height"] / 2)
+    ActionChains(page.driver).move_to_element_with_offset(canvas, dx, dy).click().perform()
+
+
+def test_click_to_find_names_the_lives_under_the_hud_digit(page):
+    x, y = hud_lives_pixel()
+    page.open("clickfind")
+    page.pause()
+    page.reset("Zone1.Act1")
+    page.el("cf-range").click()
+    page.type("cf-start", "0xFF0020")
+    page.type("cf-length", "32")
+    click_pixel(page, x, y)
+    page.said(f"Looking for what draws ({x}, {y}).")
+    until("the search to finish", lambda: "done in" in page.text("cf-state"))
+    assert page.text("cf-state").startswith("32 of 32 cells poked")
+    hits = {row.get_attribute("data-address"): row.text
+            for row in page.driver.find_elements(By.CSS_SELECTOR, "#cf-rows tr")}  # fmt: skip
+    assert "0xFF002B" in hits and "p1_lives" in hits["0xFF002B"]
+    assert page.text("current-state") == "Zone1.Act1" and page.paused()  # the game was not moved
+    page.shot("clickfind")
+
+
+def test_ram_view_highlights_what_changes(page):
+    page.open("ramview")
+    page.resume()
+    until("the grid", lambda: len(page.driver.find_elements(By.CSS_SELECTOR, "#ram-grid td")) == 256)
+    # Dasher's frame counter (0xFF0004-7) changes every frame: its low byte is highlighted.
+    until("a changed byte", lambda: "changed" in (page.driver.find_element(
+        By.CSS_SELECTOR, '#ram-grid td[title="0xFF0007"]').get_attribute("class") or ""))  # fmt: skip
+    cells = [td.text for td in page.driver.find_elements(By.CSS_SELECTOR, "#ram-grid td")[:16]]
+    assert all(len(c) == 2 and int(c, 16) >= 0 for c in cells)
+    page.shot("ramview")
+    page.pause()
+
+
+def test_record_and_replay_a_movie(page, studio):
+    from retrokit.movie import read_bk2
+
+    page.open("watch")
+    page.pause()
+    page.reset("Zone1.Act1")
+    page.click("record")
+    page.said("Recording the inputs from now")
+    page.advance(60, Keys.ARROW_RIGHT)
+    until("x after the run", lambda: page.field("p1_x"))
+    ran_to = page.field("p1_x")
+    page.type("movie-name", "run")
+    page.click("record")
+    line = page.said("Wrote 60 frames to ")
+    made = Path(line.removeprefix("Wrote 60 frames to ").rstrip("."))
+    assert made.name == "run.bk2" and made.is_relative_to(studio.game.parent.parent)
+    movie = read_bk2(made)
+    assert len(movie.frames) == 60 and movie.frames[10][0] != 0  # RIGHT held on pad 1
+
+    page.reset("Zone1.Act2")  # somewhere else: the replay goes back to the movie's start state
+    page.driver.find_element(By.CSS_SELECTOR, '#movie-rows tr[data-movie="run"] button').click()
+    page.said("Replaying run: 60 frames.")
+    until("the replay to end", lambda: page.text("run-state") != "replaying")
+    until("the same x as recorded", lambda: page.field("p1_x") == ran_to)

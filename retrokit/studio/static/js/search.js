@@ -139,6 +139,10 @@ async function poke() {
   if (value === null) throw new Error("Expected a value to poke.");
   const answer = await post("search/poke", { address: byId("poke-address").value.trim(), value,
     type: byId("poke-type").value.trim() || "|u1" });
+  // Live values come with frames; a paused game has none, so show the poked value and the fields now.
+  const cell = liveCells.get(key(answer.address, answer.type));
+  if (cell) cell.textContent = String(answer.value);
+  await refreshWatch();
   return `Poked ${hex(answer.address)} (${answer.type}): it now reads ${answer.value}.`;
 }
 

@@ -466,10 +466,38 @@ class RamSearch:
                 "Pass --force (force=True) to replace it, or choose another name."
             )
         if default:
-            if not game_file.exists():
-                atomic_write(game_file, self.game.info.source.read_bytes())
-            gamefile.set_default_state(game_file, name)
+            self._write_default_state(game_file, name)
         return outcome
+
+    def set_default_state(self, name: str) -> Path:
+        """Make state ``name`` the game's default (``states: default: NAME``), as ``save_state(default=True)`` does.
+
+        Returns:
+            The game.yaml written.
+
+        Raises:
+            InvalidArgumentError: ``name`` is not a valid state name.
+            StateNotFoundError: The game has no state of that name.
+            DataFileError: The game's data file is not a game.yaml.
+        """
+        from retrokit.data.integrate import target_folder
+
+        check_state_name(name)
+        self.game.state_path(name)  # one of its states, or a StateNotFoundError with a did-you-mean
+        game_file = target_folder(self.game) / "game.yaml"
+        if not game_file.exists():
+            self._check_own_game_yaml()
+        self._write_default_state(game_file, name)
+        return game_file
+
+    def _write_default_state(self, game_file: Path, name: str) -> None:
+        if not game_file.exists():
+            atomic_write(game_file, self.game.info.source.read_bytes())
+        gamefile.set_default_state(game_file, name)
+
+    def restart_inputs(self) -> None:
+        """Begin the inputs played afresh from now, so :meth:`movie` records from this moment (a movie's start)."""
+        self._restart()
 
     def _check_own_game_yaml(self) -> None:
         if self.game.info.source.name != "game.yaml":

@@ -36,7 +36,7 @@ from retrokit import errors
 from retrokit.studio.security import Guard
 from retrokit.studio.session import Screen, Session, Subscriber
 
-ROUTE_MODULES: tuple[str, ...] = ("play", "search", "fields", "scenario", "clickfind", "ramview")
+ROUTE_MODULES: tuple[str, ...] = ("play", "states", "search", "fields", "scenario", "clickfind", "ramview")
 """The modules of :mod:`retrokit.studio` whose ``routes`` are mounted under ``/api``."""
 
 STATIC = Path(__file__).parent / "static"

@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from retrokit.errors import InvalidArgumentError, RetrokitError, did_you_mean
+from retrokit.errors import InvalidArgumentError, RetrokitError
 from retrokit.ramsearch import RamSearch
 
 MIN_SPEED, MAX_SPEED = 0.25, 8.0
@@ -127,12 +127,14 @@ class Session:
         self._subscribers: set[Subscriber] = set()
         self._jobs: queue.SimpleQueue[_Job | None] = queue.SimpleQueue()
         self._thread: threading.Thread | None = None
+        self._stopped: threading.Thread | None = None  # the last thread stopped: the next one waits for it
         self._lock = threading.Lock()
         self._stats = _Stats()
         self._leave_timer: threading.Timer | None = None
         self._frame_source: Callable[[Session], bool] | None = None
         self._status_at = 0.0
         self.closed = False
+        self.recording = False  # a movie is being recorded (see retrokit.studio.states)
 
     # --- the thread ------------------------------------------------------------------------------
 
@@ -144,37 +146,52 @@ class Session:
     def start(self) -> None:
         """Start the emulator thread (again, after :meth:`stop`)."""
         with self._lock:
-            if self.closed:
-                raise InvalidArgumentError("Expected an open session; this one was closed. Start the studio again.")
-            if not self.running:
-                self._thread = threading.Thread(target=self._loop, name="retrokit-studio-emulator", daemon=True)
-                self._thread.start()
+            self._ensure_thread()
+
+    def _ensure_thread(self) -> None:
+        """Start a thread unless one runs (hold ``_lock``). A new thread first waits for the stopped one to end,
+        so two threads never touch the emulator at once."""
+        if self.closed:
+            raise InvalidArgumentError("Expected an open session; this one was closed. Start the studio again.")
+        if self._thread is None:
+            self._thread = threading.Thread(
+                target=self._loop, args=(self._jobs, self._stopped), name="retrokit-studio-emulator", daemon=True
+            )
+            self._thread.start()
 
     def stop(self) -> None:
-        """Stop the emulator thread, keeping the game where it is (a later :meth:`start` goes on)."""
+        """Stop the emulator thread, keeping the game where it is (a later :meth:`start` goes on).
+
+        Jobs queued before it still run; later ones go to the next thread's queue.
+        """
         with self._lock:
-            thread, self._thread = self._thread, None
-        if thread is not None and thread.is_alive():
-            self._jobs.put(None)
-            if thread is not threading.current_thread():
-                thread.join()
+            thread, jobs = self._thread, self._jobs
+            self._thread, self._jobs, self._stopped = None, queue.SimpleQueue(), thread
+            if thread is not None:
+                jobs.put(None)
+        if thread is not None and thread is not threading.current_thread():
+            thread.join()
 
     def close(self) -> None:
         """Stop the thread and close the emulator."""
         if self._leave_timer is not None:
             self._leave_timer.cancel()
         self.stop()
-        if not self.closed:
+        with self._lock:
+            if self.closed:
+                return
             self.closed = True
-            self.search.close()
+        self.search.close()
 
-    def _loop(self) -> None:
+    def _loop(self, jobs: queue.SimpleQueue[_Job | None], previous: threading.Thread | None) -> None:
+        if previous is not None:
+            previous.join()
         due = time.perf_counter()
         credit = 0.0
         while True:
             timeout = None if self.paused else max(0.0, due - time.perf_counter())
             try:
-                job = self._jobs.get(timeout=timeout)
+                job = jobs.get(timeout=timeout)
             except queue.Empty:
                 job = False
             if job is None:
@@ -189,11 +206,21 @@ class Session:
             now = time.perf_counter()
             if now - due > _LAG_LIMIT:  # too slow for this speed: run flat out rather than pile up debt
                 due = now
-            tick = 1.0 / (self.rate * min(self.speed, 1.0))
-            due += tick
+            due += 1.0 / (self.rate * min(self.speed, 1.0))
             credit += max(self.speed, 1.0)
             count, credit = int(credit), credit - int(credit)
-            self.advance(count)
+            try:
+                self.advance(count)
+            except Exception as exc:  # noqa: BLE001 (a replayed movie or a core that fails must not end the thread)
+                self.paused = True
+                self._frame_source = None
+                self.publish(_error_message(exc))
+                self.publish(self.status())
+
+    def _put(self, job: _Job) -> None:
+        with self._lock:
+            self._ensure_thread()
+            self._jobs.put(job)
 
     def _run_job(self, job: _Job) -> None:
         try:
@@ -213,7 +240,6 @@ class Session:
         """
         if self.closed:
             raise InvalidArgumentError("Expected an open session; this one was closed. Start the studio again.")
-        self.start()
         loop = asyncio.get_running_loop()
         future: asyncio.Future[Any] = loop.create_future()
 
@@ -228,14 +254,13 @@ class Session:
 
             loop.call_soon_threadsafe(settle)
 
-        self._jobs.put(_Job(fn, args, done))
+        self._put(_Job(fn, args, done))
         return await future
 
     def call_blocking(self, fn: Callable[..., Any], *args: Any) -> Any:
         """:meth:`call` for a caller that is not on an event loop (a test, a script); it waits."""
         if self.running and self._thread is threading.current_thread():
             return fn(self, *args)
-        self.start()
         box: dict[str, Any] = {}
         event = threading.Event()
 
@@ -243,7 +268,7 @@ class Session:
             box.update(result=result, exc=exc)
             event.set()
 
-        self._jobs.put(_Job(fn, args, done))
+        self._put(_Job(fn, args, done))
         event.wait()
         if box["exc"] is not None:
             raise box["exc"]
@@ -300,7 +325,7 @@ class Session:
         self._subscribers.discard(subscriber)
         if self._subscribers or self.closed:
             return
-        self.call_later(_set_paused, True)
+        self.paused = True  # read by the loop before its next frame
         self._leave_timer = threading.Timer(self.grace, self._leave)
         self._leave_timer.daemon = True
         self._leave_timer.start()
@@ -319,10 +344,11 @@ class Session:
 
         def done(_result: Any, exc: BaseException | None) -> None:
             if exc is not None:
-                self.publish({"type": "error", "error": str(exc), "kind": type(exc).__name__})
+                self.publish(_error_message(exc))
 
-        if self.running:
-            self._jobs.put(_Job(fn, args, done))
+        with self._lock:
+            if self._thread is not None:
+                self._jobs.put(_Job(fn, args, done))
 
     # --- on the emulator thread ------------------------------------------------------------------
 
@@ -343,9 +369,8 @@ class Session:
                     hook(self)
                 except Exception as exc:  # noqa: BLE001 (a tool's bug must not stop the game: it is told, and unhooked)
                     self._hooks.remove(hook)
-                    text = str(exc) if isinstance(exc, RetrokitError) else f"{type(exc).__name__}: {exc}"
-                    self.publish({"type": "error", "error": f"a frame hook failed and was removed: {text}",
-                                  "kind": type(exc).__name__})
+                    message = _error_message(exc)
+                    self.publish({**message, "error": f"a frame hook failed and was removed: {message['error']}"})
         now = time.perf_counter()
         self._stats.add(now, played)
         self.send_screen()
@@ -376,6 +401,7 @@ class Session:
             "frame": self.frame,
             "fps": self._stats.fps(time.perf_counter()),
             "replaying": self._frame_source is not None,
+            "recording": self.recording,
         }
 
     def set_speed(self, value: object) -> None:
@@ -393,11 +419,26 @@ class Session:
         self.paused = bool(paused)
         self.publish(self.status())
 
+    def refresh_game(self) -> None:
+        """Read the game's files again (a state or a default was written): its states, its data file (on the thread)."""
+        from retrokit.data.games import Game, find_game
+        from retrokit.errors import GameNotFoundError
+
+        game = self.search.game
+        try:
+            fresh = find_game(game.name)
+        except GameNotFoundError:  # a game opened by its folder, outside every games folder
+            fresh = None
+        if fresh is None or game.folders[0] not in fresh.folders:
+            fresh = Game(game.name, game.folders)
+        self.search.game = fresh
+
     def replace_search(self, search: RamSearch) -> None:
         """Play another game (or the same one afresh): close the old search, keep the pages (on the thread)."""
         old, self.search = self.search, search
         self._frame_source = None
         self._buttons = ()
+        self.recording = False
         self.rate = search.game.system.frame_rate(search.emulator.av_info().get("fps"))
         old.close()
         self.send_screen()
@@ -408,23 +449,7 @@ def _offer_screen(session: Session, subscriber: Subscriber) -> None:
     subscriber.offer_screen(Screen(session.frame, session.search.emulator.screen()))
 
 
-def _set_paused(session: Session, paused: bool) -> None:
-    session.set_paused(paused)
-
-
-def check_name(name: object, known: Sequence[str], what: str) -> str:
-    """Return ``name`` if it is one of ``known``; raise with a did-you-mean otherwise.
-
-    Raises:
-        InvalidArgumentError: ``name`` is not a string.
-        UnknownNameError: It is not one of ``known``.
-    """
-    from retrokit.errors import UnknownNameError
-
-    if not isinstance(name, str):
-        raise InvalidArgumentError(f"Expected the {what} as a string, got {type(name).__name__}.")
-    if name not in known:
-        raise UnknownNameError(
-            f"Expected a {what}: one of {', '.join(known) or '(none)'}; got {name!r}." + did_you_mean(name, known)
-        )
-    return name
+def _error_message(exc: BaseException) -> dict[str, Any]:
+    """The ``error`` message of an exception: a RetrokitError's one line, else the class and the text."""
+    text = str(exc) if isinstance(exc, RetrokitError) else f"{type(exc).__name__}: {exc}"
+    return {"type": "error", "error": text, "kind": type(exc).__name__}

@@ -1,0 +1,335 @@
+"""The studio's core on a real Dasher session: play over HTTP and the WebSocket, states, movies, faults.
+
+The session plays a copy of Dasher's folder in tmp_path, opened by its path,
+so the states and movies it writes land in that copy (a game opened by its
+folder keeps its made states next to its game.yaml).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import struct
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from starlette.testclient import TestClient
+
+from retrokit.movie import read_bk2
+from retrokit.studio.app import SCREEN_HEADER, create_app
+from retrokit.studio.session import Session
+
+REPO = Path(__file__).resolve().parent.parent
+DASHER = REPO / "games" / "Dasher-Genesis"
+TOKEN = "test-token"
+PORT = 8722
+BASE = f"http://127.0.0.1:{PORT}"
+RIGHT = 1 << 7  # the RetroPad bit of RIGHT
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory) -> Path:
+    folder = tmp_path_factory.mktemp("studio") / "Dasher-Genesis"
+    shutil.copytree(DASHER, folder)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def session(folder: Path):
+    session = Session(str(folder), "Zone1.Act1", grace=0.5)
+    yield session
+    session.close()
+
+
+@pytest.fixture(scope="module")
+def client(session: Session):
+    app = create_app(session, token=TOKEN, port=PORT)
+    with TestClient(app, base_url=BASE, headers={"X-Retrokit-Token": TOKEN}) as client:
+        yield client
+
+
+def post(client: TestClient, route: str, body: dict | None = None, status: int = 200) -> dict:
+    answer = client.post(route, json=body or {})
+    assert answer.status_code == status, answer.text
+    return answer.json()
+
+
+def ram(session: Session) -> np.ndarray:
+    return session.call_blocking(lambda s: s.search.emulator.ram.copy())
+
+
+def paused_at(client: TestClient, state: str = "Zone1.Act1") -> None:
+    post(client, "/api/play/pause")
+    post(client, "/api/play/reset", {"state": state})
+    post(client, "/api/play/buttons", {"buttons": []})
+
+
+def socket(client: TestClient):
+    return client.websocket_connect(f"ws://127.0.0.1:{PORT}/ws?token={TOKEN}")
+
+
+def receive_screen(ws) -> tuple[tuple, bytes]:
+    while True:
+        message = ws.receive()
+        if message.get("bytes"):
+            return SCREEN_HEADER.unpack_from(message["bytes"]), message["bytes"]
+
+
+# --- play -------------------------------------------------------------------------------------------------
+
+
+def test_info_lists_the_systems_buttons_and_the_default_keys(client):
+    info = client.get("/api/info").json()
+    assert info["game"] == "Dasher-Genesis" and info["system"] == "Genesis"
+    assert set(info["buttons"]) == {"B", "A", "MODE", "START", "UP", "DOWN", "LEFT", "RIGHT", "C", "Y", "X", "Z"}
+    keys = info["keys"]
+    assert keys["ArrowUp"] == "UP" and keys["ArrowDown"] == "DOWN" and keys["ArrowLeft"] == "LEFT"
+    assert keys["ArrowRight"] == "RIGHT" and keys["Enter"] == "START"
+    assert set(keys.values()) == set(info["buttons"])  # every button has a key
+    assert info["gamepad"]["12"] == "UP" and info["gamepad"]["9"] == "START"
+    assert (info["width"], info["height"]) == (320, 224) and 59 < info["frame_rate"] < 61
+    assert "Zone1.Act1" in info["states"] and info["speeds"] == [0.25, 8.0]
+
+
+def test_the_socket_sends_screens_with_the_documented_header(client, session):
+    post(client, "/api/play/resume")
+    with socket(client) as ws:
+        (magic, width, height, frame, depth), data = receive_screen(ws)
+        assert magic == b"RKS1" and (width, height, depth) == (320, 224, 3)
+        assert len(data) == SCREEN_HEADER.size + width * height * depth == 16 + 320 * 224 * 3
+        (_, _, _, later, _), _ = receive_screen(ws)
+        assert later > frame  # the game runs: each screen is a newer frame
+        pixels = np.frombuffer(data, np.uint8, offset=16).reshape(height, width, 3)
+        assert pixels.std() > 0  # a picture, not a blank
+
+
+def test_the_frame_loop_keeps_to_the_speed_asked(client, session):
+    """Never faster than asked (whatever the load); at 8x, faster than at 1x."""
+    counts = {}
+    for speed in (0.25, 1, 8):
+        post(client, "/api/play/speed", {"value": speed})
+        post(client, "/api/play/resume")
+        start = session.frame
+        time.sleep(1.0)
+        counts[speed] = session.frame - start
+    post(client, "/api/play/pause")
+    post(client, "/api/play/speed", {"value": 1})
+    assert 0 < counts[0.25] <= 0.25 * 60 + 4
+    assert 0 < counts[1] <= 60 + 4
+    assert counts[8] > counts[1]
+
+
+def test_pause_then_step_runs_exactly_the_frames_asked_with_the_buttons_held(client, session):
+    paused_at(client)
+    before = post(client, "/api/play/step", {"frames": 1})["frame"]
+    time.sleep(0.2)
+    assert session.frame == before  # paused: nothing moves
+    x = ram(session)
+    post(client, "/api/play/buttons", {"buttons": ["RIGHT"]})
+    status = post(client, "/api/play/step", {"frames": 30})
+    assert status["paused"] and status["frame"] == before + 30
+    assert (ram(session) != x).any()
+    movie = session.call_blocking(lambda s: s.search.movie())
+    assert movie.frames[-30:] == [(RIGHT, 0)] * 30  # what was held is what the session recorded
+
+
+def test_reset_puts_the_game_back_in_the_state(client, session):
+    paused_at(client)
+    fresh = ram(session)
+    post(client, "/api/play/buttons", {"buttons": ["RIGHT"]})
+    post(client, "/api/play/step", {"frames": 20})
+    assert (ram(session) != fresh).any()
+    post(client, "/api/play/reset", {})  # the state the session began from
+    assert (ram(session) == fresh).all()
+
+
+def test_the_socket_takes_the_same_commands(client, session):
+    paused_at(client)
+    with socket(client) as ws:
+        start = session.frame
+        ws.send_text(json.dumps({"type": "buttons", "buttons": ["RIGHT", "B"]}))
+        ws.send_text(json.dumps({"type": "step", "frames": 5}))
+        ws.send_text(json.dumps({"type": "speed", "value": 2}))
+        ws.send_text(json.dumps({"type": "status"}))
+        status = None
+        while status is None or status["speed"] != 2:
+            message = ws.receive()
+            if message.get("text"):
+                status = json.loads(message["text"])
+        assert status["type"] == "status" and status["paused"] and status["frame"] == start + 5
+        assert session.buttons == ("RIGHT", "B")
+        ws.send_text(json.dumps({"type": "speed", "value": "fast"}))
+        ws.send_text("not json")
+        errors = []
+        while len(errors) < 1:
+            message = ws.receive()
+            if message.get("text") and json.loads(message["text"])["type"] == "error":
+                errors.append(json.loads(message["text"]))
+        assert errors[0]["kind"] == "InvalidArgumentError"
+    post(client, "/api/play/speed", {"value": 1})
+
+
+def test_tools_hook_frames_and_publish_to_the_page(client, session):
+    paused_at(client)
+    seen = []
+
+    def hook(s: Session) -> None:
+        seen.append(s.frame)
+        s.publish({"type": "probe", "frame": s.frame})
+
+    remove = session.on_frame(hook)
+    try:
+        with socket(client) as ws:
+            post(client, "/api/play/step", {"frames": 3})
+            probe = None
+            while probe is None:
+                message = ws.receive()
+                if message.get("text") and json.loads(message["text"])["type"] == "probe":
+                    probe = json.loads(message["text"])
+        assert seen == [seen[0], seen[0] + 1, seen[0] + 2] and probe["frame"] in seen
+    finally:
+        remove()
+
+
+def test_a_failing_hook_is_removed_and_reported_while_the_game_plays_on(client, session):
+    paused_at(client)
+
+    def broken(_s: Session) -> None:
+        raise ZeroDivisionError("boom")
+
+    session.on_frame(broken)
+    with socket(client) as ws:
+        post(client, "/api/play/step", {"frames": 2})
+        error = None
+        while error is None:
+            message = ws.receive()
+            if message.get("text") and json.loads(message["text"])["type"] == "error":
+                error = json.loads(message["text"])
+    assert "ZeroDivisionError: boom" in error["error"]
+    assert post(client, "/api/play/step", {"frames": 2})["paused"]  # the loop lives on
+
+
+def test_closing_the_last_socket_pauses_and_then_stops_the_emulator(client, session):
+    post(client, "/api/play/resume")
+    with socket(client) as ws:
+        receive_screen(ws)
+        assert session.running and not session.paused
+    deadline = time.monotonic() + 10
+    while session.running and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert session.paused and not session.running  # paused at once, thread gone after the grace period
+    frame = session.frame
+    time.sleep(0.2)
+    assert session.frame == frame
+    with socket(client) as ws:  # a new tab starts it again, where it was
+        receive_screen(ws)
+        assert session.running
+
+
+# --- states -------------------------------------------------------------------------------------------------
+
+
+def test_save_a_state_with_its_record_list_load_and_make_it_the_default(client, session, folder):
+    from retrokit.data.states import read_state_file
+
+    paused_at(client)
+    post(client, "/api/play/buttons", {"buttons": ["RIGHT"]})
+    post(client, "/api/play/step", {"frames": 40})
+    saved_ram = ram(session)
+    answer = post(client, "/api/states/save", {"name": "Mine"})
+    assert answer["status"] == "made" and Path(answer["path"]) == folder / "Mine.state"
+    assert read_state_file(folder / "Mine.state").record is not None  # the record integrate writes
+    assert "Mine" in client.get("/api/states").json()["states"]
+    post(client, "/api/play/step", {"frames": 10})
+    conflict = post(client, "/api/states/save", {"name": "Mine"}, status=409)
+    assert conflict["kind"] == "FileConflictError" and "force" in conflict["error"]
+    post(client, "/api/states/load", {"name": "Mine"})
+    assert (ram(session) == saved_ram).all()
+    assert post(client, "/api/states/save", {"name": "Mine"})["status"] == "up to date"
+    post(client, "/api/play/step", {"frames": 10})
+    assert post(client, "/api/states/save", {"name": "Mine", "force": True})["status"] == "replaced"
+    listing = post(client, "/api/states/default", {"name": "Mine"})
+    assert listing["default"] == "Mine" and "default: Mine" in (folder / "game.yaml").read_text()
+
+
+def test_a_bad_state_name_or_an_unknown_state_is_a_json_error(client):
+    bad = post(client, "/api/states/save", {"name": "a/../../escape"}, status=400)
+    assert bad["kind"] == "InvalidArgumentError" and "path separator" in bad["error"]
+    unknown = post(client, "/api/states/load", {"name": "Zone1.Act9"}, status=404)
+    assert unknown["kind"] == "StateNotFoundError" and "Zone1.Act1" in unknown["error"]
+    post(client, "/api/states/default", {"name": "Nope"}, status=404)
+
+
+def test_a_corrupt_state_is_a_json_error_and_the_server_lives_on(client, session, folder, corrupt_state):
+    from retrokit.data.states import write_state
+
+    write_state(folder / "Broken.state", corrupt_state)
+    session.call_blocking(lambda s: s.refresh_game())
+    paused_at(client)
+    before = ram(session)
+    answer = post(client, "/api/states/load", {"name": "Broken"}, status=400)
+    assert answer["kind"] == "StateError"
+    assert (ram(session) == before).all()  # the game is where it was
+    assert post(client, "/api/play/step", {"frames": 2})["paused"]
+
+
+# --- movies ------------------------------------------------------------------------------------------------
+
+
+def test_record_a_movie_of_what_is_played_and_replay_it(client, session, folder):
+    paused_at(client, "Zone1.Act2")
+    post(client, "/api/movies/record")
+    post(client, "/api/play/buttons", {"buttons": ["RIGHT"]})
+    post(client, "/api/play/step", {"frames": 25})
+    post(client, "/api/play/buttons", {"buttons": ["RIGHT", "B"]})
+    post(client, "/api/play/step", {"frames": 5})
+    end = ram(session)
+    written = post(client, "/api/movies/stop", {"name": "run"})
+    path = folder / "movies" / "run.bk2"
+    assert Path(written["path"]) == path and written["frames"] == 30
+    movie = read_bk2(path)
+    assert movie.game == "Dasher-Genesis" and movie.frames == [(RIGHT, 0)] * 25 + [(RIGHT | 1, 0)] * 5
+    assert "run" in [m["name"] for m in client.get("/api/movies").json()["movies"]]
+    post(client, "/api/movies/stop", {"name": "run"}, status=400)  # nothing is being recorded
+
+    post(client, "/api/play/reset", {"state": "Zone3.Act1"})  # somewhere else, then replay
+    post(client, "/api/play/speed", {"value": 4})
+    assert post(client, "/api/movies/play", {"name": "run"})["frames"] == 30
+    deadline = time.monotonic() + 20
+    while client.get("/api/status").json()["replaying"] and time.monotonic() < deadline:
+        time.sleep(0.05)
+    post(client, "/api/play/speed", {"value": 1})
+    assert client.get("/api/status").json()["paused"]  # a replay ends paused, at its last frame
+    assert (ram(session) == end).all()
+
+
+def test_a_movie_is_not_overwritten_unless_asked(client, session):
+    paused_at(client)
+    for force, status in ((False, 200), (False, 409), (True, 200)):
+        post(client, "/api/movies/record")
+        post(client, "/api/play/step", {"frames": 3})
+        post(client, "/api/movies/stop", {"name": "twice", "force": force}, status=status)
+
+
+def test_a_corrupt_movie_is_a_json_error_and_the_server_lives_on(client, session, folder):
+    (folder / "movies" / "junk.bk2").write_bytes(b"PK\x03\x04 not really a zip" * 10)
+    answer = post(client, "/api/movies/play", {"name": "junk"}, status=400)
+    assert answer["kind"] == "MovieError"
+    unknown = post(client, "/api/movies/play", {"name": "Zone1.Act"}, status=404)
+    assert "Did you mean" in unknown["error"]
+    assert client.get("/api/status").status_code == 200
+    assert post(client, "/api/play/step", {"frames": 1})["paused"]
+
+
+def test_a_shipped_solution_movie_replays(client, session):
+    answer = post(client, "/api/movies/play", {"name": "Zone1.Act1.bk2"})
+    assert answer["frames"] > 0
+    post(client, "/api/play/pause")
+
+
+def test_screen_png(client):
+    answer = client.get("/api/screen.png")
+    assert answer.status_code == 200 and answer.content[:8] == b"\x89PNG\r\n\x1a\n"
+    assert struct.unpack(">II", answer.content[16:24]) == (320, 224)

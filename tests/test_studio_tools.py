@@ -270,6 +270,16 @@ def test_live_reward_is_the_scenarios_every_frame(client):
     assert (error["line"], error["column"]) == (1, 9)
 
 
+def test_a_scenario_failing_at_run_time_says_where_and_the_game_goes_on(client):
+    live = ok(client.post("/api/scenario/live", json={"text": "reward: 1 / (p1_lives - 3)\n"}))
+    assert (live["error"]["kind"], live["error"]["line"], live["error"]["column"]) == ("ScenarioRuntimeError", 1, 9)
+    assert "division by zero" in live["error"]["error"] and "\n" not in live["error"]["error"]
+    frame = ok(client.get("/api/status"))["frame"]
+    step(client, 3)
+    assert ok(client.get("/api/status"))["frame"] == frame + 3
+    assert ok(client.get("/api/scenario/live"))["error"]["kind"] == "ScenarioRuntimeError"
+
+
 def test_the_games_own_scenario_goes_live_by_name(client):
     live = ok(client.post("/api/scenario/live", json={}))
     assert live["name"] == "scenario" and live["players"] == 2

@@ -27,6 +27,7 @@ from __future__ import annotations
 import asyncio
 import itertools
 import time
+import weakref
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -55,6 +56,7 @@ class Job:
     """One click-to-find search: where, over which cells, and what it found so far."""
 
     id: int
+    search: Any  # the RamSearch clicked: a job ends if the session plays another game
     x: int
     y: int
     frames: int
@@ -91,7 +93,7 @@ class Job:
         }
 
 
-_jobs: dict[int, Job] = {}  # by id(session): the session's newest job
+_jobs: weakref.WeakKeyDictionary[Any, Job] = weakref.WeakKeyDictionary()  # each session's newest job
 
 
 def _cells(session: Any, region: object) -> list[int]:
@@ -146,6 +148,7 @@ def begin(session: Any, x: object, y: object, region: object, frames: object) ->
     height, width = emulator.screen_shape()
     job = Job(
         next(_IDS),
+        session.search,
         integer_of(x, "x", 0, width - 1),
         integer_of(y, "y", 0, height - 1),
         integer_of(frames, "frames", 1, MAX_FRAMES),
@@ -163,6 +166,9 @@ def begin(session: Any, x: object, y: object, region: object, frames: object) ->
 
 def work(session: Any, job: Job, seconds: float = CHUNK_SECONDS) -> None:
     """Try cells for about ``seconds``, then put the game back as it was (emulator thread)."""
+    if session.search is not job.search:
+        job.error = "Expected the game that was clicked; the session plays another one now. Click again."
+        return
     emulator = session.search.emulator
     now = emulator.get_state()
     started = time.perf_counter()
@@ -212,19 +218,19 @@ async def _run(session: Any, job: Job) -> None:
 async def start(request: Request) -> JSONResponse:
     session = session_of(request)
     body = await json_body(request)
-    old = _jobs.get(id(session))
+    old = _jobs.get(session)
     if old is not None:
         old.cancelled = True
     job = await session.call(
         begin, body.get("x"), body.get("y"), body.get("region", "candidates"), body.get("frames", FRAMES)
     )
-    _jobs[id(session)] = job
+    _jobs[session] = job
     job.task = asyncio.get_running_loop().create_task(_run(session, job))
     return JSONResponse(job.report(), status_code=202)
 
 
 def _job(request: Request) -> Job:
-    job = _jobs.get(id(session_of(request)))
+    job = _jobs.get(session_of(request))
     if job is None:
         raise InvalidArgumentError("Expected a click-to-find job; none was started. Start one: POST /api/clickfind.")
     return job

@@ -2,8 +2,8 @@
 
 Values are decoded by :class:`~retrokit.host.memory.FieldReader`, the reader
 every env uses, so the page shows what an agent would get. A frame hook
-pushes them to the page (``{"type": "fields", "frame", "values"}``) every
-few frames. An edit rewrites the field's line in the game's game.yaml through
+pushes them to the page (``{"type": "fields", "frame", "values"}``) 20
+times a second. An edit rewrites the field's line in the game's game.yaml through
 :meth:`RamSearch.save_field` (the one game.yaml writer, with its checks and
 its atomic write), then the session reads the game's fields again.
 
@@ -16,7 +16,7 @@ Routes (under ``/api``):
 from __future__ import annotations
 
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from starlette.requests import Request
@@ -26,7 +26,7 @@ from starlette.routing import Route
 from retrokit.errors import InvalidArgumentError
 from retrokit.host.memory import FieldReader
 from retrokit.studio.app import session_of
-from retrokit.studio.search import PUSH_EVERY, save_field
+from retrokit.studio.search import Pacer, save_field
 from retrokit.studio.security import json_body
 
 
@@ -36,7 +36,7 @@ class _Reader:
 
     game: Any = None
     reader: FieldReader | None = None
-    countdown: int = 0
+    pacer: Pacer = field(default_factory=Pacer)
     remove: Any = None
 
 
@@ -55,12 +55,9 @@ def field_reader(session: Any) -> FieldReader:
 
 
 def _push(session: Any) -> None:
-    """Frame hook: push every field's value every :data:`PUSH_EVERY` frames."""
-    entry = _readers[session]
-    entry.countdown -= 1
-    if entry.countdown > 0:
+    """Frame hook: push every field's value (20 times a second)."""
+    if not _readers[session].pacer.ready(session):
         return
-    entry.countdown = PUSH_EVERY
     session.publish({"type": "fields", "frame": session.frame, "values": field_reader(session).read()})
 
 

@@ -4,8 +4,8 @@ The region is given in console addresses and read as the RAM search reads
 it (:class:`~retrokit.ramsearch.ram.RamLayout`: console byte order, whatever
 the core's), so a cell shows what the console's CPU sees. While a region is
 watched, a frame hook compares it with the frame before and pushes
-``{"type": "ram", "start", "frame", "values", "changed", "differs"}`` every
-few frames: ``changed`` lists the offsets that changed in any frame since the
+``{"type": "ram", "start", "frame", "values", "changed", "differs"}`` 20
+times a second: ``changed`` lists the offsets that changed in any frame since the
 last push, ``differs`` those that differ from the chosen snapshot of the RAM
 search (``null`` without one).
 
@@ -18,7 +18,7 @@ Routes (under ``/api``):
 from __future__ import annotations
 
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -28,7 +28,7 @@ from starlette.routing import Route
 
 from retrokit.errors import RamSearchError
 from retrokit.studio.app import session_of
-from retrokit.studio.search import PUSH_EVERY, address_of, integer_of
+from retrokit.studio.search import Pacer, address_of, integer_of
 from retrokit.studio.security import json_body
 
 MAX_LENGTH = 4096
@@ -49,7 +49,7 @@ class _View:
     last: np.ndarray  # the bytes after the newest frame
     before: np.ndarray  # and after the frame before it
     changed: np.ndarray  # which changed in any frame since the last push
-    countdown: int = 0
+    pacer: Pacer = field(default_factory=Pacer)
     remove: Any = None
 
 
@@ -120,9 +120,7 @@ def _on_frame(session: Any) -> None:
     now = _bytes(session, view.buffer, view.offsets)
     view.changed |= now != view.last
     view.before, view.last = view.last, now
-    view.countdown -= 1
-    if view.countdown <= 0:
-        view.countdown = PUSH_EVERY
+    if view.pacer.ready(session):
         session.publish(_report(session, view, now, view.changed, view.snapshot))
         view.changed[:] = False
 

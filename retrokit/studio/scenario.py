@@ -14,7 +14,7 @@ env with ``scenario_every_frame`` does: the game's fields read by the envs'
 scenario. Loading a state starts a new episode (``initial()`` and the total
 begin again); once done, the total stays until then. The page gets
 ``{"type": "reward", "frame", "samples": [[frame, reward, total, done], ...], "total", "done"}``
-every few frames (the samples overlap: the page keeps each frame once), and
+20 times a second (the samples overlap: the page keeps each frame once), and
 ``GET /api/scenario/live`` returns the last :data:`HISTORY` frames.
 
 Routes (under ``/api``): ``GET /scenario?name=``, ``POST /scenario/compile``
@@ -43,12 +43,12 @@ from retrokit.dsl.source import read_source
 from retrokit.errors import DataFileError, ScenarioError, ScenarioRuntimeError
 from retrokit.studio.app import session_of
 from retrokit.studio.fields import field_reader
-from retrokit.studio.search import PUSH_EVERY
+from retrokit.studio.search import Pacer
 from retrokit.studio.security import expect, json_body
 
 HISTORY = 600
 """Frames of reward kept for the plot: 10 seconds at 60 fps."""
-_OVERLAP = 4 * PUSH_EVERY  # samples per push: a push the page missed is covered by the next
+_OVERLAP = 12  # samples a push repeats from before the last one: a push the page missed is covered by the next
 
 
 def _name(value: object, game: Any) -> str:
@@ -150,15 +150,33 @@ class _Live:
     done: bool = False
     error: dict[str, Any] | None = None
     samples: collections.deque = field(default_factory=lambda: collections.deque(maxlen=HISTORY))
-    countdown: int = 0
+    unsent: int = 0  # samples taken since the last push
+    pacer: Pacer = field(default_factory=Pacer)
     remove: Any = None
 
     def restart(self, session: Any) -> None:
-        """A new episode from the game's moment now."""
+        """A new episode from the game's moment now (a run-time error of the scenario is kept in ``error``)."""
         self.search, self.start_state = session.search, session.search.start_state
-        self.run = self.scenario.start()
-        self.run.reset(field_reader(session).read())
         self.episode_frame, self.total, self.done, self.error = 0, 0.0, False, None
+        self.run = self.scenario.start()
+        try:
+            self.run.reset(field_reader(session).read())
+        except ScenarioRuntimeError as exc:  # the scenario's fault, told to the page; the game goes on
+            self.error = error_json(exc)
+
+    def step(self, session: Any) -> None:
+        """Evaluate the scenario on this frame's fields."""
+        self.episode_frame += 1
+        try:
+            rewards, done = self.run.step(field_reader(session).read(), self.episode_frame, self.episode_frame)
+        except ScenarioRuntimeError as exc:
+            self.error = error_json(exc)
+            return
+        reward = float(sum(rewards))
+        self.total += reward
+        self.done = bool(done)
+        self.samples.append([session.frame, reward, self.total, self.done])
+        self.unsent += 1
 
     def report(self, count: int | None = None) -> dict[str, Any]:
         samples = list(self.samples)
@@ -178,28 +196,17 @@ _live: weakref.WeakKeyDictionary[Any, _Live] = weakref.WeakKeyDictionary()
 
 
 def _on_frame(session: Any) -> None:
-    """Frame hook: step the live scenario on this frame's fields, and push the reward every few frames."""
+    """Frame hook: step the live scenario on this frame's fields; push the reward 20 times a second."""
     live = _live.get(session)
-    if live is None or live.error is not None:
+    if live is None:
         return
     if live.search is not session.search or live.start_state is not session.search.start_state:
         live.restart(session)  # a state was loaded (or another game): a new episode
-    if not live.done:
-        live.episode_frame += 1
-        try:
-            rewards, done = live.run.step(field_reader(session).read(), live.episode_frame, live.episode_frame)
-        except ScenarioRuntimeError as exc:  # the scenario's fault, told to the page; the game goes on
-            live.error = error_json(exc)
-            session.publish(live.report(_OVERLAP))
-            return
-        reward = float(sum(rewards))
-        live.total += reward
-        live.done = bool(done)
-        live.samples.append([session.frame, reward, live.total, live.done])
-    live.countdown -= 1
-    if live.countdown <= 0:
-        live.countdown = PUSH_EVERY
-        session.publish(live.report(_OVERLAP))
+    if live.error is None and not live.done:
+        live.step(session)
+    if live.pacer.ready(session):
+        session.publish(live.report(live.unsent + _OVERLAP))
+        live.unsent = 0
 
 
 def _go_live(session: Any, name: str, scenario: Scenario) -> dict[str, Any]:

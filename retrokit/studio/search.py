@@ -6,7 +6,7 @@ between frames, and through the same :class:`RamSearch` methods as
 scale), snapshots, undo and redo, poke, and ``save_field`` (the one game.yaml
 writer, range included). The candidate table lists groups of candidates as
 ``ramsearch show`` does; the rows listed last are watched, and their live
-values are pushed to the page (``{"type": "candidates", ...}``) every few frames.
+values are pushed to the page (``{"type": "candidates", ...}``) 20 times a second.
 
 Routes (under ``/api``):
 
@@ -24,6 +24,7 @@ This module also holds the number helpers the other tool modules share:
 
 from __future__ import annotations
 
+import time
 import weakref
 from dataclasses import dataclass, field
 from typing import Any
@@ -40,8 +41,24 @@ from retrokit.studio.security import expect, json_body
 
 MAX_ROWS = 500
 """The most candidate groups one listing returns (and whose live values are pushed)."""
-PUSH_EVERY = 3
-"""Frames between two pushes of live values: 20 a second at 60 fps."""
+PUSH_PERIOD = 0.05
+"""Seconds between two pushes of a tool's live values: 20 a second, whatever the game's speed."""
+
+
+@dataclass
+class Pacer:
+    """When a frame hook pushes its live values next: every :data:`PUSH_PERIOD`, and after each frame of a
+    paused game (one frame advanced at a time shows each)."""
+
+    due: float = 0.0
+
+    def ready(self, session: Any) -> bool:
+        """Whether to push after this frame."""
+        now = time.monotonic()
+        if now < self.due and not session.paused:
+            return False
+        self.due = now + PUSH_PERIOD
+        return True
 
 
 def integer_of(value: object, what: str, low: int | None = None, high: int | None = None) -> int:
@@ -85,7 +102,7 @@ class _Watch:
 
     rows: list[tuple[int, str]] = field(default_factory=list)  # (address, type)
     search: Any = None  # the RamSearch they were listed from (a new game lists afresh)
-    countdown: int = 0
+    pacer: Pacer = field(default_factory=Pacer)
     remove: Any = None
 
 
@@ -93,14 +110,10 @@ _watches: weakref.WeakKeyDictionary[Any, _Watch] = weakref.WeakKeyDictionary()
 
 
 def _push_live(session: Any) -> None:
-    """Frame hook: push the watched rows' values every :data:`PUSH_EVERY` frames."""
+    """Frame hook: push the watched rows' values (20 times a second)."""
     watch = _watches.get(session)
-    if watch is None or not watch.rows or watch.search is not session.search:
+    if watch is None or not watch.rows or watch.search is not session.search or not watch.pacer.ready(session):
         return
-    watch.countdown -= 1
-    if watch.countdown > 0:
-        return
-    watch.countdown = PUSH_EVERY
     space = session.search.emulator.space
     values = [[address, code, space.peek(address, code)] for address, code in watch.rows]
     session.publish({"type": "candidates", "frame": session.frame, "values": values})

@@ -10,7 +10,7 @@ import { api, get, post, ApiError } from "./api.js";
 import { byId, el, replace } from "./dom.js";
 import { drawPlot, rangeText } from "./plot.js";
 import { on } from "./socket.js";
-import { attempt, say } from "./status.js";
+import { attempt, background, say } from "./status.js";
 
 const SECONDS = 10; // the plot's width in game time
 const DEBOUNCE_MS = 400;
@@ -205,7 +205,7 @@ export async function init(info) {
   editor.on("changes", () => {
     byId("scenario-unsaved").hidden = !unsaved();
     clearTimeout(timer);
-    timer = setTimeout(() => attempt(edited), DEBOUNCE_MS);
+    timer = setTimeout(() => background(edited), DEBOUNCE_MS);
   });
   byId("scenario-open").addEventListener("click", () => attempt(() => open(byId("scenario-name").value.trim())));
   byId("scenario-save").addEventListener("click", () => attempt(save, (line) => line));

@@ -14,6 +14,17 @@ export function say(message, kind = "ok") {
   if (kind === "ok") timer = setTimeout(() => { if (line.textContent === message) line.textContent = ""; }, 6000);
 }
 
+/** Run work the user did not click for (a compile while typing): report its error, but leave the line alone
+ * otherwise, so it does not wipe the outcome of the user's last action. */
+export async function background(action) {
+  try {
+    return await action();
+  } catch (error) {
+    say(error.message, "error");
+    return undefined;
+  }
+}
+
 /** Run an async action from a button, reporting its error (an ApiError carries the server's line). The line is
  * cleared first, so what it shows afterwards is this action's outcome, not an older one's. */
 export async function attempt(action, done) {

@@ -8,8 +8,10 @@ folder keeps its made states next to its game.yaml).
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import struct
+import threading
 import time
 from pathlib import Path
 
@@ -333,3 +335,64 @@ def test_screen_png(client):
     answer = client.get("/api/screen.png")
     assert answer.status_code == 200 and answer.content[:8] == b"\x89PNG\r\n\x1a\n"
     assert struct.unpack(">II", answer.content[16:24]) == (320, 224)
+
+
+# --- validate, new game ----------------------------------------------------------------------------------
+
+
+def test_validate_reports_as_json_while_the_game_plays_on(client, session):
+    post(client, "/api/play/speed", {"value": 1})
+    post(client, "/api/play/resume")
+    stages: list[str] = []
+
+    def drain(ws) -> None:  # screens keep coming while the check runs: read them as a page would
+        while "done" not in stages:
+            message = ws.receive()
+            if message.get("text") and json.loads(message["text"])["type"] == "validate":
+                stages.append(json.loads(message["text"])["stage"])
+
+    with socket(client) as ws:
+        reader = threading.Thread(target=drain, args=(ws,), daemon=True)
+        reader.start()
+        start = session.frame
+        report = post(client, "/api/validate", {"frames": 10})
+        played = session.frame - start
+        reader.join(timeout=30)
+    post(client, "/api/play/pause")
+    assert report["game"] == "Dasher-Genesis" and report["counts"]["pass"] > 10
+    failed = [r for r in report["results"] if r["status"] == "fail"]
+    # Only what the tests above broke on purpose (a corrupt state, a junk movie) may fail.
+    assert all("Broken" in r["state"] + r["message"] or "junk" in r["message"] for r in failed), failed
+    assert {"schema", "state loads"} <= {r["check"] for r in report["results"]}
+    assert played > 0  # the session kept playing while the check ran
+    assert "done" in stages
+    bad = post(client, "/api/validate", {"frames": -1}, status=400)
+    assert "frames" in bad["error"]
+
+
+def test_new_game_from_a_rom_file_then_the_session_plays_it(tmp_path, monkeypatch):
+    from runner_rom import write_runner_rom
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))  # new games go to the user's data folder
+    monkeypatch.delenv("RETROKIT_GAMES", raising=False)
+    rom = write_runner_rom(tmp_path / "runner.bin")
+    session = Session("Dasher-Genesis", "Zone1.Act1")
+    with TestClient(create_app(session, token=TOKEN, port=PORT), base_url=BASE,
+                    headers={"X-Retrokit-Token": TOKEN}) as client:
+        fifo = tmp_path / "fifo.md"
+        os.mkfifo(fifo)
+        refused = post(client, "/api/newgame", {"rom": str(fifo), "name": "Fifo-Genesis"}, status=400)
+        assert refused["kind"] == "FileSystemError" and "FIFO" in refused["error"]
+        made = post(client, "/api/newgame", {"rom": str(rom), "name": "Runner-Genesis"})
+        assert made["game"] == "Runner-Genesis" and Path(made["folder"]) == tmp_path / "data" / "games" / "Runner-Genesis"
+        assert made["info"]["game"] == "Runner-Genesis" and made["info"]["states"] == []
+        status = post(client, "/api/play/step", {"frames": 3})
+        assert status["game"] == "Runner-Genesis"
+        again = post(client, "/api/newgame", {"rom": str(rom), "name": "Runner-Genesis"}, status=409)
+        assert again["kind"] == "FileConflictError"
+        back = client.post("/api/game", json={"game": "Dasher-Genesis", "state": "Zone2.Act1"}).json()
+        assert back["game"] == "Dasher-Genesis" and back["status"]["state"] == "Zone2.Act1"
+        outside = post(client, "/api/game", {"game": str(DASHER)}, status=403)
+        assert outside["kind"] == "AccessDeniedError"
+        typo = post(client, "/api/game", {"game": "Dasher-Genesys"}, status=404)
+        assert "Did you mean" in typo["error"]

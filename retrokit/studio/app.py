@@ -36,7 +36,7 @@ from retrokit import errors
 from retrokit.studio.security import Guard
 from retrokit.studio.session import Screen, Session, Subscriber
 
-ROUTE_MODULES: tuple[str, ...] = ("play", "states", "search", "fields", "scenario", "clickfind", "ramview")
+ROUTE_MODULES: tuple[str, ...] = ("play", "states", "authoring", "search", "fields", "scenario", "clickfind", "ramview")
 """The modules of :mod:`retrokit.studio` whose ``routes`` are mounted under ``/api``."""
 
 STATIC = Path(__file__).parent / "static"
@@ -149,9 +149,6 @@ async def _send(websocket: WebSocket, subscriber: Subscriber) -> None:
     try:
         while True:
             await subscriber.wait()
-            screen, subscriber.screen = subscriber.screen, None
-            if screen is not None:
-                await websocket.send_bytes(pack_screen(screen))
             now = loop.time()
             later = []
             for kind, message in list(subscriber.messages.items()):
@@ -161,6 +158,9 @@ async def _send(websocket: WebSocket, subscriber: Subscriber) -> None:
                 subscriber.messages.pop(kind, None)
                 sent_at[kind] = now
                 await websocket.send_text(json.dumps(message, default=_plain))
+            screen, subscriber.screen = subscriber.screen, None  # after the messages: the status comes first
+            if screen is not None:
+                await websocket.send_bytes(pack_screen(screen))
             if later:  # come back for them when their period is over
                 loop.call_later(MESSAGE_PERIOD, subscriber.wake)
     except (WebSocketDisconnect, RuntimeError, ConnectionError):

@@ -54,7 +54,7 @@ def serve(game: str, state: str | None, *, port: int, open_browser: bool = True)
     import uvicorn
 
     from retrokit.studio.app import create_app
-    from retrokit.studio.security import new_token
+    from retrokit.studio.security import MAX_BODY, new_token
     from retrokit.studio.session import Session
 
     sock = bind(port)
@@ -66,7 +66,8 @@ def serve(game: str, state: str | None, *, port: int, open_browser: bool = True)
     actual = sock.getsockname()[1]
     token = new_token()
     app = create_app(session, token=token, port=actual)
-    config = uvicorn.Config(app, log_level="warning", ws="websockets", timeout_graceful_shutdown=2, lifespan="on")
+    config = uvicorn.Config(app, log_level="warning", ws="websockets", ws_max_size=MAX_BODY,
+                            timeout_graceful_shutdown=2, lifespan="on")
     server = uvicorn.Server(config)
     url = f"http://{HOST}:{actual}/?token={token}"
     print(f"retrokit studio: {url}", flush=True)

@@ -104,6 +104,7 @@ def reset(session: Session, state: str | None) -> None:
     else:
         search.load_state(name)  # StateNotFoundError, with a did-you-mean, for an unknown one
         search.state = name
+    session.mark_loaded()
     session.send_screen()
     session.publish(session.status())
 
@@ -176,7 +177,7 @@ def _png(session: Session) -> bytes:
     from PIL import Image
 
     buffer = io.BytesIO()
-    Image.fromarray(session.search.emulator.screen()).save(buffer, format="PNG")
+    Image.fromarray(session.screen()).save(buffer, format="PNG")
     return buffer.getvalue()
 
 

@@ -135,6 +135,7 @@ class Session:
         self._status_at = 0.0
         self.closed = False
         self.recording = False  # a movie is being recorded (see retrokit.studio.states)
+        self._loaded = True  # a state was just loaded: no frame has drawn it yet (see mark_loaded)
 
     # --- the thread ------------------------------------------------------------------------------
 
@@ -364,6 +365,7 @@ class Session:
                 self.search.step(self._buttons, 1)
             self.frame += 1
             played += 1
+            self._loaded = False
             for hook in list(self._hooks):
                 try:
                     hook(self)
@@ -382,11 +384,24 @@ class Session:
         """Take each frame's input from ``source(session)`` (it runs the frame; False: it is over) instead of the buttons."""
         self._frame_source = source
 
+    def mark_loaded(self) -> None:
+        """Say the emulator was just put in a saved state (emulator thread).
+
+        Loading a state does not draw it: the video buffer keeps the picture of before (black after a reset).
+        Until the next frame runs, :meth:`screen` is the next frame's, emulated on a scratch run
+        (:meth:`RamSearch.screen`), so a page paused after a reset sees the state it chose.
+        """
+        self._loaded = True
+
+    def screen(self) -> np.ndarray:
+        """The picture a page should show now (emulator thread)."""
+        return self.search.screen() if self._loaded else self.search.emulator.screen()
+
     def send_screen(self) -> None:
         """Offer the screen now to every page."""
         if not self._subscribers:
             return
-        screen = Screen(self.frame, self.search.emulator.screen())
+        screen = Screen(self.frame, self.screen())
         for subscriber in list(self._subscribers):
             subscriber.offer_screen(screen)
 
@@ -441,12 +456,13 @@ class Session:
         self.recording = False
         self.rate = search.game.system.frame_rate(search.emulator.av_info().get("fps"))
         old.close()
+        self._loaded = True
         self.send_screen()
         self.publish(self.status())
 
 
 def _offer_screen(session: Session, subscriber: Subscriber) -> None:
-    subscriber.offer_screen(Screen(session.frame, session.search.emulator.screen()))
+    subscriber.offer_screen(Screen(session.frame, session.screen()))
 
 
 def _error_message(exc: BaseException) -> dict[str, Any]:

@@ -1,20 +1,28 @@
 // New game: make a game from a ROM file on this machine, as `retrokit new` does (its system told from the ROM's
-// header or extension), then open it in the studio.
+// header or extension), then play it in the studio; or open another known game by name. Either way the session
+// plays another game, so the page starts afresh (its buttons, states and fields are the new game's).
 
 import { post } from "./api.js";
 import { byId, el, replace } from "./dom.js";
 import { attempt } from "./status.js";
 
 async function make() {
-  const body = { rom: byId("new-rom").value.trim(), name: byId("new-name").value.trim() };
+  const body = { rom: byId("new-rom").value.trim(), name: byId("new-name").value.trim(), open: true };
   const system = byId("new-system").value.trim();
   if (system) body.system = system;
-  const answer = await post("new", body);
+  const answer = await post("newgame", body);
   replace(byId("new-result"),
-    el("p", { class: "ok" }, `Made ${answer.game ?? body.name} in ${answer.folder ?? ""}.`),
-    answer.next ? el("p", { class: "dim" }, answer.next) : null,
-    el("button", { type: "button", onclick: () => location.reload() }, "Reload the studio"));
-  return `Made ${answer.game ?? body.name}.`;
+    el("p", { class: "ok" }, `Made ${answer.game} (told by ${answer.told_by}) in ${answer.folder}; the ROM (SHA-1 ${answer.sha1}) is ${answer.rom}.`),
+    el("p", { class: "dim" }, "Reloading the studio on it…"));
+  setTimeout(() => location.reload(), 1500);
+  return `Made ${answer.game}; the studio plays it now.`;
+}
+
+async function openGame() {
+  const game = byId("open-game").value.trim();
+  const answer = await post("game", { game });
+  setTimeout(() => location.reload(), 500);
+  return `Opening ${answer.game}…`;
 }
 
 export async function init() {
@@ -26,10 +34,18 @@ export async function init() {
       el("div", { class: "row" }, el("label", {}, "name ", el("input", { id: "new-name", size: 20, placeholder: "Runner-Genesis" })),
         el("label", {}, "system ", el("input", { id: "new-system", size: 8, placeholder: "(from the ROM)" })),
         el("button", { type: "submit", id: "new-make" }, "Make the game"))),
-    el("div", { id: "new-result" }));
+    el("div", { id: "new-result" }),
+    el("h3", {}, "Open another game"),
+    el("form", { id: "open-form", class: "row" },
+      el("label", {}, "game ", el("input", { id: "open-game", size: 24, placeholder: "Airstriker-Genesis" })),
+      el("button", { type: "submit", id: "open-make" }, "Open")));
   byId("new-form").addEventListener("submit", (event) => {
     event.preventDefault();
     attempt(make, (line) => line);
+  });
+  byId("open-form").addEventListener("submit", (event) => {
+    event.preventDefault();
+    attempt(openGame, (line) => line);
   });
 }
 

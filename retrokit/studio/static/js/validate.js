@@ -3,6 +3,7 @@
 
 import { post } from "./api.js";
 import { byId, el, replace } from "./dom.js";
+import { on } from "./socket.js";
 import { attempt } from "./status.js";
 
 const WORDS = { pass: "passed", warn: "warnings", fail: "failed", skip: "skipped" };
@@ -22,16 +23,22 @@ function showReport(report) {
 async function run() {
   const button = byId("validate-run");
   button.disabled = true;
-  byId("validate-summary").textContent = "checking… (the smoke runs take a few seconds per state)";
+  byId("validate-summary").textContent = "checking… (the game plays on meanwhile)";
   byId("validate-summary").className = "dim";
   try {
     const answer = await post("validate", {});
-    const report = answer.report ?? answer;
+    const report = answer;
     showReport(report);
     return `Validated ${report.game}: ${report.passed ? "passed" : "failed"}.`;
   } finally {
     button.disabled = false;
   }
+}
+
+/** Progress while the checks run: the stage, and what it is on (a state, a scenario). */
+function progress(message) {
+  if (message.stage === "done" || !byId("validate-run").disabled) return;
+  byId("validate-summary").textContent = `checking ${message.game ?? ""}: ${message.stage}${message.detail ? ` (${message.detail})` : ""}…`;
 }
 
 export async function init() {
@@ -44,6 +51,7 @@ export async function init() {
       el("thead", {}, el("tr", {}, ["check", "state", "result", "message"].map((h) => el("th", {}, h)))),
       el("tbody", { id: "validate-rows" }))));
   byId("validate-run").addEventListener("click", () => attempt(run, (line) => line));
+  on("validate", progress);
 }
 
 export function shown() {}

@@ -145,6 +145,38 @@ function number(value) {
   return Number.isInteger(value) ? String(value) : value.toFixed(3);
 }
 
+let filling = false;
+
+/** Fetch the last frames' samples (GET /api/scenario/live): a push carries only the newest few, so frames run
+ * faster than the pushes (a frame advance of 200, 8x) would leave a gap in the plot. */
+async function fill() {
+  if (filling) return;
+  filling = true;
+  try {
+    const report = await get("scenario/live");
+    if (report.live) for (const sample of report.samples ?? []) samples.set(sample[0], sample);
+    queuePlot();
+  } finally {
+    filling = false;
+  }
+}
+
+/** Keep the last SECONDS of samples, and draw them at the next animation frame. */
+function queuePlot() {
+  const newest = samples.size ? Math.max(...samples.keys()) : 0;
+  const keep = newest - Math.round(SECONDS * frameRate);
+  for (const frame of samples.keys()) if (frame < keep) samples.delete(frame);
+  if (plotQueued) return;
+  plotQueued = true;
+  requestAnimationFrame(() => {
+    plotQueued = false;
+    const ordered = [...samples.values()].sort((a, b) => a[0] - b[0]);
+    drawPlot(byId("reward-plot"), ordered);
+    byId("range-reward").textContent = rangeText(ordered.map((s) => s[1]));
+    byId("range-total").textContent = rangeText(ordered.map((s) => s[2]));
+  });
+}
+
 /** A reward report: merge its samples (they overlap between pushes), show the numbers, plot. */
 function showReward(report) {
   if (report.error) {
@@ -152,26 +184,18 @@ function showReward(report) {
     showErrors({ ok: false, ...report.error });
     return;
   }
+  const known = samples.size ? Math.max(...samples.keys()) : null;
+  const oldest = report.samples?.length ? report.samples[0][0] : null;
+  if (known !== null && oldest !== null && oldest > known + 1) background(fill);
   for (const sample of report.samples ?? []) samples.set(sample[0], sample);
   const newest = report.frame ?? 0;
-  const keep = newest - Math.round(SECONDS * frameRate);
-  for (const frame of samples.keys()) if (frame < keep || frame > newest) samples.delete(frame);
   const last = report.samples?.length ? report.samples[report.samples.length - 1] : null;
   byId("reward-live").textContent = `${report.name}, frame ${newest}`;
   byId("reward-now").textContent = last ? number(last[1]) : "0";
   byId("reward-total").textContent = number(report.total ?? 0);
   byId("reward-done").textContent = report.done ? "yes" : "no";
   byId("reward-done").className = report.done ? "error" : "";
-  if (!plotQueued) {
-    plotQueued = true;
-    requestAnimationFrame(() => {
-      plotQueued = false;
-      const ordered = [...samples.values()].sort((a, b) => a[0] - b[0]);
-      drawPlot(byId("reward-plot"), ordered);
-      byId("range-reward").textContent = rangeText(ordered.map((s) => s[1]));
-      byId("range-total").textContent = rangeText(ordered.map((s) => s[2]));
-    });
-  }
+  queuePlot();
 }
 
 export async function init(info) {

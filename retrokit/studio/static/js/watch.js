@@ -7,6 +7,40 @@ import { on } from "./socket.js";
 import { attempt } from "./status.js";
 
 const valueCells = new Map(); // field name -> <td>
+let shownFrame = null; // the frame of the values shown
+let reading = false;
+
+/** Show values read at a frame; an older push arriving late is dropped. The frame is on the table too. */
+function showAt(frame, values) {
+  if (frame !== undefined && shownFrame !== null && frame < shownFrame) return;
+  shownFrame = frame ?? shownFrame;
+  byId("watch-table").dataset.frame = String(shownFrame);
+  showValues(values);
+}
+
+function showValues(values) {
+  for (const [name, value] of Object.entries(values)) {
+    const cell = valueCells.get(name);
+    if (cell) cell.textContent = shownValue(value);
+  }
+}
+
+let pausedAt = null; // the frame the game is paused at (null: running)
+
+/** Read every value once the game is paused at a frame not shown yet (one read at a time). */
+async function readPaused() {
+  if (reading || pausedAt === null || pausedAt === shownFrame) return;
+  reading = true;
+  try {
+    const answer = await get("fields");
+    showAt(answer.frame, Object.fromEntries(answer.fields.map((f) => [f.name, f.value])));
+  } catch {
+    // the next status tries again
+  } finally {
+    reading = false;
+  }
+  readPaused(); // paused elsewhere meanwhile
+}
 
 function shownValue(value) {
   return typeof value === "object" && value !== null ? JSON.stringify(value) : String(value);
@@ -54,6 +88,8 @@ export async function refresh() {
     return tr;
   });
   replace(byId("watch-rows"), rows);
+  shownFrame = null;
+  showAt(answer.frame, {});
   byId("watch-count").textContent = `${answer.fields.length} fields of ${answer.game}`;
 }
 
@@ -64,11 +100,12 @@ export async function init() {
     el("div", { class: "scroll tall" }, el("table", { id: "watch-table" },
       el("thead", {}, el("tr", {}, ["field", "address", "type", "range", "value", ""].map((h) => el("th", {}, h)))),
       el("tbody", { id: "watch-rows" }))));
-  on("fields", (message) => {
-    for (const [name, value] of Object.entries(message.values)) {
-      const cell = valueCells.get(name);
-      if (cell) cell.textContent = shownValue(value);
-    }
+  on("fields", (message) => showAt(message.frame, message.values));
+  // Values are pushed every few frames; when the game stops (a pause, the end of a frame advance or of a
+  // replay) the last push may be a frame or two old, so read them once more: paused, they are exact.
+  on("status", (status) => {
+    pausedAt = status.paused ? status.frame : null;
+    readPaused();
   });
   await refresh();
 }

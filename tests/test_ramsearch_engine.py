@@ -49,6 +49,21 @@ def test_every_type_decodes_as_the_reference_reader(code):
         assert int(values[position]) == ftype.decode(bytes(data[position : position + ftype.width])), position
 
 
+def test_a_listing_reads_each_candidates_values_as_the_reference_reader():
+    rng = np.random.default_rng(3)
+    search = engine(*({int(k): int(v) for k, v in zip(rng.integers(0, 256, 40), rng.integers(0, 256, 40))}
+                      for _ in range(6)))
+    search.filter("changed", than="first")
+    listed = list_candidates(search)
+    assert listed and list_candidates(search, 7) == listed[:7]
+    assert [(c.address, SEARCH_TYPES.index(c.type)) for c in listed] == sorted(
+        (c.address, SEARCH_TYPES.index(c.type)) for c in listed)
+    for row in listed:
+        ftype, at = parse_type(row.type), row.address - BASE
+        assert row.values == tuple(ftype.decode(bytes(s[at : at + ftype.width])) for s in search.snapshots)
+        assert row.changes == sum(a != b for a, b in zip(row.values, row.values[1:]))
+
+
 def test_searched_types_cover_what_gym_retro_infers():
     kinds = {(t.kind, t.width, t.order) for t in parse_search_types(None)}
     for order in (">", "<", "><", "<>"):

@@ -303,3 +303,19 @@ def test_a_port_already_taken_by_anything_else_is_the_same_error(tmp_path):
 
         with pytest.raises(PortInUseError, match=f"retrokit studio --port {port + 1}"):
             bind(port)
+
+
+def test_an_unknown_game_is_one_line_before_anything_listens():
+    proc = subprocess.run([sys.executable, "-m", "retrokit", "studio", "Dasher-Genesys", "--no-browser", "--port", "0"],
+                          check=False, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2 and proc.stdout == ""
+    assert proc.stderr.count("\n") == 1 and "Did you mean 'Dasher-Genesis'" in proc.stderr
+
+
+def test_a_state_symlinked_out_of_the_game_is_refused(client, session, folder, tmp_path):
+    outside = tmp_path / "outside.state"
+    shutil.copy(folder / "Zone1.Act2.state", outside)
+    (folder / "Linked.state").symlink_to(outside)
+    session.call_blocking(lambda s: s.refresh_game())
+    assert "symlink" in refused(client.post("/api/states/load", json={"name": "Linked"}))
+    assert "symlink" in refused(client.post("/api/play/reset", json={"state": "Linked"}))

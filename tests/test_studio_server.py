@@ -396,3 +396,21 @@ def test_new_game_from_a_rom_file_then_the_session_plays_it(tmp_path, monkeypatc
         assert outside["kind"] == "AccessDeniedError"
         typo = post(client, "/api/game", {"game": "Dasher-Genesys"}, status=404)
         assert "Did you mean" in typo["error"]
+
+
+def test_a_studio_nobody_opened_does_not_run_the_emulator():
+    idle = Session("Dasher-Genesis", "Zone1.Act1")
+    try:
+        with TestClient(create_app(idle, token=TOKEN, port=PORT), base_url=BASE):
+            time.sleep(0.5)
+            assert not idle.running and idle.frame == 0
+    finally:
+        idle.close()
+
+
+def test_a_reset_while_paused_shows_the_state_it_loaded(client, session):
+    screens = []
+    for state in ("Zone1.Act1", "Zone3.Act1", "Zone1.Act1"):
+        paused_at(client, state)
+        screens.append(client.get("/api/screen.png").content)
+    assert screens[0] != screens[1] and screens[0] == screens[2]

@@ -114,7 +114,7 @@ def test_search_finds_lives_and_adds_it_as_a_field(client, game):
 def test_filters_take_every_form_of_than_and_scales(client):
     ok(client.post("/api/search/new", json={"types": ["|u1", ">u2"]}))
     scaled = ok(client.post("/api/search/filter", json={"op": "equal", "value": 30}))  # 3 lives, shown x10
-    rows = ok(client.get("/api/search/candidates?limit=500"))["rows"]
+    rows = ok(client.get("/api/search/candidates?limit=100"))["rows"]
     assert any(r["address"] == LIVES and "x10" in r["scales"] for r in rows), scaled
     ok(client.post("/api/search/new", json={"types": ["|u1"]}))
     step(client, 20, ["RIGHT"])
@@ -132,6 +132,43 @@ def test_filters_take_every_form_of_than_and_scales(client):
     bad = refused(client.post("/api/search/filter", json={"op": "changed", "than": "prevous"}))
     assert "Did you mean 'previous'?" in bad["error"]
     refused(client.post("/api/search/filter", json={"op": "increased", "than": "7"}))  # no snapshot 7
+
+
+def test_a_search_takes_at_most_64_snapshots(client):
+    from retrokit.studio.search import MAX_SNAPSHOTS
+
+    ok(client.post("/api/search/new"))
+    for _ in range(MAX_SNAPSHOTS - 1):
+        ok(client.post("/api/search/snapshot"))
+    full = refused(client.post("/api/search/snapshot"))
+    assert "at most 64 snapshots" in full["error"] and full["kind"] == "RamSearchError"
+    assert len(ok(client.post("/api/search/new"))["snapshots"]) == 1
+
+
+def test_the_longest_listing_stays_in_bounded_memory(game):
+    from childproc import MAX_RSS_MB, run_child
+
+    child = run_child(
+        f"""
+        from starlette.testclient import TestClient
+        from retrokit.studio.app import create_app
+        from retrokit.studio.session import Session
+
+        session = Session("Dasher-Genesis", "Zone1.Act1")
+        session.paused = True
+        app = create_app(session, token="{TOKEN}", port={PORT})
+        with TestClient(app, base_url="http://127.0.0.1:{PORT}", headers={{"X-Retrokit-Token": "{TOKEN}"}}) as client:
+            client.post("/api/play/buttons", json={{"buttons": ["RIGHT"]}})
+            for _ in range(63):  # a fresh search: every type at every address, with a value at each snapshot
+                client.post("/api/play/step", json={{"frames": 1}})
+                assert client.post("/api/search/snapshot").status_code == 200
+            rows = client.get("/api/search/candidates?limit=100").json()["rows"]
+            print(len(rows), len(rows[0]["values"]))
+        """,
+        timeout=300,
+    )
+    assert child.returncode == 0 and child.stdout.split() == ["100", "64"], child.describe()
+    assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
 
 
 def test_candidate_values_are_pushed_live_over_the_socket(client):
@@ -182,6 +219,9 @@ def test_a_field_is_edited_in_place_and_the_session_reads_it_again(client, game)
     assert changed[1].startswith('  ring_count:  {address: 0xFF00C2, type: "|i1"}')
     rows = fields(client)
     assert rows["p1_lives"]["range"] == [0, 5] and rows["ring_count"]["hex"] == "0xFF00C2"
+    ok(client.patch("/api/fields/game_mode", json={"range": [0, 4]}))  # its comment stays
+    assert '  game_mode:   {address: 0xFF0002, type: "|u1", range: [0, 4]}   # 0 title, 1 play, 2 act clear' in (
+        game.read_text())
     ok(client.patch("/api/fields/p1_lives", json={"range": None}))  # a range can be dropped
     assert "range" not in next(line for line in game.read_text().splitlines() if "p1_lives:" in line)
 
@@ -220,6 +260,19 @@ def test_compile_errors_carry_the_line_and_column_the_language_reports(client, g
     assert (syntax["kind"], syntax["line"], syntax["column"]) == ("ScenarioSyntaxError", 1, 16)
     good = ok(client.post("/api/scenario/compile", json={"text": "reward: delta(p1_x)\n"}))
     assert good == {"ok": True, "name": "scenario", "players": 1, "fields": ["p1_x"]}
+
+
+def test_editor_text_includes_only_files_of_the_games_folders(client, game, tmp_path):
+    (game.parent / "parts.yaml").write_text("define:\n  gain: delta(p1_x)\n")
+    good = ok(client.post("/api/scenario/compile", json={"text": "include: [parts.yaml]\nreward: gain\n"}))
+    assert good["ok"] and good["fields"] == ["p1_x"]
+    secret = tmp_path / "secret.yaml"
+    secret.write_text("define:\n  gain: 1\n")
+    (game.parent / "link.yaml").symlink_to(secret)
+    for name in (str(secret), "../../secret.yaml", "%2e%2e/%2e%2e/secret.yaml", "link.yaml"):
+        refused_ = ok(client.post("/api/scenario/compile", json={"text": f"include: [{name!r}]\nreward: 1\n"}))
+        assert not refused_["ok"] and "inside the game's folders" in refused_["error"], refused_
+        assert (refused_["line"], refused_["column"]) == (1, 11)
 
 
 def test_the_draft_survives_a_restart_and_only_compiling_text_is_saved(game, data):
@@ -302,6 +355,16 @@ def run_job(client: TestClient, body: dict, timeout: float = 60.0) -> dict:
     raise AssertionError(f"click to find did not finish in {timeout} s: {job}")
 
 
+def future(session: Session) -> tuple[bytes, bytes]:
+    """The RAM and the screen 10 frames from now (run on a copy of the state: the game stays where it is)."""
+    emulator = session.search.emulator
+    now = emulator.get_state()
+    emulator.run(0, 10)
+    seen = session.search.layout.read(emulator.space).tobytes(), emulator.screen().tobytes()
+    emulator.set_state(now)
+    return seen
+
+
 SPAWN_BLINK = 70  # frames: a player blinks for its first 60 (tools/testcart/src/player.c SPAWN_INVULN)
 
 
@@ -311,13 +374,13 @@ def test_click_on_the_player_finds_its_position_without_disturbing_the_game(clie
     assert values["p1_invuln"]["value"] == 0
     x, y = values["p1_x"]["value"] - values["camera_x"]["value"], values["p1_y"]["value"] - 8  # the sprite's middle
     session = client.app.state.session
-    before = session.call_blocking(lambda s: s.search.emulator.get_state())
+    before = session.call_blocking(future)
     job = run_job(client, {"x": x, "y": y, "region": {"start": "0xFF0020", "length": 32}})
     assert job["done"] == job["total"] == 32 and not job["error"]
     found = {hit["address"]: hit for hit in job["hits"]}
     assert P1_X in found and found[P1_X]["fields"] == ["p1_x"]  # its high byte moves it off the point
     assert LIVES not in found  # the HUD's lives are drawn elsewhere
-    assert session.call_blocking(lambda s: s.search.emulator.get_state()) == before  # the game is where it was
+    assert session.call_blocking(future) == before  # the game is where it was, and goes on the same
 
 
 def screen(client: TestClient):
@@ -396,6 +459,7 @@ def test_ram_view_marks_what_changed_since_the_last_frame_and_a_snapshot(client)
         ("post", "/api/search/new", {"types": ["|q7"]}, 400),
         ("post", "/api/search/snapshot", {"label": "x" * 1000}, 400),
         ("get", "/api/search/candidates?limit=0", None, 400),
+        ("get", "/api/search/candidates?limit=101", None, 400),
         ("get", "/api/search/candidates?limit=99999999999999999999", None, 400),
         ("post", "/api/search/poke", {"address": "0xFF002B", "value": 300}, 400),
         ("post", "/api/search/poke", {"address": -1, "value": 1}, 400),
@@ -423,6 +487,10 @@ def test_hostile_requests_get_one_line_json_errors(client, method, url, body, st
 
 
 def test_a_body_that_is_not_json_or_too_big_is_refused(client):
+    lone = b'{"text": "reward: 1 # \\ud800"}'  # JSON may carry half a UTF-16 pair; no file can hold it
+    for route in ("/api/scenario/compile", "/api/scenario/save", "/api/scenario/live"):
+        assert "UTF-16" in refused(client.post(route, content=lone))["error"]
+    assert "UTF-16" in refused(client.put("/api/scenario/draft", content=lone))["error"]
     refused(client.post("/api/search/filter", content=b"{not json", headers={"Content-Type": "application/json"}))
     refused(client.post("/api/search/filter", content=b"[1, 2]"))
     huge = "reward: " + "1 + " * 400_000 + "1\n"

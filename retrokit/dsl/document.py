@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 
 import numpy as np
@@ -33,7 +33,7 @@ from retrokit.dsl.check import constant
 from retrokit.dsl.parser import MAX_INT, parse
 from retrokit.dsl.source import Snippet, SourceText, align, located, read_source
 from retrokit.dsl.spec import Scalar, ScenarioSpec, Table
-from retrokit.errors import ScenarioError, did_you_mean, shown
+from retrokit.errors import RetrokitError, ScenarioError, did_you_mean, shown
 
 TOP_KEYS = (
     "name", "description", "include", "tables", "define", "reward", "rewards", "done", "dones", "actions", "crop",
@@ -198,10 +198,13 @@ class _Reader:
 class DocumentLoader:
     """Build a ScenarioSpec from a YAML file and the files it includes."""
 
-    def __init__(self, name: str) -> None:
+    def __init__(self, name: str, *, resolve_include: Callable[[Path, str], Path] | None = None) -> None:
         self.spec = ScenarioSpec(name)
         self._origins: dict[str, Snippet] = {}
         self._seen: list[Path] = []
+        #: Turns an ``include`` entry into a path, from the including file's folder; it may refuse one
+        #: (raise a RetrokitError) that leaves the folders a caller allows, as the studio's requests must.
+        self.resolve_include = resolve_include or (lambda base, name: base / name)
 
     def load_file(self, path: Path, *, top: bool = True) -> None:
         """Read ``path`` (a scenario, or an included file when ``top`` is false)."""
@@ -228,7 +231,10 @@ class DocumentLoader:
             for item in self._list(reader, entries["include"][1], "include"):
                 if base is None:
                     raise reader.error(entries["include"][1], "include needs a folder to look in: pass game_dir")
-                target = base / str(reader.plain(item))
+                try:
+                    target = self.resolve_include(base, str(reader.plain(item)))
+                except RetrokitError as exc:
+                    raise reader.error(item, f"cannot include {str(reader.plain(item))!r}: {exc}") from None
                 try:
                     found = target.is_file()
                 except (OSError, ValueError):  # a name too long for the file system, or holding NUL

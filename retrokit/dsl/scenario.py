@@ -16,7 +16,7 @@ and ``step`` env steps since reset.
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 
 from retrokit.dsl.compiler import Program
@@ -167,6 +167,7 @@ def scenario_from_text(
     source: str,
     name: str,
     game_dir: str | os.PathLike[str] | None = None,
+    resolve_include: Callable[[Path, str], Path] | None = None,
 ) -> Scenario:
     """Compile scenario YAML given as text, such as an editor's unsaved buffer.
 
@@ -179,6 +180,8 @@ def scenario_from_text(
         source: What the text's errors call it, e.g. the path it will be saved to.
         name: The scenario's name unless the text gives one (``name:``).
         game_dir: Where its ``include`` files are looked up.
+        resolve_include: Turns an ``include`` entry and the including file's folder into a path, raising a
+            :class:`~retrokit.errors.RetrokitError` for one it refuses (by default: the folder / the entry).
 
     Raises:
         ScenarioError: The text is too large, or malformed (and its subclasses, as :func:`load_scenario`).
@@ -191,6 +194,6 @@ def scenario_from_text(
         raise ScenarioError(
             f"{source}: expected a scenario of at most {MAX_YAML_BYTES >> 20} MiB; got {len(text):,} characters."
         )
-    loader = DocumentLoader(name)
+    loader = DocumentLoader(name, resolve_include=resolve_include)
     loader.load_text(text.removeprefix("\ufeff"), source, Path(game_dir) if game_dir is not None else None)
     return Scenario(loader.spec, fields)

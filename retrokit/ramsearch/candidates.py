@@ -10,6 +10,7 @@ the same bytes the same way, and :func:`list_groups` is what ``show`` lists.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -118,7 +119,18 @@ class Candidate:
     @property
     def low_byte(self) -> int:
         """The address of its least significant byte."""
-        return self.address + parse_type(self.type).significance()[0]
+        return self.address + _low_offset(self.type)
+
+
+@functools.lru_cache(maxsize=64)
+def _low_offset(code: str) -> int:
+    """Where a type's least significant byte is, from its first (a listing asks once per candidate)."""
+    return parse_type(code).significance()[0]
+
+
+@functools.lru_cache(maxsize=64)
+def _width(code: str) -> int:
+    return parse_type(code).width
 
 
 def group_candidates(candidates: Sequence[Candidate]) -> list[list[Candidate]]:
@@ -133,7 +145,7 @@ def group_candidates(candidates: Sequence[Candidate]) -> list[list[Candidate]]:
     groups: dict[tuple[int, str, tuple[int, ...]], list[Candidate]] = {}
     for c in candidates:
         groups.setdefault((c.low_byte, c.scale, c.values), []).append(c)
-    return [sorted(g, key=lambda c: parse_type(c.type).width) for g in groups.values()]
+    return [sorted(g, key=lambda c: _width(c.type)) for g in groups.values()]
 
 
 MAX_LISTED = 100_000  # `show` lists no more: each row is decoded at every snapshot in Python

@@ -18,6 +18,7 @@ value search has matched yet, read as the value itself.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -82,11 +83,13 @@ def bits(mask: int) -> list[int]:
     return [index for index in range(len(SCALES)) if mask >> index & 1]
 
 
+@functools.lru_cache(maxsize=1024)
 def scale_labels(mask: int) -> tuple[str, ...]:
     """The labels of the scales in ``mask`` (``""`` for the value itself); none when unpinned."""
     return tuple(SCALES[index].label for index in bits(mask))
 
 
+@functools.lru_cache(maxsize=1024)
 def scale_label(mask: int) -> str:
     """How ``show`` writes a candidate's scales: ``""`` for the value itself (or unpinned), else e.g. ``"-1,/2"``."""
     labels = [label or "=" for label in scale_labels(mask)]

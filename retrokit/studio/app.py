@@ -36,7 +36,9 @@ from retrokit import errors
 from retrokit.studio.security import Guard
 from retrokit.studio.session import Screen, Session, Subscriber
 
-ROUTE_MODULES: tuple[str, ...] = ("play", "states", "authoring", "search", "fields", "scenario", "clickfind", "ramview")
+ROUTE_MODULES: tuple[str, ...] = (
+    "play", "states", "authoring", "search", "fields", "scenario", "clickfind", "ramview",
+)
 """The modules of :mod:`retrokit.studio` whose ``routes`` are mounted under ``/api``."""
 
 STATIC = Path(__file__).parent / "static"
@@ -76,7 +78,7 @@ def session_of(request: Request | WebSocket) -> Session:
 def create_app(session: Session, *, token: str, port: int) -> Starlette:
     """The studio's application for ``session``, guarded by ``token`` (the server listens on ``port``).
 
-    The session's thread starts with the application and the session is closed when it shuts down.
+    The session's thread starts with the first page or request, and the session is closed when the app shuts down.
     """
     routes: list[BaseRoute] = []
     for name in ROUTE_MODULES:
@@ -84,7 +86,7 @@ def create_app(session: Session, *, token: str, port: int) -> Starlette:
 
     @contextlib.asynccontextmanager
     async def lifespan(_app: Starlette) -> AsyncIterator[None]:
-        session.start()
+        # The emulator thread starts with the first page or request, not here: a studio nobody opened stays idle.
         try:
             yield
         finally:

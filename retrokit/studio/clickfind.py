@@ -29,7 +29,7 @@ import itertools
 import time
 import weakref
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from starlette.requests import Request
 from starlette.responses import JSONResponse
@@ -40,6 +40,9 @@ from retrokit.host.typecodes import parse_type
 from retrokit.studio.app import session_of
 from retrokit.studio.search import address_of, integer_of
 from retrokit.studio.security import json_body
+
+if TYPE_CHECKING:
+    from retrokit.studio.session import Session
 
 MAX_CELLS = 8192
 """The most cells one job pokes: two tries of ~3 ms each per cell, about a minute at most."""
@@ -93,10 +96,10 @@ class Job:
         }
 
 
-_jobs: weakref.WeakKeyDictionary[Any, Job] = weakref.WeakKeyDictionary()  # each session's newest job
+_jobs: weakref.WeakKeyDictionary[Session, Job] = weakref.WeakKeyDictionary()  # each session's newest job
 
 
-def _cells(session: Any, region: object) -> list[int]:
+def _cells(session: Session, region: object) -> list[int]:
     """The byte addresses a job pokes (on the emulator thread: the candidates live there).
 
     Raises:
@@ -138,7 +141,7 @@ def _pixel(emulator: Any, job: Job) -> tuple[int, ...]:
     return tuple(int(c) for c in emulator.screen()[job.y, job.x])
 
 
-def begin(session: Any, x: object, y: object, region: object, frames: object) -> Job:
+def begin(session: Session, x: object, y: object, region: object, frames: object) -> Job:
     """Start a job at pixel (x, y): keep the moment, and the pixel's color a few frames on (emulator thread).
 
     Raises:
@@ -164,8 +167,12 @@ def begin(session: Any, x: object, y: object, region: object, frames: object) ->
     return job
 
 
-def work(session: Any, job: Job, seconds: float = CHUNK_SECONDS) -> None:
-    """Try cells for about ``seconds``, then put the game back as it was (emulator thread)."""
+def work(session: Session, job: Job, seconds: float = CHUNK_SECONDS) -> None:
+    """Try cells for about ``seconds``, then put the game back as it was (emulator thread).
+
+    The job's progress changes only once the game is back, so whoever reads it from another thread
+    never sees a job finished while its last chunk still holds the emulator.
+    """
     if session.search is not job.search:
         job.error = "Expected the game that was clicked; the session plays another one now. Click again."
         return
@@ -173,9 +180,10 @@ def work(session: Any, job: Job, seconds: float = CHUNK_SECONDS) -> None:
     now = emulator.get_state()
     started = time.perf_counter()
     names = _field_names(session)
+    done, hits = job.done, []
     try:
-        while not job.finished and time.perf_counter() - started < seconds:
-            address = job.addresses[job.done]
+        while done < len(job.addresses) and not job.cancelled and time.perf_counter() - started < seconds:
+            address = job.addresses[done]
             value = job.base_ram[address]
             changed = []
             for poked in ((value + 1) & 0xFF, value ^ 0xFF):
@@ -185,17 +193,20 @@ def work(session: Any, job: Job, seconds: float = CHUNK_SECONDS) -> None:
                 if color != job.color:
                     changed.append({"value": poked, "color": list(color)})
             if changed:
-                job.hits.append(
+                hits.append(
                     {"address": address, "hex": session.search.layout.format(address), "value": value,
                      "fields": names.get(address, []), "pokes": changed}
                 )
-            job.done += 1
+            done += 1
     finally:
         emulator.set_state(now)
+        session.mark_loaded()  # the video buffer holds the last try: a paused page is shown the game's own picture
+        job.hits.extend(hits)
+        job.done = done
         job.seconds += time.perf_counter() - started
 
 
-def _field_names(session: Any) -> dict[int, list[str]]:
+def _field_names(session: Session) -> dict[int, list[str]]:
     """The game's fields over each byte address, so a hit names the variable it is part of."""
     names: dict[int, list[str]] = {}
     for spec in session.search.game.fields.values():
@@ -204,7 +215,7 @@ def _field_names(session: Any) -> dict[int, list[str]]:
     return names
 
 
-async def _run(session: Any, job: Job) -> None:
+async def _run(session: Session, job: Job) -> None:
     """Drive a job to its end a chunk at a time, publishing its progress."""
     try:
         while not job.finished:

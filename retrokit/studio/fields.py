@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import weakref
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from starlette.requests import Request
 from starlette.responses import JSONResponse
@@ -28,6 +28,9 @@ from retrokit.host.memory import FieldReader
 from retrokit.studio.app import session_of
 from retrokit.studio.search import Pacer, save_field
 from retrokit.studio.security import json_body
+
+if TYPE_CHECKING:
+    from retrokit.studio.session import Session
 
 
 @dataclass
@@ -40,10 +43,10 @@ class _Reader:
     remove: Any = None
 
 
-_readers: weakref.WeakKeyDictionary[Any, _Reader] = weakref.WeakKeyDictionary()
+_readers: weakref.WeakKeyDictionary[Session, _Reader] = weakref.WeakKeyDictionary()
 
 
-def field_reader(session: Any) -> FieldReader:
+def field_reader(session: Session) -> FieldReader:
     """A reader of the session's game's fields, as an env reads them (emulator thread)."""
     entry = _readers.setdefault(session, _Reader())
     game = session.search.game
@@ -54,14 +57,14 @@ def field_reader(session: Any) -> FieldReader:
     return entry.reader
 
 
-def _push(session: Any) -> None:
+def _push(session: Session) -> None:
     """Frame hook: push every field's value (20 times a second)."""
     if not _readers[session].pacer.ready(session):
         return
     session.publish({"type": "fields", "frame": session.frame, "values": field_reader(session).read()})
 
 
-def _fields(session: Any) -> dict[str, Any]:
+def _fields(session: Session) -> dict[str, Any]:
     search = session.search
     values = field_reader(session).read()
     rows = [
@@ -79,7 +82,7 @@ def _fields(session: Any) -> dict[str, Any]:
     return {"game": search.game.name, "frame": session.frame, "fields": rows}
 
 
-def _edit(session: Any, name: str, changes: dict[str, Any]) -> dict[str, Any]:
+def _edit(session: Session, name: str, changes: dict[str, Any]) -> dict[str, Any]:
     spec = field_reader(session).spec(name)  # an unknown name: FieldNotFoundError, with a did-you-mean
     if spec.mask is not None:
         raise InvalidArgumentError(

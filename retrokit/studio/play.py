@@ -18,7 +18,7 @@ from retrokit.data.names import check_state_name
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean, shown
 from retrokit.host.systems import System
 from retrokit.studio.app import session_of
-from retrokit.studio.security import expect, json_body
+from retrokit.studio.security import check_inside, expect, game_roots, json_body
 from retrokit.studio.session import MAX_SPEED, MIN_SPEED, Session
 
 MAX_STEP = 3600
@@ -102,7 +102,9 @@ def reset(session: Session, state: str | None) -> None:
     if name is None:
         search.emulator.reset()
     else:
-        search.load_state(name)  # StateNotFoundError, with a did-you-mean, for an unknown one
+        path = search.game.state_path(name)  # StateNotFoundError, with a did-you-mean, for an unknown one
+        check_inside(path, game_roots(search.game), what="state")
+        search.load_state(name)
         search.state = name
     session.mark_loaded()
     session.send_screen()

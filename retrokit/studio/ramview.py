@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import weakref
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from starlette.requests import Request
@@ -30,6 +30,9 @@ from retrokit.errors import RamSearchError
 from retrokit.studio.app import session_of
 from retrokit.studio.search import Pacer, address_of, integer_of
 from retrokit.studio.security import json_body
+
+if TYPE_CHECKING:
+    from retrokit.studio.session import Session
 
 MAX_LENGTH = 4096
 """The most bytes a view shows: 256 rows of 16, more than a page can draw live."""
@@ -53,10 +56,10 @@ class _View:
     remove: Any = None
 
 
-_views: weakref.WeakKeyDictionary[Any, _View] = weakref.WeakKeyDictionary()
+_views: weakref.WeakKeyDictionary[Session, _View] = weakref.WeakKeyDictionary()
 
 
-def _region(session: Any, start: object, length: object, snapshot: object) -> tuple[int, int, int, int | None]:
+def _region(session: Session, start: object, length: object, snapshot: object) -> tuple[int, int, int, int | None]:
     """The region's start, length, snapshot position, and snapshot index, checked (emulator thread).
 
     Raises:
@@ -78,18 +81,18 @@ def _region(session: Any, start: object, length: object, snapshot: object) -> tu
     return begin, count, position, index
 
 
-def _where(session: Any, start: int, length: int) -> tuple[int, np.ndarray]:
+def _where(session: Session, start: int, length: int) -> tuple[int, np.ndarray]:
     """The buffer holding a region, and the offset of each of its bytes there (in console order)."""
     index, offsets = session.search.emulator.space.offsets(start, length)
     return index, np.array(offsets, dtype=np.intp)
 
 
-def _bytes(session: Any, buffer: int, offsets: np.ndarray) -> np.ndarray:
+def _bytes(session: Session, buffer: int, offsets: np.ndarray) -> np.ndarray:
     """The region's bytes now: only those (the whole RAM's console-order copy costs half a frame)."""
     return np.frombuffer(session.search.emulator.space.buffers[buffer], dtype=np.uint8)[offsets]
 
 
-def _differs(session: Any, view: _View, now: np.ndarray, snapshot: int | None) -> list[int] | None:
+def _differs(session: Session, view: _View, now: np.ndarray, snapshot: int | None) -> list[int] | None:
     if snapshot is None or snapshot >= len(session.search.engine.snapshots):  # a new search has fewer
         return None
     then = session.search.engine.snapshots[snapshot][view.position : view.position + view.length]
@@ -97,7 +100,7 @@ def _differs(session: Any, view: _View, now: np.ndarray, snapshot: int | None) -
 
 
 def _report(
-    session: Any, view: _View, now: np.ndarray, changed: np.ndarray, snapshot: int | None
+    session: Session, view: _View, now: np.ndarray, changed: np.ndarray, snapshot: int | None
 ) -> dict[str, Any]:
     return {
         "type": "ram",
@@ -112,7 +115,7 @@ def _report(
     }
 
 
-def _on_frame(session: Any) -> None:
+def _on_frame(session: Session) -> None:
     """Frame hook: note what changed since the frame before; push every few frames."""
     view = _views.get(session)
     if view is None or view.search is not session.search:
@@ -125,7 +128,7 @@ def _on_frame(session: Any) -> None:
         view.changed[:] = False
 
 
-def _view(session: Any, start: object, length: object, snapshot: object, watch: bool) -> dict[str, Any]:
+def _view(session: Session, start: object, length: object, snapshot: object, watch: bool) -> dict[str, Any]:
     """The region now; with ``watch``, watched from now on. ``changed``: what the last frame changed."""
     begin, count, position, index = _region(session, start, length, snapshot)
     buffer, offsets = _where(session, begin, count)
@@ -148,7 +151,7 @@ def _view(session: Any, start: object, length: object, snapshot: object, watch: 
     return _report(session, view, now, changed, index)
 
 
-def _unwatch(session: Any) -> dict[str, Any]:
+def _unwatch(session: Session) -> dict[str, Any]:
     view = _views.pop(session, None)
     if view is not None and view.remove is not None:
         view.remove()

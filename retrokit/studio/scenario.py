@@ -30,7 +30,7 @@ import collections
 import weakref
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from starlette.requests import Request
 from starlette.responses import JSONResponse
@@ -40,11 +40,14 @@ from retrokit import paths
 from retrokit.data.names import check_state_name
 from retrokit.dsl.scenario import Run, Scenario, scenario_from_text
 from retrokit.dsl.source import read_source
-from retrokit.errors import DataFileError, ScenarioError, ScenarioRuntimeError
+from retrokit.errors import DataFileError, InvalidArgumentError, ScenarioError, ScenarioRuntimeError
 from retrokit.studio.app import session_of
 from retrokit.studio.fields import field_reader
 from retrokit.studio.search import Pacer
-from retrokit.studio.security import expect, json_body
+from retrokit.studio.security import expect, json_body, resolve_path
+
+if TYPE_CHECKING:
+    from retrokit.studio.session import Session
 
 HISTORY = 600
 """Frames of reward kept for the plot: 10 seconds at 60 fps."""
@@ -83,7 +86,7 @@ class Where:
         return draft_path(self.game.name, self.name)
 
 
-def where(session: Any, name: object) -> Where:
+def where(session: Session, name: object) -> Where:
     """Scenario ``name`` (the default one if none) of the session's game (emulator thread: the game may change)."""
     search = session.search
     game = search.game
@@ -108,7 +111,13 @@ def compile_text(place: Where, text: str) -> Scenario:
         ScenarioError: It does not compile (with ``line`` and ``column`` where the language gives them).
     """
     game = place.game
-    return scenario_from_text(text, list(game.fields), source=place.source, name=place.name, game_dir=game.folders[0])
+
+    def include(base: Path, name: str) -> Path:  # the text is a request's: what it includes stays in the game's folders
+        return resolve_path(name, base, game.folders, what="scenario file to include")
+
+    return scenario_from_text(
+        text, list(game.fields), source=place.source, name=place.name, game_dir=game.folders[0], resolve_include=include
+    )
 
 
 def _compile_saved(place: Where) -> Scenario:
@@ -154,7 +163,7 @@ class _Live:
     pacer: Pacer = field(default_factory=Pacer)
     remove: Any = None
 
-    def restart(self, session: Any) -> None:
+    def restart(self, session: Session) -> None:
         """A new episode from the game's moment now (a run-time error of the scenario is kept in ``error``)."""
         self.search, self.start_state = session.search, session.search.start_state
         self.episode_frame, self.total, self.done, self.error = 0, 0.0, False, None
@@ -164,7 +173,7 @@ class _Live:
         except ScenarioRuntimeError as exc:  # the scenario's fault, told to the page; the game goes on
             self.error = error_json(exc)
 
-    def step(self, session: Any) -> None:
+    def step(self, session: Session) -> None:
         """Evaluate the scenario on this frame's fields."""
         self.episode_frame += 1
         try:
@@ -192,10 +201,10 @@ class _Live:
         }
 
 
-_live: weakref.WeakKeyDictionary[Any, _Live] = weakref.WeakKeyDictionary()
+_live: weakref.WeakKeyDictionary[Session, _Live] = weakref.WeakKeyDictionary()
 
 
-def _on_frame(session: Any) -> None:
+def _on_frame(session: Session) -> None:
     """Frame hook: step the live scenario on this frame's fields; push the reward 20 times a second."""
     live = _live.get(session)
     if live is None:
@@ -209,7 +218,7 @@ def _on_frame(session: Any) -> None:
         live.unsent = 0
 
 
-def _go_live(session: Any, name: str, scenario: Scenario) -> dict[str, Any]:
+def _go_live(session: Session, name: str, scenario: Scenario) -> dict[str, Any]:
     old = _live.get(session)
     live = _Live(name, scenario, remove=old.remove if old is not None else None)
     live.restart(session)
@@ -219,14 +228,14 @@ def _go_live(session: Any, name: str, scenario: Scenario) -> dict[str, Any]:
     return live.report()
 
 
-def _stop(session: Any) -> dict[str, Any]:
+def _stop(session: Session) -> dict[str, Any]:
     live = _live.pop(session, None)
     if live is not None and live.remove is not None:
         live.remove()
     return {"live": False}
 
 
-def _live_report(session: Any) -> dict[str, Any]:
+def _live_report(session: Session) -> dict[str, Any]:
     live = _live.get(session)
     return {"live": False} if live is None else {"live": True, **live.report()}
 
@@ -279,7 +288,7 @@ def _save(place: Where, text: str) -> Scenario:
     return scenario
 
 
-def _saved(session: Any, place: Where, scenario: Scenario) -> None:
+def _saved(session: Session, place: Where, scenario: Scenario) -> None:
     """After a save: the game's scenarios listed afresh, and the live one replaced if it is this one."""
     session.search.reload_game()
     live = _live.get(session)
@@ -287,9 +296,25 @@ def _saved(session: Any, place: Where, scenario: Scenario) -> None:
         _go_live(session, place.name, scenario)
 
 
+def _utf8(text: str) -> str:
+    """``text`` if it can be saved as UTF-8 (JSON can carry a lone surrogate, which no file holds).
+
+    Raises:
+        InvalidArgumentError: It cannot.
+    """
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError as exc:
+        raise InvalidArgumentError(
+            f"Expected the scenario's text as Unicode text; found {exc.object[exc.start]!r} at character {exc.start}, "
+            "half of a UTF-16 pair, which no file can hold. Remove it."
+        ) from None
+    return text
+
+
 async def _text(request: Request) -> tuple[Where, str]:
     body = await json_body(request)
-    text, name = expect(body, "text", str), expect(body, "name", str, None)
+    text, name = _utf8(expect(body, "text", str)), expect(body, "name", str, None)
     return await session_of(request).call(where, name), text
 
 
@@ -327,6 +352,7 @@ async def save(request: Request) -> JSONResponse:
 async def live_start(request: Request) -> JSONResponse:
     body = await json_body(request)
     text, name = expect(body, "text", str, None), expect(body, "name", str, None)
+    text = None if text is None else _utf8(text)
     session = session_of(request)
     place = await session.call(where, name)
     try:

@@ -27,32 +27,41 @@ from __future__ import annotations
 import time
 import weakref
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from starlette.requests import Request
 from starlette.responses import JSONResponse
 from starlette.routing import Route
 
-from retrokit.errors import InvalidArgumentError, shown
+from retrokit.errors import InvalidArgumentError, RamSearchError, shown
 from retrokit.ramsearch.candidates import Candidate, list_groups
 from retrokit.ramsearch.filters import OPS, THAN_FORMS
 from retrokit.studio.app import session_of
 from retrokit.studio.security import expect, json_body
 
-MAX_ROWS = 500
-"""The most candidate groups one listing returns (and whose live values are pushed)."""
+if TYPE_CHECKING:
+    from retrokit.studio.session import Session
+
+MAX_ROWS = 100
+"""The most candidate groups one listing returns (and whose live values are pushed): a listing fetches up to
+256 candidates a group, each with its value at every snapshot, on the emulator thread."""
+MAX_SNAPSHOTS = 64
+"""The most snapshots one search of the studio takes: with 100 rows listed, a listing then peaks under 200 MB
+(at 256 snapshots it took 750 MB for 500 rows). A new search starts again from one."""
 PUSH_PERIOD = 0.05
 """Seconds between two pushes of a tool's live values: 20 a second, whatever the game's speed."""
 
 
 @dataclass
 class Pacer:
-    """When a frame hook pushes its live values next: every :data:`PUSH_PERIOD`, and after each frame of a
-    paused game (one frame advanced at a time shows each)."""
+    """When a frame hook pushes its live values: every :data:`PUSH_PERIOD`, and after each frame advanced by hand.
+
+    A paused game moves a frame at a time at the user's request: each of those frames is shown.
+    """
 
     due: float = 0.0
 
-    def ready(self, session: Any) -> bool:
+    def ready(self, session: Session) -> bool:
         """Whether to push after this frame."""
         now = time.monotonic()
         if now < self.due and not session.paused:
@@ -75,8 +84,9 @@ def integer_of(value: object, what: str, low: int | None = None, high: int | Non
             pass
     if not isinstance(number, int) or isinstance(number, bool):
         raise InvalidArgumentError(f"Expected {what} as a whole number (decimal, or hex as 0xFF002B); got {shown(value)}.")
-    if (low is not None and number < low) or (high is not None and number > high):
-        raise InvalidArgumentError(f"Expected {what} from {low} to {high}; got {number}.")
+    if low is not None and number < low or high is not None and number > high:
+        bounds = f"from {low} to {high}" if high is not None else f"of {low} or more"
+        raise InvalidArgumentError(f"Expected {what} {bounds}; got {number}.")
     return number
 
 
@@ -106,10 +116,10 @@ class _Watch:
     remove: Any = None
 
 
-_watches: weakref.WeakKeyDictionary[Any, _Watch] = weakref.WeakKeyDictionary()
+_watches: weakref.WeakKeyDictionary[Session, _Watch] = weakref.WeakKeyDictionary()
 
 
-def _push_live(session: Any) -> None:
+def _push_live(session: Session) -> None:
     """Frame hook: push the watched rows' values (20 times a second)."""
     watch = _watches.get(session)
     if watch is None or not watch.rows or watch.search is not session.search or not watch.pacer.ready(session):
@@ -119,7 +129,7 @@ def _push_live(session: Any) -> None:
     session.publish({"type": "candidates", "frame": session.frame, "values": values})
 
 
-def _status(session: Any) -> dict[str, Any]:
+def _status(session: Session) -> dict[str, Any]:
     search = session.search
     return {
         "count": search.count,
@@ -132,7 +142,7 @@ def _status(session: Any) -> dict[str, Any]:
     }
 
 
-def _row(session: Any, group: list[Candidate]) -> dict[str, Any]:
+def _row(session: Session, group: list[Candidate]) -> dict[str, Any]:
     first = group[0]
     return {
         "address": first.address,
@@ -147,7 +157,7 @@ def _row(session: Any, group: list[Candidate]) -> dict[str, Any]:
     }
 
 
-def _candidates(session: Any, limit: int) -> dict[str, Any]:
+def _candidates(session: Session, limit: int) -> dict[str, Any]:
     search = session.search
     groups = list_groups(search.count, search.candidates, limit, len(search.types))
     rows = [_row(session, g) for g in groups.groups]
@@ -158,27 +168,32 @@ def _candidates(session: Any, limit: int) -> dict[str, Any]:
     return {"total": groups.total, "groups": groups.count, "more": groups.more, "rows": rows}
 
 
-def _filter(session: Any, op: str, value: object, than: object) -> dict[str, Any]:
+def _filter(session: Session, op: str, value: object, than: object) -> dict[str, Any]:
     number = None if value is None else integer_of(value, "the filter's number")
     before = session.search.count
     session.search.filter(op, number, _than(than))
     return {"before": before, "filter": session.search.history[-1], **_status(session)}
 
 
-def _snapshot(session: Any, label: str) -> dict[str, Any]:
+def _snapshot(session: Session, label: str) -> dict[str, Any]:
     if len(label) > 200:
         raise InvalidArgumentError(f"Expected a snapshot label of at most 200 characters; got {shown(label)}.")
+    if len(session.search.labels) >= MAX_SNAPSHOTS:
+        raise RamSearchError(
+            f"Expected at most {MAX_SNAPSHOTS} snapshots in one search; this one has them all. Filter with what "
+            "you have, or start a new search (POST /api/search/new) from the game now."
+        )
     index = session.search.snapshot(label)
     return {"snapshot": index, **_status(session)}
 
 
-def _poke(session: Any, address: int | str, value: int | str, type_code: str) -> dict[str, Any]:
+def _poke(session: Session, address: int | str, value: int | str, type_code: str) -> dict[str, Any]:
     where = address_of(address)
     session.search.poke(where, integer_of(value, "the value to poke"), type_code)
     return {"address": where, "type": type_code, "value": session.search.emulator.space.peek(where, type_code)}
 
 
-def save_field(session: Any, name: object, address: object, type_code: object, value_range: object, force: bool) -> dict:
+def save_field(session: Session, name: object, address: object, type_code: object, value_range: object, force: bool) -> dict:
     """Write a field into the game's game.yaml through :meth:`RamSearch.save_field`, then reload the game's fields."""
     if not isinstance(type_code, str):
         raise InvalidArgumentError(f"Expected a type code such as \"|u1\"; got {shown(type_code)}.")
@@ -204,7 +219,7 @@ async def new(request: Request) -> JSONResponse:
     if types is not None and not all(isinstance(t, str) for t in types):
         raise InvalidArgumentError(f'Expected types as a list of type codes such as ["|u1", ">u2"]; got {shown(types)}.')
 
-    def restart(session: Any) -> dict[str, Any]:
+    def restart(session: Session) -> dict[str, Any]:
         session.search.new_search(types)
         return _status(session)
 
@@ -223,14 +238,14 @@ async def filter_(request: Request) -> JSONResponse:
 
 
 async def undo(request: Request) -> JSONResponse:
-    def step(session: Any) -> dict[str, Any]:
+    def step(session: Session) -> dict[str, Any]:
         return {"undone": session.search.undo(), **_status(session)}
 
     return JSONResponse(await session_of(request).call(step))
 
 
 async def redo(request: Request) -> JSONResponse:
-    def step(session: Any) -> dict[str, Any]:
+    def step(session: Session) -> dict[str, Any]:
         return {"redone": session.search.redo(), **_status(session)}
 
     return JSONResponse(await session_of(request).call(step))

@@ -24,13 +24,17 @@ import secrets
 from collections.abc import Iterable, Sequence
 from http.cookies import SimpleCookie
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 from urllib.parse import parse_qs, unquote
 
 from starlette.requests import Request
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from retrokit.errors import AccessDeniedError, InvalidArgumentError, RequestTooLargeError, shown
+from retrokit.paths import data_dir
+
+if TYPE_CHECKING:
+    from retrokit.data.games import Game
 
 TOKEN_HEADER = "x-retrokit-token"
 MAX_BODY = 1 << 20
@@ -264,7 +268,23 @@ def _path_problem(text: str) -> str:
     return ""
 
 
-def under_any(path: Path, roots: Sequence[Path]) -> bool:
-    """Whether ``path`` (resolved) is inside one of ``roots`` (resolved)."""
+def game_roots(game: Game) -> list[Path]:
+    """The folders a request about ``game`` may reach: its folders, where its made states go, the data folder."""
+    from retrokit.data.integrate import target_folder
+
+    return [*game.folders, target_folder(game), data_dir()]
+
+
+def check_inside(path: Path, roots: Sequence[Path], *, what: str = "file") -> Path:
+    """Return ``path`` if, symlinks followed, it lies inside one of ``roots``.
+
+    Raises:
+        AccessDeniedError: It leads elsewhere (a symlink out of the game's folder).
+    """
     real = Path(os.path.realpath(path))
-    return any(real.is_relative_to(Path(os.path.realpath(root))) for root in roots)
+    if not any(real.is_relative_to(Path(os.path.realpath(root))) for root in roots):
+        raise AccessDeniedError(
+            f"Expected a {what} inside the game's folders or the data folder; found {path}, a symlink to {real}. "
+            "Copy the file into the game's folder instead of linking to it."
+        )
+    return path

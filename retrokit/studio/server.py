@@ -66,7 +66,7 @@ def serve(game: str, state: str | None, *, port: int, open_browser: bool = True)
     actual = sock.getsockname()[1]
     token = new_token()
     app = create_app(session, token=token, port=actual)
-    config = uvicorn.Config(app, log_level="warning", ws="websockets", ws_max_size=MAX_BODY,
+    config = uvicorn.Config(app, log_level="warning", ws="websockets-sansio", ws_max_size=MAX_BODY,
                             timeout_graceful_shutdown=2, lifespan="on")
     server = uvicorn.Server(config)
     url = f"http://{HOST}:{actual}/?token={token}"

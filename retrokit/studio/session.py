@@ -85,12 +85,18 @@ class Subscriber:
     def offer_screen(self, screen: Screen) -> None:
         """Make ``screen`` the next one to send (called from any thread)."""
         self.screen = screen
-        self.loop.call_soon_threadsafe(self._ready.set)
+        self._wake_soon()
 
     def offer_message(self, message: dict[str, Any]) -> None:
         """Queue ``message``, replacing an unsent one of its type (called from any thread)."""
         self.messages[str(message.get("type"))] = message
-        self.loop.call_soon_threadsafe(self._ready.set)
+        self._wake_soon()
+
+    def _wake_soon(self) -> None:
+        try:
+            self.loop.call_soon_threadsafe(self._ready.set)
+        except RuntimeError:  # its event loop is closed: the page is gone, and unsubscribing
+            pass
 
     def wake(self) -> None:
         """Make :meth:`wait` return (on the event loop's thread)."""
@@ -167,8 +173,8 @@ class Session:
         """
         with self._lock:
             thread, jobs = self._thread, self._jobs
-            self._thread, self._jobs, self._stopped = None, queue.SimpleQueue(), thread
             if thread is not None:
+                self._thread, self._jobs, self._stopped = None, queue.SimpleQueue(), thread
                 jobs.put(None)
         if thread is not None and thread is not threading.current_thread():
             thread.join()
@@ -253,7 +259,10 @@ class Session:
                 else:
                     future.set_result(result)
 
-            loop.call_soon_threadsafe(settle)
+            try:
+                loop.call_soon_threadsafe(settle)
+            except RuntimeError:  # the caller's event loop closed meanwhile: no one waits for the answer
+                pass
 
         self._put(_Job(fn, args, done))
         return await future

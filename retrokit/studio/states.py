@@ -23,7 +23,7 @@ from retrokit import paths
 from retrokit.data.names import check_state_name
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean
 from retrokit.studio.app import session_of
-from retrokit.studio.security import expect, json_body, resolve_path
+from retrokit.studio.security import expect, game_roots, json_body, resolve_path
 from retrokit.studio.session import Session
 
 MOVIES = "movies"
@@ -33,10 +33,7 @@ SUFFIX = ".bk2"
 
 def roots(session: Session) -> list[Path]:
     """The folders a request may reach: the game's folders, where its states go, and the data folder."""
-    from retrokit.data.integrate import target_folder
-
-    game = session.search.game
-    return [*game.folders, target_folder(game), paths.data_dir()]
+    return game_roots(session.search.game)
 
 
 def movie_path(session: Session, name: object, *, new: bool = False) -> Path:
@@ -147,6 +144,7 @@ def _replay(session: Session, path: Path) -> dict[str, Any]:
         return True
 
     session.recording = False
+    session.mark_loaded()
     session.play_frames(next_frame)
     session.paused = False
     session.send_screen()

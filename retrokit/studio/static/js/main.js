@@ -54,6 +54,7 @@ async function boot() {
   window.addEventListener("hashchange", () => showTab(location.hash.slice(1))); // a link or Back to #watch
   socket.on("error", (message) => say(message.error, "error"));
   socket.connect();
+  newgame.afterReload(socket.send); // queued until the socket opens
   document.body.dataset.ready = "true"; // the browser tests wait for this
 }
 

@@ -6,6 +6,23 @@ import { post } from "./api.js";
 import { byId, el, replace } from "./dom.js";
 import { attempt } from "./status.js";
 
+const RESUME = "retrokit-studio-resume";
+
+/** Reload the page on the game the session now plays, and play it: a reload closes the socket, which pauses
+ * the game, and the user asked to play this game, not to look at its first frame. */
+function reloadAndPlay(delay) {
+  sessionStorage.setItem(RESUME, "1");
+  setTimeout(() => location.reload(), delay);
+}
+
+/** Called once the page is up: resume if the reload was ours. */
+export function afterReload(send) {
+  if (sessionStorage.getItem(RESUME)) {
+    sessionStorage.removeItem(RESUME);
+    send({ type: "resume" });
+  }
+}
+
 async function make() {
   const body = { rom: byId("new-rom").value.trim(), name: byId("new-name").value.trim(), open: true };
   const system = byId("new-system").value.trim();
@@ -14,14 +31,14 @@ async function make() {
   replace(byId("new-result"),
     el("p", { class: "ok" }, `Made ${answer.game} (told by ${answer.told_by}) in ${answer.folder}; the ROM (SHA-1 ${answer.sha1}) is ${answer.rom}.`),
     el("p", { class: "dim" }, "Reloading the studio on it…"));
-  setTimeout(() => location.reload(), 1500);
+  reloadAndPlay(1500);
   return `Made ${answer.game}; the studio plays it now.`;
 }
 
 async function openGame() {
   const game = byId("open-game").value.trim();
   const answer = await post("game", { game });
-  setTimeout(() => location.reload(), 500);
+  reloadAndPlay(500);
   return `Opening ${answer.game}…`;
 }
 

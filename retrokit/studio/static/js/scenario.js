@@ -59,14 +59,15 @@ function showErrors(result) {
         editor.setCursor({ line: result.line - 1, ch: (result.column ?? 1) - 1 });
       }
     } }, where + result.error),
-    result.message && result.message !== result.error ? el("pre", { class: "dim" }, result.message) : null);
+    // The rest of the language's message: the source line and a caret under the place (fixed-width text).
+    result.message ? el("pre", { class: "dim" }, result.message.split("\n").slice(1).join("\n")) : null);
   replace(list, item);
   if (result.line) {
     const line = Math.min(result.line - 1, editor.lineCount() - 1);
     const text = editor.getLine(line) ?? "";
     const ch = Math.min(Math.max((result.column ?? 1) - 1, 0), text.length);
-    // Underline from the column to the end of the word there (or one character), where the error points.
-    const rest = text.slice(ch).match(/^\S+/);
+    // Underline the name or number at the column (or one character), where the error points.
+    const rest = text.slice(ch).match(/^[\w.]+/);
     const end = ch + Math.max(1, rest ? rest[0].length : 1);
     marks.push(editor.markText({ line, ch }, { line, ch: end }, { className: "cm-error-mark", title: result.error }));
     editor.addLineClass(line, "background", "cm-error-line");

@@ -40,7 +40,8 @@ async function save() {
   const name = byId("state-name").value.trim();
   const answer = await post("states/save", { name, default: byId("state-default").checked, force: byId("state-force").checked });
   showStates(answer);
-  const what = answer.status === "up to date" ? "is up to date" : `saved (${answer.status})`;
+  // The outcome of RamSearch.save_state: "made", "replaced" (with replace ticked) or "up to date".
+  const what = { made: "saved", "up to date": "is up to date (the same state was there)" }[answer.status] ?? answer.status;
   return `State ${answer.name} ${what}: ${answer.path}.`;
 }
 
@@ -92,6 +93,8 @@ export async function init() {
   byId("record").addEventListener("click", () => attempt(record, (line) => line));
   on("status", (status) => {
     if (typeof status.recording === "boolean" && status.recording !== recording) showRecording(status.recording);
+    // A reset from the Play panel loads a state too: the row of the state played is the highlighted one.
+    for (const row of byId("states-rows").querySelectorAll("tr")) row.classList.toggle("selected", row.dataset.state === status.state);
   });
   showStates(await get("states"));
   const movies = await get("movies");

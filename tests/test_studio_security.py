@@ -319,3 +319,20 @@ def test_a_state_symlinked_out_of_the_game_is_refused(client, session, folder, t
     session.call_blocking(lambda s: s.refresh_game())
     assert "symlink" in refused(client.post("/api/states/load", json={"name": "Linked"}))
     assert "symlink" in refused(client.post("/api/play/reset", json={"state": "Linked"}))
+
+
+def test_hostile_socket_messages_are_errors_and_the_session_lives_on(client, session):
+    url = f"ws://127.0.0.1:{PORT}/ws?token={TOKEN}"
+    with client.websocket_connect(url) as ws:
+        for text in ("{", "[]", '{"type": 5}', '{"type": "step", "frames": 1e9}', '{"type": "jump"}',
+                     '{"type": "buttons", "buttons": "RIGHT"}', "[" * 50_000 + "]" * 50_000):
+            ws.send_text(text)
+            while True:
+                message = ws.receive()
+                if message.get("text") and json.loads(message["text"])["type"] == "error":
+                    error = json.loads(message["text"])
+                    break
+            assert error["kind"] in ("InvalidArgumentError", "UnknownNameError") and "\n" not in error["error"]
+        ws.send_bytes(b"\x00" * 10)  # the page never sends binary: the socket is closed, nothing else
+    assert client.get("/api/status").status_code == 200
+    assert client.post("/api/play/step", json={"frames": 1}).json()["paused"]

@@ -33,8 +33,9 @@ from starlette.staticfiles import StaticFiles
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from retrokit import errors
+from retrokit.studio.push import Screen, Subscriber
 from retrokit.studio.security import Guard
-from retrokit.studio.session import Screen, Session, Subscriber
+from retrokit.studio.session import Session
 
 ROUTE_MODULES: tuple[str, ...] = (
     "play", "states", "authoring", "search", "fields", "scenario", "clickfind", "ramview",
@@ -165,7 +166,7 @@ async def _send(websocket: WebSocket, subscriber: Subscriber) -> None:
                 await websocket.send_bytes(pack_screen(screen))
             if later:  # come back for them when their period is over
                 loop.call_later(MESSAGE_PERIOD, subscriber.wake)
-    except (WebSocketDisconnect, RuntimeError, ConnectionError):
+    except (WebSocketDisconnect, RuntimeError, OSError):  # the page went (uvicorn's ClientDisconnected is an OSError)
         pass
 
 

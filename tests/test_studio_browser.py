@@ -322,6 +322,29 @@ def test_play_with_the_keyboard(page):
     until("1x", lambda: page.text("speed-shown") == "1×")
 
 
+def test_play_with_a_gamepad(page):
+    """The Gamepad API's standard layout: button 15 is the D-pad's right. Headless Chromium has no pad, so the page
+    is given one through the API it reads (navigator.getGamepads), as a browser would report a real pad."""
+    page.open("watch")
+    page.reset("Zone1.Act1")
+    page.resume()
+    until("the Watch panel's values", lambda: page.field("p1_x"))
+    x0 = int(page.field("p1_x"))
+    page.driver.execute_script(
+        "const buttons = Array.from({length: 17}, (_, i) => ({pressed: i === 15, value: i === 15 ? 1 : 0}));"
+        "window.fakePad = {index: 0, connected: true, mapping: 'standard', axes: [0, 0, 0, 0], buttons};"
+        "navigator.getGamepads = () => [window.fakePad];"
+        "window.dispatchEvent(new Event('gamepadconnected'));"
+    )
+    until("RIGHT held", lambda: "held" in page.driver.find_element(
+        By.CSS_SELECTOR, '#buttons [data-button="RIGHT"]').get_attribute("class"))  # fmt: skip
+    until("the player to run right", lambda: int(page.field("p1_x")) > x0 + 20)
+    page.driver.execute_script("window.fakePad.buttons[15] = {pressed: false, value: 0};")
+    until("RIGHT let go", lambda: "held" not in page.driver.find_element(
+        By.CSS_SELECTOR, '#buttons [data-button="RIGHT"]').get_attribute("class"))  # fmt: skip
+    page.pause()
+
+
 def test_find_the_lives_with_the_search_and_add_the_field(page, studio):
     """docs/ramsearch.md's walkthrough, in the page: 3 lives, run into the pit twice, the byte is found."""
     page.open("search")
@@ -472,6 +495,25 @@ def test_write_a_scenario_and_watch_its_reward_live(page, studio):
     assert not draft.exists()
     page.click("scenario-stop")
     page.said("Stopped the live reward.")
+
+
+def test_the_page_asks_before_dropping_an_unsaved_edit(page, studio):
+    page.open("scenario")
+    until("the scenario", lambda: editor_text(page))
+    saved = editor_text(page)
+    type_scenario(page, "reward: delta(p1_x) * 2\n")
+    until("the edit seen as unsaved", lambda: page.el("scenario-unsaved").is_displayed())
+    page.click("scenario-discard")
+    alert = page.driver.switch_to.alert
+    assert "not saved" in alert.text or "unsaved" in alert.text
+    alert.dismiss()  # keep it
+    page.said("Kept your edit.")
+    assert editor_text(page) == "reward: delta(p1_x) * 2\n"
+    page.click("scenario-discard")
+    page.driver.switch_to.alert.accept()
+    page.said("Dropped the edit of scenario.")
+    assert editor_text(page) == saved
+    until("the draft gone", lambda: not (studio.data / "studio" / "drafts" / "Dasher-Genesis" / "scenario.yaml").exists())
 
 
 # --- the other panels ------------------------------------------------------------------------------------

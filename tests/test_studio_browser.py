@@ -426,6 +426,15 @@ def test_save_a_state(page, studio):
     page.reset("Zone1.Run")
     page.shot("states")
 
+    # The list's own buttons: another default, and a state loaded from there.
+    row = page.driver.find_element(By.CSS_SELECTOR, '#states-rows tr[data-state="Zone1.Act2"]')
+    row.find_element(By.CSS_SELECTOR, "button.make-default").click()
+    page.said("Default state is now Zone1.Act2 (")
+    assert yaml.safe_load(game_yaml.read_text())["states"]["default"] == "Zone1.Act2"
+    page.driver.find_element(By.CSS_SELECTOR, '#states-rows tr[data-state="Zone1.Act2"] button.load').click()
+    page.said("Loaded state Zone1.Act2.")
+    until("Zone1.Act2 played", lambda: page.text("current-state") == "Zone1.Act2")
+
 
 def type_scenario(page: Page, text: str) -> None:
     """Replace the editor's text by typing, as a user would (CodeMirror keeps the indentation of a new line)."""

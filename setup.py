@@ -48,6 +48,7 @@ host = Extension(
         "retrokit/native/environment.c",
         "retrokit/native/isolate.c",
         "retrokit/native/video.c",
+        "retrokit/native/preprocess.c",
         "retrokit/native/runner.c",
     ],
     include_dirs=["retrokit/native"],

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -49,3 +50,75 @@ def test_ray_stops_a_stalled_level_and_keeps_the_other(tmp_path) -> None:
     assert "Level Dasher-Genesis/Zone2.Act2 stalled and was stopped after 5 s" in child.stderr
     summary = json.loads((tmp_path / "ray" / "summary.json").read_text())
     assert list(summary["levels"]) == ["Dasher-Genesis/Zone3.Act2"]
+
+
+LOSE_A_NODE = '''
+import json, logging, os, sys, threading, time
+from pathlib import Path
+os.environ["RAY_USAGE_STATS_ENABLED"] = "0"
+import ray
+from ray.cluster_utils import Cluster
+from retrokit.cli import main
+
+out, args = Path(sys.argv[1]), sys.argv[2:]
+cluster = Cluster(initialize_head=True, head_node_args={"num_cpus": 1, "include_dashboard": False})
+node = cluster.add_node(num_cpus=1)
+cluster.wait_for_nodes()
+ray.init(address=cluster.address, logging_level=logging.WARNING, log_to_driver=False)
+
+def lose_the_node():
+    """Once the level playing on the second node has logged an episode, remove that node."""
+    while True:
+        marks = [json.loads(p.read_text()) for p in out.parent.glob("*.node")]
+        there = [m["level"] for m in marks if m["node"] == node.node_id]
+        log = out / "episodes.jsonl"
+        if there and log.exists() and any(json.loads(line)["level"] == there[0] for line in log.read_text().splitlines()):
+            cluster.remove_node(node)
+            print("removed the node of", there[0], flush=True)
+            return
+        time.sleep(0.05)
+
+threading.Thread(target=lose_the_node, daemon=True).start()
+code = main(["evaluate", *args, "--backend", "ray", "--out", str(out)])
+ray.shutdown()
+cluster.shutdown()
+sys.exit(code)
+'''
+
+MARKING_JERK = '''
+import json, os, pathlib
+from retrokit.benchmark.jerk import jerk
+
+def marking_jerk(env, budget, seed):
+    """JERK, which first notes the Ray node its level plays on (the first time only) beside the run folder."""
+    level = env.unwrapped.state_name
+    mark = pathlib.Path(os.environ.get("MARKS", ".")) / f"{level}.node"
+    if "MARKS" in os.environ and not mark.exists():
+        import ray
+        mark.write_text(json.dumps({"level": "Dasher-Genesis/" + level, "node": ray.get_runtime_context().get_node_id()}))
+    jerk(env, budget, seed)
+'''
+
+
+def test_a_level_whose_node_is_lost_plays_again_on_the_node_left(tmp_path) -> None:
+    agents = tmp_path / "marking.py"
+    agents.write_text(MARKING_JERK)
+    args = ["--benchmark", "dasher", "--levels", "Zone2.Act2,Zone3.Act2", "--timesteps", "3000", "--seed", "3",
+            "--agent", f"{agents}:marking_jerk"]
+    assert main(["evaluate", *args, "--workers", "1", "--no-progress", "--out", str(tmp_path / "local")]) == 0
+    env = {**os.environ, "MARKS": str(tmp_path)}
+    script = tmp_path / "lose_a_node.py"
+    script.write_text(LOSE_A_NODE)
+    child = subprocess.run([sys.executable, str(script), str(tmp_path / "ray"), *args], env=env, check=False,
+                           capture_output=True, text=True, timeout=480)
+    assert child.returncode == 0, child.stdout + child.stderr
+    assert "removed the node of Dasher-Genesis/" in child.stdout
+    assert "was lost" in child.stdout and "starts again from its beginning" in child.stdout
+    local, ray = ((tmp_path / name / "summary.json").read_bytes() for name in ("local", "ray"))
+    assert local == ray
+
+    def episodes(run: str) -> list[tuple]:
+        lines = (tmp_path / run / "episodes.jsonl").read_text().splitlines()
+        return sorted((e["level"], e["episode"], e["steps"], e["reward"]) for e in map(json.loads, lines))
+
+    assert episodes("ray") == episodes("local")

@@ -19,8 +19,10 @@ import numpy as np
 import pytest
 from starlette.testclient import TestClient
 
+from retrokit.host.systems import all_systems, get_system
 from retrokit.movie import read_bk2
 from retrokit.studio.app import SCREEN_HEADER, create_app
+from retrokit.studio.play import key_map, pad_map
 from retrokit.studio.session import Session
 
 REPO = Path(__file__).resolve().parent.parent
@@ -93,6 +95,20 @@ def test_info_lists_the_systems_buttons_and_the_default_keys(client):
     assert info["gamepad"]["12"] == "UP" and info["gamepad"]["9"] == "START"
     assert (info["width"], info["height"]) == (320, 224) and 59 < info["frame_rate"] < 61
     assert "Zone1.Act1" in info["states"] and info["speeds"] == [0.25, 8.0]
+
+
+SYSTEMS = sorted(all_systems())
+
+
+@pytest.mark.parametrize("system", SYSTEMS)
+def test_every_system_has_a_key_for_every_button(system):
+    desc = get_system(system)
+    keys = key_map(desc)
+    assert set(keys.values()) == set(desc.button_names)  # one key each, none left out
+    for key, button in (("ArrowUp", "UP"), ("ArrowDown", "DOWN"), ("ArrowLeft", "LEFT"), ("ArrowRight", "RIGHT"),
+                        ("Enter", "START")):
+        assert keys.get(key) == button or button not in desc.button_names
+    assert set(pad_map(desc).values()) <= set(desc.button_names)
 
 
 def test_the_socket_sends_screens_with_the_documented_header(client, session):
@@ -388,6 +404,10 @@ def test_new_game_from_a_rom_file_then_the_session_plays_it(tmp_path, monkeypatc
         assert made["info"]["game"] == "Runner-Genesis" and made["info"]["states"] == []
         status = post(client, "/api/play/step", {"frames": 3})
         assert status["game"] == "Runner-Genesis"
+        post(client, "/api/play/reset", {})  # no states: power-on, and a movie recorded from there starts there
+        post(client, "/api/movies/record")
+        post(client, "/api/play/step", {"frames": 4})
+        assert read_bk2(post(client, "/api/movies/stop", {"name": "boot"})["path"]).frames == [(0,)] * 4  # one player
         again = post(client, "/api/newgame", {"rom": str(rom), "name": "Runner-Genesis"}, status=409)
         assert again["kind"] == "FileConflictError"
         back = client.post("/api/game", json={"game": "Dasher-Genesis", "state": "Zone2.Act1"}).json()

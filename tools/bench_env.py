@@ -24,7 +24,11 @@ Beside them, with no target: an 8-env vector against the 2-env one (the
 machine has two CPUs, so 8 envs share 2 threads; the figure shows that more
 envs than CPUs keep the throughput: it was 0.4 when each env had a thread),
 and the 2-env vector against 1 env when the scenario runs every frame, as
-the Sonic preset's does (the vector then runs one frame per native call).
+the Sonic preset's does (the vector then runs one frame per native call);
+and the observation agents train on, gray 84x84 stacked 4, made natively
+(``gray84x84x4``; ``-max`` with the max of a step's last two frames, so a
+second frame drawn), against the RGB env, and against the same made by
+Gymnasium's wrappers around it.
 
 These machines are noisy and their speed drifts from one second to the
 next, so each ratio alternates its own kinds in short bursts (short enough
@@ -55,6 +59,7 @@ import sys
 import time
 from collections.abc import Callable
 
+import gymnasium
 import numpy as np
 
 import retrokit
@@ -81,6 +86,7 @@ CEILINGS = {  # name: (kinds of the machine's own ceiling for it, measured in th
     "vector2/env": ("raw2", "raw"),
 }
 FULL_CORES = 1.9  # a ceiling this high means the machine gave both threads a core
+GRAY84X84X4 = {"grayscale": True, "resize": (84, 84), "frame_stack": 4}
 
 
 class StickyFrameSkip:
@@ -109,6 +115,13 @@ class StickyFrameSkip:
 
 
 Stepper = Callable[[int], int]  # runs n env steps of its kind; returns how many env steps that made
+
+
+def gym_gray84x84x4(env):
+    """Gray 84x84 stacked 4 the way a user without native preprocessing makes it: Gymnasium's wrappers."""
+    from gymnasium.wrappers import FrameStackObservation, GrayscaleObservation, ResizeObservation
+
+    return FrameStackObservation(ResizeObservation(GrayscaleObservation(env), (84, 84)), 4)
 
 
 def env_stepper(env) -> Stepper:
@@ -230,6 +243,15 @@ def main() -> int:
     per_frame = {**OPTIONS, "scenario_every_frame": True}
     extras = [retrokit.make(GAME, **per_frame), retrokit.make_vec(GAME, 2, **per_frame)]
     kinds["env-pf"], kinds["vector2-pf"] = env_stepper(extras[0]), vector_stepper(extras[1])
+    extras.append(retrokit.make(GAME, **OPTIONS, **GRAY84X84X4))
+    kinds["gray84x84x4"] = env_stepper(extras[-1])
+    extras.append(retrokit.make(GAME, **OPTIONS, **GRAY84X84X4, max_pool=True))
+    kinds["gray84x84x4-max"] = env_stepper(extras[-1])
+    try:
+        extras.append(gym_gray84x84x4(retrokit.make(GAME, **OPTIONS)))
+        kinds["gym-gray84x84x4"] = env_stepper(extras[-1])
+    except gymnasium.error.DependencyNotInstalled:  # ResizeObservation needs opencv (the test extra has it)
+        pass
     try:
         import stable_retro
 
@@ -242,6 +264,12 @@ def main() -> int:
               "vector2/env": ["vector2", "env", "raw2", "raw", "raw2-free"]}  # the vector's ceilings, same bursts
     notes = {"vector2-pf/env-pf": "the scenario every frame, one frame per native call"}
     groups["vector2-pf/env-pf"] = ["vector2-pf", "env-pf"]
+    groups["gray84x84x4/env"] = ["gray84x84x4", "env"]
+    notes["gray84x84x4/env"] = "gray 84x84 stack 4, made natively, against RGB"
+    groups["gray84x84x4-max/env"] = ["gray84x84x4-max", "env"]
+    notes["gray84x84x4-max/env"] = "the same with max_pool (a second frame drawn a step) against RGB"
+    groups["gray84x84x4/gym-gray84x84x4"] = ["gray84x84x4", "gym-gray84x84x4"]
+    notes["gray84x84x4/gym-gray84x84x4"] = "the same made natively against Gymnasium's wrappers around the RGB env"
     if many is not None:
         groups[f"vector{args.many}/vector2"] = [f"vector{args.many}", "vector2"]
         notes[f"vector{args.many}/vector2"] = f"{args.many} envs sharing this machine's CPUs"

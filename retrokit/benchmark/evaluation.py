@@ -20,12 +20,21 @@ from typing import Any
 from retrokit.benchmark import plots
 from retrokit.benchmark.agents import resolve_agent
 from retrokit.benchmark.definition import Benchmark, Level
-from retrokit.benchmark.level import EpisodeEnded, LevelDone, LevelFailed, LevelTask, Message, Progress
+from retrokit.benchmark.level import (
+    EpisodeEnded,
+    LevelDone,
+    LevelFailed,
+    LevelRestarted,
+    LevelTask,
+    Message,
+    Progress,
+)
 from retrokit.benchmark.paper import PaperScores, has_paper_scores, load_paper
 from retrokit.benchmark.progress import LevelProgress
 from retrokit.benchmark.report import paper_column, render_report, write_report, write_summary
 from retrokit.benchmark.rundir import RunDir
 from retrokit.benchmark.scores import Summary, level_score, summarize
+from retrokit.benchmark.speed import Speed
 from retrokit.benchmark.watchdog import DEFAULT_STALL_SECONDS, Watchdog
 from retrokit.errors import AgentError, InvalidArgumentError
 from retrokit.paths import atomic_write
@@ -53,6 +62,7 @@ class Evaluation:
         paper_dir: Where the paper's ``test-scores.csv`` is (default: found by :mod:`.paper`).
         stall_timeout: Seconds a level may go without a timestep before it is stopped and fails.
         failed: The levels that failed in this run, with why (filled by :func:`evaluate`).
+        played: The levels finished in this run: their timesteps and play seconds (filled by :func:`evaluate`).
     """
 
     benchmark: Benchmark
@@ -70,6 +80,7 @@ class Evaluation:
     paper_dir: Path | None = None
     stall_timeout: float = DEFAULT_STALL_SECONDS
     failed: dict[str, str] = field(default_factory=dict)
+    played: dict[str, tuple[int, float]] = field(default_factory=dict)
 
     def check(self) -> None:
         """Check the arguments, the levels, the ROMs and the agent; nothing is made before this passes.
@@ -101,6 +112,13 @@ class Evaluation:
             "budget": self.budget or self.benchmark.budget,
             "levels": [level.name for level in self.levels],
         }
+
+    def speed(self) -> Speed | None:
+        """How fast this run's levels played (``None`` if it finished none, as a resume of a finished run)."""
+        if not self.played:
+            return None
+        return Speed(sum(steps for steps, _ in self.played.values()), sum(s for _, s in self.played.values()),
+                     self.workers, min(self.workers, len(self.played) + len(self.failed)))
 
 
 def evaluate(evaluation: Evaluation) -> Summary:
@@ -160,8 +178,12 @@ def _run(ev: Evaluation, tasks: list[LevelTask], run: RunDir, progress: LevelPro
             if message.gif is not None:
                 atomic_write(ev.out / "gifs" / f"{level_file_name(message.level)}.gif", message.gif, overwrite=True)
             run.finish(message.level, message.timesteps, message.unfinished_reward)
+            ev.played[message.level] = (message.timesteps, message.seconds)
             score = level_score(run.episodes.get(message.level, []), run.finished[message.level])
             progress.end(message.level, f"done, {score.episodes} episode(s), score {score.mean_score:,.1f}")
+        elif isinstance(message, LevelRestarted):
+            run.restart(message.level)
+            progress.restart(message.level, message.reason)
         elif isinstance(message, LevelFailed):
             ev.failed[message.level] = message.error
             run.fail(message.level, message.error)

@@ -77,12 +77,14 @@ class LevelDone:
         unfinished_reward: The reward of the episode under way when the budget ran out (it scores a level
             that finished no episode; see :mod:`.scores`).
         gif: The best episode as a GIF, when asked for.
+        seconds: How long the agent played (from the env made to the budget spent): the level's speed.
     """
 
     level: str
     timesteps: int
     unfinished_reward: float
     gif: bytes | None = None
+    seconds: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -94,7 +96,19 @@ class LevelFailed:
     timesteps: int
 
 
-Message = Started | Progress | EpisodeEnded | LevelDone | LevelFailed
+@dataclass(frozen=True)
+class LevelRestarted:
+    """``level``'s play was lost with the machine playing it, and starts again from its beginning elsewhere.
+
+    Its episodes so far are dropped, as ``--resume`` drops an unfinished level's: the level's result depends only
+    on its seed, so the replay ends as an uninterrupted run does.
+    """
+
+    level: str
+    reason: str
+
+
+Message = Started | Progress | EpisodeEnded | LevelDone | LevelFailed | LevelRestarted
 
 
 def run_level(task: LevelTask, emit: Callable[[Message], None]) -> None:
@@ -157,10 +171,10 @@ def run_level(task: LevelTask, emit: Callable[[Message], None]) -> None:
             "env it is given (not env.unwrapped, which the budget does not count) until step() ends its play."),
             monitor.timesteps))
         return
-    gif = None
+    seconds, gif = monitor.seconds, None
     if task.gif and monitor.best_frames:
         gif = encode_gif(monitor.best_frames, GIF_FRAME_MS * monitor.best_stride)
-    emit(LevelDone(name, monitor.timesteps, monitor.unfinished_reward, gif))
+    emit(LevelDone(name, monitor.timesteps, monitor.unfinished_reward, gif, seconds))
 
 
 def encode_gif(frames: list, frame_ms: int) -> bytes:  # numpy frames

@@ -22,6 +22,8 @@ from retrokit.errors import AgentError
 
 #: At most this many frames of an episode are kept for its GIF; longer episodes keep every 2nd, 4th... frame.
 MAX_GIF_FRAMES = 256
+#: At most this many distinct valid actions are remembered as checked (a button pad has 4096 at 12 buttons).
+MAX_CHECKED_ACTIONS = 4096
 
 
 class BudgetSpent(BaseException):
@@ -110,12 +112,18 @@ class Monitor(gymnasium.Wrapper):
         self._frames: list[np.ndarray] = []
         self._stride = 1
         self._clock = time.perf_counter()
+        self._valid: set[Any] = set()  # keys (see _action_key) of actions the action space accepted
         self.action_space.seed(seed)
 
     @property
     def timesteps_left(self) -> int:
         """Timesteps the agent may still take."""
         return self.budget - self.timesteps
+
+    @property
+    def seconds(self) -> float:
+        """Seconds since the level started (its env made, before the agent's first call)."""
+        return time.perf_counter() - self._clock
 
     @property
     def unfinished_reward(self) -> float:
@@ -138,25 +146,38 @@ class Monitor(gymnasium.Wrapper):
         """Take a step of the budget, checking the action first."""
         if self.timesteps >= self.budget:
             raise BudgetSpent
-        where = f"level {self.level}, step {self.timesteps + 1}"
         if self._ended:
             raise AgentError(
-                f"Expected reset() before step() at the start of an episode ({where}), but the agent stepped "
+                f"Expected reset() before step() at the start of an episode ({self._where()}), but the agent stepped "
                 "a finished (or never started) episode; call env.reset() when terminated or truncated is true."
             )
-        if not self.action_space.contains(_as_array(action)):
-            raise AgentError(
-                f"Expected an action of {self.action_space} ({where}), got {_describe(action)}; fix the agent's actions."
-            )
+        self._check(action)
         obs, reward, terminated, truncated, info = self.env.step(action)
         self.timesteps += 1
         self._steps += 1
         self._reward += float(reward)
-        if self._steps % self._stride == 0:
+        if self.keep_frames and self._steps % self._stride == 0:
             self._keep(obs)
         if terminated or truncated:
             self._finish()
         return obs, reward, terminated, truncated, info
+
+    def _where(self) -> str:
+        return f"level {self.level}, step {self.timesteps + 1}"
+
+    def _check(self, action: Any) -> None:
+        """Check ``action`` against the action space, once per distinct action: an agent repeats a few actions
+        millions of times, and the space's check costs more than the rest of the monitor's step."""
+        key = _action_key(action)
+        if key is not None and key in self._valid:
+            return
+        if not self.action_space.contains(_as_array(action)):
+            raise AgentError(
+                f"Expected an action of {self.action_space} ({self._where()}), got {_describe(action)}; "
+                "fix the agent's actions."
+            )
+        if key is not None and len(self._valid) < MAX_CHECKED_ACTIONS:
+            self._valid.add(key)
 
     def _finish(self) -> None:
         self._ended = True
@@ -167,7 +188,7 @@ class Monitor(gymnasium.Wrapper):
             self.best_reward = self._reward
         self._frames = []
         self.on_episode(Episode(self.episodes, self._steps, self._reward, self.timesteps,
-                                round(time.perf_counter() - self._clock, 3)))
+                                round(self.seconds, 3)))
 
     def _keep(self, obs: Any) -> None:
         if not self.keep_frames or not (isinstance(obs, np.ndarray) and obs.ndim == 3):
@@ -175,6 +196,17 @@ class Monitor(gymnasium.Wrapper):
         self._frames.append(obs.copy())
         if len(self._frames) >= MAX_GIF_FRAMES:  # halve the frame rate rather than grow
             self._frames, self._stride = self._frames[::2], self._stride * 2
+
+
+def _action_key(action: Any) -> Any:
+    """What decides whether the action space accepts ``action``, as a hashable key; ``None`` if it cannot be made
+    cheaply and exactly (an action of another type, or an array of objects, is checked every time)."""
+    kind = type(action)
+    if kind is int:
+        return action
+    if kind is np.ndarray and action.dtype.kind in "biuf":
+        return action.dtype.str, action.shape, action.tobytes()
+    return None
 
 
 def _as_array(action: Any) -> Any:

@@ -49,6 +49,14 @@ class LevelProgress:
         if level in self.bars:
             self.bars[level].update(timesteps - self.bars[level].n)
 
+    def restart(self, level: str, why: str) -> None:
+        """``level`` plays again from its beginning, because of ``why``."""
+        if level in self.bars:
+            self.bars[level].reset()
+            self.bars[level].set_postfix_str("restarted")
+        elif self.show:
+            print(f"{level}: {why}", flush=True)
+
     def end(self, level: str, outcome: str) -> None:
         """``level`` ended: ``outcome`` is ``done, score 12.3`` or ``failed: why``."""
         self.ended += 1

@@ -3,7 +3,11 @@
 Each task runs :func:`~retrokit.benchmark.level.run_level` and puts its
 messages on a Ray queue as they come, so episodes stream back while levels
 play; the :class:`~retrokit.benchmark.watchdog.Watchdog` cancels a stalled
-task. Ray is the optional extra ``retrokit-rl[ray]``; every node of a cluster
+task. A level whose node is lost (``NodeDiedError``) starts again from its
+beginning on the nodes left, up to :data:`NODE_RETRIES` times: its episodes so
+far are dropped, as ``--resume`` drops an unfinished level's, so the result is
+the uninterrupted one. The queue lives on this process's node, which the run
+cannot lose anyway. Ray is the optional extra ``retrokit-rl[ray]``; every node of a cluster
 needs retrokit (and the ROMs of the benchmark's games) installed. A cluster's
 address is tried with a plain connection first, because Ray itself retries an
 unreachable address without end.
@@ -18,18 +22,20 @@ import queue
 import socket
 from collections.abc import Callable
 
-from retrokit.benchmark.level import LevelDone, LevelFailed, LevelTask, Message, Started, run_level
+from retrokit.benchmark.level import LevelDone, LevelFailed, LevelRestarted, LevelTask, Message, Started, run_level
 from retrokit.benchmark.watchdog import Watchdog
 from retrokit.errors import BackendUnavailableError, install_extra
 
 POLL_SECONDS = 0.2
+#: How many times a level whose Ray node is lost starts again on the nodes left, before it fails.
+NODE_RETRIES = 3
 #: How long a cluster's address may take to accept a connection.
 CONNECT_SECONDS = 10.0
 
 
-def _play(task: LevelTask, messages) -> int:  # a ray.util.queue.Queue
-    """A Ray task: play one level, streaming its messages."""
-    run_level(task, messages.put)
+def _play(task: LevelTask, attempt: int, messages) -> int:  # a ray.util.queue.Queue
+    """A Ray task: play one level, streaming its messages tagged with the attempt (a lost one's are dropped)."""
+    run_level(task, lambda message: messages.put((attempt, message)))
     return 0
 
 
@@ -91,43 +97,93 @@ def run_ray(tasks: list[LevelTask], handle: Callable[[Message], None], workers: 
                 f"Expected a Ray cluster at {address or 'a new local Ray'}, but it could not start or connect: {exc}."
             ) from None
     try:
-        messages = Queue()
-        play = ray.remote(num_cpus=1, max_retries=0)(_play)
-        pending = {play.remote(task, messages): task.level.name for task in tasks}
-        ended: set[str] = set()
-
-        def take(message: Message) -> None:
-            watchdog.see(message)
-            if isinstance(message, LevelDone | LevelFailed):
-                ended.add(message.level)
-                watchdog.stop(message.level)
-            if not isinstance(message, Started) and message.level in pending.values():
-                handle(message)
-
-        while pending:
-            _drain(messages, take, Empty, block=True)
-            ready, _ = ray.wait(list(pending), num_returns=len(pending), timeout=0)
-            for ref in ready:
-                _drain(messages, take, Empty, block=False)
-                level = pending.pop(ref)
-                watchdog.stop(level)
-                try:
-                    ray.get(ref)
-                except Exception as exc:  # noqa: BLE001 - a task lost to Ray (node died, worker killed)
-                    if level not in ended:
-                        handle(LevelFailed(level, f"The Ray task of level {level} failed: {exc}", 0))
-                    continue
-                if level not in ended:
-                    handle(LevelFailed(level, f"The Ray task of level {level} ended before the level did.", 0))
-            for level in watchdog.stalled():
-                ref = next(r for r, name in pending.items() if name == level)
-                ray.cancel(ref, force=True)
-                del pending[ref]
-                handle(LevelFailed(level, watchdog.error(level), watchdog.timesteps(level)))
-                watchdog.stop(level)
+        _play_all(ray, Queue, Empty, tasks, handle, watchdog)
     finally:
         if started:
             ray.shutdown()
+
+
+def _play_all(ray, queue_type, empty_error, tasks: list[LevelTask], handle: Callable[[Message], None],
+              watchdog: Watchdog) -> None:
+    """Run ``tasks`` on the connected Ray, retrying a level whose node is lost (see :data:`NODE_RETRIES`)."""
+    messages = queue_type(actor_options=_on_this_node(ray))
+    play = ray.remote(num_cpus=1, max_retries=0)(_play)
+    pending: dict = {}  # a running task's ref -> its task
+    attempts: dict[str, int] = {}  # level -> its attempt now playing (messages of earlier ones are stale)
+    ended: set[str] = set()
+
+    def submit(task: LevelTask) -> None:
+        attempt = attempts.get(task.level.name, -1) + 1
+        attempts[task.level.name] = attempt
+        pending[play.remote(task, attempt, messages)] = task
+
+    def take(tagged: tuple[int, Message]) -> None:
+        attempt, message = tagged
+        if attempts.get(message.level) != attempt or message.level in ended:
+            return  # from the attempt of a lost node, or after its level ended
+        watchdog.see(message)
+        if isinstance(message, LevelDone | LevelFailed):
+            ended.add(message.level)
+            watchdog.stop(message.level)
+        if not isinstance(message, Started):
+            handle(message)
+
+    for task in tasks:
+        submit(task)
+    while pending:
+        _drain(messages, take, empty_error, block=True)
+        ready, _ = ray.wait(list(pending), num_returns=len(pending), timeout=0)
+        for ref in ready:
+            _drain(messages, take, empty_error, block=False)
+            task = pending.pop(ref)
+            level = task.level.name
+            watchdog.stop(level)
+            try:
+                ray.get(ref)
+            except ray.exceptions.NodeDiedError as exc:
+                if level in ended:
+                    continue
+                if attempts[level] < NODE_RETRIES:
+                    handle(LevelRestarted(level, (
+                        f"the Ray node playing level {level} was lost ({_first_line(exc)}); the level starts "
+                        f"again from its beginning on the nodes left (retry {attempts[level] + 1} of {NODE_RETRIES})")))
+                    submit(task)
+                else:
+                    ended.add(level)
+                    handle(LevelFailed(level, (
+                        f"The Ray nodes playing level {level} were lost {NODE_RETRIES + 1} times, the last: "
+                        f"{_first_line(exc)}. Check the cluster's nodes, then add --resume."), 0))
+                continue
+            except Exception as exc:  # noqa: BLE001 - a task lost to Ray (its worker killed, out of memory)
+                if level not in ended:
+                    ended.add(level)
+                    handle(LevelFailed(level, f"The Ray task of level {level} failed: {exc}", 0))
+                continue
+            if level not in ended:
+                ended.add(level)
+                handle(LevelFailed(level, f"The Ray task of level {level} ended before the level did.", 0))
+        for level in watchdog.stalled():
+            ref = next(r for r, task in pending.items() if task.level.name == level)
+            ray.cancel(ref, force=True)
+            del pending[ref]
+            ended.add(level)
+            handle(LevelFailed(level, watchdog.error(level), watchdog.timesteps(level)))
+            watchdog.stop(level)
+
+
+def _on_this_node(ray) -> dict:
+    """Ray options that keep an actor on this process's node: the message queue must outlive any other node."""
+    from ray.util.scheduling_strategies import NodeAffinitySchedulingStrategy
+
+    try:
+        node = ray.get_runtime_context().get_node_id()
+    except Exception:  # noqa: BLE001 - a Ray client may not know its node: then Ray places the queue
+        return {"num_cpus": 0}
+    return {"num_cpus": 0, "scheduling_strategy": NodeAffinitySchedulingStrategy(node, soft=False)}
+
+
+def _first_line(exc: BaseException) -> str:
+    return str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
 
 
 def _drain(messages, take, empty_error, *, block: bool) -> None:

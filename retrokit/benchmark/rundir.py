@@ -222,6 +222,19 @@ class RunDir:
         self.finished[level] = FinishedLevel(timesteps, len(self.episodes.get(level, ())), unfinished_reward)
         self._save()
 
+    def restart(self, level: str) -> None:
+        """Drop the episodes of an unfinished level that plays again from its beginning (its machine was lost).
+
+        The log is rewritten without them, as ``--resume`` rewrites it, so the level's replay logs its episodes
+        from the first again.
+        """
+        if level in self.finished or not self.episodes.pop(level, None):
+            return
+        kept = [json.dumps(episode.record(name)) for name, episodes in self.episodes.items() for episode in episodes]
+        self._log.close()
+        atomic_write(self.path / EPISODES_FILE, "".join(line + "\n" for line in kept).encode(), overwrite=True)
+        self._log = open(self.path / EPISODES_FILE, "a", encoding="utf-8")  # noqa: SIM115 - open for the run
+
     def fail(self, level: str, error: str) -> None:
         """Note why a level failed (it will start again on --resume); its episodes are dropped then."""
         self.failed[level] = error

@@ -71,6 +71,7 @@ def run(args: argparse.Namespace) -> int:
     from retrokit.benchmark.comparison import compare
     from retrokit.benchmark.definition import load_benchmark
     from retrokit.benchmark.evaluation import Evaluation, evaluate
+    from retrokit.benchmark.speed import estimate_line
     from retrokit.errors import InvalidArgumentError
 
     benchmark = load_benchmark(args.benchmark)
@@ -83,13 +84,15 @@ def run(args: argparse.Namespace) -> int:
         raise InvalidArgumentError("Expected --out DIR, the folder for the results; got none.")
     agents = args.agent or ["jerk"]
     levels = benchmark.select(args.levels)
+    made: list[Evaluation] = []
 
     def make(agent: str, out: Path) -> Evaluation:
-        return Evaluation(
+        made.append(Evaluation(
             benchmark=benchmark, levels=levels, agent=agent, out=out, budget=args.timesteps, seed=args.seed,
             workers=args.workers, backend=args.backend, ray_address=args.ray_address, resume=args.resume,
             gif=args.gif, progress=not args.no_progress, stall_timeout=args.stall_timeout,
-        )
+        ))
+        return made[-1]
 
     try:
         if len(agents) == 1:
@@ -104,6 +107,10 @@ def run(args: argparse.Namespace) -> int:
     print(f"wrote {args.out}/: " + ("episodes.jsonl, summary.json, summary.csv, report.md, learning-curves.png, "
                                     "scores.png" if len(agents) == 1 else
                                     "report.md, scores.png, and a run folder per agent"))
+    for evaluation in made:  # on stderr, beside the progress: stdout is the results, the same on every machine
+        speed = evaluation.speed()
+        if speed is not None:
+            print(("" if len(made) == 1 else f"{evaluation.agent}: ") + estimate_line(speed), file=sys.stderr)
     return 0
 
 

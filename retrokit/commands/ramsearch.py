@@ -63,7 +63,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--types", metavar="CODES", help="comma-separated type codes to search (default: every type Gym Retro infers)"
     )
-    add_force_option(p, "replace an existing session file")
+    p.add_argument("--force", action="store_true", help="replace an existing session file")
 
     p = sub("run", "move the game on (hold buttons, play a script or a movie), then take a snapshot", _run)
     p.add_argument(
@@ -112,7 +112,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("address", metavar="ADDRESS", help="its console address, e.g. 0xFF002B")
     p.add_argument("type", metavar="TYPE", help="its type code, e.g. '|u1'")
     p.add_argument("--game-file", metavar="PATH", help="the game.yaml to write (default: the game's own)")
-    add_force_option(p, "replace a field of the same name")
+    p.add_argument("--force", action="store_true", help="replace a field of the same name")
     p.add_argument(
         "--range", nargs=2, metavar=("LO", "HI"), help="the values the field may hold, written as range: [LO, HI]"
     )
@@ -120,11 +120,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p = sub("savestate", "save the game's state now as a state of the game, in the data folder", _savestate)
     p.add_argument("name", metavar="NAME", help="the state's name, e.g. Level1")
     p.add_argument("--default", action="store_true", help="make it the state make(game) starts from")
-    add_force_option(p, "replace a different state of that name")
+    p.add_argument("--force", action="store_true", help="replace a different state of that name")
 
     p = sub("movie", "write the inputs played since the start state as a stable-retro movie", _movie)
     p.add_argument("file", metavar="FILE.bk2")
-    add_force_option(p, "replace an existing file")
+    p.add_argument("--force", action="store_true", help="replace an existing file")
     parser.set_defaults(run=run)
 
 

@@ -121,10 +121,12 @@ class StepArrays(Tracked):
         self.info = dict(zip(keys, columns)) | dict(zip((f"_{key}" for key in keys), mask_rows))
         # Plain memoryviews write single items without a trip through numpy.
         self.flags = (memoryview(self.rewards), memoryview(self.terminations), memoryview(self.truncations))
-        self._all_masks = memoryview(self.masks).cast("B")
+        # No fields (info_keys=[]): nothing to refill, and a memoryview of no items cannot be cast.
+        self._all_masks = memoryview(self.masks).cast("B") if self.masks.size else None
         self._ones = b"\x01" * self.masks.size
         super().__init__([self.rewards, self.terminations, self.truncations, self.fields, self.masks, *columns, *mask_rows])
 
     def refill_masks(self) -> None:
         """Set every mask back to True, in case a caller changed one before letting go."""
-        self._all_masks[:] = self._ones
+        if self._all_masks is not None:
+            self._all_masks[:] = self._ones

@@ -16,8 +16,6 @@ from typing import Any
 
 import numpy as np
 
-from retrokit.movie.recorder import EpisodeMovies
-
 
 class StableRetroCompat:
     """Mixed into RetroEnv: stable-retro's ``buttons``, ``get_action_meaning``, ``get_ram``, ``load_state``."""
@@ -49,14 +47,5 @@ class StableRetroCompat:
         from retrokit.data.resolve import resolve_state
 
         start = resolve_state(self.game, state, players=self.players)  # type: ignore[attr-defined]
-        self.state_name, self._state = start.name, start.state
-        self._first_frame = self._first_obs = None  # the first observation is the new state's
-        old = self.movies  # type: ignore[attr-defined]
-        if old is not None:  # later movies start from the new state, under its name
-            old.end()
-            game, stepper = self.game, self.stepper  # type: ignore[attr-defined]
-            self.movies = EpisodeMovies(
-                old.folder, f"{game.name}-{self.state_name or 'power-on'}", game.name,
-                self.emulator.system.name, self.players, self._state,  # type: ignore[attr-defined]
-            )
-            stepper.observers[stepper.observers.index(old)] = self.movies
+        self._starts, self._start_odds = [start], None  # no more drawing among weighted states
+        self._use_start(start)  # type: ignore[attr-defined]

@@ -19,18 +19,21 @@ import numpy as np
 from gymnasium import spaces
 
 from retrokit.data.games import Game, find_game
-from retrokit.data.resolve import Resolved, State, resolve
+from retrokit.data.resolve import Resolved, StartState, State, resolve, resolve_state
 from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
 from retrokit.envs.compat import StableRetroCompat
 from retrokit.envs.options import check_crop, check_options, check_seed, make_arguments
 from retrokit.envs.pickling import PicklesAsArguments
+from retrokit.envs.preprocessing import OBSERVATION_OPTIONS, Preprocessing, preprocessing
+from retrokit.envs.starts import check_weights, probabilities
 from retrokit.envs.stepper import Stepper, drive
 from retrokit.envs.viewer import render_modes
-from retrokit.errors import InvalidArgumentError, StateError
+from retrokit.errors import InvalidArgumentError, StateError, UnknownNameError, did_you_mean
 from retrokit.host.emulator import Emulator
 from retrokit.host.fields import out_of_range, ranged
 from retrokit.host.memory import FieldReader
+from retrokit.host.systems import get_system
 from retrokit.movie.recorder import EpisodeMovies
 
 __all__ = ["RetroEnv", "State", "make"]
@@ -43,7 +46,8 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         game: The game's name, e.g. ``"Airstriker-Genesis"``, a loaded :class:`Game`, or a
             :class:`~retrokit.data.resolve.Resolved` (game, ROM, checked state and scenario found
             once; ``state`` and ``scenario`` are then not given).
-        state: A state name, a ``.state`` path, or a :class:`State`.
+        state: A state name, a ``.state`` path, a :class:`State`, or a mapping of state names to
+            weights: each reset draws one (seeded by ``reset(seed=...)``).
         scenario: A scenario name of the game, a path to a ``.yaml`` or
             Gym Retro ``.json`` scenario, or ``None`` for the game's default.
         obs_type: ``"rgb"`` (the screen) or ``"ram"`` (the system RAM).
@@ -61,6 +65,12 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         skip_video: Tell the core that only a step's last frame is seen (none
             with RAM observations and no render mode), so a core that asks
             skips drawing the rest (``retrokit build-core``); False draws all.
+        grayscale, resize, resize_method, crop, frame_stack, channels_first, max_pool: The observation's
+            native preprocessing (see :mod:`retrokit.envs.preprocessing`).
+        noop_max: At each reset, run a random number of steps from 1 to ``noop_max`` without buttons
+            (seeded); 0 runs none.
+        reward_clip: ``True`` gives the reward's sign, a number ``c`` clips it to ``[-c, c]``.
+        info_keys: The fields that ``info`` holds (``[]`` for none, the fastest); ``None`` for all.
 
     The env pickles as these arguments (see :mod:`retrokit.envs.pickling`):
     unpickled, it is a fresh env made from them, not yet reset; the
@@ -73,7 +83,7 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
     def __init__(
         self,
         game: str | Game | Resolved,
-        state: str | os.PathLike[str] | State | None = State.DEFAULT,
+        state: str | os.PathLike[str] | State | Mapping[str, float] | None = State.DEFAULT,
         scenario: str | os.PathLike[str] | Mapping[str, Any] | None = None,
         *,
         obs_type: str = "rgb",
@@ -87,35 +97,69 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         scenario_every_frame: bool = False,
         options: Mapping[str, str] | None = None,
         skip_video: bool = True,
+        grayscale: bool = False,
+        resize: tuple[int, int] | None = None,
+        resize_method: str = "area",
+        crop: tuple[int, int, int, int] | None = None,
+        frame_stack: int = 1,
+        channels_first: bool = False,
+        max_pool: bool = False,
+        noop_max: int = 0,
+        reward_clip: bool | float = False,
+        info_keys: list[str] | None = None,
     ) -> None:
         PicklesAsArguments.__init__(
             self, game, state, scenario, obs_type=obs_type, action_type=action_type, frameskip=frameskip,
             sticky_prob=sticky_prob, max_episode_steps=max_episode_steps, players=players, render_mode=render_mode,
             record=record, scenario_every_frame=scenario_every_frame, options=options, skip_video=skip_video,
+            grayscale=grayscale, resize=resize, resize_method=resize_method, crop=crop, frame_stack=frame_stack,
+            channels_first=channels_first, max_pool=max_pool, noop_max=noop_max, reward_clip=reward_clip,
+            info_keys=info_keys,
         )
         checked = check_options(
             {
                 "obs_type": obs_type, "action_type": action_type, "frameskip": frameskip, "sticky_prob": sticky_prob,
                 "max_episode_steps": max_episode_steps, "players": players, "render_mode": render_mode,
                 "record": record, "scenario_every_frame": scenario_every_frame, "options": options,
-                "skip_video": skip_video,
+                "skip_video": skip_video, "grayscale": grayscale, "resize": resize, "resize_method": resize_method,
+                "crop": crop, "frame_stack": frame_stack, "channels_first": channels_first, "max_pool": max_pool,
+                "noop_max": noop_max, "reward_clip": reward_clip, "info_keys": info_keys,
             }
         )  # the same rules as retrokit.make's, whichever way the env is made
+        self.noop_max, self.reward_clip = checked["noop_max"], checked["reward_clip"]
         frameskip, sticky_prob, players = checked["frameskip"], checked["sticky_prob"], checked["players"]
         max_episode_steps, scenario_every_frame = checked["max_episode_steps"], checked["scenario_every_frame"]
         skip_video, options = checked["skip_video"], checked["options"]
         found = game.game if isinstance(game, Resolved) else find_game(game)
         if players > max(found.players, 1):
             raise InvalidArgumentError(f"Expected 1 to {found.players} players for {found.name}, got {players}.")
+        self.info_keys = _check_info_keys(checked["info_keys"], list(found.fields))
+        weights = check_weights(state) if isinstance(state, Mapping) and not isinstance(game, Resolved) else None
         # Game, ROM, checked state and scenario are found once, in the data layer.
-        setup = game if isinstance(game, Resolved) else resolve(found, state, scenario, players=players)
+        first = next(iter(weights)) if weights else state
+        setup = game if isinstance(game, Resolved) else resolve(found, first, scenario, players=players)
         self.game: Game = setup.game
+        #: Where episodes start, and the chance of each (``None``: always the one).
+        self._starts: list[StartState] = [setup.start]
+        self._start_odds: np.ndarray | None = None
+        if weights and len(weights) > 1:
+            self._starts += [resolve_state(self.game, name, players=players) for name in list(weights)[1:]]
+            self._start_odds = probabilities(weights)
         self.obs_type, self.frameskip, self.sticky_prob = obs_type, frameskip, float(sticky_prob)
         self.max_episode_steps, self.players, self.render_mode = max_episode_steps, players, render_mode
         self.scenario_every_frame = scenario_every_frame
 
         self.state_name, self._state = setup.start.name, setup.start.state
+        self.movies: EpisodeMovies | None = None
         self.scenario = self._compile_scenario(setup.scenario)
+        self._crop = getattr(self.scenario, "crop", None)
+        observation = {name: checked[name] for name in OBSERVATION_OPTIONS}
+        known_screen = get_system(self.game.system).screen
+        self.preprocessing: Preprocessing | None = None
+        if known_screen is not None:  # checked before any core is loaded
+            self.preprocessing = preprocessing(
+                observation, known_screen, obs_type=obs_type, every_frame=scenario_every_frame, scenario_crop=self._crop
+            )
         self.emulator = Emulator(self.game.system, setup.rom, options=options, ports=max(players, 2))
         self.reader = FieldReader(self.game.fields, self.emulator.space)
         rate = self.emulator.system.frame_rate(self.emulator.av_info()["fps"])  # the core says NTSC or PAL
@@ -131,13 +175,23 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
             players=players,
             every_frame=scenario_every_frame,
         )
-        self._crop = getattr(self.scenario, "crop", None)
         self._screen_shape = self.emulator.system.screen or self._first_frame_shape()
         check_crop(self._crop, self._screen_shape)
+        if known_screen is None:
+            self.preprocessing = preprocessing(
+                observation, self._screen_shape, obs_type=obs_type, every_frame=scenario_every_frame,
+                scenario_crop=self._crop,
+            )
+        if self.preprocessing is not None:
+            self.emulator.set_preprocess(self.preprocessing.native())
         self.observation_space = self._make_observation_space()
         self._buffers = BufferPool(self.observation_space.shape)
+        self._noop = np.zeros(self.emulator.ports, dtype=np.uint16)
+        self._info_index = None if self.info_keys is None else [self.reader.names.index(k) for k in self.info_keys]
+        self._info_array = np.zeros(len(self._info_index or ()), dtype=np.int64)
+        #: The info's fields after a step, as int64s (a vector env copies them into its batch).
+        self.info_values = memoryview(self.reader.values if self._info_index is None else self._info_array)
         self.record_dir = Path(record) if record is not None else None
-        self.movies: EpisodeMovies | None = None
         if self.record_dir is not None:
             stem = f"{self.game.name}-{self.state_name or 'power-on'}"
             self.movies = EpisodeMovies(
@@ -150,16 +204,39 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         self._at_start = False
         seen = "last" if obs_type == "rgb" or render_mode is not None else "none"
         self.emulator.set_video_frames(seen if skip_video else "all")
-        if self._state is not None and ranged(self.game.fields.values()):
+        if ranged(self.game.fields.values()):
             # The start state's first frame is emulated once anyway (the first observation): do it now,
             # so that a state whose fields are out of their ranges (another game's) is refused at make().
             try:
-                self._start()
-                self.emulator.forget_action()
-                self._initial_observation()
+                for start in reversed(self._starts):  # the first is the one in use after
+                    self._use_start(start)
+                    if self._state is not None:
+                        self._start()
+                        self.emulator.forget_action()
+                        self._initial_observation()
             except StateError:
                 self.close()
                 raise
+
+    @property
+    def info_names(self) -> tuple[str, ...]:
+        """The fields that ``info`` holds, in :attr:`info_values`' order."""
+        return tuple(self.reader.names) if self.info_keys is None else self.info_keys
+
+    def _use_start(self, start: StartState) -> None:
+        """Start the next episodes at ``start``; later movies are recorded from it, under its name."""
+        if getattr(self, "_state", None) is start.state and getattr(self, "state_name", None) == start.name:
+            return
+        self.state_name, self._state = start.name, start.state
+        self._first_frame = self._first_obs = None  # the first observation is the new state's
+        old = self.movies
+        if old is not None:
+            old.end()
+            self.movies = EpisodeMovies(
+                old.folder, f"{self.game.name}-{self.state_name or 'power-on'}", self.game.name,
+                self.emulator.system.name, self.players, self._state,
+            )  # fmt: skip
+            self.stepper.observers[self.stepper.observers.index(old)] = self.movies
 
     @property
     def direct_screen(self) -> bool:
@@ -192,11 +269,13 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
             self.emulator.run(0, 1)
             self._check_ranges()
             self._first_frame = self.emulator.screen()
-            self._first_obs = self.observe()
+            self._first_obs = self.observe() if self.preprocessing is None else None
             self._start()
             self.emulator.forget_action()
         if self.obs_type == "ram":
             return self.observe()
+        if self.preprocessing is not None:  # each episode's stack starts anew
+            return self._observe_first(self._first_frame)
         return self._first_obs.copy()  # type: ignore[union-attr]
 
     def _check_ranges(self) -> None:
@@ -216,7 +295,15 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
                 f"broken: pick another, or remake it (retrokit integrate, or ramsearch savestate)."
             )
 
+    def _observe_first(self, frame: np.ndarray | None = None) -> np.ndarray:
+        """An episode's first observation, of the last frame or of ``frame``: preprocessed, with the stack filled."""
+        if self.preprocessing is None:
+            return self.observe()
+        return self.emulator.observe(self._buffers.take(), restart=True, frame=frame)
+
     def _make_observation_space(self) -> spaces.Box:
+        if self.preprocessing is not None:
+            return self.preprocessing.space()
         if self.obs_type == "ram":
             return spaces.Box(0, 255, (len(self.emulator.ram),), np.uint8)
         height, width = self._screen_shape
@@ -237,14 +324,28 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None) -> tuple[np.ndarray, dict[str, Any]]:
         super().reset(seed=check_seed(seed))
+        if self._start_odds is not None:
+            self._use_start(self._starts[int(self.np_random.choice(len(self._starts), p=self._start_odds))])
         self._start()
         self.emulator.forget_action()
         self.emulator.set_sticky(self.sticky_prob, int(self.np_random.integers(0, 2**63)))
-        values = self.stepper.start()
-        obs = self._initial_observation()
-        self._at_start = True
+        noops = int(self.np_random.integers(1, self.noop_max + 1)) if self.noop_max else 0
+        if noops:
+            self.emulator.run(self._noop, noops * self.frameskip)  # one call: only its last frame is drawn
+            self.emulator.forget_action()
+            values = self.stepper.start()
+            obs = self._observe_first()  # the screen the last no-op drew
+        else:
+            values = self.stepper.start()
+            obs = self._initial_observation()
+        self._at_start = not noops
         if self.movies is not None:
             self.movies.start()
+            if noops:
+                none = (0,) * self.players
+                self.movies.frames(none, none, noops * self.frameskip)
+        if self.info_keys is not None:
+            values = {key: values[key] for key in self.info_keys}
         if self.render_mode == "human":
             self.render()
         return obs, values
@@ -273,6 +374,9 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         rewards, done, values = stepper.rewards, stepper.done, stepper.values
         if obs is None:
             obs = self.observe()
+        if self._info_index is not None:
+            self._info_array[:] = self.reader.values[self._info_index]
+            values = {key: values[key] for key in self.info_keys}  # type: ignore[union-attr]
         truncated = self.max_episode_steps is not None and stepper.steps >= self.max_episode_steps and not done
         if self.players > 1:
             values["rewards"] = rewards
@@ -281,10 +385,19 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
             self.movies.end()
         if self.render_mode == "human":
             self.render()
-        return obs, float(sum(rewards)), done, truncated, values
+        return obs, self._clipped(float(sum(rewards))), done, truncated, values
+
+    def _clipped(self, reward: float) -> float:
+        """The reward as ``reward_clip`` says: itself (False), its sign (True), or within ``[-c, c]``."""
+        clip = self.reward_clip
+        if clip is False:
+            return reward
+        return float(np.sign(reward)) if clip is True else min(max(reward, -clip), clip)
 
     def observe(self) -> np.ndarray:
-        """The observation now: the screen (cropped as the scenario says, in the fixed shape) or the RAM."""
+        """The observation now: the screen (cropped as the scenario says, in the fixed shape, or preprocessed) or the RAM."""
+        if self.preprocessing is not None:
+            return self.emulator.observe(self._buffers.take())
         if self.obs_type == "ram":
             out = self._buffers.take()
             out[:] = self.emulator.ram
@@ -323,6 +436,21 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
             self._viewer = None
         if hasattr(self, "emulator"):
             self.emulator.close()
+
+
+def _check_info_keys(keys: tuple[str, ...] | None, fields: list[str]) -> tuple[str, ...] | None:
+    """Refuse an ``info_keys`` name that is no field of the game, with the closest one.
+
+    Raises:
+        UnknownNameError: A name is no field.
+    """
+    for key in keys or ():
+        if key not in fields:
+            raise UnknownNameError(
+                f"Expected info_keys to name fields of the game ({', '.join(fields) or 'it has none'}), got {key!r}."
+                + did_you_mean(key, fields)
+            )
+    return keys
 
 
 def make(

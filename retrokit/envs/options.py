@@ -135,6 +135,69 @@ def _core_options(value: object) -> dict[str, str] | None:
     )
 
 
+#: The observation's resampling methods (OpenCV's INTER_AREA, INTER_LINEAR, INTER_NEAREST).
+RESIZE_METHODS = ("area", "bilinear", "nearest")
+#: The largest side of a resized observation, the most frames stacked, and the most no-op steps at reset.
+MAX_SIDE = 4096
+MAX_FRAME_STACK = 64
+MAX_NOOPS = 10_000
+
+
+def _whole_tuple(name: str, value: object, length: int, low: int, example: str) -> tuple[int, ...] | None:
+    """``None``, or a tuple or list of ``length`` whole numbers of at least ``low`` (at most MAX_SIDE * 4)."""
+    if value is None:
+        return None
+    if not isinstance(value, (tuple, list)) or len(value) != length:
+        raise InvalidArgumentError(
+            f"Expected {name} to be a tuple of {length} whole numbers or None, got {shown(value)}; pass e.g. "
+            f"{name}={example}."
+        )
+    return tuple(_integer(f"each number of {name}", v, low, MAX_SIDE * 4) for v in value)
+
+
+def _resize(value: object) -> tuple[int, int] | None:
+    size = _whole_tuple("resize", value, 2, 1, "(84, 84)")
+    if size is not None and max(size) > MAX_SIDE:
+        raise InvalidArgumentError(f"Expected resize's height and width up to {MAX_SIDE}, got {size}; pass e.g. (84, 84).")
+    return size  # type: ignore[return-value]
+
+
+def _crop(value: object) -> tuple[int, int, int, int] | None:
+    return _whole_tuple("crop", value, 4, 0, "(0, 16, 0, 0) (pixels off the top, bottom, left and right)")  # type: ignore[return-value]
+
+
+def _frame_stack(value: object) -> int:
+    return _integer("frame_stack", value, 1, MAX_FRAME_STACK)
+
+
+def _noop_max(value: object) -> int:
+    return _integer("noop_max", value, 0, MAX_NOOPS)
+
+
+def _reward_clip(value: object) -> bool | float:
+    """False (off), True (the reward's sign, as Atari agents clip) or a bound c > 0 (clip to [-c, c])."""
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, numbers.Real) and math.isfinite(float(value)) and float(value) > 0:
+        return float(value)
+    raise InvalidArgumentError(
+        f"Expected reward_clip to be False, True (the reward's sign) or a bound above 0, got {shown(value)}; "
+        f"pass e.g. reward_clip=True or reward_clip=1.0."
+    )
+
+
+def _info_keys(value: object) -> tuple[str, ...] | None:
+    """``None`` (every field), or a list of field names (empty: no info at all)."""
+    if value is None:
+        return None
+    if isinstance(value, (list, tuple)) and all(isinstance(k, str) for k in value):
+        return tuple(dict.fromkeys(value))
+    raise InvalidArgumentError(
+        f"Expected info_keys to be a list of field names (empty for no info) or None for every field, got "
+        f"{shown(value)}; pass e.g. info_keys=['score'] or info_keys=[]."
+    )
+
+
 #: Every keyword option of RetroEnv, and how it is checked (tests check this matches RetroEnv).
 OPTIONS: dict[str, Callable[[Any], Any]] = {
     "obs_type": _choice("obs_type", OBS_TYPES),
@@ -148,6 +211,18 @@ OPTIONS: dict[str, Callable[[Any], Any]] = {
     "scenario_every_frame": _flag("scenario_every_frame"),
     "skip_video": _flag("skip_video"),
     "options": _core_options,
+    # Observation preprocessing, done natively (retrokit/envs/preprocessing.py).
+    "grayscale": _flag("grayscale"),
+    "resize": _resize,
+    "resize_method": _choice("resize_method", RESIZE_METHODS),
+    "crop": _crop,
+    "frame_stack": _frame_stack,
+    "channels_first": _flag("channels_first"),
+    "max_pool": _flag("max_pool"),
+    # Episodes and what a step hands back.
+    "noop_max": _noop_max,
+    "reward_clip": _reward_clip,
+    "info_keys": _info_keys,
 }
 
 
@@ -197,9 +272,10 @@ def make_arguments(game: object, state: object, scenario: object, options: Mappi
             f"Expected game to be a game's name (str) or a Game, got {shown(game)}; pass e.g. 'Airstriker-Genesis' "
             f"(`retrokit games` lists them)."
         )
-    if not (state is None or isinstance(state, (str, os.PathLike, enum.Enum))):
+    if not (state is None or isinstance(state, (str, os.PathLike, enum.Enum, Mapping))):
         raise InvalidArgumentError(
-            f"Expected state to be a state's name, a .state path, retrokit.State or None, got {shown(state)}."
+            f"Expected state to be a state's name, a .state path, retrokit.State, a mapping of state names to "
+            f"weights (one drawn at each reset) or None, got {shown(state)}."
         )
     if not (scenario is None or isinstance(scenario, (str, os.PathLike, Mapping))):
         raise InvalidArgumentError(

@@ -33,6 +33,7 @@ from retrokit.envs.buffers import BufferPool, Pool, StepArrays
 from retrokit.envs.memory import MIN_ENV_BYTES, build_envs, check_fits
 from retrokit.envs.options import check_num_envs, check_seed
 from retrokit.envs.pickling import PicklesAsArguments
+from retrokit.envs.starts import per_env_states
 from retrokit.envs.stepper import drive
 from retrokit.errors import InvalidArgumentError, shown
 from retrokit.host.runner import Runner
@@ -102,12 +103,12 @@ class ThreadedVectorEnv(PicklesAsArguments, VectorEnv):
         for i, stepper in enumerate(self._steppers):
             stepper.use_masks(self._actions[i])
         self._direct_screens = all(env.direct_screen for env in envs) and self._batches is not None
-        names = {tuple(env.reader.names) for env in envs}
+        names = {env.info_names for env in envs}
         if len(names) == 1 and all(env.players == 1 and env.reader.fits_int64 for env in envs):
             keys = names.pop()
             num_envs = self.num_envs  # not self: a closure over self would keep the envs alive until GC
             self._step_arrays = Pool(lambda: StepArrays(num_envs, keys))
-            self._field_values = [memoryview(env.reader.values) for env in envs]
+            self._field_values = [env.info_values for env in envs]
         return Runner([env.emulator for env in envs], self.threads - 1)
 
     def _each(self, job: Callable[[int], Any]) -> list[Any]:
@@ -196,7 +197,7 @@ class ThreadedVectorEnv(PicklesAsArguments, VectorEnv):
         for i, result in enumerate(results):
             rewards[i], terminations[i], truncations[i] = result[1], result[2], result[3]
         for row, values in zip(arrays.rows, self._field_values):
-            row[:] = values  # the env's reader decoded this step's fields into it
+            row[:] = values  # the env's reader decoded this step's fields (its info's) into it
         arrays.refill_masks()
         return observations, arrays.rewards, arrays.terminations, arrays.truncations, dict(arrays.info)
 
@@ -267,6 +268,6 @@ def make_vec(
 
     num_envs = check_num_envs(num_envs)
     check_fits(num_envs, (MIN_ENV_BYTES, MIN_ENV_BYTES), at_least=True)  # before a list of num_envs functions
-    start = State.DEFAULT if state is None else state
+    starts = [State.DEFAULT if s is None else s for s in per_env_states(state, num_envs)]  # a list: one per env
     # partials, not lambdas: the vector env pickles as its env functions
-    return ThreadedVectorEnv([functools.partial(make, game, start, scenario, **options)] * num_envs, threads)
+    return ThreadedVectorEnv([functools.partial(make, game, s, scenario, **options) for s in starts], threads)

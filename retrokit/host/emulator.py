@@ -243,6 +243,32 @@ class Emulator:
         """How often the core asked whether video and audio are wanted (0: it never asks, so never skips)."""
         return self._emu.av_asked
 
+    @property
+    def av_drawn(self) -> int:
+        """How often the core asked whether to draw its frame and was told yes (``av_asked`` counts every ask)."""
+        return self._emu.av_drawn
+
+    def set_preprocess(self, spec: tuple[int, ...] | None) -> None:
+        """Make observations natively, or (``None``) go back to the RGB screen.
+
+        Args:
+            spec: :meth:`retrokit.envs.preprocessing.Preprocessing.native`'s tuple.
+                Then :meth:`run`'s ``screen`` and :meth:`observe`'s ``out`` are
+                buffers of the preprocessed observation's shape.
+        """
+        self._emu.set_preprocess(spec)
+
+    def observe(self, out: np.ndarray, *, restart: bool = False, frame: np.ndarray | None = None) -> np.ndarray:
+        """Write the preprocessed observation of the last frame (or of an RGB ``frame``) into ``out``.
+
+        Args:
+            out: A uint8 buffer of the observation's shape.
+            restart: Begin an episode: forget the stacked frames and fill the stack with this one.
+            frame: An RGB ``(H, W, 3)`` frame to use instead of the core's last one.
+        """
+        self._emu.observe(out, restart, frame)
+        return out
+
     def forget_action(self) -> None:
         """Make the next ``run`` apply its buttons from its first frame."""
         self._emu.forget_action()

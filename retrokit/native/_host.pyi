@@ -44,6 +44,24 @@ class Emulator:
     @property
     def av_asked(self) -> int:
         """How often the core asked whether video and audio are wanted (GET_AUDIO_VIDEO_ENABLE)."""
+    @property
+    def av_drawn(self) -> int:
+        """How often the core asked and was told to draw the frame (video wanted)."""
+    def set_preprocess(self, spec: tuple[int, ...] | None) -> None:
+        """Make observations through the native preprocessing, or (``None``) as the RGB screen.
+
+        ``spec`` is ``(screen_height, screen_width, top, bottom, left, right, height, width, method, gray,
+        max_pool, stack, channels_first)`` (``rk_prep_spec``; method 0 none, 1 area, 2 bilinear, 3 nearest).
+        Then ``run``'s screen (and a Runner's) is a uint8 buffer of the observation's size, and a run keeps
+        its next-to-last frame for the max-pool (and tells the core both are seen).
+        """
+    def observe(
+        self, out: npt.NDArray[np.uint8], restart: bool = False, frame: npt.NDArray[np.uint8] | None = None
+    ) -> None:
+        """Write the preprocessed observation of the last frame (or of the RGB ``frame``) into ``out``.
+
+        ``restart`` begins an episode: the stack is filled with this frame and any kept frame forgotten.
+        """
     def forget_action(self) -> None:
         """Make the next ``run`` apply its action from the first frame, as after a reset."""
     def run(
@@ -85,8 +103,9 @@ class Runner:
 
         Any number of emulators: the threads take them one at a time until
         none is left. ``actions`` has one row of port masks per emulator. Each
-        screen is converted into its buffer when its shape fits the frame; the
-        result says, per emulator, whether it was.
+        screen is converted into its buffer when its shape fits the frame (or,
+        for an emulator with a preprocessing, its observation is made into it:
+        always); the result says, per emulator, whether it was.
         """
 
 def pack_buttons(

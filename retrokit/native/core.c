@@ -177,6 +177,8 @@ void rk_core_close(rk_core *core) {
     core->n_overrides = 0;
     for (int i = 0; i < core->n_log; i++) free(core->log[i].text);
     core->n_log = 0;
+    rk_prep_free(core->prep);
+    core->prep = NULL;
     free(core->audio);
     core->audio = NULL;
     core->audio_len = core->audio_cap = 0;
@@ -223,15 +225,18 @@ void rk_core_run(rk_core *core, const uint16_t *actions, int n_ports, int frames
         stick = u < core->sticky_prob;
     }
     core->last_stuck = stick && frames > 0;
+    /* With max_pool the observation is the max of the last two frames: both are seen. */
+    int keep = core->prep && rk_prep_wants_previous(core->prep), seen = keep ? 2 : 1;
     rk_enter(core);
     for (int f = 0; f < frames; f++) {
         /* The first frame of a new action keeps the last applied one when it sticks. */
         memcpy(core->buttons, (f == 0 && stick) ? core->held : action, sizeof core->buttons);
         int all = core->video_frames == RK_VIDEO_ALL;
-        core->av_enable = (all || (core->video_frames == RK_VIDEO_LAST && f == frames - 1)) |
+        core->av_enable = (all || (core->video_frames == RK_VIDEO_LAST && f >= frames - seen)) |
                           (all || core->capture_audio) << 1;
         core->api.run();
         core->frame++;
+        if (keep && f == frames - 2) rk_prep_keep(core->prep, core); /* before the last frame overwrites it */
     }
     rk_leave();
     if (frames > 0) {
@@ -241,6 +246,10 @@ void rk_core_run(rk_core *core, const uint16_t *actions, int n_ports, int frames
 }
 
 int rk_core_screen_into(rk_core *core, uint8_t *dst, unsigned width, unsigned height) {
+    if (core->prep) {
+        rk_prep_observe(core->prep, core, dst);
+        return 1;
+    }
     if (!core->frame_data || core->frame_width != width || core->frame_height != height) return 0;
     return rk_frame_to_rgb(core->frame_data, core->frame_pitch, width, height, core->pixel_format, dst) == 0;
 }

@@ -14,6 +14,7 @@
 #include <stdint.h>
 
 #include "libretro_api.h"
+#include "preprocess.h"
 
 #define RK_MAX_PORTS 8
 #define RK_MAX_LOG 256
@@ -113,6 +114,10 @@ typedef struct rk_core {
     int video_frames; /* RK_VIDEO_*, for the frames of each run */
     int av_enable;    /* the answer for the frame running now */
     uint64_t av_asked; /* how often the core asked */
+    uint64_t av_drawn; /* how often it was told to draw the frame */
+
+    /* The observation's preprocessing, or NULL for the plain RGB screen. */
+    rk_prep *prep;
 
     /* Audio, captured only when asked. */
     int capture_audio;
@@ -145,7 +150,8 @@ void rk_leave(void);
 void rk_core_run(rk_core *core, const uint16_t *actions, int n_ports, int frames);
 void rk_core_seed(rk_core *core, double prob, uint64_t seed);
 /* Convert the last frame into an RGB buffer of height x width x 3, if the
- * frame has that size; returns whether it did. */
+ * frame has that size; returns whether it did. With a preprocessor, make the
+ * observation into dst instead (of its size; width and height are unused). */
 int rk_core_screen_into(rk_core *core, uint8_t *dst, unsigned width, unsigned height);
 
 #endif

@@ -271,6 +271,7 @@ bool rk_cb_environment(unsigned cmd, void *data) {
         return true;
     case RK_ENV_GET_AUDIO_VIDEO_ENABLE:
         core->av_asked++;
+        core->av_drawn += core->av_enable & 1;
         if (data) *(int *)data = core->av_enable;
         return true;
     case RK_ENV_GET_FASTFORWARDING:

@@ -40,6 +40,21 @@ int rk_py_get_screen(PyObject *obj, Py_buffer *view, unsigned height, unsigned w
     return -1;
 }
 
+int rk_py_get_obs(EmulatorObject *emu, PyObject *obj, Py_buffer *view) {
+    rk_prep *prep = emu->core.prep;
+    if (!prep) return rk_py_get_screen(obj, view, 0, 0);
+    if (PyObject_GetBuffer(obj, view, PyBUF_WRITABLE | PyBUF_FORMAT | PyBUF_ND | PyBUF_C_CONTIGUOUS) < 0) return -1;
+    const char *f = view->format ? view->format : "B";
+    size_t size = rk_prep_obs_size(prep);
+    if (view->itemsize == 1 && (f[0] == 'B' || f[0] == 'c') && !f[1] && (size_t)view->len == size) return 0;
+    PyErr_Format(InvalidArgumentError,
+                 "the observation buffer must be a C-contiguous uint8 array of %zu bytes (the preprocessed "
+                 "observation's shape), got %zd bytes of format %s; make it with numpy.empty of the env's "
+                 "observation_space.shape", size, view->len, f);
+    PyBuffer_Release(view);
+    return -1;
+}
+
 static PyMethodDef module_methods[] = {
     {"read_fields", (PyCFunction)(void (*)(void))rk_py_read_fields, METH_FASTCALL, "Decode RAM fields by a plan."},
     {"pack_buttons", (PyCFunction)(void (*)(void))rk_py_pack_buttons, METH_FASTCALL,

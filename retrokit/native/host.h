@@ -48,4 +48,9 @@ PyObject *rk_py_release(Py_buffer *view, PyObject *result);
  * of this height and width unless they are 0; else raise and return -1. */
 int rk_py_get_screen(PyObject *obj, Py_buffer *view, unsigned height, unsigned width);
 
+/* Get `obj` as where `emu`'s observation goes: with a preprocessor, a writable
+ * C-contiguous uint8 array of the observation's size; else a screen buffer of
+ * any height and width (rk_py_get_screen). Else raise and return -1. */
+int rk_py_get_obs(EmulatorObject *emu, PyObject *obj, Py_buffer *view);
+
 #endif

@@ -181,6 +181,53 @@ static PyObject *emulator_set_video_frames(EmulatorObject *self, PyObject *arg) 
     Py_RETURN_NONE;
 }
 
+static PyObject *emulator_set_preprocess(EmulatorObject *self, PyObject *arg) {
+    rk_prep_spec spec = {0};
+    rk_prep *prep = NULL;
+    if (arg != Py_None) {
+        if (!PyArg_ParseTuple(arg, "IIIIIIIIiiiIi;the preprocessing must be a tuple of 13 integers",
+                              &spec.screen_height, &spec.screen_width, &spec.top, &spec.bottom, &spec.left,
+                              &spec.right, &spec.height, &spec.width, &spec.method, &spec.gray, &spec.max_pool,
+                              &spec.stack, &spec.channels_first))
+            return NULL;
+        char error[256];
+        if (!(prep = rk_prep_new(&spec, error, sizeof error))) return PyErr_Format(InvalidArgumentError, "%s", error);
+    }
+    if (rk_py_enter(self, 0)) {
+        rk_prep_free(prep);
+        return NULL;
+    }
+    rk_prep_free(self->core.prep);
+    self->core.prep = prep;
+    rk_py_leave(self);
+    Py_RETURN_NONE;
+}
+
+static PyObject *emulator_observe(EmulatorObject *self, PyObject *args) {
+    PyObject *out, *frame_obj = Py_None;
+    int restart = 0;
+    if (!PyArg_ParseTuple(args, "O|pO", &out, &restart, &frame_obj)) return NULL;
+    if (!self->core.prep) return PyErr_Format(InvalidArgumentError, "observe() needs a preprocessing; call set_preprocess first");
+    Py_buffer obs = {0}, frame = {0};
+    if (rk_py_get_obs(self, out, &obs)) return NULL;
+    if (frame_obj != Py_None && rk_py_get_screen(frame_obj, &frame, 0, 0)) return rk_py_release(&obs, NULL);
+    if (rk_py_enter(self, 1)) {
+        PyBuffer_Release(&frame);
+        return rk_py_release(&obs, NULL);
+    }
+    rk_core *c = &self->core;
+    Py_BEGIN_ALLOW_THREADS
+    if (restart) rk_prep_restart(c->prep);
+    if (frame.buf)
+        rk_prep_observe_rgb(c->prep, frame.buf, (unsigned)frame.shape[1], (unsigned)frame.shape[0], obs.buf);
+    else
+        rk_prep_observe(c->prep, c, obs.buf);
+    Py_END_ALLOW_THREADS
+    rk_py_leave(self);
+    PyBuffer_Release(&frame);
+    return rk_py_release(&obs, Py_NewRef(Py_None));
+}
+
 static PyObject *emulator_forget_action(EmulatorObject *self, PyObject *unused) {
     self->core.have_held = 0;
     Py_RETURN_NONE;
@@ -205,7 +252,7 @@ static PyObject *emulator_run(EmulatorObject *self, PyObject *const *args, Py_ss
     memcpy(actions, buf.buf, (size_t)n * 2);
     PyBuffer_Release(&buf);
     int want_screen = nargs == 3 && args[2] != Py_None;
-    if (want_screen && rk_py_get_screen(args[2], &screen, 0, 0)) return NULL;
+    if (want_screen && rk_py_get_obs(self, args[2], &screen)) return NULL;
     if (rk_py_enter(self, 1)) return rk_py_release(&screen, NULL);
     int converted = 0;
     rk_core *c = &self->core;
@@ -213,7 +260,8 @@ static PyObject *emulator_run(EmulatorObject *self, PyObject *const *args, Py_ss
     rk_core_run(c, actions, c->n_ports, (int)frames);
     /* Convert while the frame is still in the cache, if it fits the buffer. */
     if (want_screen)
-        converted = rk_core_screen_into(c, screen.buf, (unsigned)screen.shape[1], (unsigned)screen.shape[0]);
+        converted = rk_core_screen_into(c, screen.buf, screen.ndim == 3 ? (unsigned)screen.shape[1] : 0,
+                                        screen.ndim == 3 ? (unsigned)screen.shape[0] : 0);
     Py_END_ALLOW_THREADS
     rk_py_leave(self);
     return rk_py_release(&screen, want_screen ? PyBool_FromLong(converted) : Py_NewRef(Py_None));
@@ -241,6 +289,10 @@ static PyObject *emulator_held(EmulatorObject *self, PyObject *unused) {
 
 static PyObject *emulator_get_av_asked(EmulatorObject *self, void *closure) {
     return PyLong_FromUnsignedLongLong(self->core.av_asked);
+}
+
+static PyObject *emulator_get_av_drawn(EmulatorObject *self, void *closure) {
+    return PyLong_FromUnsignedLongLong(self->core.av_drawn);
 }
 
 typedef struct {
@@ -418,6 +470,10 @@ static PyMethodDef emulator_methods[] = {
     {"set_sticky", (PyCFunction)emulator_set_sticky, METH_VARARGS, "Set the sticky-action probability and seed the RNG."},
     {"set_video_frames", (PyCFunction)emulator_set_video_frames, METH_O,
      "Which frames of each run the core is told to draw: VIDEO_ALL, VIDEO_LAST or VIDEO_NONE."},
+    {"set_preprocess", (PyCFunction)emulator_set_preprocess, METH_O,
+     "Make observations through a native preprocessing (a tuple of 13 integers, see _host.pyi), or None for RGB."},
+    {"observe", (PyCFunction)emulator_observe, METH_VARARGS,
+     "observe(out, restart=False, frame=None): the preprocessed observation of the last frame (or of frame)."},
     {"forget_action", (PyCFunction)emulator_forget_action, METH_NOARGS, "Apply the next action from its first frame."},
     {"held", (PyCFunction)emulator_held, METH_NOARGS, "The buttons of the last frame run, one mask per port."},
     {"run", (PyCFunction)(void (*)(void))emulator_run, METH_FASTCALL,
@@ -438,6 +494,8 @@ static PyMethodDef emulator_methods[] = {
 static PyGetSetDef emulator_getset[] = {
     {"frame", (getter)emulator_get_frame, NULL, "Frames run since the core was loaded.", NULL},
     {"av_asked", (getter)emulator_get_av_asked, NULL, "How often the core asked whether video and audio are wanted.",
+     NULL},
+    {"av_drawn", (getter)emulator_get_av_drawn, NULL, "How often the core asked and was told to draw the frame.",
      NULL},
     {"stuck", (getter)emulator_get_stuck, NULL, "Whether the last run's first frame kept the previous buttons.", NULL},
     {NULL, NULL, NULL, NULL, NULL},

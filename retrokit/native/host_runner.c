@@ -71,10 +71,10 @@ static PyObject *runner_run(RunnerObject *self, PyObject *args) {
         RK_CHECK(emu->core.n_ports == ports, InvalidArgumentError,
                  "every emulator must have %d ports; emulator %zd has %d", ports, i, emu->core.n_ports);
         if (screen_seq) {
-            if (rk_py_get_screen(PySequence_Fast_GET_ITEM(screen_seq, i), &views[i], 0, 0)) goto done;
+            if (rk_py_get_obs(emu, PySequence_Fast_GET_ITEM(screen_seq, i), &views[i])) goto done;
             tasks[i].screen = views[i].buf;
-            tasks[i].screen_height = (unsigned)views[i].shape[0];
-            tasks[i].screen_width = (unsigned)views[i].shape[1];
+            tasks[i].screen_height = views[i].ndim == 3 ? (unsigned)views[i].shape[0] : 0;
+            tasks[i].screen_width = views[i].ndim == 3 ? (unsigned)views[i].shape[1] : 0;
         }
         if (rk_py_enter(emu, 1)) goto done;
         claimed++;

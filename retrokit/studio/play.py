@@ -99,8 +99,9 @@ def reset(session: Session, state: str | None) -> None:
     search = session.search
     name = state if state is not None else search.state
     session.play_frames(None)
-    if name is None:
+    if name is None:  # a game without states (a new one): power-on
         search.emulator.reset()
+        search.restart_inputs()  # a movie recorded from here starts here
     else:
         path = search.game.state_path(name)  # StateNotFoundError, with a did-you-mean, for an unknown one
         check_inside(path, game_roots(search.game), what="state")

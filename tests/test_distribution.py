@@ -105,3 +105,24 @@ def test_an_unknown_guide_is_one_line_with_a_suggestion(capsys, topic: str, hint
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("retrokit: error: Expected one of retrokit's guides")
     assert hint in err and "Traceback" not in err
+
+
+def test_the_studio_page_ships_in_the_wheel_whole() -> None:
+    """Every file of the page (HTML, CSS, JS modules, the vendored editor and its license) is package data,
+    and every file the page loads (``src``/``href``, ``import ... from "./x.js"``) is one of them."""
+    static = PACKAGE / "studio" / "static"
+    patterns = tomllib.loads((REPO / "pyproject.toml").read_text())["tool"]["setuptools"]["package-data"]["retrokit"]
+    shipped = {p for pattern in patterns for p in PACKAGE.glob(pattern) if p.is_file()}
+    files = {p for p in static.rglob("*") if p.is_file()}
+    assert {static / "index.html", static / "vendor" / "codemirror" / "LICENSE"} <= files
+    assert files <= shipped, sorted(str(p.relative_to(static)) for p in files - shipped)
+    loaded = []
+    for page in files:
+        text = page.read_text(encoding="utf-8")
+        if page.suffix == ".html":
+            loaded += [(page, name) for name in re.findall(r'(?:src|href)="([^":#]+)"', text)]
+        elif page.suffix == ".js" and "vendor" not in page.parts:
+            loaded += [(page, name) for name in re.findall(r'^import .*? from "(\./[^"]+)";$', text, re.MULTILINE)]
+    assert len(loaded) > 20
+    missing = [f"{page.name} loads {name}" for page, name in loaded if not (page.parent / name).resolve().is_file()]
+    assert not missing

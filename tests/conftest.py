@@ -81,3 +81,23 @@ def corrupt_state(good_state: bytes) -> bytes:
     from corrupt import random_body
 
     return random_body(good_state, random.Random(1), keep_pointers=True)
+
+
+@pytest.fixture(scope="module")
+def studio_game(tmp_path_factory) -> Path:
+    """A copy of Dasher's folder for one test module's studio to write its states and movies into."""
+    import shutil
+
+    folder = tmp_path_factory.mktemp("studio") / "Dasher-Genesis"
+    shutil.copytree(REPO / "games" / "Dasher-Genesis", folder)
+    return folder
+
+
+@pytest.fixture(scope="module")
+def studio_session(studio_game: Path):
+    """A studio session on that copy at Zone1.Act1, its emulator thread stopping 0.5 s after the last page."""
+    from retrokit.studio.session import Session
+
+    session = Session(str(studio_game), "Zone1.Act1", grace=0.5)
+    yield session
+    session.close()

@@ -35,22 +35,8 @@ BASE = f"http://127.0.0.1:{PORT}"
 
 
 @pytest.fixture(scope="module")
-def folder(tmp_path_factory) -> Path:
-    folder = tmp_path_factory.mktemp("guarded") / "Dasher-Genesis"
-    shutil.copytree(DASHER, folder)
-    return folder
-
-
-@pytest.fixture(scope="module")
-def session(folder: Path):
-    session = Session(str(folder), "Zone1.Act1", grace=0.5)
-    yield session
-    session.close()
-
-
-@pytest.fixture(scope="module")
-def app(session: Session):
-    return create_app(session, token=TOKEN, port=PORT)
+def app(studio_session: Session):
+    return create_app(studio_session, token=TOKEN, port=PORT)
 
 
 @pytest.fixture(scope="module")
@@ -82,10 +68,10 @@ def test_a_request_without_the_token_is_refused(bare, route):
     assert "wrong token" in refused(bare.get(route + "?token=" + TOKEN[:-1]))
 
 
-def test_a_post_without_the_token_changes_nothing(bare, session):
-    speed = session.speed
+def test_a_post_without_the_token_changes_nothing(bare, studio_session):
+    speed = studio_session.speed
     refused(bare.post("/api/play/speed", json={"value": 0.5}))
-    assert session.speed == speed
+    assert studio_session.speed == speed
 
 
 def test_the_token_in_the_query_sets_a_cookie_the_page_then_uses(app, client):
@@ -186,10 +172,10 @@ def test_a_request_naming_a_movie_outside_the_game_is_refused(client, name):
     assert writing.status_code in (400, 403) and writing.json()["kind"] in ("AccessDeniedError", "InvalidArgumentError")
 
 
-def test_a_movie_symlinked_out_of_the_game_is_refused(client, folder, tmp_path):
+def test_a_movie_symlinked_out_of_the_game_is_refused(client, studio_game, tmp_path):
     outside = tmp_path / "outside.bk2"
-    shutil.copy(folder / "movies" / "Zone1.Act1.bk2", outside)
-    (folder / "movies" / "escape.bk2").symlink_to(outside)
+    shutil.copy(studio_game / "movies" / "Zone1.Act1.bk2", outside)
+    (studio_game / "movies" / "escape.bk2").symlink_to(outside)
     assert "symlink" in refused(client.post("/api/movies/play", json={"name": "escape"}))
 
 
@@ -312,16 +298,16 @@ def test_an_unknown_game_is_one_line_before_anything_listens():
     assert proc.stderr.count("\n") == 1 and "Did you mean 'Dasher-Genesis'" in proc.stderr
 
 
-def test_a_state_symlinked_out_of_the_game_is_refused(client, session, folder, tmp_path):
+def test_a_state_symlinked_out_of_the_game_is_refused(client, studio_session, studio_game, tmp_path):
     outside = tmp_path / "outside.state"
-    shutil.copy(folder / "Zone1.Act2.state", outside)
-    (folder / "Linked.state").symlink_to(outside)
-    session.call_blocking(lambda s: s.refresh_game())
+    shutil.copy(studio_game / "Zone1.Act2.state", outside)
+    (studio_game / "Linked.state").symlink_to(outside)
+    studio_session.call_blocking(lambda s: s.refresh_game())
     assert "symlink" in refused(client.post("/api/states/load", json={"name": "Linked"}))
     assert "symlink" in refused(client.post("/api/play/reset", json={"state": "Linked"}))
 
 
-def test_hostile_socket_messages_are_errors_and_the_session_lives_on(client, session):
+def test_hostile_socket_messages_are_errors_and_the_session_lives_on(client, studio_session):
     url = f"ws://127.0.0.1:{PORT}/ws?token={TOKEN}"
     with client.websocket_connect(url) as ws:
         for text in ("{", "[]", '{"type": 5}', '{"type": "step", "frames": 1e9}', '{"type": "jump"}',

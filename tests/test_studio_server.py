@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import json
 import os
-import shutil
 import struct
 import threading
 import time
@@ -34,22 +33,8 @@ RIGHT = 1 << 7  # the RetroPad bit of RIGHT
 
 
 @pytest.fixture(scope="module")
-def folder(tmp_path_factory) -> Path:
-    folder = tmp_path_factory.mktemp("studio") / "Dasher-Genesis"
-    shutil.copytree(DASHER, folder)
-    return folder
-
-
-@pytest.fixture(scope="module")
-def session(folder: Path):
-    session = Session(str(folder), "Zone1.Act1", grace=0.5)
-    yield session
-    session.close()
-
-
-@pytest.fixture(scope="module")
-def client(session: Session):
-    app = create_app(session, token=TOKEN, port=PORT)
+def client(studio_session: Session):
+    app = create_app(studio_session, token=TOKEN, port=PORT)
     with TestClient(app, base_url=BASE, headers={"X-Retrokit-Token": TOKEN}) as client:
         yield client
 
@@ -72,6 +57,14 @@ def paused_at(client: TestClient, state: str = "Zone1.Act1") -> None:
 
 def socket(client: TestClient):
     return client.websocket_connect(f"ws://127.0.0.1:{PORT}/ws?token={TOKEN}")
+
+
+def next_message(ws, kind: str) -> dict:
+    """Read the socket (screens and other messages go by, as on a page) until a JSON message of this type."""
+    while True:
+        message = ws.receive()
+        if message.get("text") and json.loads(message["text"])["type"] == kind:
+            return json.loads(message["text"])
 
 
 def receive_screen(ws) -> tuple[tuple, bytes]:
@@ -111,7 +104,7 @@ def test_every_system_has_a_key_for_every_button(system):
     assert set(pad_map(desc).values()) <= set(desc.button_names)
 
 
-def test_the_socket_sends_screens_with_the_documented_header(client, session):
+def test_the_socket_sends_screens_with_the_documented_header(client, studio_session):
     post(client, "/api/play/resume")
     with socket(client) as ws:
         (magic, width, height, frame, depth), data = receive_screen(ws)
@@ -123,15 +116,15 @@ def test_the_socket_sends_screens_with_the_documented_header(client, session):
         assert pixels.std() > 0  # a picture, not a blank
 
 
-def test_the_frame_loop_keeps_to_the_speed_asked(client, session):
+def test_the_frame_loop_keeps_to_the_speed_asked(client, studio_session):
     """Never faster than asked (whatever the load); at 8x, faster than at 1x."""
     counts = {}
     for speed in (0.25, 1, 8):
         post(client, "/api/play/speed", {"value": speed})
         post(client, "/api/play/resume")
-        start = session.frame
+        start = studio_session.frame
         time.sleep(1.0)
-        counts[speed] = session.frame - start
+        counts[speed] = studio_session.frame - start
     post(client, "/api/play/pause")
     post(client, "/api/play/speed", {"value": 1})
     assert 0 < counts[0.25] <= 0.25 * 60 + 4
@@ -139,34 +132,34 @@ def test_the_frame_loop_keeps_to_the_speed_asked(client, session):
     assert counts[8] > counts[1]
 
 
-def test_pause_then_step_runs_exactly_the_frames_asked_with_the_buttons_held(client, session):
+def test_pause_then_step_runs_exactly_the_frames_asked_with_the_buttons_held(client, studio_session):
     paused_at(client)
     before = post(client, "/api/play/step", {"frames": 1})["frame"]
     time.sleep(0.2)
-    assert session.frame == before  # paused: nothing moves
-    x = ram(session)
+    assert studio_session.frame == before  # paused: nothing moves
+    x = ram(studio_session)
     post(client, "/api/play/buttons", {"buttons": ["RIGHT"]})
     status = post(client, "/api/play/step", {"frames": 30})
     assert status["paused"] and status["frame"] == before + 30
-    assert (ram(session) != x).any()
-    movie = session.call_blocking(lambda s: s.search.movie())
+    assert (ram(studio_session) != x).any()
+    movie = studio_session.call_blocking(lambda s: s.search.movie())
     assert movie.frames[-30:] == [(RIGHT, 0)] * 30  # what was held is what the session recorded
 
 
-def test_reset_puts_the_game_back_in_the_state(client, session):
+def test_reset_puts_the_game_back_in_the_state(client, studio_session):
     paused_at(client)
-    fresh = ram(session)
+    fresh = ram(studio_session)
     post(client, "/api/play/buttons", {"buttons": ["RIGHT"]})
     post(client, "/api/play/step", {"frames": 20})
-    assert (ram(session) != fresh).any()
+    assert (ram(studio_session) != fresh).any()
     post(client, "/api/play/reset", {})  # the state the session began from
-    assert (ram(session) == fresh).all()
+    assert (ram(studio_session) == fresh).all()
 
 
-def test_the_socket_takes_the_same_commands(client, session):
+def test_the_socket_takes_the_same_commands(client, studio_session):
     paused_at(client)
     with socket(client) as ws:
-        start = session.frame
+        start = studio_session.frame
         ws.send_text(json.dumps({"type": "buttons", "buttons": ["RIGHT", "B"]}))
         ws.send_text(json.dumps({"type": "step", "frames": 5}))
         ws.send_text(json.dumps({"type": "speed", "value": 2}))
@@ -177,19 +170,14 @@ def test_the_socket_takes_the_same_commands(client, session):
             if message.get("text"):
                 status = json.loads(message["text"])
         assert status["type"] == "status" and status["paused"] and status["frame"] == start + 5
-        assert session.buttons == ("RIGHT", "B")
+        assert studio_session.buttons == ("RIGHT", "B")
         ws.send_text(json.dumps({"type": "speed", "value": "fast"}))
         ws.send_text("not json")
-        errors = []
-        while len(errors) < 1:
-            message = ws.receive()
-            if message.get("text") and json.loads(message["text"])["type"] == "error":
-                errors.append(json.loads(message["text"]))
-        assert errors[0]["kind"] == "InvalidArgumentError"
+        assert next_message(ws, "error")["kind"] == "InvalidArgumentError"
     post(client, "/api/play/speed", {"value": 1})
 
 
-def test_tools_hook_frames_and_publish_to_the_page(client, session):
+def test_tools_hook_frames_and_publish_to_the_page(client, studio_session):
     paused_at(client)
     seen = []
 
@@ -197,79 +185,71 @@ def test_tools_hook_frames_and_publish_to_the_page(client, session):
         seen.append(s.frame)
         s.publish({"type": "probe", "frame": s.frame})
 
-    remove = session.on_frame(hook)
+    remove = studio_session.on_frame(hook)
     try:
         with socket(client) as ws:
             post(client, "/api/play/step", {"frames": 3})
-            probe = None
-            while probe is None:
-                message = ws.receive()
-                if message.get("text") and json.loads(message["text"])["type"] == "probe":
-                    probe = json.loads(message["text"])
+            probe = next_message(ws, "probe")
         assert seen == [seen[0], seen[0] + 1, seen[0] + 2] and probe["frame"] in seen
     finally:
         remove()
 
 
-def test_a_failing_hook_is_removed_and_reported_while_the_game_plays_on(client, session):
+def test_a_failing_hook_is_removed_and_reported_while_the_game_plays_on(client, studio_session):
     paused_at(client)
 
     def broken(_s: Session) -> None:
         raise ZeroDivisionError("boom")
 
-    session.on_frame(broken)
+    studio_session.on_frame(broken)
     with socket(client) as ws:
         post(client, "/api/play/step", {"frames": 2})
-        error = None
-        while error is None:
-            message = ws.receive()
-            if message.get("text") and json.loads(message["text"])["type"] == "error":
-                error = json.loads(message["text"])
+        error = next_message(ws, "error")
     assert "ZeroDivisionError: boom" in error["error"]
     assert post(client, "/api/play/step", {"frames": 2})["paused"]  # the loop lives on
 
 
-def test_closing_the_last_socket_pauses_and_then_stops_the_emulator(client, session):
+def test_closing_the_last_socket_pauses_and_then_stops_the_emulator(client, studio_session):
     post(client, "/api/play/resume")
     with socket(client) as ws:
         receive_screen(ws)
-        assert session.running and not session.paused
+        assert studio_session.running and not studio_session.paused
     deadline = time.monotonic() + 10
-    while session.running and time.monotonic() < deadline:
+    while studio_session.running and time.monotonic() < deadline:
         time.sleep(0.05)
-    assert session.paused and not session.running  # paused at once, thread gone after the grace period
-    frame = session.frame
+    assert studio_session.paused and not studio_session.running  # paused at once, thread gone after the grace period
+    frame = studio_session.frame
     time.sleep(0.2)
-    assert session.frame == frame
+    assert studio_session.frame == frame
     with socket(client) as ws:  # a new tab starts it again, where it was
         receive_screen(ws)
-        assert session.running
+        assert studio_session.running
 
 
 # --- states -------------------------------------------------------------------------------------------------
 
 
-def test_save_a_state_with_its_record_list_load_and_make_it_the_default(client, session, folder):
+def test_save_a_state_with_its_record_list_load_and_make_it_the_default(client, studio_session, studio_game):
     from retrokit.data.states import read_state_file
 
     paused_at(client)
     post(client, "/api/play/buttons", {"buttons": ["RIGHT"]})
     post(client, "/api/play/step", {"frames": 40})
-    saved_ram = ram(session)
+    saved_ram = ram(studio_session)
     answer = post(client, "/api/states/save", {"name": "Mine"})
-    assert answer["status"] == "made" and Path(answer["path"]) == folder / "Mine.state"
-    assert read_state_file(folder / "Mine.state").record is not None  # the record integrate writes
+    assert answer["status"] == "made" and Path(answer["path"]) == studio_game / "Mine.state"
+    assert read_state_file(studio_game / "Mine.state").record is not None  # the record integrate writes
     assert "Mine" in client.get("/api/states").json()["states"]
     post(client, "/api/play/step", {"frames": 10})
     conflict = post(client, "/api/states/save", {"name": "Mine"}, status=409)
     assert conflict["kind"] == "FileConflictError" and "force" in conflict["error"]
     post(client, "/api/states/load", {"name": "Mine"})
-    assert (ram(session) == saved_ram).all()
+    assert (ram(studio_session) == saved_ram).all()
     assert post(client, "/api/states/save", {"name": "Mine"})["status"] == "up to date"
     post(client, "/api/play/step", {"frames": 10})
     assert post(client, "/api/states/save", {"name": "Mine", "force": True})["status"] == "replaced"
     listing = post(client, "/api/states/default", {"name": "Mine"})
-    assert listing["default"] == "Mine" and "default: Mine" in (folder / "game.yaml").read_text()
+    assert listing["default"] == "Mine" and "default: Mine" in (studio_game / "game.yaml").read_text()
 
 
 def test_a_bad_state_name_or_an_unknown_state_is_a_json_error(client):
@@ -280,32 +260,32 @@ def test_a_bad_state_name_or_an_unknown_state_is_a_json_error(client):
     post(client, "/api/states/default", {"name": "Nope"}, status=404)
 
 
-def test_a_corrupt_state_is_a_json_error_and_the_server_lives_on(client, session, folder, corrupt_state):
+def test_a_corrupt_state_is_a_json_error_and_the_server_lives_on(client, studio_session, studio_game, corrupt_state):
     from retrokit.data.states import write_state
 
-    write_state(folder / "Broken.state", corrupt_state)
-    session.call_blocking(lambda s: s.refresh_game())
+    write_state(studio_game / "Broken.state", corrupt_state)
+    studio_session.call_blocking(lambda s: s.refresh_game())
     paused_at(client)
-    before = ram(session)
+    before = ram(studio_session)
     answer = post(client, "/api/states/load", {"name": "Broken"}, status=400)
     assert answer["kind"] == "StateError"
-    assert (ram(session) == before).all()  # the game is where it was
+    assert (ram(studio_session) == before).all()  # the game is where it was
     assert post(client, "/api/play/step", {"frames": 2})["paused"]
 
 
 # --- movies ------------------------------------------------------------------------------------------------
 
 
-def test_record_a_movie_of_what_is_played_and_replay_it(client, session, folder):
+def test_record_a_movie_of_what_is_played_and_replay_it(client, studio_session, studio_game):
     paused_at(client, "Zone1.Act2")
     post(client, "/api/movies/record")
     post(client, "/api/play/buttons", {"buttons": ["RIGHT"]})
     post(client, "/api/play/step", {"frames": 25})
     post(client, "/api/play/buttons", {"buttons": ["RIGHT", "B"]})
     post(client, "/api/play/step", {"frames": 5})
-    end = ram(session)
+    end = ram(studio_session)
     written = post(client, "/api/movies/stop", {"name": "run"})
-    path = folder / "movies" / "run.bk2"
+    path = studio_game / "movies" / "run.bk2"
     assert Path(written["path"]) == path and written["frames"] == 30
     movie = read_bk2(path)
     assert movie.game == "Dasher-Genesis" and movie.frames == [(RIGHT, 0)] * 25 + [(RIGHT | 1, 0)] * 5
@@ -320,10 +300,10 @@ def test_record_a_movie_of_what_is_played_and_replay_it(client, session, folder)
         time.sleep(0.05)
     post(client, "/api/play/speed", {"value": 1})
     assert client.get("/api/status").json()["paused"]  # a replay ends paused, at its last frame
-    assert (ram(session) == end).all()
+    assert (ram(studio_session) == end).all()
 
 
-def test_a_movie_is_not_overwritten_unless_asked(client, session):
+def test_a_movie_is_not_overwritten_unless_asked(client, studio_session):
     paused_at(client)
     for force, status in ((False, 200), (False, 409), (True, 200)):
         post(client, "/api/movies/record")
@@ -331,8 +311,8 @@ def test_a_movie_is_not_overwritten_unless_asked(client, session):
         post(client, "/api/movies/stop", {"name": "twice", "force": force}, status=status)
 
 
-def test_a_corrupt_movie_is_a_json_error_and_the_server_lives_on(client, session, folder):
-    (folder / "movies" / "junk.bk2").write_bytes(b"PK\x03\x04 not really a zip" * 10)
+def test_a_corrupt_movie_is_a_json_error_and_the_server_lives_on(client, studio_session, studio_game):
+    (studio_game / "movies" / "junk.bk2").write_bytes(b"PK\x03\x04 not really a zip" * 10)
     answer = post(client, "/api/movies/play", {"name": "junk"}, status=400)
     assert answer["kind"] == "MovieError"
     unknown = post(client, "/api/movies/play", {"name": "Zone1.Act"}, status=404)
@@ -341,7 +321,7 @@ def test_a_corrupt_movie_is_a_json_error_and_the_server_lives_on(client, session
     assert post(client, "/api/play/step", {"frames": 1})["paused"]
 
 
-def test_a_shipped_solution_movie_replays(client, session):
+def test_a_shipped_solution_movie_replays(client, studio_session):
     answer = post(client, "/api/movies/play", {"name": "Zone1.Act1.bk2"})
     assert answer["frames"] > 0
     post(client, "/api/play/pause")
@@ -356,7 +336,7 @@ def test_screen_png(client):
 # --- validate, new game ----------------------------------------------------------------------------------
 
 
-def test_validate_reports_as_json_while_the_game_plays_on(client, session):
+def test_validate_reports_as_json_while_the_game_plays_on(client, studio_session):
     post(client, "/api/play/speed", {"value": 1})
     post(client, "/api/play/resume")
     stages: list[str] = []
@@ -370,9 +350,9 @@ def test_validate_reports_as_json_while_the_game_plays_on(client, session):
     with socket(client) as ws:
         reader = threading.Thread(target=drain, args=(ws,), daemon=True)
         reader.start()
-        start = session.frame
+        start = studio_session.frame
         report = post(client, "/api/validate", {"frames": 10})
-        played = session.frame - start
+        played = studio_session.frame - start
         reader.join(timeout=30)
     post(client, "/api/play/pause")
     assert report["game"] == "Dasher-Genesis" and report["counts"]["pass"] > 10
@@ -428,7 +408,7 @@ def test_a_studio_nobody_opened_does_not_run_the_emulator():
         idle.close()
 
 
-def test_a_reset_while_paused_shows_the_state_it_loaded(client, session):
+def test_a_reset_while_paused_shows_the_state_it_loaded(client, studio_session):
     screens = []
     for state in ("Zone1.Act1", "Zone3.Act1", "Zone1.Act1"):
         paused_at(client, state)

@@ -20,7 +20,11 @@ for its cores), and the ratios retrokit/turbo are printed beside the
 targets: >= 1.5 at 2 and 4 envs, RGB and gray; under load, the 2-env vector
 >= 1.2x the 1-env rate.
 
-Usage: python tools/bench_vector.py [--rounds 3] [--seconds 3] [--turbo-python PATH] [--check]
+``--load`` measures only the two configs under load (and the unloaded 2-env
+RGB one, to see that a change for the load does not cost the quiet case), so
+an A/B of a runner change takes a couple of minutes, not ten.
+
+Usage: python tools/bench_vector.py [--rounds 3] [--seconds 3] [--turbo-python PATH] [--check] [--load]
 """
 
 from __future__ import annotations
@@ -161,6 +165,9 @@ def main() -> int:
     parser.add_argument("--seconds", type=float, default=3.0, help="measured seconds per config per round")
     parser.add_argument("--turbo-python", help="an interpreter that imports stable-retro-turbo's stable_retro")
     parser.add_argument("--check", action="store_true", help="exit 1 if a target is missed")
+    parser.add_argument(
+        "--load", action="store_true", help="only the configs under load, and 2 envs RGB unloaded beside them"
+    )
     parser.add_argument("--child", nargs=3, metavar=("KIND", "N", "OBS"), help=argparse.SUPPRESS)
     parser.add_argument("--rom", help=argparse.SUPPRESS)
     args = parser.parse_args()
@@ -176,10 +183,11 @@ def main() -> int:
     else:
         print("stable-retro-turbo: not measured (pass --turbo-python, an interpreter that imports it)")
     print(f"{len(os.sched_getaffinity(0))} CPUs, load average {os.getloadavg()[0]:.1f} at the start")
+    configs = [c for c in CONFIGS if c[2] or c == (2, "rgb", False)] if args.load else CONFIGS
     rates: dict[tuple[str, tuple], list[float]] = {}
     hows: dict[tuple[str, tuple], str] = {}
     for round_ in range(args.rounds):
-        for config in CONFIGS:
+        for config in configs:
             for kind, python in kinds.items():
                 got = run_config(python, kind, config, args.seconds, rom)
                 if got is not None:
@@ -194,7 +202,7 @@ def main() -> int:
     missed = []
     print(f"\nenv steps/s, median of {args.rounds}:")
     print(f"{'config':<40} {'retrokit':>9} {'turbo':>9} {'ratio':>7}  target")
-    for config in CONFIGS:
+    for config in configs:
         ours, theirs = median("retrokit", config), median("turbo", config)
         ratio = ours / theirs if ours and theirs else None
         target = RATIO_TARGET if config[0] >= 2 and not config[2] else None

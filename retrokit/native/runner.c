@@ -31,9 +31,10 @@
  * that waits for tasks in progress does the same: it spins while that is
  * cheap, then sleeps until the worker that finishes the last task wakes it.
  */
-#define _POSIX_C_SOURCE 200809L /* clock_gettime under -std=c11 */
+#define _GNU_SOURCE /* clock_gettime under -std=c11; sched_getcpu and thread affinity */
 #include "runner.h"
 
+#include <sched.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -106,8 +107,30 @@ static void *worker_main(void *arg) {
     }
 }
 
+/* Keep the workers off the CPU the caller runs on now. When a worker sleeps and the caller wakes it, Linux
+ * places it beside its waker if no CPU is idle, which under load (another process on the other core) puts
+ * both of our threads on the caller's core while that process keeps the other core to itself: the two
+ * emulators then run one after the other, plus the cost of switching. Kept off the caller's CPU, a worker
+ * shares the busy core instead, where, sleeping between tasks, it is run ahead of a process that never
+ * sleeps. Only done when the caller's CPU changed (a syscall per worker), and never when the process may
+ * use only the caller's CPU. */
+static void keep_workers_off_caller(rk_runner *r) {
+    if (!r->cpus) return;
+    int cpu = sched_getcpu();
+    if (cpu < 0 || cpu == r->caller_cpu) return;
+    r->caller_cpu = cpu;
+    cpu_set_t set;
+    memcpy(&set, r->cpus, sizeof set);
+    if (CPU_ISSET(cpu, &set) && CPU_COUNT(&set) > 1) CPU_CLR(cpu, &set);
+    for (int i = 0; i < r->n_workers; i++) pthread_setaffinity_np(r->workers[i].thread, sizeof set, &set);
+}
+
 int rk_runner_init(rk_runner *r, int threads) {
     memset(r, 0, sizeof *r);
+    r->caller_cpu = -1;
+    cpu_set_t *cpus = malloc(sizeof *cpus);
+    if (cpus && sched_getaffinity(0, sizeof *cpus, cpus) == 0 && CPU_COUNT(cpus) > 1) r->cpus = cpus;
+    else free(cpus);
     r->workers = calloc((size_t)(threads > 0 ? threads : 1), sizeof(rk_worker));
     if (!r->workers) return -1;
     sem_init(&r->done, 0, 0);
@@ -134,6 +157,7 @@ void rk_runner_run(rk_runner *r, rk_task *tasks, int n) {
     uint32_t call = call_of(atomic_load(&r->work)) + 1;
     atomic_store(&r->work, ((uint64_t)call << 32) | (uint32_t)n);
     int helpers = n - 1 < r->n_workers ? n - 1 : r->n_workers;
+    if (helpers > 0) keep_workers_off_caller(r);
     for (int i = 0; i < helpers; i++) {
         rk_worker *w = &r->workers[i];
         if (atomic_load(&w->sleeping)) sem_post(&w->wake);
@@ -161,6 +185,8 @@ void rk_runner_close(rk_runner *r) {
     }
     free(r->workers);
     r->workers = NULL;
+    free(r->cpus);
+    r->cpus = NULL;
     r->n_workers = 0;
     sem_destroy(&r->done);
 }

@@ -44,6 +44,8 @@ typedef struct rk_runner {
     sem_t done;            /* posted by the worker that finishes a call's last task, if the caller sleeps */
     atomic_int caller_sleeping;
     int busy_calls;        /* calls left for which the caller sleeps at once: it lost the CPU while spinning */
+    void *cpus;            /* the CPUs the process may use (a cpu_set_t), or NULL: workers are kept off the caller's */
+    int caller_cpu;        /* the CPU the workers were last kept off, or -1 */
     atomic_int quit;
 } rk_runner;
 

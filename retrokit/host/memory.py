@@ -79,14 +79,24 @@ class AddressSpace:
         Raises:
             InvalidArgumentError: The bytes are not all inside one mapped region.
         """
-        for index, region in enumerate(self.regions):
-            if region.start <= address and address + width <= region.start + region.length:
-                return index, address
+        index = self._region_of(address, width)
+        if index is not None:
+            return index, address
         mapped = ", ".join(f"{r.start:#x}-{r.start + r.length - 1:#x}" for r in self.regions) or "none"
         raise InvalidArgumentError(
             f"Expected an address inside the mapped memory ({mapped}), got {address:#x} (width {width}). "
             f"Check the field's address: it is a console address, not a buffer offset."
         )
+
+    def holds(self, address: int, width: int = 1) -> bool:
+        """Whether ``width`` bytes at ``address`` all lie inside one mapped region (where :meth:`locate` finds them)."""
+        return self._region_of(address, width) is not None
+
+    def _region_of(self, address: int, width: int) -> int | None:
+        for index, region in enumerate(self.regions):
+            if region.start <= address and address + width <= region.start + region.length:
+                return index
+        return None
 
     def offsets(self, address: int, width: int) -> tuple[int, list[int]]:
         """Return the buffer index and the buffer offset of each byte at ``address``."""

@@ -101,11 +101,7 @@ def _span(spec: FieldSpec) -> str:
 
 
 def _outside(spec: FieldSpec, space: AddressSpace) -> str:
-    from retrokit.errors import RetrokitError
-
-    try:
-        space.locate(spec.address, spec.field_type.width)
-    except RetrokitError:
+    if not space.holds(spec.address, spec.field_type.width):
         mapped = ", ".join(f"{r.start:#x}-{r.start + r.length - 1:#x}" for r in space.regions)
         return (f"expected field {spec.name!r} ({spec.type} at {spec.address:#x}) inside the system's memory "
                 f"({mapped}); found it outside. Fix its address in the data file: it is a console address.")

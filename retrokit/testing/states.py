@@ -35,7 +35,6 @@ from retrokit.errors import RetrokitError
 from retrokit.testing.report import FAIL, PASS, SKIP, WARN, GameReport
 
 if TYPE_CHECKING:
-    from retrokit.host.fields import FieldSpec
     from retrokit.host.memory import AddressSpace
 
 __all__ = ["IDLE_FRAMES", "StateProbe", "check_states", "parse_states", "probe_states", "state_space"]
@@ -121,17 +120,9 @@ def parse_states(game: Game, names: Sequence[str]) -> dict[str, StateProbe]:
         space = state_space(game, data)
         if space is None:
             continue
-        mapped = [f for f in game.fields.values() if _inside(space, f)]
+        mapped = [f for f in game.fields.values() if space.holds(f.address, f.field_type.width)]
         probe.start = FieldReader(mapped, space).read()
     return probes
-
-
-def _inside(space: AddressSpace, spec: FieldSpec) -> bool:
-    try:
-        space.locate(spec.address, spec.field_type.width)
-    except RetrokitError:
-        return False
-    return True
 
 
 # --- Results -----------------------------------------------------------------------------------------

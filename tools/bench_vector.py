@@ -8,8 +8,7 @@ rounds interleave the configs so that a drift of the machine's speed hits
 them all alike.
 
 Configs: 1, 2 and 4 envs, with RGB observations and with gray 84x84 stack 4
-ones (natively when ``make_vec`` takes ``grayscale``/``resize``/``frame_stack``,
-else through Gymnasium's wrappers, as a user would), plus 1 env and the 2-env
+ones (made natively: ``make_vec``'s ``grayscale``/``resize``/``frame_stack``), plus 1 env and the 2-env
 vector with a third process burning one core (``while True: pass``, as a
 learner would).
 
@@ -55,37 +54,13 @@ def label(config: tuple[int, str, bool]) -> str:
 
 
 def retrokit_vec(n: int, obs: str):
-    """retrokit's vector env of ``n`` envs; gray natively if make_vec can, else through Gymnasium's wrappers."""
-    import functools
-
+    """retrokit's vector env of ``n`` envs, gray 84x84 stack 4 made natively inside the step."""
     import retrokit
-    from retrokit.envs.options import OPTIONS
-    from retrokit.envs.vector import ThreadedVectorEnv
 
     options = {"frameskip": FRAMESKIP, "sticky_prob": STICKY}
-    if obs == "rgb":
-        return retrokit.make_vec(GAME, n, **options), "native"
-    if {"grayscale", "resize", "frame_stack"} <= set(OPTIONS):
-        return retrokit.make_vec(GAME, n, grayscale=True, resize=(84, 84), frame_stack=4, **options), "native"
-    return ThreadedVectorEnv([functools.partial(wrapped_gray, options)] * n), "Gymnasium wrappers"
-
-
-def wrapped_gray(options: dict):
-    """One env preprocessed by Gymnasium's wrappers (cv2's area resize as a PIL box filter: no cv2 here)."""
-    import gymnasium
-    import numpy as np
-    from gymnasium.wrappers import FrameStackObservation, GrayscaleObservation, TransformObservation
-    from PIL import Image
-
-    import retrokit
-
-    env = GrayscaleObservation(retrokit.make(GAME, **options))
-    space = gymnasium.spaces.Box(0, 255, (84, 84), np.uint8)
-
-    def resize(frame):
-        return np.asarray(Image.fromarray(frame).resize((84, 84), Image.BOX))
-
-    return FrameStackObservation(TransformObservation(env, resize, space), 4)
+    if obs == "gray":
+        options.update(grayscale=True, resize=(84, 84), frame_stack=4)
+    return retrokit.make_vec(GAME, n, **options)
 
 
 def turbo_vec(n: int, obs: str, rom: str):
@@ -98,7 +73,7 @@ def turbo_vec(n: int, obs: str, rom: str):
         rom_path=rom,
         frame_skip=FRAMESKIP, sticky_action_prob=STICKY, **(gray if obs == "gray" else {}),
     )
-    return vec, "native"
+    return vec
 
 
 def game_rom() -> str:
@@ -112,7 +87,7 @@ def measure(kind: str, n: int, obs: str, seconds: float, rom: str) -> dict:
     """Env steps/s of one vector env stepping no-op actions for about ``seconds``."""
     import numpy as np
 
-    vec, how = retrokit_vec(n, obs) if kind == "retrokit" else turbo_vec(n, obs, rom)
+    vec = retrokit_vec(n, obs) if kind == "retrokit" else turbo_vec(n, obs, rom)
     space = vec.single_action_space
     actions = np.zeros((n,) + space.shape, dtype=space.dtype)
     vec.reset(seed=0)
@@ -124,7 +99,7 @@ def measure(kind: str, n: int, obs: str, seconds: float, rom: str) -> dict:
             vec.step(actions)
         steps += 10
     vec.close()
-    return {"rate": steps * n / elapsed, "how": how}
+    return {"rate": steps * n / elapsed}
 
 
 # --- the parent ---------------------------------------------------------------------------------
@@ -185,14 +160,12 @@ def main() -> int:
     print(f"{len(os.sched_getaffinity(0))} CPUs, load average {os.getloadavg()[0]:.1f} at the start")
     configs = [c for c in CONFIGS if c[2] or c == (2, "rgb", False)] if args.load else CONFIGS
     rates: dict[tuple[str, tuple], list[float]] = {}
-    hows: dict[tuple[str, tuple], str] = {}
     for round_ in range(args.rounds):
         for config in configs:
             for kind, python in kinds.items():
                 got = run_config(python, kind, config, args.seconds, rom)
                 if got is not None:
                     rates.setdefault((kind, config), []).append(got["rate"])
-                    hows[kind, config] = got["how"]
         print(f"round {round_ + 1}/{args.rounds} done, load average {os.getloadavg()[0]:.1f}", flush=True)
 
     def median(kind: str, config: tuple) -> float | None:
@@ -209,10 +182,9 @@ def main() -> int:
         mark = "" if ratio is None or target is None else ("ok" if ratio >= target else "MISSED")
         if mark == "MISSED":
             missed.append(label(config))
-        how = f" ({hows['retrokit', config]})" if config[1] == "gray" and ("retrokit", config) in hows else ""
         print(
             f"{label(config):<40} {fmt(ours):>9} {fmt(theirs):>9} {fmt(ratio, 2):>7}  "
-            f"{f'>= {target} {mark}' if target else ''}{how}"
+            f"{f'>= {target} {mark}' if target else ''}"
         )
     print("\nunder load (one core kept busy), 2-env vector / 1 env:")
     for kind in kinds:

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import io
 import os
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Self
 
@@ -290,8 +290,24 @@ class RamSearch:
         Raises:
             MovieError: The movie is malformed or of another game.
         """
+        _, frames = self.replaying(movie, until)
+        end = 0
+        for end in frames:
+            pass
+        return self._snap(f"movie {Path(movie).name} to frame {end}", snapshot)
+
+    def replaying(self, movie: str | os.PathLike[str], until: int | None = None) -> tuple[Movie, Iterator[int]]:
+        """Check a ``.bk2`` movie of this game, and play it lazily: one frame each time its iterator is advanced.
+
+        The iterator is :func:`retrokit.movie.playback.replay`'s, so the start state
+        goes through its check: it yields 0 once the console is at the movie's
+        start, then each frame's number (1-based) once it has run, up to ``until``
+        (all by default). From the start on, the inputs played are the movie's.
+
+        Raises:
+            MovieError: The movie is malformed or of another game (at once, before anything runs).
+        """
         from retrokit.movie import read_bk2
-        from retrokit.movie.playback import replay
 
         recorded = read_bk2(movie)
         if recorded.game != self.game.name:
@@ -307,13 +323,18 @@ class RamSearch:
             raise InvalidArgumentError(
                 f"Expected --until from 0 to the movie's {len(recorded.frames)} frames, got {until!r}."
             )
-        for _ in replay(recorded, self.emulator, source=str(movie), stop=end):  # its start state checked there
-            pass
+        return recorded, self._replay(recorded, str(movie), end)
+
+    def _replay(self, recorded: Movie, source: str, end: int) -> Iterator[int]:
+        from retrokit.movie.playback import replay
+
+        frames = replay(recorded, self.emulator, source=source, stop=end)  # its start state checked there
+        yield next(frames)
         # The inputs played now begin at the movie's start (b"": power-on), whatever replayed it.
         self.start_state, self.inputs, self.unreplayable = recorded.state or b"", [], None
-        for frame in recorded.frames[:end]:
-            self._played(frame, 1)
-        return self._snap(f"movie {Path(movie).name} to frame {end}", snapshot)
+        for number in frames:
+            self._played(recorded.frames[number - 1], 1)
+            yield number
 
     def poke(self, address: int, value: int, type_code: str = "|u1") -> None:
         """Write a value into RAM (the next snapshot sees it).

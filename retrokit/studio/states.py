@@ -126,22 +126,14 @@ def _stop(session: Session, path: Path, force: bool) -> dict[str, Any]:
 
 
 def _replay(session: Session, path: Path) -> dict[str, Any]:
-    from retrokit.movie import read_bk2
-
-    movie = read_bk2(path)
     search = session.search
-    search.play(path, until=0, snapshot=False)  # checks the game and the start state, and puts the console there
-    names = search.game.system.buttons_of
-    frames = iter(movie.frames)
+    movie, frames = search.replaying(path)  # checks the game, then plays one frame each time it is advanced
+    next(frames)  # the console at the movie's start, its state checked: a bad one fails this request
 
     def next_frame(session: Session) -> bool:
-        masks = next(frames, None)
-        if masks is None:
-            return False
         if session.search is not search:  # the game was switched meanwhile
             return False
-        search.step([f"{port}:{b}" for port, mask in enumerate(masks, 1) for b in names(mask)], 1)
-        return True
+        return next(frames, None) is not None
 
     session.recording = False
     session.mark_loaded()

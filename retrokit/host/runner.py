@@ -32,6 +32,16 @@ class Runner:
         self._handles = [e.handle for e in emulators]
         self._native = primitives.NativeRunner(threads)
 
+    @property
+    def moved(self) -> int:
+        """How many times a caller, left waiting, moved a worker that had lost its CPU onto its own.
+
+        Workers are kept off the caller's CPU; when another process takes a
+        worker's CPU in the middle of a step, the waiting caller hands it its
+        own instead of idling (see ``native/runner.c``).
+        """
+        return self._native.moved
+
     def run(
         self,
         which: Sequence[int],

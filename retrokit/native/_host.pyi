@@ -92,6 +92,9 @@ class Runner:
 
     def __init__(self, threads: int) -> None:
         """Start ``threads`` workers (0 runs everything on the calling thread)."""
+    @property
+    def moved(self) -> int:
+        """How many times a waiting caller moved a worker that lost its CPU (to another process) onto its own."""
     def run(
         self,
         emulators: Sequence[Emulator],

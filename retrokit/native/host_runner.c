@@ -102,6 +102,16 @@ done:
     return result;
 }
 
+static PyObject *runner_get_moved(RunnerObject *self, void *closure) {
+    return PyLong_FromUnsignedLongLong(self->runner.moved);
+}
+
+static PyGetSetDef runner_getset[] = {
+    {"moved", (getter)runner_get_moved, NULL,
+     "How many times a waiting caller moved a worker that lost its CPU onto its own.", NULL},
+    {NULL, NULL, NULL, NULL, NULL},
+};
+
 static PyMethodDef runner_methods[] = {
     {"run", (PyCFunction)runner_run, METH_VARARGS,
      "run(emulators, actions, frames, screens=None): run them all; return whether each screen was converted."},
@@ -115,6 +125,7 @@ PyTypeObject RunnerType = {
     .tp_flags = Py_TPFLAGS_DEFAULT,
     .tp_doc = "Runner(threads): worker threads that, with the caller, run several emulators' frames in one call.",
     .tp_methods = runner_methods,
+    .tp_getset = runner_getset,
     .tp_init = (initproc)runner_init,
     .tp_new = PyType_GenericNew,
 };

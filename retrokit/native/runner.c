@@ -30,6 +30,17 @@
  * their word before reading the other's, so no wake-up is lost. A caller
  * that waits for tasks in progress does the same: it spins while that is
  * cheap, then sleeps until the worker that finishes the last task wakes it.
+ *
+ * A waiting caller also moves a stalled worker onto its own CPU. Workers are
+ * kept off the caller's CPU (see keep_workers_off_caller), so under load a
+ * worker shares the other CPU with the busy process, and the scheduler, being
+ * fair, may take that CPU from it in the middle of a task for a whole tick
+ * (4 ms at 250 Hz, four steps' worth) while the caller's CPU sits idle,
+ * since the caller has nothing left but to wait. So while it waits, the
+ * caller reads each working worker's CPU-time clock every RK_WATCH_NS; one
+ * that ran less than half the time for RK_STALL_NS is waiting for its CPU,
+ * and the caller pins it to the caller's own CPU and sleeps there, which
+ * hands that CPU to the worker at once. The next call lets it go back.
  */
 #define _GNU_SOURCE /* clock_gettime under -std=c11; sched_getcpu and thread affinity */
 #include "runner.h"
@@ -42,6 +53,8 @@
 #define RK_SPIN_NS 1000000     /* how long a waiting thread spins before it sleeps, on a quiet machine */
 #define RK_PREEMPTED_NS 200000 /* a gap this long in a spinning thread's clock: it lost the CPU */
 #define RK_BUSY_CALLS 256      /* calls for which a thread that lost the CPU while spinning sleeps at once */
+#define RK_WATCH_NS 100000     /* how often a waiting caller reads its working workers' CPU-time clocks */
+#define RK_STALL_NS 200000     /* a worker that ran under half of this long a stretch is waiting for its CPU */
 
 static inline void cpu_relax(void) {
 #if defined(__x86_64__) || defined(__i386__)
@@ -59,16 +72,19 @@ static inline uint64_t now_ns(void) {
     return (uint64_t)t.tv_sec * 1000000000u + (uint64_t)t.tv_nsec;
 }
 
-/* Take and run the tasks of call `call` until none is left; tasks go from the last to the first. */
-static void take_tasks(rk_runner *r, uint32_t call) {
+/* Take and run the tasks of call `call` until none is left; tasks go from the last to the first.
+ * `w` is the worker taking them, or NULL for the caller. */
+static void take_tasks(rk_runner *r, uint32_t call, rk_worker *w) {
     uint64_t work = atomic_load(&r->work);
     while (call_of(work) == call && (uint32_t)work > 0) {
         if (!atomic_compare_exchange_weak(&r->work, &work, work - 1)) continue; /* `work` now holds the new word */
         rk_task *task = &r->tasks[(uint32_t)work - 1]; /* the call cannot end while one of its tasks runs */
         int n = r->n_tasks;                            /* (so this is still the call's) */
+        if (w) atomic_store(&w->working, 1);
         rk_core_run(task->core, task->actions, task->core->n_ports, task->frames);
         task->converted =
             task->screen && rk_core_screen_into(task->core, task->screen, task->screen_width, task->screen_height);
+        if (w) atomic_store(&w->working, 0);
         /* The last task done wakes a caller that sleeps; a post that comes late is a spurious wake-up the
          * caller's loop absorbs. */
         if (atomic_fetch_add(&r->finished, 1) + 1 == n && atomic_load(&r->caller_sleeping)) sem_post(&r->done);
@@ -103,7 +119,7 @@ static void *worker_main(void *arg) {
         if (atomic_load(&r->quit)) return NULL;
         seen = call_of(work);
         if (w->busy_calls > 0) w->busy_calls--;
-        take_tasks(r, seen);
+        take_tasks(r, seen, w);
     }
 }
 
@@ -125,6 +141,78 @@ static void keep_workers_off_caller(rk_runner *r) {
     for (int i = 0; i < r->n_workers; i++) pthread_setaffinity_np(r->workers[i].thread, sizeof set, &set);
 }
 
+static uint64_t ns_of(const struct timespec *t) { return (uint64_t)t->tv_sec * 1000000000u + (uint64_t)t->tv_nsec; }
+
+/* Whether worker `w`, working, has been waiting for its CPU: it ran under half of the last RK_STALL_NS or more
+ * (since the caller began to watch it, or since it last ran over half of a stretch). */
+static int stalled(rk_worker *w, uint64_t now) {
+    struct timespec t;
+    if (!w->has_clock || clock_gettime(w->clock, &t) != 0) return 0;
+    uint64_t ran = ns_of(&t);
+    if (!w->watch_at) {
+        w->watch_cpu = ran, w->watch_at = now;
+        return 0;
+    }
+    uint64_t wall = now - w->watch_at;
+    if (wall < RK_STALL_NS) return 0;
+    if ((ran - w->watch_cpu) * 2 < wall) return 1;
+    w->watch_cpu = ran, w->watch_at = now; /* it ran: watch a new stretch */
+    return 0;
+}
+
+/* Called by a waiting caller at most every RK_WATCH_NS: pin the first stalled worker to the caller's CPU and
+ * return 1 (the caller then sleeps, handing its CPU over); else 0. */
+static int move_stalled_worker(rk_runner *r) {
+    uint64_t now = now_ns();
+    if (!r->cpus || now - r->watched_at < RK_WATCH_NS) return 0;
+    r->watched_at = now;
+    for (int i = 0; i < r->n_workers; i++) {
+        rk_worker *w = &r->workers[i];
+        if (!atomic_load(&w->working)) {
+            w->watch_at = 0;
+            continue;
+        }
+        if (!stalled(w, now)) continue;
+        int cpu = sched_getcpu();
+        if (cpu < 0 || !CPU_ISSET(cpu, (cpu_set_t *)r->cpus)) return 0;
+        cpu_set_t here;
+        CPU_ZERO(&here);
+        CPU_SET(cpu, &here);
+        if (pthread_setaffinity_np(w->thread, sizeof here, &here) != 0) return 0;
+        r->caller_cpu = -1; /* so the next call lets it go back off the caller's CPU */
+        r->moved++;
+        return 1;
+    }
+    return 0;
+}
+
+/* Wait until all n tasks of the call are done: spin while it is cheap, then sleep until the worker that
+ * finishes the last one wakes the caller; meanwhile, watch for a stalled worker to move onto this CPU. */
+static void wait_for_tasks(rk_runner *r, int n) {
+    for (int i = 0; i < r->n_workers; i++) r->workers[i].watch_at = 0;
+    r->watched_at = 0;
+    int moved = 0;
+    uint64_t start = now_ns(), last = start;
+    for (unsigned turn = 1; atomic_load(&r->finished) != n; turn++) {
+        cpu_relax();
+        if (turn % 64) continue;
+        if (!moved) moved = move_stalled_worker(r);
+        if (!moved && keep_spinning(&r->busy_calls, start, &last)) continue;
+        atomic_store(&r->caller_sleeping, 1);
+        while (atomic_load(&r->finished) != n) {
+            if (moved || !r->cpus) {
+                sem_wait(&r->done);
+                continue;
+            }
+            uint64_t until = now_ns() + RK_WATCH_NS;
+            struct timespec t = {(time_t)(until / 1000000000u), (long)(until % 1000000000u)};
+            sem_clockwait(&r->done, CLOCK_MONOTONIC, &t);
+            moved = move_stalled_worker(r);
+        }
+        atomic_store(&r->caller_sleeping, 0);
+    }
+}
+
 int rk_runner_init(rk_runner *r, int threads) {
     memset(r, 0, sizeof *r);
     r->caller_cpu = -1;
@@ -143,6 +231,7 @@ int rk_runner_init(rk_runner *r, int threads) {
             rk_runner_close(r);
             return -1;
         }
+        w->has_clock = pthread_getcpuclockid(w->thread, &w->clock) == 0;
         r->n_workers++;
     }
     return 0;
@@ -162,17 +251,9 @@ void rk_runner_run(rk_runner *r, rk_task *tasks, int n) {
         rk_worker *w = &r->workers[i];
         if (atomic_load(&w->sleeping)) sem_post(&w->wake);
     }
-    take_tasks(r, call);
-    /* Only tasks that some worker took and is still running are left to wait for: spin while it is cheap,
-     * then sleep until the last one is done. */
-    uint64_t start = now_ns(), last = start;
-    for (unsigned turn = 1; atomic_load(&r->finished) != n; turn++) {
-        cpu_relax();
-        if (turn % 64 || keep_spinning(&r->busy_calls, start, &last)) continue;
-        atomic_store(&r->caller_sleeping, 1);
-        while (atomic_load(&r->finished) != n) sem_wait(&r->done);
-        atomic_store(&r->caller_sleeping, 0);
-    }
+    take_tasks(r, call, NULL);
+    /* Only tasks that some worker took and is still running are left to wait for. */
+    wait_for_tasks(r, n);
     if (r->busy_calls > 0) r->busy_calls--;
 }
 

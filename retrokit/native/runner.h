@@ -3,6 +3,7 @@
 
 #include <pthread.h>
 #include <semaphore.h>
+#include <time.h>
 #include <stdatomic.h>
 #include <stdint.h>
 
@@ -25,7 +26,12 @@ typedef struct {
     sem_t wake;            /* posted only when the worker said it sleeps */
     struct rk_runner *runner;
     atomic_int sleeping;
+    atomic_int working;    /* set while it runs a task */
     int busy_calls;        /* calls left for which this worker sleeps at once: it lost the CPU while spinning */
+    /* Read by a waiting caller only: the worker's CPU-time clock, and when the caller last read it. */
+    clockid_t clock;
+    int has_clock;
+    uint64_t watch_cpu, watch_at;
 } rk_worker;
 
 /* The most tasks one call may have: a call's tasks left are counted in the low 32 bits of `work`. */
@@ -46,6 +52,8 @@ typedef struct rk_runner {
     int busy_calls;        /* calls left for which the caller sleeps at once: it lost the CPU while spinning */
     void *cpus;            /* the CPUs the process may use (a cpu_set_t), or NULL: workers are kept off the caller's */
     int caller_cpu;        /* the CPU the workers were last kept off, or -1 */
+    uint64_t watched_at;   /* when a waiting caller last read the workers' clocks */
+    uint64_t moved;        /* how many times a waiting caller moved a stalled worker onto its own CPU */
     atomic_int quit;
 } rk_runner;
 

@@ -1,0 +1,67 @@
+"""The native runner beside a process that keeps a CPU busy: a worker stalled behind it is moved, results unchanged.
+
+The vector env's worker threads are kept off the caller's CPU. When another
+process shares the worker's CPU, the scheduler takes it from the worker in
+the middle of a step while the caller, its own envs done, only waits; the
+caller then moves the worker onto its own CPU. Here the caller is pinned to
+one CPU and a burner to the other, where the worker is kept, so the worker
+is sure to stall; the test checks that the runner moved it, and that every
+observation and reward still equals a single env's.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+CPUS = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else []
+
+CHILD = textwrap.dedent(
+    """
+    import json, os, subprocess, sys
+    import numpy as np
+    import retrokit
+
+    caller_cpu, busy_cpu = int(sys.argv[1]), int(sys.argv[2])
+    options = {"frameskip": 4, "sticky_prob": 0.25, "action_type": "discrete"}
+    n, steps, seed = 2, 300, 3
+    vec = retrokit.make_vec("Airstriker-Genesis", n, **options)  # its runner may use every CPU
+    singles = [retrokit.make("Airstriker-Genesis", **options) for _ in range(n)]
+    burner = subprocess.Popen(
+        [sys.executable, "-c", f"import os; os.sched_setaffinity(0, {{{busy_cpu}}})\\nwhile True: pass"]
+    )
+    try:
+        os.sched_setaffinity(0, {caller_cpu})  # this thread only: the workers are kept on the other CPU
+        obs, _ = vec.reset(seed=seed)
+        expected = [env.reset(seed=seed + i)[0] for i, env in enumerate(singles)]
+        same = all((obs[i] == expected[i]).all() for i in range(n))
+        for step in range(steps):
+            actions = np.random.default_rng(step).integers(0, 126, n)
+            obs, rewards, terms, truncs, _ = vec.step(actions)
+            for i, env in enumerate(singles):
+                o, r, term, trunc, _ = env.step(actions[i])
+                same = same and (obs[i] == o).all() and rewards[i] == r and terms[i] == term and truncs[i] == trunc
+        print(json.dumps({"moved": vec._runner.moved, "same": bool(same)}))
+    finally:
+        burner.kill()
+        burner.wait()
+        vec.close()
+    """
+)
+
+
+@pytest.mark.skipif(len(CPUS) < 2, reason="needs two CPUs: one for the caller, one for the worker and the burner")
+def test_a_worker_stalled_behind_a_busy_process_is_moved_onto_the_waiting_callers_cpu() -> None:
+    proc = subprocess.run(
+        [sys.executable, "-c", CHILD, str(CPUS[0]), str(CPUS[1])],
+        capture_output=True, text=True, timeout=300, check=False,
+    )
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    got = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert got["same"], "the vector's observations or rewards differ from single envs' under load"
+    assert got["moved"] > 0, "no stalled worker was moved, though a burner shared its CPU for 300 steps"

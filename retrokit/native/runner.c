@@ -120,6 +120,8 @@ static void *worker_main(void *arg) {
         seen = call_of(work);
         if (w->busy_calls > 0) w->busy_calls--;
         take_tasks(r, seen, w);
+        /* Moved onto the caller's CPU, it must not spin there while the caller wakes: the machine is busy. */
+        if (atomic_exchange(&w->moved, 0)) w->busy_calls = RK_BUSY_CALLS;
     }
 }
 
@@ -178,6 +180,7 @@ static int move_stalled_worker(rk_runner *r) {
         cpu_set_t here;
         CPU_ZERO(&here);
         CPU_SET(cpu, &here);
+        atomic_store(&w->moved, 1);
         if (pthread_setaffinity_np(w->thread, sizeof here, &here) != 0) return 0;
         r->caller_cpu = -1; /* so the next call lets it go back off the caller's CPU */
         r->moved++;
@@ -204,9 +207,13 @@ static void wait_for_tasks(rk_runner *r, int n) {
                 sem_wait(&r->done);
                 continue;
             }
-            uint64_t until = now_ns() + RK_WATCH_NS;
-            struct timespec t = {(time_t)(until / 1000000000u), (long)(until % 1000000000u)};
-            sem_clockwait(&r->done, CLOCK_MONOTONIC, &t);
+            /* sem_timedwait's realtime clock, not sem_clockwait's monotonic one (glibc 2.30+): a jump of the
+             * clock only ends one wait early or late, and the loop looks again. */
+            struct timespec t;
+            clock_gettime(CLOCK_REALTIME, &t);
+            t.tv_nsec += RK_WATCH_NS;
+            if (t.tv_nsec >= 1000000000) t.tv_sec++, t.tv_nsec -= 1000000000;
+            sem_timedwait(&r->done, &t);
             moved = move_stalled_worker(r);
         }
         atomic_store(&r->caller_sleeping, 0);

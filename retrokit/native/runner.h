@@ -27,6 +27,7 @@ typedef struct {
     struct rk_runner *runner;
     atomic_int sleeping;
     atomic_int working;    /* set while it runs a task */
+    atomic_int moved;      /* set by a caller that moved it onto its CPU (the machine is busy) */
     int busy_calls;        /* calls left for which this worker sleeps at once: it lost the CPU while spinning */
     /* Read by a waiting caller only: the worker's CPU-time clock, and when the caller last read it. */
     clockid_t clock;

@@ -27,10 +27,12 @@ CHILD = textwrap.dedent(
     import numpy as np
     import retrokit
 
-    caller_cpu, busy_cpu = int(sys.argv[1]), int(sys.argv[2])
+    caller_cpu, busy_cpu, n, one_cpu = (int(a) for a in sys.argv[1:])
     options = {"frameskip": 4, "sticky_prob": 0.25, "action_type": "discrete"}
-    n, steps, seed = 2, 300, 3
-    vec = retrokit.make_vec("Airstriker-Genesis", n, **options)  # its runner may use every CPU
+    steps, seed = 300, 3
+    if one_cpu:  # the whole process on the caller's CPU, before the runner starts: there is nowhere to move to
+        os.sched_setaffinity(0, {caller_cpu})
+    vec = retrokit.make_vec("Airstriker-Genesis", n, threads=2, **options)
     singles = [retrokit.make("Airstriker-Genesis", **options) for _ in range(n)]
     burner = subprocess.Popen(
         [sys.executable, "-c", f"import os; os.sched_setaffinity(0, {{{busy_cpu}}})\\nwhile True: pass"]
@@ -55,13 +57,28 @@ CHILD = textwrap.dedent(
 )
 
 
-@pytest.mark.skipif(len(CPUS) < 2, reason="needs two CPUs: one for the caller, one for the worker and the burner")
-def test_a_worker_stalled_behind_a_busy_process_is_moved_onto_the_waiting_callers_cpu() -> None:
+def run_child(n: int, one_cpu: bool) -> dict:
     proc = subprocess.run(
-        [sys.executable, "-c", CHILD, str(CPUS[0]), str(CPUS[1])],
+        [sys.executable, "-c", CHILD, str(CPUS[0]), str(CPUS[1]), str(n), str(int(one_cpu))],
         capture_output=True, text=True, timeout=300, check=False,
     )
     assert proc.returncode == 0, proc.stderr[-2000:]
-    got = json.loads(proc.stdout.strip().splitlines()[-1])
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+needs_two_cpus = pytest.mark.skipif(len(CPUS) < 2, reason="needs two CPUs: the caller's, and the worker's and burner's")
+
+
+@needs_two_cpus
+@pytest.mark.parametrize("n", [2, 5], ids=["2-envs", "5-envs-on-2-threads"])
+def test_a_worker_stalled_behind_a_busy_process_is_moved_onto_the_waiting_callers_cpu(n: int) -> None:
+    got = run_child(n, one_cpu=False)
     assert got["same"], "the vector's observations or rewards differ from single envs' under load"
     assert got["moved"] > 0, "no stalled worker was moved, though a burner shared its CPU for 300 steps"
+
+
+@needs_two_cpus
+def test_a_process_confined_to_one_cpu_moves_nothing_and_steps_the_same() -> None:
+    got = run_child(2, one_cpu=True)
+    assert got["same"], "the vector's observations or rewards differ from single envs' on one CPU"
+    assert got["moved"] == 0, "the runner moved a worker, though the process may use one CPU only"

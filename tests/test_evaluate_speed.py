@@ -13,7 +13,14 @@ from retrokit.benchmark.agents import random_agent
 from retrokit.benchmark.definition import load_benchmark
 from retrokit.benchmark.jerk import jerk
 from retrokit.benchmark.monitor import BudgetSpent, Monitor
-from retrokit.benchmark.speed import SONIC_BUDGET, SONIC_LEVELS, Speed, estimate_line, protocol_minutes
+from retrokit.benchmark.speed import (
+    SONIC_BUDGET,
+    SONIC_LEVELS,
+    Speed,
+    busy_workers,
+    estimate_line,
+    protocol_minutes,
+)
 from retrokit.cli import main
 from retrokit.envs.env import RetroEnv
 from retrokit.errors import AgentError
@@ -119,9 +126,36 @@ def test_the_protocol_is_the_papers() -> None:
 
 
 def test_the_protocol_takes_its_rounds_of_levels_at_the_level_speed() -> None:
-    assert protocol_minutes(1000.0, 2) == pytest.approx(6 * 1000 / 60)  # 11 levels on 2 workers: 6 rounds
-    assert protocol_minutes(1000.0, 11) == pytest.approx(1000 / 60)
-    line = estimate_line(Speed(steps=20_000, seconds=20.0, workers=4, at_once=2))
+    assert protocol_minutes(1000.0, 2, 2) == pytest.approx(6 * 1000 / 60)  # 11 levels on 2 workers: 6 rounds
+    assert protocol_minutes(1000.0, 11, 11) == pytest.approx(1000 / 60)
+    # More levels than cores share them: 11 at once on 2 cores, or rounds of 3, 3, 3 and 2, keep both busy.
+    assert protocol_minutes(1000.0, 11, 2) == pytest.approx(5.5 * 1000 / 60)
+    assert protocol_minutes(1000.0, 3, 2) == pytest.approx((3 * 1.5 + 1) * 1000 / 60)
+    line = estimate_line(Speed(steps=20_000, seconds=20.0, workers=4, at_once=2, cores=4))
     assert "1,000 env steps/s per level, 2,000 in all with 2 level(s) at once" in line
     assert "about 50 minutes here with --workers 4 (3 round(s) of levels)" in line
     assert "measured with 2 level(s) at once, so with 4 at once it may be slower" in line
+
+
+def test_a_level_rate_measured_with_the_cores_shared_is_a_cores_rate_shared() -> None:
+    shared = Speed(steps=20_000, seconds=30.0, workers=3, at_once=3, cores=2)  # 3 levels on 2 cores
+    assert shared.core_rate == pytest.approx(1000.0)
+    assert estimate_line(shared).endswith("--workers 3 (4 round(s) of levels).")  # every round busies both cores
+
+
+@pytest.mark.parametrize(
+    "cores, workers", [(1, 1), (2, 3), (3, 4), (4, 6), (6, 11), (16, 11)], ids=lambda v: str(v)
+)
+def test_the_busy_worker_count_leaves_no_core_idle_in_the_last_round(cores: int, workers: int) -> None:
+    assert busy_workers(cores) == workers
+    last = SONIC_LEVELS % workers or workers
+    assert last >= min(cores, SONIC_LEVELS)
+
+
+def test_a_last_round_that_leaves_cores_idle_names_the_worker_count_that_does_not() -> None:
+    line = estimate_line(Speed(steps=20_000, seconds=20.0, workers=2, at_once=2, cores=2))
+    assert "about 100 minutes here with --workers 2 (6 round(s) of levels)" in line
+    assert line.endswith(
+        "its last round plays 1 level(s) on 2 cores, leaving 1 idle: --workers 3 keeps every core busy in every "
+        "round, about 92 minutes."
+    )

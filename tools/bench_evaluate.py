@@ -149,7 +149,7 @@ def main() -> None:
         run = statistics.median(e[1] / b[1] for e, b in zip(rates["eval", workers], rates["bare", workers], strict=True))
         print(f"{workers} worker(s): evaluation / bare env, play {play:.3f} (target >= {TARGET_RATIO}), "
               f"whole run {run:.3f}")
-    minutes = protocol_minutes(median("eval", 2, 0), 2)
+    minutes = protocol_minutes(median("eval", 2, 0), 2, 2)  # 2 levels at once on 2 cores: a core each
     ceiling_rate = median("bare", 1, 0) * cores
     print(f"Sonic protocol ({SONIC_LEVELS} levels x {SONIC_BUDGET:,} timesteps), at the evaluation's "
           f"{median('eval', 2, 0):,.0f} steps/s per level with 2 workers: about {minutes:,.0f} minutes "

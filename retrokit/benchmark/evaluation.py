@@ -36,6 +36,7 @@ from retrokit.benchmark.rundir import RunDir
 from retrokit.benchmark.scores import Summary, level_score, summarize
 from retrokit.benchmark.speed import Speed
 from retrokit.benchmark.watchdog import DEFAULT_STALL_SECONDS, Watchdog
+from retrokit.envs.vector import available_cpus
 from retrokit.errors import AgentError, InvalidArgumentError
 from retrokit.paths import atomic_write
 
@@ -118,7 +119,7 @@ class Evaluation:
         if not self.played:
             return None
         return Speed(sum(steps for steps, _ in self.played.values()), sum(s for _, s in self.played.values()),
-                     self.workers, min(self.workers, len(self.played) + len(self.failed)))
+                     self.workers, min(self.workers, len(self.played) + len(self.failed)), available_cpus())
 
 
 def evaluate(evaluation: Evaluation) -> Summary:

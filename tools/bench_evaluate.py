@@ -17,7 +17,8 @@ Two rates are given for each:
 
 From the evaluation's play rate with 2 workers comes the estimated time of
 the paper's protocol (11 test levels of 1M timesteps, a level in one process
-from start to end: ceil(11 / workers) rounds), beside the target of 60
+from start to end: ceil(11 / workers) rounds), with 2 workers and with the
+count that keeps both cores busy in every round (3), beside the target of 60
 minutes on 2 cores and the machine's ceiling: the bare env's play rate with
 one process alone times the usable cores, every core busy all along.
 
@@ -115,7 +116,7 @@ def evaluation_run(levels: list[str], workers: int, timesteps: int, agent: str) 
 
 def main() -> None:
     from retrokit.benchmark.definition import load_benchmark
-    from retrokit.benchmark.speed import SONIC_BUDGET, SONIC_LEVELS, ceiling_minutes, protocol_minutes
+    from retrokit.benchmark.speed import SONIC_BUDGET, SONIC_LEVELS, busy_workers, ceiling_minutes, protocol_minutes
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--timesteps", type=int, default=10_000, help="timesteps per level (default: 10000, the benchmark's)")
@@ -154,6 +155,9 @@ def main() -> None:
     print(f"Sonic protocol ({SONIC_LEVELS} levels x {SONIC_BUDGET:,} timesteps), at the evaluation's "
           f"{median('eval', 2, 0):,.0f} steps/s per level with 2 workers: about {minutes:,.0f} minutes "
           f"(target <= {TARGET_MINUTES:g} on {TARGET_CORES} cores)")
+    busy = busy_workers(TARGET_CORES)
+    print(f"  with --workers {busy}, every round keeping the {TARGET_CORES} cores busy (the last round of 2 workers "
+          f"plays one level alone): about {protocol_minutes(median('eval', 2, 0), busy, TARGET_CORES):,.0f} minutes")
     print(f"machine's ceiling: bare env {median('bare', 1, 0):,.0f} steps/s x {cores} usable core(s) = "
           f"{ceiling_rate:,.0f} steps/s, the protocol in {ceiling_minutes(median('bare', 1, 0), cores):,.0f} minutes")
 

@@ -66,10 +66,18 @@ static inline void cpu_relax(void) {
 
 static inline uint32_t call_of(uint64_t work) { return (uint32_t)(work >> 32); }
 
-static inline uint64_t now_ns(void) {
+/* Clock `clock` in nanoseconds into *ns; 0 on success. */
+static inline int clock_ns(clockid_t clock, uint64_t *ns) {
     struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (uint64_t)t.tv_sec * 1000000000u + (uint64_t)t.tv_nsec;
+    if (clock_gettime(clock, &t) != 0) return -1;
+    *ns = (uint64_t)t.tv_sec * 1000000000u + (uint64_t)t.tv_nsec;
+    return 0;
+}
+
+static inline uint64_t now_ns(void) {
+    uint64_t ns = 0;
+    clock_ns(CLOCK_MONOTONIC, &ns);
+    return ns;
 }
 
 /* Take and run the tasks of call `call` until none is left; tasks go from the last to the first.
@@ -143,14 +151,11 @@ static void keep_workers_off_caller(rk_runner *r) {
     for (int i = 0; i < r->n_workers; i++) pthread_setaffinity_np(r->workers[i].thread, sizeof set, &set);
 }
 
-static uint64_t ns_of(const struct timespec *t) { return (uint64_t)t->tv_sec * 1000000000u + (uint64_t)t->tv_nsec; }
-
 /* Whether worker `w`, working, has been waiting for its CPU: it ran under half of the last RK_STALL_NS or more
  * (since the caller began to watch it, or since it last ran over half of a stretch). */
 static int stalled(rk_worker *w, uint64_t now) {
-    struct timespec t;
-    if (!w->has_clock || clock_gettime(w->clock, &t) != 0) return 0;
-    uint64_t ran = ns_of(&t);
+    uint64_t ran;
+    if (!w->has_clock || clock_ns(w->clock, &ran) != 0) return 0;
     if (!w->watch_at) {
         w->watch_cpu = ran, w->watch_at = now;
         return 0;

@@ -4,7 +4,7 @@
 
 import { post } from "./api.js";
 import { byId, el, replace } from "./dom.js";
-import { attempt } from "./status.js";
+import { attemptOnSubmit } from "./status.js";
 
 const RESUME = "retrokit-studio-resume";
 
@@ -56,14 +56,8 @@ export async function init() {
     el("form", { id: "open-form", class: "row" },
       el("label", {}, "game ", el("input", { id: "open-game", size: 24, placeholder: "Airstriker-Genesis" })),
       el("button", { type: "submit", id: "open-make" }, "Open")));
-  byId("new-form").addEventListener("submit", (event) => {
-    event.preventDefault();
-    attempt(make, (line) => line);
-  });
-  byId("open-form").addEventListener("submit", (event) => {
-    event.preventDefault();
-    attempt(openGame, (line) => line);
-  });
+  attemptOnSubmit(byId("new-form"), make, (line) => line);
+  attemptOnSubmit(byId("open-form"), openGame, (line) => line);
 }
 
 export function shown() {}

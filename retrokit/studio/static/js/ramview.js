@@ -5,7 +5,7 @@
 import { api, post } from "./api.js";
 import { byId, el, hex, parseNumber, replace } from "./dom.js";
 import { on } from "./socket.js";
-import { attempt } from "./status.js";
+import { attempt, attemptOnSubmit } from "./status.js";
 
 const COLUMNS = 16;
 let visible = false;
@@ -71,10 +71,7 @@ export async function init() {
     el("p", { class: "dim" }, el("output", { id: "ram-frame" }), " · ", el("span", { class: "changed" }, "changed since the last update"),
       " · ", el("span", { class: "differs" }, "differs from the snapshot")),
     el("div", { class: "scroll tall" }, el("table", { id: "ram-grid", class: "ramgrid" })));
-  byId("ram-form").addEventListener("submit", (event) => {
-    event.preventDefault();
-    attempt(watch);
-  });
+  attemptOnSubmit(byId("ram-form"), watch);
   on("ram", (report) => {
     if (visible) show(report);
   });

@@ -9,7 +9,7 @@
 import { get, post } from "./api.js";
 import { byId, el, hex, parseNumber, replace } from "./dom.js";
 import { on } from "./socket.js";
-import { attempt } from "./status.js";
+import { attempt, attemptOnSubmit } from "./status.js";
 import { refresh as refreshWatch } from "./watch.js";
 
 const LIMIT = 100;
@@ -188,10 +188,7 @@ export async function init() {
 
   byId("search-op").addEventListener("change", formChanged);
   byId("search-than").addEventListener("change", formChanged);
-  byId("search-filter").addEventListener("submit", (event) => {
-    event.preventDefault();
-    attempt(filter, (line) => line);
-  });
+  attemptOnSubmit(byId("search-filter"), filter, (line) => line);
   byId("search-new").addEventListener("click", () => attempt(async () => {
     const types = byId("search-types").value.trim();
     showStatus(await post("search/new", types ? { types: types.split(/[\s,]+/) } : {}));
@@ -204,26 +201,16 @@ export async function init() {
     await list();
     return answer.snapshot;
   }, (index) => `Snapshot ${index}.`));
-  byId("search-undo").addEventListener("click", () => attempt(async () => {
-    const answer = await post("search/undo");
-    showStatus(answer);
-    await list();
-    return `Undid ${answer.undone}: ${answer.count.toLocaleString("en")} candidates.`;
-  }, (line) => line));
-  byId("search-redo").addEventListener("click", () => attempt(async () => {
-    const answer = await post("search/redo");
-    showStatus(answer);
-    await list();
-    return `Redid ${answer.redone}: ${answer.count.toLocaleString("en")} candidates.`;
-  }, (line) => line));
-  byId("field-form").addEventListener("submit", (event) => {
-    event.preventDefault();
-    attempt(addField, (line) => line);
-  });
-  byId("poke-form").addEventListener("submit", (event) => {
-    event.preventDefault();
-    attempt(poke, (line) => line);
-  });
+  for (const [verb, key, did] of [["undo", "undone", "Undid"], ["redo", "redone", "Redid"]]) {
+    byId(`search-${verb}`).addEventListener("click", () => attempt(async () => {
+      const answer = await post(`search/${verb}`);
+      showStatus(answer);
+      await list();
+      return `${did} ${answer[key]}: ${answer.count.toLocaleString("en")} candidates.`;
+    }, (line) => line));
+  }
+  attemptOnSubmit(byId("field-form"), addField, (line) => line);
+  attemptOnSubmit(byId("poke-form"), poke, (line) => line);
 
   // Live values of the listed rows; a changed value flashes.
   on("candidates", (message) => {

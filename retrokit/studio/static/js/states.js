@@ -5,7 +5,7 @@ import { get, post } from "./api.js";
 import { byId, el, replace } from "./dom.js";
 import { setStates } from "./play.js";
 import { on } from "./socket.js";
-import { attempt } from "./status.js";
+import { attempt, attemptOnSubmit } from "./status.js";
 
 let recording = false;
 
@@ -86,10 +86,7 @@ export async function init() {
       el("button", { type: "button", id: "record" }, "Record"),
       el("input", { id: "movie-name", size: 14, placeholder: "movie name", hidden: true, "aria-label": "movie name" })),
     el("table", { id: "movies-table" }, el("tbody", { id: "movie-rows" })));
-  byId("state-form").addEventListener("submit", (event) => {
-    event.preventDefault();
-    attempt(save, (line) => line);
-  });
+  attemptOnSubmit(byId("state-form"), save, (line) => line);
   byId("record").addEventListener("click", () => attempt(record, (line) => line));
   on("status", (status) => {
     if (typeof status.recording === "boolean" && status.recording !== recording) showRecording(status.recording);

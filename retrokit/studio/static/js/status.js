@@ -40,3 +40,11 @@ export async function attempt(action, done) {
     return undefined;
   }
 }
+
+/** On the form's submit, instead of the page's navigation, attempt the action (see attempt). */
+export function attemptOnSubmit(form, action, done) {
+  form.addEventListener("submit", (event) => {
+    event.preventDefault();
+    attempt(action, done);
+  });
+}

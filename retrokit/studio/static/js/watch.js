@@ -4,7 +4,7 @@
 import { get, api } from "./api.js";
 import { byId, el, parseNumber, replace } from "./dom.js";
 import { on } from "./socket.js";
-import { attempt } from "./status.js";
+import { attemptOnSubmit } from "./status.js";
 
 const valueCells = new Map(); // field name -> <td>
 let shownFrame = null; // the frame of the values shown
@@ -55,18 +55,15 @@ function editor(field, tr) {
   const save = el("button", { type: "submit" }, "Save");
   const cancel = el("button", { type: "button", onclick: () => refresh() }, "Cancel");
   const form = el("form", { class: "row" }, address, type, lo, " to ", hi, save, cancel);
-  form.addEventListener("submit", (event) => {
-    event.preventDefault();
-    attempt(async () => {
-      const low = parseNumber(lo.value, "range's low end");
-      const high = parseNumber(hi.value, "range's high end");
-      if ((low === null) !== (high === null)) throw new Error("Expected both ends of the range, or neither.");
-      const answer = await api("PATCH", `fields/${encodeURIComponent(field.name)}`,
-        { address: address.value.trim(), type: type.value.trim(), range: low === null ? null : [low, high] });
-      await refresh();
-      return answer;
-    }, (answer) => `Wrote field ${answer.name} (${answer.hex}, ${answer.type}) into ${answer.path}.`);
-  });
+  attemptOnSubmit(form, async () => {
+    const low = parseNumber(lo.value, "range's low end");
+    const high = parseNumber(hi.value, "range's high end");
+    if ((low === null) !== (high === null)) throw new Error("Expected both ends of the range, or neither.");
+    const answer = await api("PATCH", `fields/${encodeURIComponent(field.name)}`,
+      { address: address.value.trim(), type: type.value.trim(), range: low === null ? null : [low, high] });
+    await refresh();
+    return answer;
+  }, (answer) => `Wrote field ${answer.name} (${answer.hex}, ${answer.type}) into ${answer.path}.`);
   replace(tr, el("td", { class: "mono" }, field.name), el("td", { colspan: 4 }, form));
   address.focus();
 }

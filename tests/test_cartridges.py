@@ -1,0 +1,75 @@
+"""Every cartridge of tools/cartridges.yaml: its committed ROM is the one its game.yaml names, and a fresh build
+from its source, with the toolchain that built it, gives that ROM byte for byte."""
+
+from __future__ import annotations
+
+import hashlib
+import re
+import shlex
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+REPO = Path(__file__).resolve().parent.parent
+CARTRIDGES: dict[str, dict] = yaml.safe_load((REPO / "tools" / "cartridges.yaml").read_text())
+
+
+def _rom(game: str) -> Path:
+    return REPO / "games" / game / CARTRIDGES[game]["rom"]
+
+
+@pytest.mark.parametrize("game", CARTRIDGES)
+def test_each_entry_names_its_source_rom_and_benchmark(game: str) -> None:
+    entry = CARTRIDGES[game]
+    assert set(entry) == {"source", "rom", "tools", "versions", "packages", "benchmark"}, game
+    assert (REPO / entry["source"] / "Makefile").is_file()
+    assert (REPO / entry["source"] / "toolchain.txt").is_file()
+    assert _rom(game).is_file()
+    assert (REPO / "retrokit" / "benchmark" / f"{entry['benchmark']}.yaml").is_file()
+
+
+@pytest.mark.parametrize("game", CARTRIDGES)
+def test_committed_rom_is_the_one_game_yaml_names(game: str) -> None:
+    doc = yaml.safe_load((REPO / "games" / game / "game.yaml").read_text())
+    assert [r["sha1"] for r in doc["roms"]] == [hashlib.sha1(_rom(game).read_bytes()).hexdigest()]
+
+
+def test_ci_installs_every_cartridge_toolchain() -> None:
+    ci = (REPO / ".ci" / "run").read_text()
+    listed = set(re.search(r"^optional=\(([^)]*)\)", ci, re.MULTILINE).group(1).split())
+    needed = {package for entry in CARTRIDGES.values() for package in entry["packages"]}
+    assert needed <= listed, f".ci/run does not install {sorted(needed - listed)}"
+
+
+@pytest.mark.parametrize("game", CARTRIDGES)
+def test_rom_rebuilds_byte_for_byte(game: str, tmp_path: Path) -> None:
+    entry = CARTRIDGES[game]
+    source = REPO / entry["source"]
+    missing = [tool for tool in entry["tools"] if not shutil.which(tool)]
+    if missing:
+        pytest.skip(
+            f"{game}'s toolchain is not installed (missing {', '.join(missing)}; Debian: "
+            f"{' '.join(entry['packages'])}); its committed ROM's SHA-1 is checked against game.yaml instead"
+        )
+    # Byte for byte holds for the toolchain that built the committed ROM (`make install` records it).
+    recorded = (source / "toolchain.txt").read_text().splitlines()
+    installed = [_first_line(command) for command in entry["versions"]]
+    if installed != recorded:
+        pytest.skip(f"{game}'s committed ROM was built with {recorded}, this machine has {installed}")
+    build = tmp_path / "build"
+    result = subprocess.run(
+        ["make", "-s", "-C", str(source), f"BUILD={build}", f"PYTHON={sys.executable}"],
+        capture_output=True, text=True, check=False,
+    )
+    assert result.returncode == 0, result.stdout + result.stderr
+    rebuilt = (build / entry["rom"]).read_bytes()
+    assert rebuilt == _rom(game).read_bytes(), f"the committed {entry['rom']} differs from a fresh build: run make install"
+
+
+def _first_line(command: str) -> str:
+    result = subprocess.run(shlex.split(command), capture_output=True, text=True, check=False)
+    return (result.stdout or result.stderr).splitlines()[0]

@@ -221,6 +221,7 @@ OPTIONS: dict[str, Callable[[Any], Any]] = {
     "max_pool": _flag("max_pool"),
     # Episodes and what a step hands back.
     "noop_max": _noop_max,
+    "reset_frame": _flag("reset_frame"),
     "reward_clip": _reward_clip,
     "info_keys": _info_keys,
 }

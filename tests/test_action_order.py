@@ -59,7 +59,7 @@ print(json.dumps(out))
 
 def _first_game(system: str) -> Path:
     root = wheel_dir() / "data" / "stable"
-    return sorted(p for p in root.iterdir() if p.name.endswith(f"-{system}-v0"))[0]
+    return min(p for p in root.iterdir() if p.name.endswith(f"-{system}-v0"))
 
 
 @pytest.mark.parametrize("system", SYSTEMS)

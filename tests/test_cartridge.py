@@ -10,10 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import re
-import shutil
 import struct
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np

@@ -9,8 +9,12 @@ import pytest
 
 import retrokit
 
-pytest.importorskip("stable_baselines3", reason="needs stable-baselines3 and torch: pip install torch==2.13.0 stable-baselines3 (the CPU wheel; docs/evaluate.md)")
-from stable_baselines3.common.vec_env import DummyVecEnv  # noqa: E402
+pytest.importorskip(
+    "stable_baselines3",
+    reason="needs stable-baselines3 and torch's CPU build: pip install torch --index-url "
+    "https://download.pytorch.org/whl/cpu && pip install stable-baselines3",
+)
+from stable_baselines3.common.vec_env import DummyVecEnv
 
 # Short episodes, sticky actions and frame skip: several autoresets, each drawing on the env's own RNG.
 OPTIONS = {"obs_type": "ram", "action_type": "discrete", "frameskip": 4, "sticky_prob": 0.25, "max_episode_steps": 40}

@@ -68,14 +68,17 @@ def test_the_header_tells_the_system_whatever_the_extension(tmp_path):
     assert roms.guess_system(b"just some notes\n", "notes.txt") == (None, "")
 
 
-def test_system_passed_when_nothing_tells_it(data, tmp_path, capsys):
+def test_system_told_by_the_name_or_passed_when_the_rom_tells_nothing(data, tmp_path, capsys):
     blob = tmp_path / "mystery.rom"
     blob.write_bytes(bytes(range(256)) * 64)
-    status, _, err = cli(capsys, "new", str(blob), "--name", "Mystery-Snes")
-    assert status == 2 and "found neither in" in err and "--system" in err
-    status, out, err = cli(capsys, "new", str(blob), "--name", "Mystery-Snes", "--system", "Snes")
+    status, out, err = cli(capsys, "new", str(blob), "--name", "Mystery-Snes")
     assert status == 0, err
-    assert "told by its --system" in out and find_game("Mystery-Snes").system.name == "Snes"
+    assert "told by its name" in out and find_game("Mystery-Snes").system.name == "Snes"
+    other = tmp_path / "other.rom"
+    other.write_bytes(bytes(range(255, -1, -1)) * 64)
+    status, out, err = cli(capsys, "new", str(other), "--name", "Other-Snes", "--system", "Snes")
+    assert status == 0, err
+    assert "told by its --system" in out and find_game("Other-Snes").system.name == "Snes"
 
 
 @pytest.mark.parametrize(
@@ -112,7 +115,7 @@ def test_a_known_rom_or_a_file_that_is_no_rom_is_refused(data, tmp_path, capsys)
     huge = tmp_path / "huge.md"
     with open(huge, "wb") as f:  # sparse: 40 MiB on paper, nothing on disk
         f.truncate(40 * 2**20)
-    for path, message in [(notes, "found neither"), (empty, "found an empty file"), (fifo, "found a FIFO"),
+    for path, message in [(notes, "found none in"), (empty, "found an empty file"), (fifo, "found a FIFO"),
                           (zero, "found a device"), (huge, "at most 32 MiB"),
                           (tmp_path / "missing.md", "No such file"), (tmp_path, "found a folder")]:
         status, _, err = cli(capsys, "new", str(path), "--name", "Junk-Genesis")

@@ -31,7 +31,7 @@ stable_retro = pytest.importorskip("stable_retro")
 ale_py = pytest.importorskip("ale_py")
 
 STEPS = 600
-MOVIE_STEPS = 200
+MOVIE_STEPS = 100
 SWITCHES = ("SELECT", "RESET")  # console switches: pressed at random they restart or change the game
 GAMES = [
     "Adventure", "AirRaid", "Alien", "Asterix", "Asteroids", "BeamRider", "Bowling", "Boxing", "Breakout",
@@ -273,3 +273,36 @@ def test_new_refuses_a_bin_no_cartridge_is_in_one_line(tmp_path: Path, size: int
     with _data_folder(tmp_path / "data"), pytest.raises(RomError, match=expected) as error:
         new_game(rom, name)
     assert "\n" not in str(error.value)
+
+
+# --- Frogger: the frog moves, once the game is started and its intro is over ------------------------------
+
+
+def _frog_moves(emulator, state, wait: int) -> bool:
+    """Whether tapping UP ``wait`` frames after ``state`` changes the game (RAM) from waiting without input."""
+    up = emulator.system.mask(["UP"])
+    emulator.set_state(state)
+    emulator.run([0, 0], wait)
+    for _ in range(4):  # four hops: held 4 frames, released 4 (the game moves one hop per press)
+        emulator.run([up, 0], 4)
+        emulator.run([0, 0], 4)
+    pressed = emulator.ram.copy()
+    emulator.set_state(state)
+    emulator.run([0, 0], wait + 32)
+    return bool((emulator.ram != pressed).any())
+
+
+def test_froggers_frog_moves_after_reset_and_the_intro(imported: Path) -> None:
+    from retrokit.host.emulator import Emulator
+
+    frogger = Path(ale_py.__file__).parent / "roms" / "frogger.bin"
+    with Emulator("Atari2600", frogger) as emulator:
+        assert emulator.options() == {}  # stable-retro's stella declares no core option to set
+        power_on = emulator.get_state()
+        # Before RESET the game is on its attract screen: no joystick input on either port does anything.
+        assert not _frog_moves(emulator, power_on, 600)
+        emulator.run([emulator.system.mask(["RESET"]), 0], 5)
+        started = emulator.get_state()
+        # Then the intro plays for about 7 seconds (440 frames) before the frog takes input; then it hops.
+        assert not _frog_moves(emulator, started, 300)
+        assert _frog_moves(emulator, started, 480)

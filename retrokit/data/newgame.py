@@ -146,6 +146,9 @@ def new_game(
                 f"known header). If it is a ROM, end --name with its system (as in Galaxian-Atari2600), "
                 f"or pass --system {'|'.join(all_systems())}."
             )
+    problem = roms.rom_problem(chosen, data)
+    if problem:
+        raise RomError(f"Expected a {chosen.name} ROM the {chosen.core} core runs; found that {str(rom)!r}: {problem}.")
     sizes = sorted(size for rule in chosen.detect for size in rule.sizes)
     if sizes and not sizes[0] <= len(data) <= sizes[-1]:  # a system whose ROMs have no header: only sizes tell
         raise RomError(

@@ -192,6 +192,42 @@ def size_system(size: int, filename: str | os.PathLike[str]) -> System | None:
     return None
 
 
+INES_PRG_UNIT = 16 * 1024
+INES_CHR_UNIT = 8 * 1024
+INES_TRAINER = 512
+
+
+def _ines_problem(system: System, data: bytes) -> str:
+    """What is wrong with an iNES ROM for ``system``'s core: too short for its header's sizes, or an unknown mapper."""
+    if len(data) < NES_HEADER_SIZE:
+        return f"it is {len(data)} bytes, shorter than the {NES_HEADER_SIZE}-byte iNES header"
+    prg, chr_, flags6, flags7 = data[4], data[5], data[6], data[7]
+    need = NES_HEADER_SIZE + (INES_TRAINER if flags6 & 0x04 else 0) + prg * INES_PRG_UNIT + chr_ * INES_CHR_UNIT
+    if prg == 0:
+        return "its iNES header gives it no program ROM (byte 4 is 0)"
+    if len(data) < need:
+        return (f"it is truncated: its iNES header gives {prg} x 16 KiB of program ROM and {chr_} x 8 KiB of "
+                f"character ROM, {need} bytes with the header, and the file has {len(data)}")
+    mapper = (flags6 >> 4) | (flags7 & 0xF0)
+    if flags7 & 0x0C == 0x08:  # NES 2.0: 4 more bits of mapper in byte 8 (numbers past 255 are left to the core)
+        mapper |= (data[8] & 0x0F) << 8
+    if mapper in system.missing_mappers:
+        return f"its iNES mapper {mapper} is one the {system.core} core cannot run (it has no such board)"
+    return ""
+
+
+_FORMATS = {"ines": _ines_problem}
+
+
+def rom_problem(system: System, data: bytes) -> str:
+    """Why ``data`` cannot be a ROM ``system``'s core runs, by what its header says (``""``: nothing known).
+
+    Only systems whose descriptor names a ``rom.format`` are checked (the NES's iNES header).
+    """
+    check = _FORMATS.get(system.rom_format)
+    return check(system, data) if check else ""
+
+
 def guess_system(data: bytes, filename: str | os.PathLike[str]) -> tuple[System | None, str]:
     """The likely system of a file: from its header, else its size, else its extension; and how it was told.
 

@@ -67,6 +67,9 @@ class System:
             length is refused before it; ``"parsed"``: the core reads a state
             within the length it is given, so any length goes to it as it is.
         detect: How its ROMs' bytes tell the system, for ROMs no game knows.
+        rom_format: The layout a ROM's header describes (``"ines"``), checked by
+            :func:`retrokit.data.roms.rom_problem`; ``""``: none.
+        missing_mappers: Mapper numbers of that format the core cannot run.
         reset_before_state: The core restores some state only partly (so a
             load's outcome would depend on what ran before it): the console is
             reset before each state is loaded, so every load starts alike.
@@ -87,6 +90,8 @@ class System:
     state_length: str = "exact"
     reset_before_state: bool = False
     detect: tuple[DetectRule, ...] = ()
+    rom_format: str = ""
+    missing_mappers: frozenset[int] = frozenset()
 
     def __str__(self) -> str:
         return self.name
@@ -159,6 +164,8 @@ def _parse(name: str, entry: object) -> System:
             state_length=_one_of(entry.get("state_length", "exact"), ("exact", "parsed"), "state_length"),
             reset_before_state=_one_of(entry.get("reset_before_state", False), (False, True), "reset_before_state"),
             detect=tuple(_detect_rule(rule) for rule in entry.get("detect") or ()),
+            rom_format=_one_of(str((entry.get("rom") or {}).get("format", "")), ("", "ines"), "rom.format"),
+            missing_mappers=frozenset(int(m) for m in (entry.get("rom") or {}).get("missing_mappers", ())),
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise DataFileError(f"{_FILE}: system {name!r} is malformed: {exc!r}.") from exc

@@ -84,6 +84,13 @@ def test_the_descriptors_detect_rules_tell_the_rest():
         assert roms.guess_system(bytes(size), "x.bin") == (roms.get_system("Atari2600"), "size")
     assert roms.guess_system(bytes(4096), "x.gb") == (roms.get_system("GameBoy"), "extension")  # size needs .bin/.a26
     assert roms.guess_system(bytes(3000), "x.bin") == (None, "")
+    snes = bytearray(0x10000)
+    snes[0xFFD5], snes[0xFFDC:0xFFE0] = 0x21, bytes.fromhex("34125BED")  # HiROM, a wrong complement
+    assert roms.header_system(bytes(snes)) is None  # a complement that does not complement the checksum
+    snes[0xFFDC:0xFFE0] = (0x1234 ^ 0xFFFF).to_bytes(2, "little") + (0x1234).to_bytes(2, "little")
+    assert roms.guess_system(bytes(snes), "x.bin") == (roms.get_system("Snes"), "header")
+    snes[0xFFD5] = 0x00  # no map mode there: not a header
+    assert roms.header_system(bytes(snes)) is None
 
 
 def test_system_told_by_the_name_or_passed_when_the_rom_tells_nothing(data, tmp_path, capsys):

@@ -152,15 +152,19 @@ def may_be_rom(filename: str | os.PathLike[str]) -> bool:
 
 def _rule_score(rule: DetectRule, data: bytes) -> int:
     """How many bytes of ``data`` a header rule compared and found (0: it does not hold)."""
+    size = 4 if rule.complement else len(rule.mark)
     for offset in rule.at:
-        if data[offset : offset + len(rule.mark)] != rule.mark:
+        found = data[offset : offset + size]
+        if rule.complement:
+            if len(found) < size or int.from_bytes(found[:2], "little") ^ int.from_bytes(found[2:], "little") != 0xFFFF:
+                continue
+        elif found != rule.mark:
             continue
         if rule.byte_at is None:
-            return len(rule.mark)
+            return size
         where = offset + rule.byte_at
-        if where < len(data) and data[where] >> rule.byte_shift in rule.byte_in:
-            return len(rule.mark) + 1
-        return 0
+        if 0 <= where < len(data) and data[where] >> rule.byte_shift in rule.byte_in:
+            return size + 1
     return 0
 
 
@@ -176,7 +180,7 @@ def header_system(data: bytes) -> str | None:
     best, named = 0, None
     for system in all_systems().values():
         for rule in system.detect:
-            score = _rule_score(rule, data) if rule.mark else 0
+            score = _rule_score(rule, data) if rule.at else 0
             if score > best:
                 best, named = score, system.name
     return named

@@ -26,7 +26,8 @@ class DetectRule:
 
     Attributes:
         at: Offsets where the mark may be (the first where it is counts).
-        mark: The bytes there; empty for a rule by size.
+        mark: The bytes there; empty for a rule by size or checksum.
+        complement: The mark is a checksum's complement: two little-endian words whose XOR is 0xFFFF.
         byte_at: An offset, after the mark's start, of one more byte to check (``None``: none).
         byte_shift: Bits to drop from that byte (4: its high nibble).
         byte_in: The values it may have, once shifted.
@@ -36,6 +37,7 @@ class DetectRule:
 
     at: tuple[int, ...] = ()
     mark: bytes = b""
+    complement: bool = False
     byte_at: int | None = None
     byte_shift: int = 0
     byte_in: frozenset[int] = frozenset()
@@ -178,14 +180,16 @@ def _detect_rule(rule: dict) -> DetectRule:
     made = DetectRule(
         at=tuple(at) if isinstance(at, list) else (int(at),) if at != () else (),
         mark=mark,
+        complement=_one_of(rule.get("complement", False), (False, True), "complement"),
         byte_at=int(byte["at"]) if byte else None,
         byte_shift=int(byte.get("shift", 0)),
         byte_in=frozenset(int(v) for v in byte.get("in", ())),
         sizes=frozenset(int(v) for v in rule.get("sizes", ())),
         extensions=tuple(str(e) for e in rule.get("extensions", ())),
     )
-    if bool(made.mark) == bool(made.sizes) or bool(made.mark) != bool(made.at):
-        raise ValueError(f"a detect rule holds a mark (at + text or hex) or sizes (+ extensions), not both: {rule!r}")
+    marked = bool(made.mark) or made.complement
+    if marked == bool(made.sizes) or marked != bool(made.at):
+        raise ValueError(f"a detect rule holds a mark (at + text, hex or complement) or sizes, not both: {rule!r}")
     return made
 
 

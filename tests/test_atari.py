@@ -199,14 +199,16 @@ def _vet(data: bytes, game: str = "Pong"):
         pytest.param("truncated", "core refused the state", id="truncated"),
         pytest.param("another-system", "core can run; found one that it cannot", id="a-genesis-state"),
         pytest.param("empty", "expected a serialized core state", id="empty"),
+        pytest.param("huge", "at most", id="huge-past-the-largest-state"),
     ],
 )
 def test_a_hostile_state_ends_in_one_clear_error(imported: Path, airstriker_state: bytes, kind: str, expected: str) -> None:
-    from retrokit.data.states import read_state
+    from retrokit.data.states import MAX_STATE_SIZE, read_state
     from retrokit.errors import StateError
 
-    data = {"truncated": read_state(_shipped_state("Pong"))[:100], "another-system": bytes(airstriker_state),
-            "empty": b""}[kind]
+    pong = read_state(_shipped_state("Pong"))
+    data = {"truncated": pong[:100], "another-system": bytes(airstriker_state), "empty": b"",
+            "huge": pong + bytes(MAX_STATE_SIZE)}[kind]
     with pytest.raises(StateError, match=expected) as error:
         with retrokit.make("Pong-Atari2600", state=_write(imported, data)) as env:
             env.reset(seed=0)

@@ -209,9 +209,11 @@ def test_a_hostile_state_ends_in_one_clear_error(imported: Path, airstriker_stat
     pong = read_state(_shipped_state("Pong"))
     data = {"truncated": pong[:100], "another-system": bytes(airstriker_state), "empty": b"",
             "huge": pong + bytes(MAX_STATE_SIZE)}[kind]
-    with pytest.raises(StateError, match=expected) as error:
-        with retrokit.make("Pong-Atari2600", state=_write(imported, data)) as env:
-            env.reset(seed=0)
+    with (
+        pytest.raises(StateError, match=expected) as error,
+        retrokit.make("Pong-Atari2600", state=_write(imported, data)) as env,
+    ):
+        env.reset(seed=0)
     assert "\n" not in str(error.value)
 
 

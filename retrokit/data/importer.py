@@ -28,7 +28,14 @@ from tqdm import tqdm
 from retrokit import paths
 from retrokit.data import roms
 from retrokit.data.games import Game, list_games
-from retrokit.errors import FileConflictError, MissingExtraError, RetrokitError, RomError, UnknownNameError, did_you_mean
+from retrokit.errors import (
+    FileConflictError,
+    MissingExtraError,
+    RetrokitError,
+    RomError,
+    UnknownNameError,
+    did_you_mean,
+)
 from retrokit.host.systems import extension_of
 
 ROM_PACKAGES: dict[str, tuple[str, str]] = {"ale-py": ("ale_py", "roms")}

@@ -1,5 +1,8 @@
 """What a core would do with a state's bytes that no probe can see: pointers built from them, unchecked.
 
+One check per core that builds pointers from a state's bytes, looked up by
+system (:func:`state_layout_problem`); a core without one is left to the probe.
+
 Genesis Plus GX restores the cartridge's memory map from a state (its
 ``md_cart_context_load``): for each of the 68000's 64 banks of 64 KiB the
 state holds one byte, ``0xFF`` for the battery RAM, else the bank of the ROM
@@ -23,6 +26,15 @@ So such a state is refused by reading those bytes, before any probe: the
 verdict does not depend on luck. No state a core writes has such a byte (the
 core maps banks only inside its ROM area): the 928 Genesis states that
 stable-retro ships all pass.
+
+Stella (stable-retro's 3.9 build) restores a bank-switched cartridge's banks
+from a state as 16-bit numbers (``CartridgeF8::load`` and its kin) and maps
+the bank at ``myImage + (bank << 12)`` (1 KiB slices for E0, 2 KiB for E7)
+without checking the number against the ROM's banks. The cartridge's part of a
+state begins with its class name (a 4-byte length, then the name), which the
+core checks before reading on; so every place the name occurs is checked, and a
+name planted earlier in the state cannot hide the one the core reads (but the
+copy of the name in the state's header, which the core only compares).
 """
 
 from __future__ import annotations
@@ -46,18 +58,33 @@ GENESIS_ROM_BANKS = 10485760 >> 16
 """Banks of 64 KiB in the core's ROM area (``MAXROMSIZE``, 10 MiB): a bank byte must be below this, or 0xFF."""
 _SRAM = 0xFF
 
+STELLA_BANKS: dict[bytes, tuple[int, ...]] = {
+    b"CartridgeF8": (2,), b"CartridgeF8SC": (2,), b"CartridgeF6": (4,), b"CartridgeF6SC": (4,),
+    b"CartridgeF4": (8,), b"CartridgeF4SC": (8,), b"CartridgeFA": (3,), b"CartridgeUA": (2,),
+    b"CartridgeEF": (16,), b"CartridgeF0": (16,), b"CartridgeE0": (8, 8, 8, 8), b"CartridgeE7": (8, 8, 4),
+}
+"""Stella's bank-switched cartridge classes whose state holds bank numbers it uses unchecked: for each 16-bit
+number that follows the class name, the banks (slices, RAM pages) of that kind the cartridge has."""
+
 
 def state_layout_problem(system: str, state: bytes) -> str:
     """Why the core would build a pointer outside its own memory from ``state`` (``""`` when it would not).
 
     Only what is known of a core's layout is checked: a Genesis state in
-    Genesis Plus GX 1.7.5's format. Anything else is left to the probe.
+    Genesis Plus GX 1.7.5's format, an Atari 2600 state in stella's.
+    Anything else is left to the probe.
 
     Args:
         system: The system's name (``"Genesis"``).
         state: The serialized state.
     """
-    if system != "Genesis" or len(state) != GENESIS_STATE_SIZE or not state.startswith(GENESIS_SIGNATURE):
+    check = _CHECKS.get(system)
+    return check(state) if check else ""
+
+
+def _genesis_problem(state: bytes) -> str:
+    """The Genesis Plus GX check: the 68000's bank map and the Z80's bank address."""
+    if len(state) != GENESIS_STATE_SIZE or not state.startswith(GENESIS_SIGNATURE):
         return ""
     (z80_bank,) = struct.unpack_from("<I", state, GENESIS_Z80_BANK)
     if z80_bank & ~GENESIS_Z80_BANK_BITS:
@@ -75,3 +102,28 @@ def state_layout_problem(system: str, state: bytes) -> str:
         f"area (bank {bank:#04x} at ROM bank {value:#04x}; the area holds {GENESIS_ROM_BANKS:#04x}), which reads "
         "memory the core does not own"
     )
+
+
+def _stella_problem(state: bytes) -> str:
+    """The stella check: every bank number after a bank-switched cartridge's class name is one of its banks."""
+    # A state begins with two strings: the format's header, then the cartridge's class name, which the core only
+    # compares; the name's copy that holds the banks comes after the console's chips.
+    header = 4 + struct.unpack_from("<I", state)[0] if len(state) >= 4 else 0
+    for name, limits in STELLA_BANKS.items():
+        marker = struct.pack("<I", len(name)) + name
+        at = state.find(marker)
+        while at >= 0:
+            start = at + len(marker)
+            if at != header and start + 2 * len(limits) <= len(state):  # a shorter state fails the load before any bank is mapped
+                numbers = struct.unpack_from(f"<{len(limits)}H", state, start)
+                for number, banks in zip(numbers, limits, strict=True):
+                    if number >= banks:
+                        return (
+                            f"its {name.decode()} cartridge is in bank {number}, of the {banks} it has there, "
+                            "which maps memory the core does not own"
+                        )
+            at = state.find(marker, at + 1)
+    return ""
+
+
+_CHECKS = {"Genesis": _genesis_problem, "Atari2600": _stella_problem}

@@ -114,6 +114,10 @@ static void take_coin(unsigned char n, struct player *p)
 static void run(struct player *p, unsigned char held)
 {
     int x;
+    /* A pad's rocker cannot press both ways at once; a tool can, and then
+     * neither counts. */
+    if ((held & (PAD_LEFT | PAD_RIGHT)) == (PAD_LEFT | PAD_RIGHT))
+        held &= ~(PAD_LEFT | PAD_RIGHT);
     if (held & PAD_RIGHT) {
         if (p->vx < RUN_MAX)
             p->vx += RUN_ACCEL;

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 import yaml
 
+from cartgame import ABSENT, ALIVE, DYING, CartGame, game_fields, lose_every_life, ram_h_fields, run_into_goal, start_selected
 from retrokit.data.roms import rom_sha1
-from retrokit.host.emulator import Emulator
 from retrokit.host.systems import get_system
 
 REPO = Path(__file__).resolve().parent.parent
@@ -28,48 +28,14 @@ ROM = GAME_DIR / "rom.nes"
 END_X = {(0, 0): 2248, (0, 1): 2280, (1, 0): 2568, (1, 1): 2840, (2, 0): 3192, (2, 1): 3416}
 GROUND = 0x0400  # one byte per 16-pixel column: height 0-4 (0 = pit), bit 7 = a coin
 ENEMIES, ENEMY_SIZE = 0x0380, 10
-MODE_TITLE, MODE_PLAY, MODE_CLEAR, MODE_GAMEOVER = 0, 1, 2, 3
-ALIVE, DYING, OUT, ABSENT = 0, 1, 2, 3
-FIELDS = {
-    name: (int(f["address"]), f["type"])
-    for name, f in yaml.safe_load((GAME_DIR / "game.yaml").read_text())["fields"].items()
-}
+FIELDS = game_fields(GAME_DIR)
 
 
-class Hopper:
+class Hopper(CartGame):
     """An emulator running Hopper, with the game's fields by name."""
 
     def __init__(self) -> None:
-        self.emu = Emulator.for_rom(ROM)
-        self.mask = self.emu.system.mask
-
-    def __getitem__(self, name: str) -> int:
-        return self.emu.peek(*FIELDS[name])
-
-    def __setitem__(self, name: str, value: int) -> None:
-        address, code = FIELDS[name]
-        self.emu.poke(address, value, code)
-
-    def run(self, p1: list[str] = (), p2: list[str] = (), frames: int = 1) -> None:
-        self.emu.run([self.mask(list(p1)), self.mask(list(p2))], frames)
-
-    def run_until(self, condition, p1: list[str] = (), p2: list[str] = (), limit: int = 600) -> int:
-        """Run frames holding the buttons until ``condition()``; return the frames run."""
-        for n in range(limit):
-            if condition():
-                return n
-            self.run(p1, p2)
-        raise AssertionError(f"condition not met within {limit} frames")
-
-    def boot(self) -> None:
-        """Run until the title's main loop is counting frames (FCEUmm powers on with RAM full of 0xFF)."""
-        self.run_until(lambda: 2 <= self["frame"] < 100, limit=120)
-        assert self["game_mode"] == MODE_TITLE
-
-    def start(self, p1: list[str] = ("START",), p2: list[str] = ()) -> None:
-        """Press START for one frame at the title and wait for the stage to begin."""
-        self.run(p1, p2)
-        self.run_until(lambda: self["game_mode"] == MODE_PLAY, limit=60)
+        super().__init__(ROM, FIELDS)
 
     def column(self, x: int) -> int:
         return self.emu.peek(GROUND + x // 16)
@@ -83,7 +49,7 @@ def hopper():
     game = Hopper()
     game.boot()
     yield game
-    game.emu.close()
+    game.close()
 
 
 @pytest.fixture
@@ -112,22 +78,8 @@ def test_game_yaml_lists_the_committed_rom() -> None:
     assert [r["sha1"] for r in doc["roms"]] == [rom_sha1(ROM)]
 
 
-def _ram_h() -> dict[str, int]:
-    """src/ram.h's fixed addresses, by game.yaml's field names."""
-    values = {
-        name: int(v, 16)
-        for name, v in re.findall(r"^#define (\w+) (0x[0-9A-Fa-f]+)\b", (CART_DIR / "src" / "ram.h").read_text(), re.M)
-    }
-    out = {k[len("ADDR_"):].lower(): v for k, v in values.items() if k.startswith("ADDR_")}
-    for player in (1, 2):
-        for k, v in values.items():
-            if k.startswith("P_"):
-                out[f"p{player}_{k[2:].lower()}"] = values[f"ADDR_P{player}"] + v
-    return out
-
-
 def test_game_yaml_and_crt0_addresses_match_ram_h() -> None:
-    known = _ram_h()
+    known = ram_h_fields(CART_DIR / "src" / "ram.h")
     for name, (address, _) in FIELDS.items():
         assert name in known, f"game.yaml field {name!r} is not in src/ram.h"
         assert address == known[name], f"{name}: game.yaml says {address:#x}, src/ram.h {known[name]:#x}"
@@ -230,13 +182,7 @@ def test_walking_into_a_pit_loses_a_life_and_respawns(playing: Hopper) -> None:
 
 
 def test_losing_every_life_is_game_over(playing: Hopper) -> None:
-    for lives in (2, 1, 0):
-        playing.run_until(lambda: playing["p1_state"] == DYING, ["RIGHT"], limit=400)
-        assert playing["p1_lives"] == lives
-        playing.run_until(lambda: playing["p1_state"] != DYING, limit=120)
-    assert playing["p1_state"] == OUT
-    assert playing["game_mode"] == MODE_GAMEOVER
-    playing.run_until(lambda: playing["game_mode"] == MODE_TITLE, limit=300)
+    lose_every_life(playing)
     assert (playing["world"], playing["stage"]) == (0, 0)
 
 
@@ -268,13 +214,9 @@ def test_walking_into_a_crawler_costs_a_life(playing: Hopper) -> None:
 def test_reaching_end_x_clears_the_stage(playing: Hopper) -> None:
     playing["camera_x"] = playing["end_x"] - 160
     playing["p1_x"] = playing["end_x"] - 40
-    playing.run_until(lambda: playing["level_done"] == 1, ["RIGHT"], limit=120)
-    assert playing["game_mode"] == MODE_CLEAR
-    assert playing["p1_score"] >= 1000, "the stage-clear bonus"
-    playing.run_until(lambda: playing["game_mode"] == MODE_PLAY, limit=300)
-    assert (playing["world"], playing["stage"], playing["level_done"]) == (0, 1, 0)
+    run_into_goal(playing)
+    assert (playing["world"], playing["stage"]) == (0, 1)
     assert playing["end_x"] == END_X[0, 1]
-    assert playing["p1_x"] == playing["start_x"]
 
 
 # --- level select ------------------------------------------------------------------------------
@@ -285,17 +227,10 @@ def test_reaching_end_x_clears_the_stage(playing: Hopper) -> None:
 def test_writing_world_and_stage_selects_the_level(world: int, stage: int, when: str) -> None:
     game = Hopper()
     try:
-        if when == "at-title":
-            game.boot()
-        game["world"], game["stage"] = world, stage  # before the first frame: the boot's RAM clear keeps them
-        if when == "before-first-frame":
-            game.boot()
-        game.start()
-        assert (game["world"], game["stage"]) == (world, stage)
+        start_selected(game, {"world": world, "stage": stage}, when)
         assert game["end_x"] == END_X[world, stage]
-        assert game["level_width"] > game["end_x"]
     finally:
-        game.emu.close()
+        game.close()
 
 
 # --- two players ---------------------------------------------------------------------------------
@@ -340,7 +275,7 @@ def _play(start_frame: int, seed: int = 7) -> tuple[bytes, bytes]:
         crawlers = bytes(game.emu.peek(ENEMIES + i) for i in range(8 * ENEMY_SIZE))
         return crawlers, bytes(game.emu.ram)
     finally:
-        game.emu.close()
+        game.close()
 
 
 def test_same_inputs_give_the_same_ram_and_the_start_frame_changes_the_crawlers() -> None:

@@ -49,7 +49,8 @@ void enemies_update(void)
                 e->state = ES_WALK;
             }
         }
-        if (e->state != ES_GONE)
+        /* Players are always on screen: only crawlers near it can touch one. */
+        if (e->state != ES_GONE && e->x + 16 > camera_x && e->x < camera_x + 272)
             touch(e);
     }
 }

@@ -121,11 +121,20 @@ void read_pads(void)
     pad2 = held2;
     if (++frame_lo == 0)
         ++frame_hi;
-    rng = (rng ^ (held1 | ((unsigned)held2 << 8))) * 25173u + 13849u + frame_lo;
+    rng ^= (held1 | ((unsigned)held2 << 8)) ^ frame_lo;
+    rnd();
 }
 
+/* One step of a 16-bit xorshift (shifts 7, 9, 8): shifts, where a multiply
+ * would cost the 6502 a frame's spare time; 0 would stay 0, so it becomes 1. */
 unsigned char rnd(void)
 {
-    rng = rng * 25173u + 13849u;
-    return (unsigned char)(rng >> 8);
+    unsigned x = rng;
+    if (!x)
+        x = 1;
+    x ^= x << 7;
+    x ^= x >> 9;
+    x ^= x << 8;
+    rng = x;
+    return (unsigned char)x;
 }

@@ -46,11 +46,11 @@ _DIGITS = {
 
 
 def _fit(high: int) -> np.dtype:
-    """The smallest unsigned dtype that holds 0 .. high."""
-    for dtype in (np.uint8, np.uint16, np.uint32):
+    """The smallest unsigned dtype that holds 0 .. high (int64 up to its top, uint64 past it: ``u8``)."""
+    for dtype in (np.uint8, np.uint16, np.uint32, np.int64):
         if high <= np.iinfo(dtype).max:
             return np.dtype(dtype)
-    return np.dtype(np.int64)
+    return np.dtype(np.uint64)
 
 
 def parse_search_types(codes: Sequence[str] | None) -> tuple[FieldType, ...]:
@@ -148,9 +148,15 @@ class _Decoder:
     def decode(self, ftype: FieldType) -> np.ndarray:
         digits = UNSIGNED if ftype.kind == SIGNED else ftype.kind
         value = self.part(digits, ftype.significance())
-        if ftype.kind == SIGNED:  # the same bits, read as two's complement
+        if ftype.kind != SIGNED:
+            return value
+        bits = 8 * ftype.width
+        if bits == 8 * value.itemsize:  # the same bits, read as two's complement
             return value.view(np.dtype(f"i{value.itemsize}"))
-        return value
+        # A width without a dtype of its own (3, 5, 6, 7 bytes): extend the sign bit by hand.
+        signed = value.astype(np.int64)
+        signed -= (signed >> (bits - 1)) << bits
+        return signed.astype(value_dtype(ftype))
 
 
 def _run(offsets: tuple[int, ...]) -> bool:

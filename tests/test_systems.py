@@ -36,12 +36,13 @@ from retrokit.data.statecheck import load_state
 from retrokit.data.states import StateRecord, read_state, write_state
 from retrokit.host.emulator import Emulator
 from retrokit.host.memory import FieldReader
-from retrokit.host.typecodes import parse_type
+from retrokit.host.fields import FieldSpec
 from retrokit.movie import play, read_bk2
 from retrokit.paths import wheel_dir
 from retrokit.ramsearch import RamSearch
 from retrokit.ramsearch.engine import Engine
 from retrokit.ramsearch.scales import SCALES
+from retrokit.ramsearch.types import search_type
 from stable_retro_game import Integration, pressed, wandering, write_integration
 
 stable_retro = pytest.importorskip("stable_retro")
@@ -228,10 +229,22 @@ def test_a_stable_retro_movie_plays_in_retrokit(cart: Cartridge, tmp_path: Path)
 # --- ramsearch ----------------------------------------------------------------------------------------
 
 
+def searched_as(spec: FieldSpec) -> str | None:
+    """The type a search finds a field as: its own, or a bit type for a one-bit flag (None: no search type reads it)."""
+    if spec.mask is None:
+        return spec.type
+    if spec.type == "|u1" and spec.mask in BIT_MASKS:
+        return f"|u1&0x{spec.mask:02X}"
+    return None
+
+
+BIT_MASKS = [1 << bit for bit in range(8)]
+
+
 def test_ramsearch_finds_each_field_at_its_console_address(cart: Cartridge, capsys, tmp_path: Path) -> None:
     """Each field's values along a play, searched for as a user would (``equal VALUE`` at each snapshot),
     leave its address and type among the candidates, in the system's RAM region and byte order."""
-    fields = [f for f in cart.game.fields.values() if f.mask is None]
+    fields = [f for f in cart.game.fields.values() if searched_as(f)]
     with RamSearch(cart.game) as search:
         base = cart.system.ram_base
         assert search.layout.regions[0][0] == base, search.layout.describe()
@@ -246,13 +259,13 @@ def test_ramsearch_finds_each_field_at_its_console_address(cart: Cartridge, caps
         layout = search.layout
     as_stored = 1 << next(i for i, scale in enumerate(SCALES) if not scale.label)  # the value itself
     for spec in fields:
-        engine = Engine(layout, [parse_type(spec.type)])
+        engine = Engine(layout, [search_type(searched_as(spec))])
         for snapshot, value in zip(snapshots, values):
             engine.add_snapshot(snapshot)
             engine.filter("equal", value[spec.name])
         found = engine.candidates.alive[0] & (engine.candidates.scale[0] & as_stored != 0)
         where = f"{spec.name} ({layout.format(spec.address)}, {spec.type})"
-        assert found[layout.position(spec.address, parse_type(spec.type).width)], f"{where} not found"
+        assert found[layout.position(spec.address, spec.field_type.width)], f"{where} not found"
         if len({v[spec.name] for v in values}) >= 4:  # a value that moved pins its address down
             assert np.count_nonzero(found) <= 8, f"{where}: {np.count_nonzero(found)} candidates"
     # The command shows the RAM region in console addresses.

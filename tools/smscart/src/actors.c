@@ -82,15 +82,26 @@ static void lose_life(volatile Player *p)
     p->vy = -0x300;
 }
 
+/* The ground under a player's feet: the higher of the columns under its two
+ * edges, so it stands while either foot is on a ledge. */
+static int16_t support(uint16_t x)
+{
+    int16_t a = ground_top(x - 3), b = ground_top(x + 3);
+    return a < b ? a : b;
+}
+
+/* Ground ahead higher than the feet is a wall, except one step (8 pixels)
+ * for a player on foot, who walks up it. So a player who walks off into a
+ * pit has fallen below the far side's top and cannot run across it. */
 static void move_x(volatile Player *p)
 {
     uint16_t sum = p->xsub + (uint8_t)(p->vx & 0xFF);
     uint16_t nx = p->x + (p->vx >> 8) + (sum >> 8);
-    uint16_t edge = p->vx > 0 ? nx + 3 : nx - 4;
+    int16_t ahead = ground_top(p->vx > 0 ? nx + 3 : nx - 3);
     uint16_t left = G.camera_x + 6, right = G.camera_x + SCREEN_W - 6;
 
-    if (nx < left || nx > right || ground_top(edge) < p->y - 8) {
-        p->vx = 0;  /* a screen edge, or a wall higher than a step */
+    if (nx < left || nx > right || ahead < p->y - (p->on_ground ? 8 : 0)) {
+        p->vx = 0;  /* a screen edge or a wall */
         p->xsub = 0;
         if (p->x < left)
             p->x = left;
@@ -98,17 +109,19 @@ static void move_x(volatile Player *p)
     }
     p->x = nx;
     p->xsub = sum & 0xFF;
+    if (p->on_ground && ahead < p->y)
+        p->y = ahead;  /* up a step */
 }
 
 static void move_y(volatile Player *p)
 {
-    int16_t top = ground_top(p->x);
+    int16_t top = support(p->x);
     uint16_t sum = p->ysub + (uint8_t)(p->vy & 0xFF);
     int16_t ny = p->y + (p->vy >> 8) + (sum >> 8);
 
     p->ysub = sum & 0xFF;
-    if (p->vy >= 0 && ny >= top && p->y <= top + 8) {
-        p->y = top;  /* landed, or walked up a step */
+    if (p->vy >= 0 && ny >= top && p->y <= top) {
+        p->y = top;  /* standing, or landed from above */
         p->vy = 0;
         p->ysub = 0;
         p->on_ground = 1;

@@ -129,6 +129,14 @@ def test_starts_moves_and_scrolls(hopper: Hopper) -> None:
     assert hopper["p1_vy"] < 0  # button 1 jumps
 
 
+def test_left_and_right_together_cancel_out(hopper: Hopper) -> None:
+    hopper.boot()
+    hopper.start()
+    x = hopper["p1_x"]
+    hopper.run(["LEFT", "RIGHT"], frames=30)
+    assert hopper["p1_x"] == x and hopper["p1_vx"] == 0
+
+
 def test_button_2_jumps_too(hopper: Hopper) -> None:
     hopper.boot()
     hopper.start()

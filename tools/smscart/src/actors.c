@@ -172,10 +172,11 @@ static void player_update(uint8_t i)
     if (p->invuln)
         p->invuln--;
 
-    if (held & PAD_RIGHT) {
+    /* LEFT and RIGHT together cancel out (the pad's rocker cannot press both). */
+    if ((held & (PAD_LEFT | PAD_RIGHT)) == PAD_RIGHT) {
         p->vx = p->vx + ACCEL > MAX_VX ? MAX_VX : p->vx + ACCEL;
         p->facing = 0;
-    } else if (held & PAD_LEFT) {
+    } else if ((held & (PAD_LEFT | PAD_RIGHT)) == PAD_LEFT) {
         p->vx = p->vx - ACCEL < -MAX_VX ? -MAX_VX : p->vx - ACCEL;
         p->facing = 1;
     } else if (p->vx > FRICTION) {

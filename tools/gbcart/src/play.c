@@ -86,6 +86,9 @@ static void run_and_jump(void) {
     int16_t vx = player.vx;
     int16_t x, y;
     uint8_t floor;
+    /* A real d-pad cannot press left and right at once: both count as neither. */
+    if ((held & (PAD_LEFT | PAD_RIGHT)) == (PAD_LEFT | PAD_RIGHT))
+        held &= (uint8_t)~(PAD_LEFT | PAD_RIGHT);
     if (held & PAD_RIGHT) {
         vx += vx < 0 ? 2 * RUN_ACCEL : RUN_ACCEL;
         if (vx > RUN_MAX)

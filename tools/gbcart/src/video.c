@@ -65,7 +65,7 @@ static const uint16_t obj_colors[2][4] = {
     {0, RGB(31, 26, 0), RGB(28, 4, 4), RGB(0, 0, 0)},     /* walkers */
 };
 /* The Game Boy's four greys: the sky darkens level by level. */
-static const uint8_t dmg_bgp[LEVELS] = {0xE4, 0xE5, 0xE6};
+static const uint8_t dmg_bgp[LEVELS] = {0xE4, 0xE1, 0xD2}; /* sky white, light, dark grey */
 
 /* What the next VBlank copies into VRAM. */
 static uint8_t column_buf[PLAY_ROWS];

@@ -106,3 +106,14 @@ def test_jerk_takes_the_scenarios_jump_button(tmp_path: Path) -> None:
         assert env.actions.to_masks(jerk.moves[False, True]) == [env.emulator.system.mask(["RIGHT", "C"])]
     finally:
         env.close()
+
+
+@pytest.mark.parametrize("name", sorted(all_systems()))
+def test_the_studio_keys_give_enter_to_the_start_button_and_a_key_to_every_button(name: str) -> None:
+    from retrokit.studio.play import key_map, pad_map
+
+    system = get_system(name)
+    keys = key_map(system)
+    assert keys["Enter"] == system.start and pad_map(system)["9"] == system.start
+    assert set(keys.values()) == set(system.button_names)
+    assert {keys[k] for k in ("ArrowUp", "ArrowDown", "ArrowLeft", "ArrowRight")} == {"UP", "DOWN", "LEFT", "RIGHT"}

@@ -27,7 +27,7 @@ ROM = GAME_DIR / "rom.nes"
 # The stages' goal x, from tools/nescart/src/world.c: five columns before each stage's end.
 END_X = {(0, 0): 2248, (0, 1): 2312, (1, 0): 2568, (1, 1): 2840, (2, 0): 3192, (2, 1): 3416}
 GROUND = 0x0400  # one byte per 16-pixel column: height 0-4 (0 = pit), bit 7 = a coin
-ENEMIES, ENEMY_SIZE = 0x0380, 10
+ENEMIES, ENEMY_SIZE = 0x0300, 10
 FIELDS = game_fields(GAME_DIR)
 
 

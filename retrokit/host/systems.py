@@ -75,6 +75,12 @@ class System:
         reset_before_state: The core restores some state only partly (so a
             load's outcome would depend on what ran before it): the console is
             reset before each state is loaded, so every load starts alike.
+        start: The button that starts a game from its title screen.
+        jump: The button JERK jumps with, unless a scenario names another.
+        switches: Console switches (not pad buttons), which default action sets, the random
+            agent, JERK and validate's smoke run leave alone.
+        proven_by: What proves retrokit runs the system right, by kind (``"cartridge"``,
+            ``"stable-retro"``, ``"ale-py"``): a game's name, or ``""``; empty if nothing does.
     """
 
     name: str
@@ -94,6 +100,19 @@ class System:
     detect: tuple[DetectRule, ...] = ()
     rom_format: str = ""
     missing_mappers: frozenset[int] = frozenset()
+    start: str = "START"
+    jump: str | None = None
+    switches: tuple[str, ...] = ()
+    proven_by: dict[str, str] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for what, names in (("start", [self.start]), ("jump", [self.jump] if self.jump else []), ("switches", self.switches)):
+            for name in names:
+                if name not in self.button_names:
+                    raise DataFileError(
+                        f"{_FILE}: system {self.name!r}: expected its {what} to be one of its buttons "
+                        f"({', '.join(self.button_names)}), got {name!r}." + did_you_mean(str(name), self.button_names)
+                    )
 
     def __str__(self) -> str:
         return self.name
@@ -130,6 +149,21 @@ class System:
         if reported is None:
             return next(iter(self.frame_rates.values()))
         return min(self.frame_rates.values(), key=lambda rate: abs(rate - reported))
+
+    @property
+    def proven(self) -> bool:
+        """Whether anything proves retrokit runs this system right (``proven_by``)."""
+        return bool(self.proven_by)
+
+    @property
+    def switch_mask(self) -> int:
+        """The RetroPad bits of the console switches."""
+        return self.mask(self.switches)
+
+    @property
+    def pad_buttons(self) -> tuple[str, ...]:
+        """The buttons that exist, console switches left out, in RetroPad id order."""
+        return tuple(b for b in self.button_names if b not in self.switches)
 
     def mask(self, buttons: Iterable[str]) -> int:
         """Return the RetroPad bit mask that presses the named buttons."""
@@ -168,6 +202,10 @@ def _parse(name: str, entry: object) -> System:
             detect=tuple(_detect_rule(rule) for rule in entry.get("detect") or ()),
             rom_format=_one_of(str((entry.get("rom") or {}).get("format", "")), ("", "ines"), "rom.format"),
             missing_mappers=frozenset(int(m) for m in (entry.get("rom") or {}).get("missing_mappers", ())),
+            start=str(entry.get("start", "START")),
+            jump=str(entry["jump"]) if entry.get("jump") else None,
+            switches=tuple(str(b) for b in entry.get("switches", ())),
+            proven_by={str(k): str(v or "") for k, v in (entry.get("proven_by") or {}).items()},
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise DataFileError(f"{_FILE}: system {name!r} is malformed: {exc!r}.") from exc

@@ -343,3 +343,18 @@ def test_same_inputs_give_the_same_ram() -> None:
 def test_the_frame_counter_drives_walker_timing() -> None:
     # Pressing START a frame later changes the random pauses, so where the walkers are later on.
     assert _play(start_frame=10)[0] != _play(start_frame=11)[0]
+
+
+# --- the benchmarks ------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name,system", [("trekker", "GameBoy"), ("trekker-color", "GbColor")])
+def test_benchmark_is_a_built_in_on_shipped_states(name: str, system: str) -> None:
+    from retrokit.benchmark.definition import load_benchmark
+
+    benchmark = load_benchmark(name)
+    assert benchmark.name == name
+    levels = {level.name for level in benchmark.levels()}
+    assert levels == {f"Trekker-{system}/Level{n}" for n in (1, 2, 3)}
+    for n in (1, 2, 3):
+        assert (ROMS[system].parent / f"Level{n}.state").is_file()

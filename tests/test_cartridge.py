@@ -9,7 +9,6 @@ a misaligned word access in the game would crash it (and set ``crash``).
 from __future__ import annotations
 
 import hashlib
-import re
 import shutil
 import struct
 import subprocess
@@ -20,7 +19,7 @@ import numpy as np
 import pytest
 import yaml
 
-from retrokit.host.emulator import Emulator
+from cartgame import CartridgeGame, assert_fields_match, game_fields, header_defines
 
 REPO = Path(__file__).resolve().parent.parent
 GAME_DIR = REPO / "games" / "Dasher-Genesis"
@@ -33,42 +32,17 @@ MODE_TITLE, MODE_PLAY, MODE_CLEAR, MODE_GAMEOVER = 0, 1, 2, 3
 ALIVE, DYING, OUT, ABSENT = 0, 1, 2, 3
 
 
-def _fields() -> dict[str, tuple[int, str]]:
-    doc = yaml.safe_load((GAME_DIR / "game.yaml").read_text())
-    return {name: (int(f["address"]), f["type"]) for name, f in doc["fields"].items()}
+FIELDS = game_fields(GAME_DIR)
 
 
-FIELDS = _fields()
-
-
-class Dasher:
+class Dasher(CartridgeGame):
     """An emulator running Dasher, with the game's fields by name."""
 
     def __init__(self, rom: Path, *, tmss: bool = False) -> None:
         options = {"genesis_plus_gx_addr_error": "enabled"}
         if tmss:
             options["genesis_plus_gx_bios"] = "enabled"
-        self.emu = Emulator.for_rom(rom, options=options)
-        self.mask = self.emu.system.mask
-
-    def __getitem__(self, name: str) -> int:
-        address, code = FIELDS[name]
-        return self.emu.peek(address, code)
-
-    def __setitem__(self, name: str, value: int) -> None:
-        address, code = FIELDS[name]
-        self.emu.poke(address, value, code)
-
-    def run(self, p1: list[str] = (), p2: list[str] = (), frames: int = 1) -> None:
-        self.emu.run([self.mask(p1), self.mask(p2)], frames)
-
-    def run_until(self, condition, p1: list[str] = (), p2: list[str] = (), limit: int = 600) -> int:
-        """Run frames holding the buttons until ``condition()``; return the frames run."""
-        for n in range(limit):
-            if condition():
-                return n
-            self.run(p1, p2)
-        raise AssertionError(f"condition not met within {limit} frames")
+        super().__init__(rom, FIELDS, options)
 
     def boot(self) -> None:
         """Run until the title screen's main loop is counting frames."""
@@ -125,8 +99,7 @@ def test_game_yaml_lists_the_committed_rom(dasher_rom: Path) -> None:
 
 def _ram_h() -> dict[str, int]:
     """The fixed addresses of src/ram.h, by game.yaml's field names."""
-    defines = dict(re.findall(r"^#define (\w+) (0x[0-9A-Fa-f]+)\b", (CART_DIR / "src" / "ram.h").read_text(), re.MULTILINE))
-    values = {name: int(v, 16) for name, v in defines.items()}
+    values = header_defines(CART_DIR / "src" / "ram.h")
     out = {k[len("ADDR_"):].lower(): v for k, v in values.items() if k.startswith("ADDR_")}
     for player in (1, 2):
         base = values[f"ADDR_P{player}"]
@@ -137,10 +110,7 @@ def _ram_h() -> dict[str, int]:
 
 
 def test_game_yaml_addresses_match_the_source() -> None:
-    known = _ram_h()
-    for name, (address, _) in FIELDS.items():
-        assert name in known, f"game.yaml field {name!r} is not in src/ram.h"
-        assert address == known[name], f"{name}: game.yaml says {address:#x}, src/ram.h {known[name]:#x}"
+    assert_fields_match(FIELDS, _ram_h(), "src/ram.h")
     for name in ("zone", "act", "game_mode", "frame", "end_x", "level_done"):
         assert name in FIELDS
     for player in ("p1", "p2"):
@@ -313,7 +283,7 @@ def test_zones_look_different(dasher_rom: Path) -> None:
 def test_port_2_moves_player_2(playing: Dasher) -> None:
     assert playing["p2_state"] == ABSENT
     x1 = playing["p1_x"]
-    playing.run(p2=["RIGHT"], frames=60)
+    playing.run([], ["RIGHT"], frames=60)
     assert playing["p2_state"] == ALIVE, "any button on pad 2 joins player 2"
     assert playing["p2_lives"] == 3
     assert playing["p2_x"] > playing["start_x"] + 20
@@ -328,7 +298,7 @@ def test_port_2_moves_player_2(playing: Dasher) -> None:
 def test_start_on_port_2_starts_a_two_player_game(dasher: Dasher) -> None:
     dasher.start(p1=[], p2=["START"])
     assert dasher["p1_state"] == ALIVE and dasher["p2_state"] == ALIVE
-    dasher.run(p2=["RIGHT", "B"], frames=10)
+    dasher.run([], ["RIGHT", "B"], frames=10)
     assert dasher["p2_vy"] != 0 or dasher["p2_y"] < 192, "player 2 jumps"
 
 
@@ -346,7 +316,7 @@ def _play(rom: Path, start_frame: int, seed: int = 7) -> tuple[bytes, list[bytes
         choices = [["RIGHT"], ["RIGHT", "B"], ["RIGHT", "C"], [], ["LEFT"]]
         snapshots = []
         for i in range(400):
-            game.run(choices[rng.choice(5, p=[0.6, 0.15, 0.1, 0.1, 0.05])], p2=["RIGHT"] if i % 3 else [])
+            game.run(choices[rng.choice(5, p=[0.6, 0.15, 0.1, 0.1, 0.05])], ["RIGHT"] if i % 3 else [])
             if i % 100 == 99:
                 snapshots.append(bytes(game.emu.ram))
         enemies = bytes(game.emu.peek(0xFF0060 + i) for i in range(8 * 12))

@@ -9,14 +9,13 @@ facts of the core that the GameBoy and GbColor descriptors in host/systems.yaml 
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 
-from retrokit.host.emulator import Emulator
+from cartgame import CartridgeGame, assert_fields_match, game_fields, header_defines
 
 REPO = Path(__file__).resolve().parent.parent
 CART_DIR = REPO / "tools" / "gbcart"
@@ -32,39 +31,14 @@ MODE_TITLE, MODE_PLAY, MODE_CLEAR, MODE_GAMEOVER = 0, 1, 2, 3
 ALIVE, DYING, OUT = 0, 1, 2
 
 
-def _fields(system: str) -> dict[str, tuple[int, str]]:
-    doc = yaml.safe_load((ROMS[system].parent / "game.yaml").read_text())
-    return {name: (int(f["address"]), f["type"]) for name, f in doc["fields"].items()}
+FIELDS = game_fields(ROMS["GameBoy"].parent)
 
 
-FIELDS = _fields("GameBoy")
-
-
-class Trekker:
+class Trekker(CartridgeGame):
     """An emulator running Trekker, with the game's fields by name."""
 
     def __init__(self, system: str = "GameBoy") -> None:
-        self.emu = Emulator.for_rom(ROMS[system])
-        self.mask = self.emu.system.mask
-
-    def __getitem__(self, name: str) -> int:
-        address, code = FIELDS[name]
-        return self.emu.peek(address, code)
-
-    def __setitem__(self, name: str, value: int) -> None:
-        address, code = FIELDS[name]
-        self.emu.poke(address, value, code)
-
-    def run(self, buttons: list[str] = (), frames: int = 1) -> None:
-        self.emu.run([self.mask(list(buttons))], frames)
-
-    def run_until(self, condition, buttons: list[str] = (), limit: int = 600) -> int:
-        """Run frames holding the buttons until ``condition()``; return the frames run."""
-        for n in range(limit):
-            if condition():
-                return n
-            self.run(buttons)
-        raise AssertionError(f"condition not met within {limit} frames")
+        super().__init__(ROMS[system], FIELDS)
 
     def boot(self) -> None:
         """Run until the title screen's main loop is counting frames.
@@ -109,8 +83,7 @@ def playing(trekker: Trekker) -> Trekker:
 
 def _ram_h() -> dict[str, int]:
     """The fixed addresses of src/ram.h, by game.yaml's field names."""
-    text = (CART_DIR / "src" / "ram.h").read_text()
-    values = {k: int(v, 16) for k, v in re.findall(r"^#define (\w+) (0x[0-9A-Fa-f]+)\b", text, re.MULTILINE)}
+    values = header_defines(CART_DIR / "src" / "ram.h")
     out = {k[len("ADDR_"):].lower(): v for k, v in values.items() if k.startswith("ADDR_")}
     out.update({f"p1_{k[2:].lower()}": values["ADDR_P1"] + v for k, v in values.items() if k.startswith("P_")})
     return out
@@ -118,12 +91,9 @@ def _ram_h() -> dict[str, int]:
 
 @pytest.mark.parametrize("system", ROMS)
 def test_game_yaml_addresses_match_the_source(system: str) -> None:
-    known = _ram_h()
-    fields = _fields(system)
+    fields = game_fields(ROMS[system].parent)
     assert fields == FIELDS, "both builds share one RAM map"
-    for name, (address, _) in fields.items():
-        assert name in known, f"game.yaml field {name!r} is not in src/ram.h"
-        assert address == known[name], f"{name}: game.yaml says {address:#x}, src/ram.h {known[name]:#x}"
+    assert_fields_match(fields, _ram_h(), "src/ram.h")
     assert fields["p1_x"][1] == "<i2" and fields["p1_score"][1] == "<d4" and fields["p1_lives"][1] == "|u1"
     assert yaml.safe_load((ROMS[system].parent / "game.yaml").read_text())["players"] == 1
 

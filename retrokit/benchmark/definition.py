@@ -28,7 +28,7 @@ from retrokit.data.yamlfile import load_yaml
 from retrokit.errors import BenchmarkFileError, RomNotFoundError, StateNotFoundError, UnknownNameError, did_you_mean
 from retrokit.paths import read_regular_file
 
-# Every benchmark file shipped beside this module (one per test cartridge) is a built-in, by its file's name.
+# Every benchmark file beside this module is built in, by its name: each cartridge's (dasher.yaml, ...).
 BUILTIN_FILES = {path.stem: path for path in sorted(Path(__file__).parent.glob("*.yaml"))}
 BUILTINS = (*BUILTIN_FILES, "sonic")
 SPLITS = ("test", "train", "all")

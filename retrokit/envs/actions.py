@@ -11,7 +11,8 @@ Four types, as in Gym Retro:
   group (a product), per player.
 - ``"multi_discrete"``: one choice per group, per player.
 
-Groups come from the scenario's ``actions`` or, failing that, the system's.
+Groups come from the scenario's ``actions`` or, failing that, the system's,
+numbered as stable-retro numbers them (:func:`stable_retro_order`).
 """
 
 from __future__ import annotations
@@ -28,6 +29,23 @@ from retrokit.host.primitives import pack_buttons
 from retrokit.host.systems import System
 
 ACTION_TYPES = ("all", "filtered", "discrete", "multi_discrete")
+
+
+def stable_retro_order(groups: Sequence[Sequence[int]]) -> list[list[int]]:
+    """Groups of button masks in the order stable-retro numbers discrete and multi-discrete actions.
+
+    stable-retro keeps a scenario's groups in a map from each group's mask (every
+    button it mentions) to the set of its combinations, so the groups come in
+    ascending order of that mask, each group's combinations in ascending order
+    of their own masks, once each; a group whose mask an earlier group already
+    has is dropped. Using its order, not the listed one, makes action 9 press
+    the same buttons here as there (a policy trained there, a logged action
+    sequence or a hand-written table carries over).
+    """
+    by_mask: dict[int, list[int]] = {}
+    for group in groups:
+        by_mask.setdefault(int(np.bitwise_or.reduce(group)) if group else 0, sorted(set(group)))
+    return [by_mask[mask] for mask in sorted(by_mask)]
 
 
 class ActionMap:
@@ -58,8 +76,7 @@ class ActionMap:
                 f"Expected button combinations for action type {action_type!r}, but neither the scenario nor the "
                 f"{system.name} system lists any. Use action_type='all', or add 'actions' to the scenario."
             )
-        # Each group: its combinations as masks, and the mask of every button it mentions.
-        self.combos = [[system.mask(combo) for combo in group] for group in groups]
+        self.combos = stable_retro_order([[system.mask(combo) for combo in group] for group in groups])
         self.group_masks = [int(np.bitwise_or.reduce(c)) if c else 0 for c in self.combos]
         self.valid = [set(c) for c in self.combos]
         self.num_buttons = len(system.buttons)
@@ -83,19 +100,48 @@ class ActionMap:
     def _groups_as_names(self) -> list[list[list[str]]]:
         return [[self.system.buttons_of(m) for m in group] for group in self.combos]
 
-    def press(self, buttons: Sequence[str]) -> np.ndarray:
-        """The one-player ``"all"``/``"filtered"`` action that presses the named buttons.
+    def press(self, buttons: Sequence[str]) -> np.ndarray | int:
+        """The one-player action of this map's type that presses the named buttons.
+
+        With ``"discrete"`` and ``"multi_discrete"``, the buttons must be one listed
+        combination of each group (``["RIGHT", "B"]``: ``RIGHT`` of the D-pad's group,
+        ``B`` of the face buttons').
 
         Raises:
-            InvalidArgumentError: This map's actions are not button arrays.
+            UnknownNameError: A name is not one of the system's buttons.
+            InvalidArgumentError: The buttons are no choice of this map's groups.
         """
-        if self.action_type not in ("all", "filtered"):
-            raise InvalidArgumentError(
-                f"Expected an action type of 'all' or 'filtered' to press buttons by name, got {self.action_type!r}; "
-                f"its actions pick button combinations by index."
-            )
         mask = self.system.mask(buttons)
-        return ((mask >> np.arange(self.num_buttons)) & 1).astype(np.int8)
+        if self._packs:
+            return ((mask >> np.arange(self.num_buttons)) & 1).astype(np.int8)
+        picks = []
+        for combos, group_mask in zip(self.combos, self.group_masks):
+            if mask & group_mask not in combos:
+                break
+            picks.append(combos.index(mask & group_mask))
+        if len(picks) < len(self.combos) or mask & ~int(np.bitwise_or.reduce(self.group_masks)):
+            listed = "; ".join(" ".join("+".join(self.system.buttons_of(m)) or "none" for m in c) for c in self.combos)
+            raise InvalidArgumentError(
+                f"Expected buttons that make one listed combination of each group of the {self.action_type!r} "
+                f"actions ({listed}), got {list(buttons)}. Use action_type='all', or list the combination in "
+                f"the scenario's actions."
+            )
+        if self.action_type == "multi_discrete":
+            return np.array(picks, dtype=self.space.dtype)
+        index, radix = 0, 1
+        for pick, combos in zip(picks, self.combos):
+            index, radix = index + pick * radix, radix * len(combos)
+        return index
+
+    def leave_switches(self, action: object) -> object:
+        """``action`` with the console switches released (an agent that samples ``"all"`` leaves them alone)."""
+        if not self._packs or not self.system.switches:
+            return action  # the groups of the other types hold switches only where a scenario asked for them
+        array = np.array(action, copy=True)
+        for name in self.system.switches:
+            bit = self.system.button_bit(name)
+            array.reshape(self.players, self.num_buttons)[:, bit] = 0
+        return array
 
     def combine(self, per_player: Sequence[object]) -> object:
         """Join one action per player (each of :meth:`single_player_space`) into one action of this map."""

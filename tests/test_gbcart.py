@@ -128,7 +128,8 @@ def test_colour_build_is_in_colour_and_the_game_boy_build_in_four_greys(system: 
         game.start()
         game.run(frames=2)
         pixels = np.unique(game.emu.screen().reshape(-1, 3), axis=0)
-        grey = bool((pixels[:, 0] == pixels[:, 1]).all() and (pixels[:, 1] == pixels[:, 2]).all())
+        # Grey within RGB565's rounding: green has 6 bits, so gambatte's white is (248, 252, 248).
+        grey = bool((np.abs(pixels.astype(int) - pixels[:, :1].astype(int)) <= 4).all())
         if system == "GameBoy":
             assert grey and len(pixels) == 4, pixels
         else:

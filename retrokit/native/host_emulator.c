@@ -428,6 +428,9 @@ static PyObject *emulator_serialize(EmulatorObject *self, PyObject *unused) {
     bool ok = false;
     if (out) {
         Py_BEGIN_ALLOW_THREADS
+        /* A core may write less than its size (Genesis Plus GX: a quarter): the rest is zeros, not whatever
+         * the allocator left there, so that a state's bytes depend on the game alone. */
+        memset(dst, 0, size);
         rk_enter(&self->core);
         ok = self->core.api.serialize(dst, size);
         rk_leave();

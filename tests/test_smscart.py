@@ -12,7 +12,7 @@ import struct
 from pathlib import Path
 
 import pytest
-import yaml
+from cartplay import CartridgePlay, game_fields
 
 from retrokit.host.emulator import Emulator
 
@@ -27,37 +27,15 @@ ALIVE, DYING, OUT, ABSENT = 0, 1, 2, 3
 
 
 def _fields(system: str) -> dict[str, tuple[int, str]]:
-    doc = yaml.safe_load((GAMES[system] / "game.yaml").read_text())
-    return {name: (int(f["address"]), f["type"]) for name, f in doc["fields"].items()}
+    return game_fields(GAMES[system])
 
 
-class Hopper:
+class Hopper(CartridgePlay):
     """An emulator running one of Hopper's ROMs, with the game's fields by name."""
 
     def __init__(self, system: str) -> None:
+        super().__init__(Emulator.for_rom(GAMES[system] / ROMS[system]), _fields(system))
         self.system = system
-        self.fields = _fields(system)
-        self.emu = Emulator.for_rom(GAMES[system] / ROMS[system])
-        self.mask = self.emu.system.mask
-
-    def __getitem__(self, name: str) -> int:
-        address, code = self.fields[name]
-        return self.emu.peek(address, code)
-
-    def __setitem__(self, name: str, value: int) -> None:
-        address, code = self.fields[name]
-        self.emu.poke(address, value, code)
-
-    def run(self, p1=(), p2=(), frames: int = 1) -> None:
-        self.emu.run([self.mask(list(p1)), self.mask(list(p2))], frames)
-
-    def run_until(self, condition, p1=(), p2=(), limit: int = 600) -> int:
-        """Run frames holding the buttons until ``condition()``; return the frames run."""
-        for n in range(limit):
-            if condition():
-                return n
-            self.run(p1, p2)
-        raise AssertionError(f"condition not met within {limit} frames")
 
     def boot(self) -> None:
         self.run_until(lambda: self["frame"] >= 2, limit=120)

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import struct
 import sys
+from pathlib import Path
 
 SIZE = 0x8000
 HEADER = 0x7FF0
@@ -46,11 +47,10 @@ def main(argv: list[str]) -> int:
     if len(argv) != 4 or argv[3] not in REGIONS:
         print(__doc__.strip().splitlines()[2], file=sys.stderr)
         return 2
-    with open(argv[1], "rb") as f:
-        rom = fix(f.read(), argv[3])
-    with open(argv[2], "wb") as f:
-        f.write(rom)
-    print(f"{argv[2]}: {len(rom)} bytes, checksum {checksum(rom):04X}, region {REGIONS[argv[3]]:X}")
+    source, target, console = argv[1:]
+    rom = fix(Path(source).read_bytes(), console)
+    Path(target).write_bytes(rom)
+    print(f"{target}: {len(rom)} bytes, checksum {checksum(rom):04X}, region {REGIONS[console]:X}")
     return 0
 
 

@@ -151,6 +151,26 @@ static void take_coins(uint8_t i)
     }
 }
 
+/* A jump starts on the press of a jump button while standing; letting go
+ * while still rising fast cuts it short (so taps hop and holds leap). */
+static void jump_and_fall(volatile Player *p, uint8_t held, uint8_t pressed)
+{
+    if (!(held & PAD_JUMP)) {
+        p->jump_held = 0;
+    } else if (p->on_ground && (pressed & PAD_JUMP)) {
+        p->on_ground = 0;
+        p->jump_held = 1;
+        p->vy = -JUMP_VY;
+    }
+    if (p->on_ground)
+        return;
+    if (p->vy < -JUMP_RELEASE && !p->jump_held)
+        p->vy = -JUMP_RELEASE;
+    p->vy += GRAVITY;
+    if (p->vy > MAX_FALL)
+        p->vy = MAX_FALL;
+}
+
 static void player_update(uint8_t i)
 {
     volatile Player *p = &G.p[i];
@@ -186,18 +206,7 @@ static void player_update(uint8_t i)
     } else {
         p->vx = 0;
     }
-    if (p->on_ground && (pressed & PAD_JUMP)) {
-        p->vy = -JUMP_VY;
-        p->on_ground = 0;
-        p->jump_held = 1;
-    }
-    if (!(held & PAD_JUMP))
-        p->jump_held = 0;
-    if (!p->on_ground) {
-        if (!p->jump_held && p->vy < -JUMP_RELEASE)
-            p->vy = -JUMP_RELEASE;
-        p->vy = p->vy + GRAVITY > MAX_FALL ? MAX_FALL : p->vy + GRAVITY;
-    }
+    jump_and_fall(p, held, pressed);
     move_x(p);
     move_y(p);
     if (p->y > SCREEN_BOTTOM + 16) {

@@ -12,9 +12,7 @@ import struct
 from pathlib import Path
 
 import pytest
-from cartplay import CartridgePlay, game_fields
-
-from retrokit.host.emulator import Emulator
+from cartgame import CartGame, game_fields
 
 REPO = Path(__file__).resolve().parent.parent
 CART_DIR = REPO / "tools" / "smscart"
@@ -30,21 +28,16 @@ def _fields(system: str) -> dict[str, tuple[int, str]]:
     return game_fields(GAMES[system])
 
 
-class Hopper(CartridgePlay):
+class Hopper(CartGame):
     """An emulator running one of Hopper's ROMs, with the game's fields by name."""
 
     def __init__(self, system: str) -> None:
-        super().__init__(Emulator.for_rom(GAMES[system] / ROMS[system]), _fields(system))
+        super().__init__(GAMES[system] / ROMS[system], _fields(system))
         self.system = system
-
-    def boot(self) -> None:
-        self.run_until(lambda: self["frame"] >= 2, limit=120)
-        assert self["game_mode"] == MODE_TITLE
 
     def start(self, p1=None, p2=()) -> None:
         """Press the start button (or ``p1``/``p2``) for one frame at the title; wait for play."""
-        self.run([START[self.system]] if p1 is None else p1, p2)
-        self.run_until(lambda: self["game_mode"] == MODE_PLAY, limit=120)
+        super().start([START[self.system]] if p1 is None else p1, p2)
 
     def ground(self, column: int) -> int:
         return self.emu.peek(GROUND + column)

@@ -80,7 +80,9 @@ def corrupt_state(good_state: bytes) -> bytes:
 
     from corrupt import random_body
 
-    return random_body(good_state, random.Random(1), keep_pointers=True)
+    # Seed 6: with the bytes statelayout reads kept real (bank map, Z80 bank, VDP FIFO index), the body of
+    # seeds 1 to 5 happens to run; this one crashes the core in the probe's run.
+    return random_body(good_state, random.Random(6), keep_pointers=True)
 
 
 @pytest.fixture(scope="module")

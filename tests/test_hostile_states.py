@@ -127,6 +127,37 @@ def test_a_z80_bank_outside_the_68000s_space_is_refused(good_state: bytes) -> No
     assert "Z80 bank address is 0x1ff8000" in state_layout_problem("Genesis", bytes(state))
 
 
+def test_a_vdp_fifo_index_past_the_fifo_is_refused(good_state: bytes) -> None:
+    import struct
+
+    from retrokit.host.statelayout import GENESIS_FIFO_INDEX, state_layout_problem
+
+    state = bytearray(good_state)
+    assert struct.unpack_from("<I", state, GENESIS_FIFO_INDEX)[0] < 4  # the offset holds what the core wrote
+    struct.pack_into("<I", state, GENESIS_FIFO_INDEX, 3)
+    assert state_layout_problem("Genesis", bytes(state)) == ""
+    struct.pack_into("<I", state, GENESIS_FIFO_INDEX, 4)
+    assert "VDP FIFO write index is 0x4," in state_layout_problem("Genesis", bytes(state))
+
+
+def test_a_wild_vdp_fifo_index_really_crashes_the_core(tmp_path: Path, good_state: bytes) -> None:
+    import struct
+
+    from retrokit.host.statelayout import GENESIS_FIFO_INDEX
+
+    state = bytearray(good_state)
+    struct.pack_into("<I", state, GENESIS_FIFO_INDEX, 0x40000000)
+    (tmp_path / "wild.bin").write_bytes(state)
+    child = run_child(f"""
+        from retrokit.host.emulator import Emulator, claim_mint
+        emu = Emulator.for_rom({str(DASHER / "rom.md")!r})
+        emu.set_state(claim_mint()(open({str(tmp_path / "wild.bin")!r}, 'rb').read(), 'Genesis'))
+        emu.run([0, 0], 10)
+        print('survived')
+    """)
+    assert child.signal == "SIGSEGV", child.describe()
+
+
 def test_the_probe_child_refuses_a_wild_memory_map_too(good_state: bytes) -> None:
     verdict = probe_state(wild_map(good_state, 0xA0), "Genesis", DASHER / "rom.md", frames=1, input_frames=0)
     assert not verdict.safe and "outside the core's ROM area" in verdict.reason, verdict

@@ -19,6 +19,11 @@ The Z80's window into the 68000's space is the same: its base address
 24 bits (the core itself only ever writes ``& 0xFF8000``) calls a function
 pointer read from past the table.
 
+The VDP's FIFO is the same again: its write index (``fifo_idx``, 4 bytes) is
+restored from the state, and the next write to the VDP's data port stores at
+``fifo[fifo_idx]`` in a 4-entry array (the core itself keeps the index
+``& 3``): 0x40000000 is a SIGSEGV at the game's next VDP write.
+
 So such a state is refused by reading those bytes, before any probe: the
 verdict does not depend on luck. No state a core writes has such a byte (the
 core maps banks only inside its ROM area): the 928 Genesis states that
@@ -53,6 +58,10 @@ GENESIS_Z80_BANK = 16 + 0x10000 + 0x2000 + 1
 work RAM, the Z80's RAM and the Z80's bus state."""
 GENESIS_Z80_BANK_BITS = 0xFF8000
 """The bits a Z80 bank address may have: 9 bits of bank, in the 68000's 24-bit space."""
+GENESIS_FIFO_INDEX = 16 + 0x10000 + 0x2000 + 1 + 4 + 0x10 + 0x400 + 0x10000 + 0x80 + 0x80 + 0x20 + 12
+"""Where a Mega Drive state's VDP FIFO write index (4 bytes, little-endian, 0 to 3) is: after the Z80's bank address,
+the I/O registers, and the VDP's sprite table, VRAM, CRAM, VSRAM, registers and its first 12 bytes of state."""
+GENESIS_FIFO_SIZE = 4
 GENESIS_BANKS = 0x40
 GENESIS_ROM_BANKS = 10485760 >> 16
 """Banks of 64 KiB in the core's ROM area (``MAXROMSIZE``, 10 MiB): a bank byte must be below this, or 0xFF."""
@@ -78,6 +87,12 @@ def _genesis_problem(state: bytes) -> str:
         return (
             f"its Z80 bank address is {z80_bank:#x}, outside the 68000's 24-bit space (a core writes only "
             f"addresses within {GENESIS_Z80_BANK_BITS:#x}), which reads memory the core does not own"
+        )
+    (fifo_index,) = struct.unpack_from("<I", state, GENESIS_FIFO_INDEX)
+    if fifo_index >= GENESIS_FIFO_SIZE:
+        return (
+            f"its VDP FIFO write index is {fifo_index:#x}, past the FIFO's {GENESIS_FIFO_SIZE} entries (a core keeps "
+            "it below 4), so the next VDP write stores into memory the core does not own"
         )
     banks = state[GENESIS_BANK_MAP : GENESIS_BANK_MAP + GENESIS_BANKS]
     wild = [(i, b) for i, b in enumerate(banks) if GENESIS_ROM_BANKS <= b < _SRAM]

@@ -56,8 +56,8 @@ static void show_title_level(void) {
     text(12, 14, line);
 }
 
+/* The title: mode 0 only once drawn, so a RUN pressed from then on is seen. */
 static void enter_title(void) {
-    GAME_MODE = MODE_TITLE;
     CAMERA_X = 0;
     bat_clear();
     sprites_hide_from(0);
@@ -65,6 +65,7 @@ static void enter_title(void) {
     show_title_level();
     text(12, 18, "PUSH RUN");
     text(7, 26, "RETROKIT TEST CARTRIDGE");
+    GAME_MODE = MODE_TITLE;
 }
 
 static void start_level(void) {

@@ -1,0 +1,344 @@
+"""Hopper, our PC Engine cartridge, on the real mednafen_pce_fast core through retrokit's host.
+
+The game is documented in tools/pcecart/README.md; its RAM map is
+games/Hopper-PCEngine/game.yaml (checked here against tools/pcecart/src/ram.h).
+The byte-for-byte rebuild is tests/test_cartridges.py's; every tool on this
+system is tests/test_systems.py's. Here: the game itself, and the facts about
+the core that the PCEngine descriptor rests on.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+import retrokit
+from retrokit.host.emulator import Emulator
+
+REPO = Path(__file__).resolve().parent.parent
+GAME_DIR = REPO / "games" / "Hopper-PCEngine"
+ROM = GAME_DIR / "rom.pce"
+CART_DIR = REPO / "tools" / "pcecart"
+RAM_BASE = 0xF80000  # console address of work RAM's first byte, logical $2000
+GROUND = 0xF80300  # ground height in tiles per 8-pixel column, 0 = pit
+END_X = {0: 1200, 1: 1520, 2: 1840}  # tools/pcecart/src/levels.c
+TITLE, PLAY, CLEAR, GAMEOVER = 0, 1, 2, 3
+ALIVE, DYING = 0, 1
+
+
+def _fields() -> dict[str, tuple[int, str]]:
+    doc = yaml.safe_load((GAME_DIR / "game.yaml").read_text())
+    return {name: (int(f["address"]), f["type"]) for name, f in doc["fields"].items()}
+
+
+FIELDS = _fields()
+
+
+class Hopper:
+    """An emulator running Hopper, with the game's fields by name."""
+
+    def __init__(self) -> None:
+        self.emu = Emulator.for_rom(ROM)
+        self.mask = self.emu.system.mask
+
+    def __getitem__(self, name: str) -> int:
+        address, code = FIELDS[name]
+        return self.emu.peek(address, code)
+
+    def __setitem__(self, name: str, value: int) -> None:
+        address, code = FIELDS[name]
+        self.emu.poke(address, value, code)
+
+    def run(self, buttons: Sequence[str] = (), frames: int = 1) -> None:
+        self.emu.run([self.mask(list(buttons))], frames)
+
+    def run_until(self, condition: Callable[[], bool], buttons: Sequence[str] = (), limit: int = 600) -> int:
+        """Run frames holding the buttons until ``condition()``; return the frames run."""
+        for n in range(limit):
+            if condition():
+                return n
+            self.run(buttons)
+        raise AssertionError(f"condition not met within {limit} frames")
+
+    def boot(self) -> None:
+        """Run until the title's main loop is counting frames."""
+        self.run_until(lambda: self["frame"] >= 2, limit=120)
+        assert self["game_mode"] == TITLE
+
+    def start(self, level: int | None = None) -> None:
+        """Select a level by poking it at the title, press RUN, and wait for play."""
+        if level is not None:
+            self["level"] = level
+        self.run(["RUN"])
+        self.run_until(lambda: self["game_mode"] == PLAY, limit=120)
+
+    def ground(self, x: int) -> int:
+        return self.emu.peek(GROUND + x // 8)
+
+    def first_pit(self) -> tuple[int, int]:
+        """The first pit right of the player: its left and right edges, level pixels."""
+        x = self["x"]
+        while self.ground(x):
+            x += 8
+        left = x - x % 8
+        right = left
+        while not self.ground(right):
+            right += 8
+        return left, right
+
+    def pad(self, buttons: Sequence[str], frames: int = 1) -> list[int]:
+        """The pad byte the game reads on each of ``frames`` frames holding the buttons."""
+        seen = []
+        for _ in range(frames):
+            self.run(buttons)
+            seen.append(self["pad"])
+        return seen
+
+
+@pytest.fixture
+def hopper():
+    game = Hopper()
+    game.boot()
+    yield game
+    game.emu.close()
+
+
+@pytest.fixture
+def playing(hopper: Hopper) -> Hopper:
+    hopper.start()
+    return hopper
+
+
+# --- the ROM and its data file ----------------------------------------------------------------
+
+
+def test_rom_boots_from_bank_0() -> None:
+    rom = ROM.read_bytes()
+    assert len(rom) == 32 * 1024
+    # At power-on the console maps ROM bank 0 at $E000: the reset vector is at the end of the file's first 8 KiB.
+    reset = int.from_bytes(rom[0x1FFE:0x2000], "little")
+    assert 0xE000 <= reset < 0xFFF6
+
+
+def test_game_yaml_lists_the_committed_rom() -> None:
+    doc = yaml.safe_load((GAME_DIR / "game.yaml").read_text())
+    assert [r["sha1"] for r in doc["roms"]] == [hashlib.sha1(ROM.read_bytes()).hexdigest()]
+    assert doc["players"] == 1 and doc["system"] == "PCEngine"
+
+
+def _ram_h() -> dict[str, int]:
+    """src/ram.h's fixed addresses, as console addresses by game.yaml's field names."""
+    defines = re.findall(r"^#define ADDR_(\w+) +(0x[0-9A-Fa-f]+)", (CART_DIR / "src" / "ram.h").read_text(), re.MULTILINE)
+    return {name.lower(): RAM_BASE + int(value, 16) - 0x2000 for name, value in defines}
+
+
+def test_game_yaml_addresses_match_the_source() -> None:
+    known = _ram_h()
+    for name, (address, _) in FIELDS.items():
+        assert name in known, f"game.yaml field {name!r} is not in src/ram.h"
+        assert address == known[name], f"{name}: game.yaml says {address:#x}, src/ram.h {known[name]:#x}"
+    assert GROUND == known["ground"]
+    assert FIELDS["x"][1] == "<u2" and FIELDS["y"][1] == "<i2" and FIELDS["score"][1] == ">d4"
+
+
+# --- the core, as the PCEngine descriptor describes it -----------------------------------------
+
+
+def test_work_ram_is_logical_2000_at_console_f80000(hopper: Hopper) -> None:
+    ram = hopper.emu.ram
+    # The wheel's core reports the SuperGrafx's 32 KiB; a PC Engine uses the first 8 KiB, the rest stays 0xFF.
+    assert len(ram) == 32 * 1024
+    assert (ram[0x2000:] == 0xFF).all()
+    frame = hopper["frame"]
+    assert frame > 0
+    assert int(ram[0x208]) | int(ram[0x209]) << 8 == frame, "logical $2208 (frame, little-endian) is buffer offset 0x208"
+
+
+def test_screen_is_242_lines_of_256_pixels() -> None:
+    env = retrokit.make("Hopper-PCEngine", state="Level1")
+    try:
+        obs, _ = env.reset(seed=0)
+        for _ in range(10):
+            obs, *_ = env.step(env.action_space.sample() * 0)
+        assert obs.shape == (242, 256, 3)
+        assert len(np.unique(obs.reshape(-1, 3), axis=0)) > 4, "a blank screen"
+        assert env.metadata["render_fps"] == pytest.approx(59.826)
+    finally:
+        env.close()
+
+
+def test_each_pad_button_reaches_the_game(hopper: Hopper) -> None:
+    bits = {"I": 1, "II": 2, "SELECT": 4, "UP": 16, "RIGHT": 32, "DOWN": 64, "LEFT": 128}
+    for name, bit in bits.items():
+        assert hopper.pad([name], 2)[-1] == bit, name
+        hopper.run()
+    assert hopper.pad(["I", "II"], 2)[-1] == 3
+    hopper.run()
+    # V and VI (RetroPad L and R) are buttons of a 6-button pad, which the core's pad is not.
+    assert hopper.pad(["V", "VI"], 4) == [0, 0, 0, 0]
+
+
+@pytest.mark.parametrize(("switch", "fires"), [("III", "II"), ("IV", "I")])
+def test_iii_and_iv_toggle_turbo_so_no_action_group_has_them(hopper: Hopper, switch: str, fires: str) -> None:
+    bit = {"I": 1, "II": 2}[fires]
+    state = hopper.emu.get_state()
+    assert hopper.pad([fires], 8) == [bit] * 8
+    hopper.run()
+    hopper.pad([switch], 2)
+    hopper.run()
+    turbo = hopper.pad([fires], 8)
+    assert 0 in turbo and bit in turbo, f"holding {fires} after pressing {switch} fires on and off: {turbo}"
+    hopper.emu.set_state(state)
+    hopper.run()
+    assert 0 in hopper.pad([fires], 8), "the turbo outlives a state load"
+    groups = hopper.emu.system.actions
+    assert not any(b in combo for group in groups for combo in group for b in ("III", "IV", "V", "VI"))
+    assert ("I",) in groups[2] and ("II",) in groups[2]
+
+
+# --- playing ------------------------------------------------------------------------------------
+
+
+def test_starts_on_run_at_the_title(hopper: Hopper) -> None:
+    hopper.run(frames=30)
+    assert hopper["game_mode"] == TITLE, "the title waits for RUN"
+    hopper.start()
+    assert (hopper["level"], hopper["lives"], hopper["score"], hopper["state"]) == (0, 3, 0, ALIVE)
+    assert hopper["x"] == hopper["start_x"] and hopper["y"] == 208
+
+
+def test_main_loop_keeps_up_with_vblank(playing: Hopper) -> None:
+    frame, vblanks, lag = playing["frame"], playing["vblanks"], playing["lag"]
+    playing.run(["RIGHT"], frames=120)
+    assert playing["frame"] - frame == 120
+    assert (playing["vblanks"] - vblanks) % 256 == 120
+    assert playing["lag"] == lag, "a frame of play took longer than a frame"
+
+
+def test_holding_right_moves_x_and_the_camera(playing: Hopper) -> None:
+    x = playing["x"]
+    playing.run(["RIGHT"], frames=50)
+    assert playing["x"] > x + 80
+    assert playing["camera_x"] > 0, "the camera scrolls with the player"
+    right = playing["x"]
+    playing.run(["LEFT"], frames=60)  # it slides to a stop first
+    assert playing["x"] < right
+    playing.run(frames=30)
+    assert playing["vx"] == 0
+    both = playing["x"]
+    playing.run(["LEFT", "RIGHT"], frames=30)
+    assert playing["x"] == both, "left and right at once steer neither way"
+
+
+def test_coins_score_in_bcd(playing: Hopper) -> None:
+    # Level 1 opens with four coins at head height (columns 12-15, x 96-127).
+    playing.run_until(lambda: playing["x"] >= 136, ["RIGHT"], limit=120)
+    assert playing["coins"] == 4
+    assert playing["score"] == 40
+    assert playing.emu.peek(FIELDS["score"][0] + 3) == 0x40, "8 BCD digits, most significant byte first"
+
+
+@pytest.mark.parametrize("button", ["I", "II"], ids=["jump-I", "jump-II"])
+def test_jumping_over_a_pit_keeps_the_life(playing: Hopper, button: str) -> None:
+    left, right = playing.first_pit()
+    playing.run_until(lambda: playing["x"] >= left - 30, ["RIGHT"])
+    playing.run(["RIGHT", button], frames=20)
+    playing.run_until(lambda: playing["on_ground"] == 1, ["RIGHT"])
+    assert playing["x"] > right
+    assert (playing["state"], playing["lives"], playing["deaths"]) == (ALIVE, 3, 0)
+
+
+def test_walking_into_a_pit_loses_a_life_and_respawns(playing: Hopper) -> None:
+    left, right = playing.first_pit()
+    playing.run_until(lambda: playing["state"] == DYING, ["RIGHT"], limit=300)
+    assert left - 8 <= playing["x"] <= right
+    assert playing["lives"] == 2 and playing["deaths"] == 1
+    playing.run_until(lambda: playing["state"] == ALIVE, limit=300)
+    assert playing["x"] == playing["start_x"] and playing["camera_x"] == 0
+    assert playing["lives"] == 2
+
+
+def _crawler_ahead(game: Hopper) -> int:
+    """The address of the first live crawler right of the player."""
+    base, live = FIELDS["enemy_count"][0] + 0xD, []
+    for i in range(game["enemy_count"]):
+        at = base + 10 * i
+        if game.emu.peek(at + 7) and game.emu.peek(at, "<u2") > game["x"]:
+            live.append((game.emu.peek(at, "<u2"), at))
+    return min(live)[1]
+
+
+def test_a_crawler_on_the_ground_costs_a_life(playing: Hopper) -> None:
+    crawler = _crawler_ahead(playing)
+    # Stand in its patrol, clear of pits: it walks into the player.
+    playing["x"] = playing.emu.peek(crawler + 2, "<u2") + 4
+    playing.run_until(lambda: playing["state"] == DYING, limit=600)
+    assert playing["lives"] == 2
+    assert playing.emu.peek(crawler + 7) != 0, "the crawler lives on"
+
+
+def test_a_player_in_the_air_defeats_a_crawler(playing: Hopper) -> None:
+    crawler = _crawler_ahead(playing)
+    score = playing["score"]
+    # Drop the player onto it from above.
+    playing["x"] = playing.emu.peek(crawler, "<u2")
+    playing["y"] = playing.emu.peek(crawler + 6) - 30
+    playing["on_ground"] = 0
+    playing.run_until(lambda: playing.emu.peek(crawler + 7) == 0 or playing["state"] != ALIVE, limit=120)
+    assert playing["state"] == ALIVE and playing.emu.peek(crawler + 7) == 0
+    assert playing["vy"] < 0, "it bounces off the crawler"
+    assert playing["score"] - score == 100
+
+
+def test_losing_every_life_is_game_over(playing: Hopper) -> None:
+    for lives in (2, 1, 0):
+        playing.run_until(lambda: playing["state"] == DYING, ["RIGHT"], limit=400)
+        assert playing["lives"] == lives
+        playing.run_until(lambda: playing["state"] == ALIVE or playing["game_mode"] == GAMEOVER, limit=300)
+    assert playing["game_mode"] == GAMEOVER
+    playing.run_until(lambda: playing["game_mode"] == TITLE, limit=400)
+    playing.start()
+    assert (playing["lives"], playing["deaths"], playing["score"]) == (3, 0, 0)
+
+
+def test_reaching_end_x_clears_the_level(playing: Hopper) -> None:
+    end_x = playing["end_x"]
+    assert end_x == END_X[0] and playing.ground(end_x - 48) and playing.ground(end_x)
+    playing["x"] = end_x - 48  # flat ground before the goal
+    playing.run_until(lambda: playing["level_done"] == 1, ["RIGHT"], limit=120)
+    assert playing["x"] >= end_x
+    assert (playing["game_mode"], playing["score"]) == (CLEAR, 1000)
+    playing.run_until(lambda: playing["game_mode"] == PLAY, limit=400)
+    assert (playing["level"], playing["level_done"], playing["end_x"]) == (1, 0, END_X[1])
+    assert playing["score"] == 1000 and playing["lives"] == 3
+
+
+@pytest.mark.parametrize(("poked", "level"), [(0, 0), (1, 1), (2, 2), (3, 0), (200, 0)],
+                         ids=["level-1", "level-2", "level-3", "out-of-range-3", "out-of-range-200"])  # fmt: skip
+def test_level_select_by_poke(hopper: Hopper, poked: int, level: int) -> None:
+    hopper.start(poked)
+    assert hopper["level"] == level
+    assert hopper["end_x"] == END_X[level]
+    assert hopper["level_width"] == {0: 1280, 1: 1600, 2: 1920}[level]
+
+
+def test_same_inputs_from_a_state_replay_the_same_game(playing: Hopper) -> None:
+    state = playing.emu.get_state()
+    rng = np.random.default_rng(7)
+    inputs = [list(rng.choice(["RIGHT", "LEFT", "I", "II"], size=rng.integers(0, 3), replace=False)) for _ in range(300)]
+    runs = []
+    for _ in range(2):
+        playing.emu.set_state(state)
+        trace = []
+        for buttons in inputs:
+            playing.run(buttons)
+            trace.append((playing["x"], playing["y"], playing["rng"], playing["score"]))
+        runs.append((trace, bytes(playing.emu.ram[:0x2000])))
+    assert runs[0] == runs[1]
+    assert len({t[2] for t in runs[0][0]}) > 200, "the random state moves every frame"

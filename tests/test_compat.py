@@ -31,12 +31,13 @@ def test_buttons_are_stable_retros_names_in_its_order(dasher) -> None:
         pytest.param("all", np.eye(12, dtype=np.int8)[7] + np.eye(12, dtype=np.int8)[0], ["B", "RIGHT"], id="all"),
         pytest.param("filtered", np.ones(12, dtype=np.int8), [], id="filtered_drops_impossible_combinations"),
         pytest.param("discrete", 0, [], id="discrete_noop"),
-        pytest.param("multi_discrete", np.array([2, 2, 1]), ["A", "DOWN", "RIGHT"], id="multi_discrete"),
+        # stable-retro's numbering: the third group's combinations sorted by mask, B (bit 0) first.
+        pytest.param("multi_discrete", np.array([2, 2, 1]), ["B", "DOWN", "RIGHT"], id="multi_discrete"),
     ],
 )
 def test_get_action_meaning_names_the_buttons_the_console_sees(action_type: str, action, meaning: list[str]) -> None:
     env = retrokit.make("Airstriker-Genesis", action_type=action_type)
-    if action_type == "multi_discrete":  # Genesis's groups: [] UP DOWN, [] LEFT RIGHT, then A/B/C combinations
+    if action_type == "multi_discrete":  # Genesis's groups: [] UP DOWN, [] LEFT RIGHT, then B/A/C combinations
         assert env.action_space.nvec.tolist() == [3, 3, 14]
     assert env.get_action_meaning(action) == meaning
     env.close()

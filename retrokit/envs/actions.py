@@ -11,7 +11,8 @@ Four types, as in Gym Retro:
   group (a product), per player.
 - ``"multi_discrete"``: one choice per group, per player.
 
-Groups come from the scenario's ``actions`` or, failing that, the system's.
+Groups come from the scenario's ``actions`` or, failing that, the system's,
+numbered as stable-retro numbers them (:func:`stable_retro_order`).
 """
 
 from __future__ import annotations
@@ -28,6 +29,23 @@ from retrokit.host.primitives import pack_buttons
 from retrokit.host.systems import System
 
 ACTION_TYPES = ("all", "filtered", "discrete", "multi_discrete")
+
+
+def stable_retro_order(groups: Sequence[Sequence[int]]) -> list[list[int]]:
+    """Groups of button masks in the order stable-retro numbers discrete and multi-discrete actions.
+
+    stable-retro keeps a scenario's groups in a map from each group's mask (every
+    button it mentions) to the set of its combinations, so the groups come in
+    ascending order of that mask, each group's combinations in ascending order
+    of their own masks, once each; a group whose mask an earlier group already
+    has is dropped. Using its order, not the listed one, makes action 9 press
+    the same buttons here as there (a policy trained there, a logged action
+    sequence or a hand-written table carries over).
+    """
+    by_mask: dict[int, list[int]] = {}
+    for group in groups:
+        by_mask.setdefault(int(np.bitwise_or.reduce(group)) if group else 0, sorted(set(group)))
+    return [by_mask[mask] for mask in sorted(by_mask)]
 
 
 class ActionMap:
@@ -58,8 +76,7 @@ class ActionMap:
                 f"Expected button combinations for action type {action_type!r}, but neither the scenario nor the "
                 f"{system.name} system lists any. Use action_type='all', or add 'actions' to the scenario."
             )
-        # Each group: its combinations as masks, and the mask of every button it mentions.
-        self.combos = [[system.mask(combo) for combo in group] for group in groups]
+        self.combos = stable_retro_order([[system.mask(combo) for combo in group] for group in groups])
         self.group_masks = [int(np.bitwise_or.reduce(c)) if c else 0 for c in self.combos]
         self.valid = [set(c) for c in self.combos]
         self.num_buttons = len(system.buttons)

@@ -10,15 +10,13 @@ from __future__ import annotations
 
 import hashlib
 import re
-import shutil
 import struct
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
+from cartgame import CartGame, game_fields
 
 from retrokit.host.emulator import Emulator
 
@@ -33,42 +31,17 @@ MODE_TITLE, MODE_PLAY, MODE_CLEAR, MODE_GAMEOVER = 0, 1, 2, 3
 ALIVE, DYING, OUT, ABSENT = 0, 1, 2, 3
 
 
-def _fields() -> dict[str, tuple[int, str]]:
-    doc = yaml.safe_load((GAME_DIR / "game.yaml").read_text())
-    return {name: (int(f["address"]), f["type"]) for name, f in doc["fields"].items()}
+FIELDS = game_fields(GAME_DIR)
 
 
-FIELDS = _fields()
-
-
-class Dasher:
+class Dasher(CartGame):
     """An emulator running Dasher, with the game's fields by name."""
 
     def __init__(self, rom: Path, *, tmss: bool = False) -> None:
         options = {"genesis_plus_gx_addr_error": "enabled"}
         if tmss:
             options["genesis_plus_gx_bios"] = "enabled"
-        self.emu = Emulator.for_rom(rom, options=options)
-        self.mask = self.emu.system.mask
-
-    def __getitem__(self, name: str) -> int:
-        address, code = FIELDS[name]
-        return self.emu.peek(address, code)
-
-    def __setitem__(self, name: str, value: int) -> None:
-        address, code = FIELDS[name]
-        self.emu.poke(address, value, code)
-
-    def run(self, p1: list[str] = (), p2: list[str] = (), frames: int = 1) -> None:
-        self.emu.run([self.mask(p1), self.mask(p2)], frames)
-
-    def run_until(self, condition, p1: list[str] = (), p2: list[str] = (), limit: int = 600) -> int:
-        """Run frames holding the buttons until ``condition()``; return the frames run."""
-        for n in range(limit):
-            if condition():
-                return n
-            self.run(p1, p2)
-        raise AssertionError(f"condition not met within {limit} frames")
+        super().__init__(Emulator.for_rom(rom, options=options), FIELDS)
 
     def boot(self) -> None:
         """Run until the title screen's main loop is counting frames."""

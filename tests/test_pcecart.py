@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import hashlib
 import re
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
+from cartgame import CartGame, game_fields
 
 import retrokit
 from retrokit.host.emulator import Emulator
@@ -32,39 +33,14 @@ TITLE, PLAY, CLEAR, GAMEOVER = 0, 1, 2, 3
 ALIVE, DYING = 0, 1
 
 
-def _fields() -> dict[str, tuple[int, str]]:
-    doc = yaml.safe_load((GAME_DIR / "game.yaml").read_text())
-    return {name: (int(f["address"]), f["type"]) for name, f in doc["fields"].items()}
+FIELDS = game_fields(GAME_DIR)
 
 
-FIELDS = _fields()
-
-
-class Hopper:
+class Hopper(CartGame):
     """An emulator running Hopper, with the game's fields by name."""
 
     def __init__(self) -> None:
-        self.emu = Emulator.for_rom(ROM)
-        self.mask = self.emu.system.mask
-
-    def __getitem__(self, name: str) -> int:
-        address, code = FIELDS[name]
-        return self.emu.peek(address, code)
-
-    def __setitem__(self, name: str, value: int) -> None:
-        address, code = FIELDS[name]
-        self.emu.poke(address, value, code)
-
-    def run(self, buttons: Sequence[str] = (), frames: int = 1) -> None:
-        self.emu.run([self.mask(list(buttons))], frames)
-
-    def run_until(self, condition: Callable[[], bool], buttons: Sequence[str] = (), limit: int = 600) -> int:
-        """Run frames holding the buttons until ``condition()``; return the frames run."""
-        for n in range(limit):
-            if condition():
-                return n
-            self.run(buttons)
-        raise AssertionError(f"condition not met within {limit} frames")
+        super().__init__(Emulator.for_rom(ROM), FIELDS)
 
     def boot(self) -> None:
         """Run until the title's main loop is counting frames."""
@@ -134,7 +110,9 @@ def test_game_yaml_lists_the_committed_rom() -> None:
 
 def _ram_h() -> dict[str, int]:
     """src/ram.h's fixed addresses, as console addresses by game.yaml's field names."""
-    defines = re.findall(r"^#define ADDR_(\w+) +(0x[0-9A-Fa-f]+)", (CART_DIR / "src" / "ram.h").read_text(), re.MULTILINE)
+    defines = re.findall(
+        r"^#define ADDR_(\w+) +(0x[0-9A-Fa-f]+)", (CART_DIR / "src" / "ram.h").read_text(), re.MULTILINE
+    )
     return {name.lower(): RAM_BASE + int(value, 16) - 0x2000 for name, value in defines}
 
 
@@ -157,7 +135,9 @@ def test_work_ram_is_logical_2000_at_console_f80000(hopper: Hopper) -> None:
     assert (ram[0x2000:] == 0xFF).all()
     frame = hopper["frame"]
     assert frame > 0
-    assert int(ram[0x208]) | int(ram[0x209]) << 8 == frame, "logical $2208 (frame, little-endian) is buffer offset 0x208"
+    assert int(ram[0x208]) | int(ram[0x209]) << 8 == frame, (
+        "logical $2208 (frame, little-endian) is buffer offset 0x208"
+    )
 
 
 def test_screen_is_242_lines_of_256_pixels() -> None:
@@ -331,7 +311,9 @@ def test_level_select_by_poke(hopper: Hopper, poked: int, level: int) -> None:
 def test_same_inputs_from_a_state_replay_the_same_game(playing: Hopper) -> None:
     state = playing.emu.get_state()
     rng = np.random.default_rng(7)
-    inputs = [list(rng.choice(["RIGHT", "LEFT", "I", "II"], size=rng.integers(0, 3), replace=False)) for _ in range(300)]
+    inputs = [
+        list(rng.choice(["RIGHT", "LEFT", "I", "II"], size=rng.integers(0, 3), replace=False)) for _ in range(300)
+    ]
     runs = []
     for _ in range(2):
         playing.emu.set_state(state)

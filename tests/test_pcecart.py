@@ -324,3 +324,26 @@ def test_same_inputs_from_a_state_replay_the_same_game(playing: Hopper) -> None:
         runs.append((trace, bytes(playing.emu.ram[:0x2000])))
     assert runs[0] == runs[1]
     assert len({t[2] for t in runs[0][0]}) > 200, "the random state moves every frame"
+
+
+@pytest.mark.parametrize("level", [0, 1, 2], ids=["level-1", "level-2", "level-3"])
+def test_a_live_player_never_sinks_into_the_ground(hopper: Hopper, level: int) -> None:
+    # Random running and jumping; a wall beside the player once let it fall through the ground next to it.
+    hopper.start(level)
+    rng = np.random.default_rng(level)
+    step = 8  # src/player.c's STEP: a foot may be this far below a column's top for a frame, walking up
+    for _ in range(500):
+        buttons = ["RIGHT"] if rng.random() < 0.8 else ["LEFT"]
+        if rng.random() < 0.3:
+            buttons.append("I")
+        hopper.run(buttons, frames=int(rng.integers(1, 8)))
+        if hopper["game_mode"] != PLAY or hopper["state"] != ALIVE:
+            hopper.run_until(lambda: hopper["game_mode"] == TITLE or (hopper["game_mode"], hopper["state"]) == (PLAY, ALIVE),
+                             limit=600)  # fmt: skip
+            if hopper["game_mode"] == TITLE:  # after a game over
+                hopper.start(level)
+            continue
+        x, y = hopper["x"], hopper["y"]
+        for foot in (x - 5, x + 5):
+            height = hopper.ground(foot)
+            assert not height or y <= 240 - 8 * height + step, f"feet at y {y} inside the ground at x {foot}"

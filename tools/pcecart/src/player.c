@@ -34,9 +34,12 @@ void player_die(void) {
     ++DEATHS;
 }
 
-/* The highest ground under the player's feet. */
+/* The highest ground under the player's feet: a column whose top is more than a
+ * step above the feet is a wall beside the player, not ground under it. */
 static int support(void) {
     int a = floor_at((int)PX - HALF_WIDTH), b = floor_at((int)PX + HALF_WIDTH);
+    if (a < PY - STEP) a = NO_FLOOR;
+    if (b < PY - STEP) b = NO_FLOOR;
     return a < b ? a : b;
 }
 
@@ -81,14 +84,11 @@ static void fall(void) {
     if (vy > MAX_FALL) vy = MAX_FALL;
     t = YS + vy;
     floor = support();
-    if (vy >= 0 && PY <= floor && PY + (t >> 4) >= floor) {
-        PY = floor;
+    if (vy >= 0 && PY + (t >> 4) >= floor) {
+        PY = floor;   /* landing, or walking up a step */
         YS = 0;
         vy = 0;
         ON_GROUND = 1;
-    } else if (ON_GROUND && floor < PY && PY - floor <= STEP) {
-        PY = floor;   /* a step up */
-        vy = 0;
     } else {
         PY += t >> 4;
         YS = t & 15;

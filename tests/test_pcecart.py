@@ -28,6 +28,7 @@ ROM = GAME_DIR / "rom.pce"
 CART_DIR = REPO / "tools" / "pcecart"
 RAM_BASE = 0xF80000  # console address of work RAM's first byte, logical $2000
 GROUND = 0xF80300  # ground height in tiles per 8-pixel column, 0 = pit
+CRAWLERS = 0xF80230  # 6 x 10 bytes: <u2 x, <u2 x0, <u2 x1, |u1 y, |u1 state (0 gone), |i1 direction, |u1 pause
 END_X = {0: 1200, 1: 1520, 2: 1840}  # tools/pcecart/src/levels.c
 TITLE, PLAY, CLEAR, GAMEOVER = 0, 1, 2, 3
 ALIVE, DYING = 0, 1
@@ -121,7 +122,7 @@ def test_game_yaml_addresses_match_the_source() -> None:
     for name, (address, _) in FIELDS.items():
         assert name in known, f"game.yaml field {name!r} is not in src/ram.h"
         assert address == known[name], f"{name}: game.yaml says {address:#x}, src/ram.h {known[name]:#x}"
-    assert GROUND == known["ground"]
+    assert (GROUND, CRAWLERS) == (known["ground"], known["enemies"])
     assert FIELDS["x"][1] == "<u2" and FIELDS["y"][1] == "<i2" and FIELDS["score"][1] == ">d4"
 
 
@@ -246,9 +247,9 @@ def test_walking_into_a_pit_loses_a_life_and_respawns(playing: Hopper) -> None:
 
 def _crawler_ahead(game: Hopper) -> int:
     """The address of the first live crawler right of the player."""
-    base, live = FIELDS["enemy_count"][0] + 0xD, []
+    live = []
     for i in range(game["enemy_count"]):
-        at = base + 10 * i
+        at = CRAWLERS + 10 * i
         if game.emu.peek(at + 7) and game.emu.peek(at, "<u2") > game["x"]:
             live.append((game.emu.peek(at, "<u2"), at))
     return min(live)[1]
@@ -347,3 +348,33 @@ def test_a_live_player_never_sinks_into_the_ground(hopper: Hopper, level: int) -
         for foot in (x - 5, x + 5):
             height = hopper.ground(foot)
             assert not height or y <= 240 - 8 * height + step, f"feet at y {y} inside the ground at x {foot}"
+
+
+def _hazard_ahead(game: Hopper) -> bool:
+    """A pit, a wall or a live crawler just ahead of the player."""
+    x, y = game["x"], game["y"]
+    for d in range(6, 22, 2):
+        height = game.ground(x + d)
+        if not height or 240 - 8 * height < y - 8:
+            return True
+    for i in range(game["enemy_count"]):
+        at = CRAWLERS + 10 * i
+        if game.emu.peek(at + 7) and 0 < game.emu.peek(at, "<u2") - x < 36:
+            return True
+    return False
+
+
+@pytest.mark.parametrize("level", [0, 1, 2], ids=["level-1", "level-2", "level-3"])
+def test_every_level_can_be_cleared(hopper: Hopper, level: int) -> None:
+    # A simple runner: hold RIGHT, and jump (held 20 frames) when a pit, a wall or a crawler is just ahead.
+    hopper.start(level)
+    hold = 0
+    for _ in range(3000):
+        if hopper["game_mode"] != PLAY:
+            break
+        if hopper["on_ground"] and not hopper["pad"] & 1 and _hazard_ahead(hopper):
+            hold = 20
+        hopper.run(["RIGHT", "I"] if hold else ["RIGHT"])
+        hold = max(hold - 1, 0)
+    assert hopper["level_done"] == 1 and hopper["x"] >= END_X[level]
+    assert hopper["lives"] > 0

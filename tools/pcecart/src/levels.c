@@ -12,7 +12,7 @@ static const unsigned char coins1[] = {
 static const unsigned char runs2[] = {
     16, 4,  5, 0,  12, 4,  6, 6,  14, 4,  5, 0,  10, 5,  4, 0,  12, 5,  8, 4,
     6, 0,  18, 4,  6, 7,  12, 4,  5, 0,  16, 4,  6, 0,  14, 4,  25, 4,  0};
-static const unsigned char crawlers2[] = {23, 31,  41, 50,  100, 113,  124, 131,  163, 172,  0};
+static const unsigned char crawlers2[] = {23, 31,  41, 46,  100, 113,  124, 131,  163, 172,  0};
 static const unsigned char coins2[] = {
     18, 19,  19, 19,  20, 19,  40, 16,  41, 16,  76, 23,  77, 23,  110, 24,  111, 24,  150, 18,  151, 18,  0};
 

@@ -1,7 +1,7 @@
-"""Hopper, our PC Engine cartridge, on the real mednafen_pce_fast core through retrokit's host.
+"""Skipper, our PC Engine cartridge, on the real mednafen_pce_fast core through retrokit's host.
 
 The game is documented in tools/pcecart/README.md; its RAM map is
-games/Hopper-PCEngine/game.yaml (checked here against tools/pcecart/src/ram.h).
+games/Skipper-PCEngine/game.yaml (checked here against tools/pcecart/src/ram.h).
 The byte-for-byte rebuild is tests/test_cartridges.py's; every tool on this
 system is tests/test_systems.py's. Here: the game itself, and the facts about
 the core that the PCEngine descriptor rests on.
@@ -23,7 +23,7 @@ import retrokit
 from retrokit.host.emulator import Emulator
 
 REPO = Path(__file__).resolve().parent.parent
-GAME_DIR = REPO / "games" / "Hopper-PCEngine"
+GAME_DIR = REPO / "games" / "Skipper-PCEngine"
 ROM = GAME_DIR / "rom.pce"
 CART_DIR = REPO / "tools" / "pcecart"
 RAM_BASE = 0xF80000  # console address of work RAM's first byte, logical $2000
@@ -37,8 +37,8 @@ ALIVE, DYING = 0, 1
 FIELDS = game_fields(GAME_DIR)
 
 
-class Hopper(CartGame):
-    """An emulator running Hopper, with the game's fields by name."""
+class Skipper(CartGame):
+    """An emulator running Skipper, with the game's fields by name."""
 
     def __init__(self) -> None:
         super().__init__(Emulator.for_rom(ROM), FIELDS)
@@ -79,17 +79,17 @@ class Hopper(CartGame):
 
 
 @pytest.fixture
-def hopper():
-    game = Hopper()
+def skipper():
+    game = Skipper()
     game.boot()
     yield game
     game.emu.close()
 
 
 @pytest.fixture
-def playing(hopper: Hopper) -> Hopper:
-    hopper.start()
-    return hopper
+def playing(skipper: Skipper) -> Skipper:
+    skipper.start()
+    return skipper
 
 
 # --- the ROM and its data file ----------------------------------------------------------------
@@ -129,12 +129,12 @@ def test_game_yaml_addresses_match_the_source() -> None:
 # --- the core, as the PCEngine descriptor describes it -----------------------------------------
 
 
-def test_work_ram_is_logical_2000_at_console_f80000(hopper: Hopper) -> None:
-    ram = hopper.emu.ram
+def test_work_ram_is_logical_2000_at_console_f80000(skipper: Skipper) -> None:
+    ram = skipper.emu.ram
     # The wheel's core reports the SuperGrafx's 32 KiB; a PC Engine uses the first 8 KiB, the rest stays 0xFF.
     assert len(ram) == 32 * 1024
     assert (ram[0x2000:] == 0xFF).all()
-    frame = hopper["frame"]
+    frame = skipper["frame"]
     assert frame > 0
     assert int(ram[0x208]) | int(ram[0x209]) << 8 == frame, (
         "logical $2208 (frame, little-endian) is buffer offset 0x208"
@@ -142,7 +142,7 @@ def test_work_ram_is_logical_2000_at_console_f80000(hopper: Hopper) -> None:
 
 
 def test_screen_is_242_lines_of_256_pixels() -> None:
-    env = retrokit.make("Hopper-PCEngine", state="Level1")
+    env = retrokit.make("Skipper-PCEngine", state="Level1")
     try:
         obs, _ = env.reset(seed=0)
         for _ in range(10):
@@ -154,31 +154,31 @@ def test_screen_is_242_lines_of_256_pixels() -> None:
         env.close()
 
 
-def test_each_pad_button_reaches_the_game(hopper: Hopper) -> None:
+def test_each_pad_button_reaches_the_game(skipper: Skipper) -> None:
     bits = {"I": 1, "II": 2, "SELECT": 4, "UP": 16, "RIGHT": 32, "DOWN": 64, "LEFT": 128}
     for name, bit in bits.items():
-        assert hopper.pad([name], 2)[-1] == bit, name
-        hopper.run()
-    assert hopper.pad(["I", "II"], 2)[-1] == 3
-    hopper.run()
+        assert skipper.pad([name], 2)[-1] == bit, name
+        skipper.run()
+    assert skipper.pad(["I", "II"], 2)[-1] == 3
+    skipper.run()
     # V and VI (RetroPad L and R) are buttons of a 6-button pad, which the core's pad is not.
-    assert hopper.pad(["V", "VI"], 4) == [0, 0, 0, 0]
+    assert skipper.pad(["V", "VI"], 4) == [0, 0, 0, 0]
 
 
 @pytest.mark.parametrize(("switch", "fires"), [("III", "II"), ("IV", "I")])
-def test_iii_and_iv_toggle_turbo_so_no_action_group_has_them(hopper: Hopper, switch: str, fires: str) -> None:
+def test_iii_and_iv_toggle_turbo_so_no_action_group_has_them(skipper: Skipper, switch: str, fires: str) -> None:
     bit = {"I": 1, "II": 2}[fires]
-    state = hopper.emu.get_state()
-    assert hopper.pad([fires], 8) == [bit] * 8
-    hopper.run()
-    hopper.pad([switch], 2)
-    hopper.run()
-    turbo = hopper.pad([fires], 8)
+    state = skipper.emu.get_state()
+    assert skipper.pad([fires], 8) == [bit] * 8
+    skipper.run()
+    skipper.pad([switch], 2)
+    skipper.run()
+    turbo = skipper.pad([fires], 8)
     assert 0 in turbo and bit in turbo, f"holding {fires} after pressing {switch} fires on and off: {turbo}"
-    hopper.emu.set_state(state)
-    hopper.run()
-    assert 0 in hopper.pad([fires], 8), "the turbo outlives a state load"
-    groups = hopper.emu.system.actions
+    skipper.emu.set_state(state)
+    skipper.run()
+    assert 0 in skipper.pad([fires], 8), "the turbo outlives a state load"
+    groups = skipper.emu.system.actions
     assert not any(b in combo for group in groups for combo in group for b in ("III", "IV", "V", "VI"))
     assert ("I",) in groups[2] and ("II",) in groups[2]
 
@@ -186,15 +186,15 @@ def test_iii_and_iv_toggle_turbo_so_no_action_group_has_them(hopper: Hopper, swi
 # --- playing ------------------------------------------------------------------------------------
 
 
-def test_starts_on_run_at_the_title(hopper: Hopper) -> None:
-    hopper.run(frames=30)
-    assert hopper["game_mode"] == TITLE, "the title waits for RUN"
-    hopper.start()
-    assert (hopper["level"], hopper["lives"], hopper["score"], hopper["state"]) == (0, 3, 0, ALIVE)
-    assert hopper["x"] == hopper["start_x"] and hopper["y"] == 208
+def test_starts_on_run_at_the_title(skipper: Skipper) -> None:
+    skipper.run(frames=30)
+    assert skipper["game_mode"] == TITLE, "the title waits for RUN"
+    skipper.start()
+    assert (skipper["level"], skipper["lives"], skipper["score"], skipper["state"]) == (0, 3, 0, ALIVE)
+    assert skipper["x"] == skipper["start_x"] and skipper["y"] == 208
 
 
-def test_main_loop_keeps_up_with_vblank(playing: Hopper) -> None:
+def test_main_loop_keeps_up_with_vblank(playing: Skipper) -> None:
     frame, vblanks, lag = playing["frame"], playing["vblanks"], playing["lag"]
     playing.run(["RIGHT"], frames=120)
     assert playing["frame"] - frame == 120
@@ -202,7 +202,7 @@ def test_main_loop_keeps_up_with_vblank(playing: Hopper) -> None:
     assert playing["lag"] == lag, "a frame of play took longer than a frame"
 
 
-def test_holding_right_moves_x_and_the_camera(playing: Hopper) -> None:
+def test_holding_right_moves_x_and_the_camera(playing: Skipper) -> None:
     x = playing["x"]
     playing.run(["RIGHT"], frames=50)
     assert playing["x"] > x + 80
@@ -217,7 +217,7 @@ def test_holding_right_moves_x_and_the_camera(playing: Hopper) -> None:
     assert playing["x"] == both, "left and right at once steer neither way"
 
 
-def test_coins_score_in_bcd(playing: Hopper) -> None:
+def test_coins_score_in_bcd(playing: Skipper) -> None:
     # Level 1 opens with four coins at head height (columns 12-15, x 96-127).
     playing.run_until(lambda: playing["x"] >= 136, ["RIGHT"], limit=120)
     assert playing["coins"] == 4
@@ -226,7 +226,7 @@ def test_coins_score_in_bcd(playing: Hopper) -> None:
 
 
 @pytest.mark.parametrize("button", ["I", "II"], ids=["jump-I", "jump-II"])
-def test_jumping_over_a_pit_keeps_the_life(playing: Hopper, button: str) -> None:
+def test_jumping_over_a_pit_keeps_the_life(playing: Skipper, button: str) -> None:
     left, right = playing.first_pit()
     playing.run_until(lambda: playing["x"] >= left - 30, ["RIGHT"])
     playing.run(["RIGHT", button], frames=20)
@@ -235,7 +235,7 @@ def test_jumping_over_a_pit_keeps_the_life(playing: Hopper, button: str) -> None
     assert (playing["state"], playing["lives"], playing["deaths"]) == (ALIVE, 3, 0)
 
 
-def test_walking_into_a_pit_loses_a_life_and_respawns(playing: Hopper) -> None:
+def test_walking_into_a_pit_loses_a_life_and_respawns(playing: Skipper) -> None:
     left, right = playing.first_pit()
     playing.run_until(lambda: playing["state"] == DYING, ["RIGHT"], limit=300)
     assert left - 8 <= playing["x"] <= right
@@ -245,7 +245,7 @@ def test_walking_into_a_pit_loses_a_life_and_respawns(playing: Hopper) -> None:
     assert playing["lives"] == 2
 
 
-def _crawler_ahead(game: Hopper) -> int:
+def _crawler_ahead(game: Skipper) -> int:
     """The address of the first live crawler right of the player."""
     live = []
     for i in range(game["enemy_count"]):
@@ -255,7 +255,7 @@ def _crawler_ahead(game: Hopper) -> int:
     return min(live)[1]
 
 
-def test_a_crawler_on_the_ground_costs_a_life(playing: Hopper) -> None:
+def test_a_crawler_on_the_ground_costs_a_life(playing: Skipper) -> None:
     crawler = _crawler_ahead(playing)
     # Stand in its patrol, clear of pits: it walks into the player.
     playing["x"] = playing.emu.peek(crawler + 2, "<u2") + 4
@@ -264,7 +264,7 @@ def test_a_crawler_on_the_ground_costs_a_life(playing: Hopper) -> None:
     assert playing.emu.peek(crawler + 7) != 0, "the crawler lives on"
 
 
-def test_a_player_in_the_air_defeats_a_crawler(playing: Hopper) -> None:
+def test_a_player_in_the_air_defeats_a_crawler(playing: Skipper) -> None:
     crawler = _crawler_ahead(playing)
     score = playing["score"]
     # Drop the player onto it from above.
@@ -277,7 +277,7 @@ def test_a_player_in_the_air_defeats_a_crawler(playing: Hopper) -> None:
     assert playing["score"] - score == 100
 
 
-def test_losing_every_life_is_game_over(playing: Hopper) -> None:
+def test_losing_every_life_is_game_over(playing: Skipper) -> None:
     for lives in (2, 1, 0):
         playing.run_until(lambda: playing["state"] == DYING, ["RIGHT"], limit=400)
         assert playing["lives"] == lives
@@ -288,7 +288,7 @@ def test_losing_every_life_is_game_over(playing: Hopper) -> None:
     assert (playing["lives"], playing["deaths"], playing["score"]) == (3, 0, 0)
 
 
-def test_reaching_end_x_clears_the_level(playing: Hopper) -> None:
+def test_reaching_end_x_clears_the_level(playing: Skipper) -> None:
     end_x = playing["end_x"]
     assert end_x == END_X[0] and playing.ground(end_x - 48) and playing.ground(end_x)
     playing["x"] = end_x - 48  # flat ground before the goal
@@ -302,14 +302,14 @@ def test_reaching_end_x_clears_the_level(playing: Hopper) -> None:
 
 @pytest.mark.parametrize(("poked", "level"), [(0, 0), (1, 1), (2, 2), (3, 0), (200, 0)],
                          ids=["level-1", "level-2", "level-3", "out-of-range-3", "out-of-range-200"])  # fmt: skip
-def test_level_select_by_poke(hopper: Hopper, poked: int, level: int) -> None:
-    hopper.start(poked)
-    assert hopper["level"] == level
-    assert hopper["end_x"] == END_X[level]
-    assert hopper["level_width"] == {0: 1280, 1: 1600, 2: 1920}[level]
+def test_level_select_by_poke(skipper: Skipper, poked: int, level: int) -> None:
+    skipper.start(poked)
+    assert skipper["level"] == level
+    assert skipper["end_x"] == END_X[level]
+    assert skipper["level_width"] == {0: 1280, 1: 1600, 2: 1920}[level]
 
 
-def test_same_inputs_from_a_state_replay_the_same_game(playing: Hopper) -> None:
+def test_same_inputs_from_a_state_replay_the_same_game(playing: Skipper) -> None:
     state = playing.emu.get_state()
     rng = np.random.default_rng(7)
     inputs = [
@@ -328,29 +328,29 @@ def test_same_inputs_from_a_state_replay_the_same_game(playing: Hopper) -> None:
 
 
 @pytest.mark.parametrize("level", [0, 1, 2], ids=["level-1", "level-2", "level-3"])
-def test_a_live_player_never_sinks_into_the_ground(hopper: Hopper, level: int) -> None:
+def test_a_live_player_never_sinks_into_the_ground(skipper: Skipper, level: int) -> None:
     # Random running and jumping; a wall beside the player once let it fall through the ground next to it.
-    hopper.start(level)
+    skipper.start(level)
     rng = np.random.default_rng(level)
     step = 8  # src/player.c's STEP: a foot may be this far below a column's top for a frame, walking up
     for _ in range(500):
         buttons = ["RIGHT"] if rng.random() < 0.8 else ["LEFT"]
         if rng.random() < 0.3:
             buttons.append("I")
-        hopper.run(buttons, frames=int(rng.integers(1, 8)))
-        if hopper["game_mode"] != PLAY or hopper["state"] != ALIVE:
-            hopper.run_until(lambda: hopper["game_mode"] == TITLE or (hopper["game_mode"], hopper["state"]) == (PLAY, ALIVE),
+        skipper.run(buttons, frames=int(rng.integers(1, 8)))
+        if skipper["game_mode"] != PLAY or skipper["state"] != ALIVE:
+            skipper.run_until(lambda: skipper["game_mode"] == TITLE or (skipper["game_mode"], skipper["state"]) == (PLAY, ALIVE),
                              limit=600)  # fmt: skip
-            if hopper["game_mode"] == TITLE:  # after a game over
-                hopper.start(level)
+            if skipper["game_mode"] == TITLE:  # after a game over
+                skipper.start(level)
             continue
-        x, y = hopper["x"], hopper["y"]
+        x, y = skipper["x"], skipper["y"]
         for foot in (x - 5, x + 5):
-            height = hopper.ground(foot)
+            height = skipper.ground(foot)
             assert not height or y <= 240 - 8 * height + step, f"feet at y {y} inside the ground at x {foot}"
 
 
-def _hazard_ahead(game: Hopper) -> bool:
+def _hazard_ahead(game: Skipper) -> bool:
     """A pit, a wall or a live crawler just ahead of the player."""
     x, y = game["x"], game["y"]
     for d in range(6, 22, 2):
@@ -365,16 +365,16 @@ def _hazard_ahead(game: Hopper) -> bool:
 
 
 @pytest.mark.parametrize("level", [0, 1, 2], ids=["level-1", "level-2", "level-3"])
-def test_every_level_can_be_cleared(hopper: Hopper, level: int) -> None:
+def test_every_level_can_be_cleared(skipper: Skipper, level: int) -> None:
     # A simple runner: hold RIGHT, and jump (held 20 frames) when a pit, a wall or a crawler is just ahead.
-    hopper.start(level)
+    skipper.start(level)
     hold = 0
     for _ in range(3000):
-        if hopper["game_mode"] != PLAY:
+        if skipper["game_mode"] != PLAY:
             break
-        if hopper["on_ground"] and not hopper["pad"] & 1 and _hazard_ahead(hopper):
+        if skipper["on_ground"] and not skipper["pad"] & 1 and _hazard_ahead(skipper):
             hold = 20
-        hopper.run(["RIGHT", "I"] if hold else ["RIGHT"])
+        skipper.run(["RIGHT", "I"] if hold else ["RIGHT"])
         hold = max(hold - 1, 0)
-    assert hopper["level_done"] == 1 and hopper["x"] >= END_X[level]
-    assert hopper["lives"] > 0
+    assert skipper["level_done"] == 1 and skipper["x"] >= END_X[level]
+    assert skipper["lives"] > 0

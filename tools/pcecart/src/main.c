@@ -1,4 +1,4 @@
-/* Hopper: a small PC Engine platformer for retrokit's tests. The title, the
+/* Skipper: a small PC Engine platformer for retrokit's tests. The title, the
  * game's modes, the pad, the random state, the score and the HUD. */
 #include "art.h"
 #include "hw.h"
@@ -61,7 +61,7 @@ static void enter_title(void) {
     CAMERA_X = 0;
     bat_clear();
     sprites_hide_from(0);
-    text(13, 8, "HOPPER");
+    text(12, 8, "SKIPPER");
     show_title_level();
     text(12, 18, "PUSH RUN");
     text(7, 26, "RETROKIT TEST CARTRIDGE");

@@ -1,10 +1,10 @@
-/* Hopper's fixed RAM map.
+/* Skipper's fixed RAM map.
  *
  * Work RAM is the 8 KiB page $F8, mapped by the crt0 at logical $2000-$3FFF
  * (zero page $2000, CPU stack $2100). $2200-$23FF is this fixed map; the
  * linker config (pce.cfg) starts C's own data at $2400. retrokit names a byte
  * by its console address 0xF80000 + (logical - $2000): $2200 is 0xF80200.
- * games/Hopper-PCEngine/game.yaml repeats these addresses; tests/test_pcecart.py
+ * games/Skipper-PCEngine/game.yaml repeats these addresses; tests/test_pcecart.py
  * checks the two agree. Multi-byte values are little-endian (the 6502 family's
  * order) except the score, 8 BCD digits stored most significant byte first.
  */

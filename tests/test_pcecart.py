@@ -10,17 +10,15 @@ the core that the PCEngine descriptor rests on.
 from __future__ import annotations
 
 import hashlib
-import re
 from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
-from cartgame import CartGame, game_fields
+from cartgame import CartGame, game_fields, ram_h_fields
 
 import retrokit
-from retrokit.host.emulator import Emulator
 
 REPO = Path(__file__).resolve().parent.parent
 GAME_DIR = REPO / "games" / "Skipper-PCEngine"
@@ -41,19 +39,13 @@ class Skipper(CartGame):
     """An emulator running Skipper, with the game's fields by name."""
 
     def __init__(self) -> None:
-        super().__init__(Emulator.for_rom(ROM), FIELDS)
-
-    def boot(self) -> None:
-        """Run until the title's main loop is counting frames."""
-        self.run_until(lambda: self["frame"] >= 2, limit=120)
-        assert self["game_mode"] == TITLE
+        super().__init__(ROM, FIELDS)
 
     def start(self, level: int | None = None) -> None:
         """Select a level by poking it at the title, press RUN, and wait for play."""
         if level is not None:
             self["level"] = level
-        self.run(["RUN"])
-        self.run_until(lambda: self["game_mode"] == PLAY, limit=120)
+        super().start(["RUN"])
 
     def ground(self, x: int) -> int:
         return self.emu.peek(GROUND + x // 8)
@@ -83,7 +75,7 @@ def skipper():
     game = Skipper()
     game.boot()
     yield game
-    game.emu.close()
+    game.close()
 
 
 @pytest.fixture
@@ -110,11 +102,8 @@ def test_game_yaml_lists_the_committed_rom() -> None:
 
 
 def _ram_h() -> dict[str, int]:
-    """src/ram.h's fixed addresses, as console addresses by game.yaml's field names."""
-    defines = re.findall(
-        r"^#define ADDR_(\w+) +(0x[0-9A-Fa-f]+)", (CART_DIR / "src" / "ram.h").read_text(), re.MULTILINE
-    )
-    return {name.lower(): RAM_BASE + int(value, 16) - 0x2000 for name, value in defines}
+    """src/ram.h's fixed addresses (logical, from $2000), as console addresses by game.yaml's field names."""
+    return {name: RAM_BASE + logical - 0x2000 for name, logical in ram_h_fields(CART_DIR / "src" / "ram.h").items()}
 
 
 def test_game_yaml_addresses_match_the_source() -> None:

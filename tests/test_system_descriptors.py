@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import json
+import re
+from pathlib import Path
 
 import pytest
+import yaml
 
 from retrokit.errors import InvalidArgumentError, UnknownNameError, UnsupportedSystemError
 from retrokit.host.cores import find_core
 from retrokit.host.systems import all_systems, get_system, system_for_extension
-from retrokit.paths import wheel_cores_dir
+from retrokit.paths import wheel_cores_dir, wheel_dir
 
 
 def wheel_systems() -> dict[str, dict]:
@@ -87,3 +90,54 @@ def test_genesis_dump_aliases_name_genesis() -> None:
     for ext in ("gen", "smd"):
         assert system_for_extension(ext).name == "Genesis"
     assert system_for_extension("bin").name == "N64"  # a system's own extension wins over an alias
+
+# --- what proves each system: the descriptor's proven_by, tools/cartridges.yaml and docs/systems.md agree ----
+
+REPO = Path(__file__).resolve().parent.parent
+CARTRIDGES = yaml.safe_load((REPO / "tools" / "cartridges.yaml").read_text())
+
+
+def test_each_cartridge_proves_its_system_and_each_proof_exists() -> None:
+    for game in CARTRIDGES:
+        assert get_system(game.rsplit("-", 1)[1]).proven_by.get("cartridge") == game, game
+    for system in all_systems().values():
+        assert set(system.proven_by) <= {"cartridge", "stable-retro", "ale-py"}, system.name
+        if "cartridge" in system.proven_by:
+            assert system.proven_by["cartridge"] in CARTRIDGES, system.name
+        if "stable-retro" in system.proven_by:  # a wheel game whose ROM the wheel ships
+            folder = wheel_dir() / "data" / "stable" / f"{system.proven_by['stable-retro']}-v0"
+            assert any(folder.glob("rom.*")), folder
+
+
+def systems_page() -> dict[str, dict[str, str]]:
+    """docs/systems.md: each system's table, row name -> text."""
+    sections = re.split(r"^## ", (REPO / "docs" / "systems.md").read_text(), flags=re.M)[1:]
+    out = {}
+    for section in sections:
+        name, _, body = section.partition("\n")
+        out[name.strip()] = dict(re.findall(r"^\| ([^|]+?) \| (.+) \|$", body, flags=re.M))
+    return out
+
+
+def test_the_systems_page_has_every_system_and_says_how_each_is_proven() -> None:
+    page = systems_page()
+    assert set(page) == set(all_systems())
+    for name, rows in page.items():
+        system = get_system(name)
+        assert rows["core"] == f"`{system.core}`" and f"base `0x{system.ram_base:X}`" in rows["RAM"], name
+        if system.proven:
+            assert all(game in rows["proven by"] for game in system.proven_by.values() if game), name
+        else:
+            assert rows["proven by"].startswith("Nothing proves it yet"), name
+        for rate in system.frame_rates.values():
+            assert f"{rate:g}" in rows["frame rate"], name
+
+
+def test_games_marks_the_games_of_an_unproven_system(capsys) -> None:
+    from retrokit.cli import main
+
+    assert main(["games", "1942-Nes"]) == 0
+    out = capsys.readouterr().out
+    assert ("[unproven: Nes]" in out) == (not get_system("Nes").proven)
+    assert main(["games", "Dasher-Genesis"]) == 0
+    assert "unproven" not in capsys.readouterr().out

@@ -167,7 +167,9 @@ def test_iii_and_iv_toggle_turbo_so_no_action_group_has_them(skipper: Skipper, s
     skipper.emu.set_state(state)
     skipper.run()
     assert 0 in skipper.pad([fires], 8), "the turbo outlives a state load"
-    groups = skipper.emu.system.actions
+    system = skipper.emu.system
+    assert set(system.switches) == {"III", "IV"}, "the descriptor calls them switches: agents leave them alone"
+    groups = system.actions
     assert not any(b in combo for group in groups for combo in group for b in ("III", "IV", "V", "VI"))
     assert ("I",) in groups[2] and ("II",) in groups[2]
 

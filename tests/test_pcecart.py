@@ -26,7 +26,7 @@ ROM = GAME_DIR / "rom.pce"
 CART_DIR = REPO / "tools" / "pcecart"
 RAM_BASE = 0xF80000  # console address of work RAM's first byte, logical $2000
 GROUND = 0xF80300  # ground height in tiles per 8-pixel column, 0 = pit
-CRAWLERS = 0xF80230  # 6 x 10 bytes: <u2 x, <u2 x0, <u2 x1, |u1 y, |u1 state (0 gone), |i1 direction, |u1 pause
+CRAWLERS = 0xF80200  # 6 x 10 bytes: <u2 x, <u2 x0, <u2 x1, |u1 y, |u1 state (0 gone), |i1 direction, |u1 pause
 END_X = {0: 1200, 1: 1520, 2: 1840}  # tools/pcecart/src/levels.c
 TITLE, PLAY, CLEAR, GAMEOVER = 0, 1, 2, 3
 ALIVE, DYING = 0, 1
@@ -125,9 +125,7 @@ def test_work_ram_is_logical_2000_at_console_f80000(skipper: Skipper) -> None:
     assert (ram[0x2000:] == 0xFF).all()
     frame = skipper["frame"]
     assert frame > 0
-    assert int(ram[0x208]) | int(ram[0x209]) << 8 == frame, (
-        "logical $2208 (frame, little-endian) is buffer offset 0x208"
-    )
+    assert int(ram[0x48]) | int(ram[0x49]) << 8 == frame, "logical $2048 (frame, little-endian) is buffer offset 0x48"
 
 
 def test_screen_is_242_lines_of_256_pixels() -> None:

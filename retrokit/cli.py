@@ -19,13 +19,15 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import shlex
 import sys
 from collections.abc import Iterable, Sequence
+from typing import NoReturn
 
 from retrokit import __version__
 from retrokit.commands import command_modules
-from retrokit.errors import RetrokitError
+from retrokit.errors import RetrokitError, did_you_mean
 
 ERROR_STATUS = 2
 
@@ -57,6 +59,18 @@ class CommandParser(argparse.ArgumentParser):
         action = super().add_subparsers(**kwargs)
         self.subcommands = action.choices  # the same dict, filled as subcommands are added
         return action
+
+    def error(self, message: str) -> NoReturn:
+        """Print a usage error and exit; an invalid choice (a misspelled command) gets a did-you-mean."""
+        found = re.search(r"argument (\S+): invalid choice: '([^']*)' \(choose from (.*)\)$", message)
+        if found:
+            what, given, listed = found.groups()
+            choices = re.findall(r"'([^']*)'", listed)
+            message = (
+                f"Expected {what} to be one of {', '.join(choices)}; got {given!r}."
+                + did_you_mean(given, choices) + f" See: {self.prog} --help."
+            )
+        super().error(message)
 
     def format_help(self) -> str:
         """The help, ending with the examples (argparse's epilog would wrap them into one paragraph).

@@ -109,3 +109,35 @@ def test_play_without_pygame_names_an_unknown_state_first(capsys, monkeypatch) -
     monkeypatch.setitem(sys.modules, "pygame", None)
     status, _, err = run(capsys, "play", "Dasher-Genesis", "--state", "Zone9.Act1")
     assert status == 2 and "Zone9.Act1" in err and "pygame" not in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        pytest.param(["gams"], "got 'gams'. Did you mean 'games'? See: retrokit --help.", id="command-typo"),
+        pytest.param(["ramsearch", "sav"], "Did you mean 'save'? See: retrokit ramsearch --help.", id="subcommand-typo"),
+        pytest.param(
+            ["integrate", "Airstriker-Genesis", "Level9"],
+            "found no state 'Level9' (its states: Level1), and no recipe", id="integrate-unknown-state",
+        ),
+    ],
+)
+def test_a_misspelled_name_gets_one_line_that_teaches(argv, expected, capsys) -> None:
+    status = cli.main(argv)
+    err = capsys.readouterr().err
+    assert status == 2 and expected in err, err
+    assert err.count("\n") <= 2, err  # the usage line at most, and the message
+
+
+def test_a_game_name_error_is_one_short_line_and_any_case_finds_the_game() -> None:
+    import retrokit
+    from retrokit.errors import GameNotFoundError
+
+    with pytest.raises(GameNotFoundError) as error:
+        retrokit.make("Airstrikr-Genesis")
+    message = str(error.value)
+    assert "site-packages" not in message and len(message) < 250, message
+    assert "Did you mean 'Airstriker-Genesis'?" in message and "retrokit games" in message
+    env = retrokit.make("airstriker-genesis")  # as `retrokit games airstriker-genesis` finds it
+    assert env.game.name == "Airstriker-Genesis"
+    env.close()

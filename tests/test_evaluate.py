@@ -147,7 +147,8 @@ def test_an_earlier_evaluation_is_never_overwritten(reference, capsys) -> None:
         (["--agent", "no_such_module:agent"], "importing 'no_such_module' failed"),
         (["--agent", "retrokit.benchmark.agents:nothing"], "to define a callable 'nothing'"),
         (["--benchmark", "dashr"], "Did you mean 'dasher'?"),
-        (["--workers", "0"], "--workers and --timesteps of 1 or more"),
+        (["--workers", "0"], "Expected --workers of 1 or more, got 0."),
+        (["--timesteps", "-5"], "Expected --timesteps of 1 or more, got -5."),
         (["--seed", "-1"], "Expected a --seed of 0 or more, got -1"),
         (["--stall-timeout", "0"], "Expected a --stall-timeout of more than 0 seconds"),
         (["--stall-timeout", "nan"], "Expected a --stall-timeout of more than 0 seconds"),
@@ -155,7 +156,7 @@ def test_an_earlier_evaluation_is_never_overwritten(reference, capsys) -> None:
         (["--agent", "jerk", "--agent", "jerk"], "Expected each --agent once"),
         (["--agent", "jerk", "--agent", "jerky"], "Did you mean 'jerk'?"),
     ],
-    ids=["unknown-level", "level-typo", "agent-typo", "agent-module", "agent-callable", "benchmark-typo", "workers",
+    ids=["unknown-level", "level-typo", "agent-typo", "agent-module", "agent-callable", "benchmark-typo", "workers", "timesteps",
          "negative-seed", "zero-stall", "nan-stall", "ray-address-without-ray", "agent-twice", "second-agent-typo"],
 )
 def test_bad_names_fail_before_anything_is_written(tmp_path, capsys, args, expected) -> None:

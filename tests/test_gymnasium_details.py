@@ -45,7 +45,7 @@ def test_render_fps_is_per_env_and_reaches_gymnasium_make_and_the_pettingzoo_env
     assert four.metadata["render_fps"] == pytest.approx(NTSC / 4) and two.metadata["render_fps"] == pytest.approx(NTSC / 2)
     assert retrokit.RetroEnv.metadata["render_fps"] == 60  # the class's own is left alone
     players = multiplayer.parallel_env(GAME, frameskip=3, obs_type="ram")
-    assert players.metadata["render_fps"] == pytest.approx(NTSC / 3) and players.metadata["name"] == "retrokit_v0"
+    assert players.metadata["render_fps"] == pytest.approx(NTSC / 3) and players.metadata["name"] == f"{GAME}_v0"
     for env in (four, two, players):
         env.close()
 

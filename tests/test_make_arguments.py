@@ -8,7 +8,9 @@ Gymnasium ids.
 
 from __future__ import annotations
 
+import enum
 import inspect
+import re
 
 import gymnasium
 import numpy as np
@@ -252,3 +254,29 @@ def test_a_retroenv_made_directly_takes_numpy_integers() -> None:
     env = RetroEnv(AIRSTRIKER, frameskip=np.int64(4))
     assert env.frameskip == 4 and type(env.frameskip) is int
     env.close()
+
+
+@pytest.mark.parametrize(
+    ("keywords", "expected"),
+    [
+        pytest.param({"use_restricted_actions": 2}, "use action_type='filtered', 'all', 'discrete'", id="use_restricted_actions"),
+        pytest.param({"inttype": 1}, "stable-retro's 'inttype'; leave it out", id="inttype"),
+        pytest.param({"info": "data"}, "game.yaml or data.json", id="info"),
+    ],
+)
+def test_stable_retro_keywords_name_retrokits_equivalent(keywords: dict, expected: str) -> None:
+    with pytest.raises(UnknownNameError, match=re.escape(expected)):
+        retrokit.make("Airstriker-Genesis", **keywords)
+
+
+def test_stable_retro_enums_name_the_string_to_pass() -> None:
+    class Actions(enum.Enum):  # stable-retro's enums, as its package defines them
+        DISCRETE = 2
+
+    class Observations(enum.Enum):
+        IMAGE = 0
+
+    with pytest.raises(InvalidArgumentError, match=re.escape("pass action_type='discrete' for Actions.DISCRETE")):
+        retrokit.make("Airstriker-Genesis", action_type=Actions.DISCRETE)
+    with pytest.raises(InvalidArgumentError, match=re.escape("pass obs_type='rgb' for Observations.IMAGE")):
+        retrokit.make("Airstriker-Genesis", obs_type=Observations.IMAGE)

@@ -89,3 +89,28 @@ def test_sonic_state_is_accepted_by_the_core_unchanged(genesis: Emulator, state:
     data = gzip.decompress(state.read_bytes())
     genesis.set_state(vet_state(data, "Genesis", genesis.rom, shipped=state))  # the wheel ships it: no probe
     assert genesis.get_state()[:16] == data[:16]
+
+
+@pytest.mark.parametrize("reset_frame", [True, False], ids=["reset_frame", "no_reset_frame"])
+def test_reset_frame_replays_stable_retro_step_for_step(reset_frame: bool) -> None:
+    import retrokit
+
+    reference = stable_retro.make("Airstriker-Genesis-v0", render_mode=None, use_restricted_actions=stable_retro.Actions.ALL)
+    ours = retrokit.make("Airstriker-Genesis", action_type="all", reset_frame=reset_frame, skip_video=False)
+    try:
+        theirs_obs, _ = reference.reset(seed=0)
+        obs, _ = ours.reset(seed=0)
+        same = [bool((obs == theirs_obs).all())]
+        rng = np.random.default_rng(1)
+        for step in range(300):
+            action = (rng.random(12) < 0.3).astype(np.int8)
+            theirs = reference.step(action)
+            got = ours.step(action)
+            same.append(bool((got[0] == theirs[0]).all()))
+            if reset_frame:
+                assert got[1:3] == theirs[1:3] and got[4] == {k: theirs[4][k] for k in got[4]}, f"step {step}"
+        # With stable-retro's reset frame every observation is the same; without it, each comes a frame earlier.
+        assert all(same) if reset_frame else not all(same)
+    finally:
+        ours.close()
+        reference.close()

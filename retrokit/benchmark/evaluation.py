@@ -92,9 +92,10 @@ class Evaluation:
         """
         if self.backend not in BACKENDS:
             raise InvalidArgumentError(f"Expected --backend local or ray, got {self.backend!r}.")
-        if self.workers < 1 or (self.budget is not None and self.budget < 1):
-            raise InvalidArgumentError(
-                f"Expected --workers and --timesteps of 1 or more, got {self.workers} and {self.budget}.")
+        if self.workers < 1:
+            raise InvalidArgumentError(f"Expected --workers of 1 or more, got {self.workers}.")
+        if self.budget is not None and self.budget < 1:
+            raise InvalidArgumentError(f"Expected --timesteps of 1 or more, got {self.budget}.")
         if self.seed < 0:
             raise InvalidArgumentError(f"Expected a --seed of 0 or more, got {self.seed}.")
         if not (math.isfinite(self.stall_timeout) and self.stall_timeout > 0):

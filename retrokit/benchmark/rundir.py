@@ -8,7 +8,8 @@ uninterrupted run. Each episode line is flushed as it comes, and ``run.json``
 is replaced atomically after it, so a killed run leaves a readable folder.
 
 A run holds an OS lock on ``run.lock`` for its lifetime (it dies with the
-process), so a second run on the same folder is refused. Everything read back
+process), so a second run on the same folder is refused; the file is removed
+when the run ends (a killed run leaves it, unlocked, for the next to take). Everything read back
 is checked: a damaged folder ends in one :class:`~retrokit.errors.RunFolderError`.
 """
 
@@ -241,17 +242,43 @@ class RunDir:
         self._save()
 
     def close(self) -> None:
-        """Close the episode log and release the folder."""
+        """Close the episode log and release the folder, removing its lock file."""
         self._log.close()
+        # Unlinked while still held: a run that opened the old file meanwhile sees it is no longer the path's
+        # file once it gets the lock, and takes the new one (see _lock), so two runs never both hold the folder.
+        try:
+            (self.path / LOCK_FILE).unlink()
+        except FileNotFoundError:
+            pass
         os.close(self._lock)
 
 
 def _lock(path: Path) -> int:
     """Take the folder's lock (released when the descriptor closes or the process dies); return the descriptor.
 
+    A run that ends removes the lock file while it still holds it; the lock
+    taken is on the file that is at ``path`` once taken, not on one removed
+    meanwhile.
+
     Raises:
         RunFolderError: Another run holds it, or the lock file cannot be made.
     """
+    for _ in range(100):
+        fd = _lock_once(path)
+        try:
+            held, there = os.fstat(fd), os.stat(path, follow_symlinks=False)
+        except FileNotFoundError:
+            there = None
+        if there is not None and (held.st_dev, held.st_ino) == (there.st_dev, there.st_ino):
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+            return fd
+        os.close(fd)  # removed by the run that held it, after we opened it: lock the file there now
+    raise RunFolderError(f"Expected to lock {path} for this run, but it kept being replaced; use another --out.")
+
+
+def _lock_once(path: Path) -> int:
+    """Open ``path`` and take its lock; return the descriptor."""
     try:
         fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC, 0o644)
     except OSError as exc:
@@ -270,8 +297,6 @@ def _lock(path: Path) -> int:
                 f"Expected no other evaluation running in {path.parent}, but one is (process {holder}); "
                 "wait for it to end, or use another --out."
             ) from None
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
     except (RetrokitError, OSError):
         os.close(fd)
         raise

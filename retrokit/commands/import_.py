@@ -22,8 +22,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="import ROMs of known games from folders and zip files",
         description="Search files, folders and zip files for the ROMs of known games (by SHA-1, "
         "by stable-retro's rules), and copy each match into the data folder. A different ROM "
-        "already imported is never replaced unless --force is given. A progress bar counts the files "
-        "searched, on standard error.",
+        "already imported is never replaced unless --force is given. On a terminal, a progress bar counts "
+        "the files searched, on standard error (none in a pipe or a log file).",
     )
     parser.add_argument("paths", nargs="*", metavar="PATH", help="files, folders or zip files to search")
     parser.add_argument("--game", metavar="NAME", help="show the SHA-1s this game expects, and whether its ROM is present")
@@ -50,6 +50,7 @@ def _unmatched(entry: UnmatchedFile) -> str:
 
 def run(args: argparse.Namespace) -> int:
     """Import ROMs, and/or show what a game expects."""
+    from retrokit.benchmark.progress import is_terminal
     from retrokit.data.games import find_game
     from retrokit.data.importer import import_roms
     from retrokit.errors import FileSystemError, InvalidArgumentError
@@ -67,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
             )
     status = 0
     if args.paths:
-        report = import_roms(args.paths, data_dir=args.data_dir, overwrite=args.force, progress=True)
+        report = import_roms(args.paths, data_dir=args.data_dir, overwrite=args.force, progress=is_terminal())
         print(f"Imported {len(report.imported)} ROM{'s' * (len(report.imported) != 1)} into {report.data_dir / 'roms'}.")
         _section("Imported", [f"{r.game} <- {r.source}" for r in report.imported], True)
         _section("Already imported", [f"{r.game} <- {r.source}" for r in report.already_present], args.verbose)

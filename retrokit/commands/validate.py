@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -37,6 +38,7 @@ def run(args: argparse.Namespace) -> int:
 
     from tqdm import tqdm
 
+    from retrokit.benchmark.progress import is_terminal
     from retrokit.errors import InvalidArgumentError
     from retrokit.testing import STAGES, check_game
     from retrokit.testing.report import PASS, GameReport, render, summary, write_json
@@ -60,7 +62,9 @@ def run(args: argparse.Namespace) -> int:
             )
         targets = ["."]
     reports: list[GameReport] = []
-    with tqdm(total=len(targets) * len(STAGES), unit="stage", leave=False) as bar:
+    # A bar redraws in place, which only a terminal shows: in a pipe or a log, one line per stage instead.
+    bars = is_terminal()
+    with tqdm(total=len(targets) * len(STAGES), unit="stage", leave=False, disable=not bars) as bar:
         for target in targets:
             started = [0]  # stages of this game begun; the bar counts those finished
 
@@ -69,6 +73,8 @@ def run(args: argparse.Namespace) -> int:
                 if not detail:  # a stage starts (so the one before it is done); details only say where it is
                     bar.update(1 if started[0] else 0)
                     started[0] += 1
+                    if not bars and not args.quiet:
+                        print(f"{name}: {stage} ({started[0]}/{len(STAGES)})", file=sys.stderr, flush=True)
 
             reports.append(check_game(target, frames=args.frames, progress=step))
             bar.update(len(STAGES) - max(started[0] - 1, 0))  # the last stage, and any a broken game skipped

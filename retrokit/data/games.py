@@ -274,7 +274,7 @@ class Game:
                 "Delete that file, then import the right ROM with: retrokit import /path/to/your/roms"
             )
         raise RomNotFoundError(
-            f"Expected the ROM of {self.name} (a {self.system} ROM with SHA-1 {expected}) "
+            f"Expected the ROM of {self.name} (the {self.system} ROM with SHA-1 {expected}) "
             f"in {self.imported_rom_path(data_dir)}; found no ROM there. Import it with: "
             "retrokit import /path/to/your/roms (folders and .zip files are searched; "
             "set RETROKIT_DATA to store ROMs elsewhere)."
@@ -419,6 +419,9 @@ def find_game(name: Game | str | os.PathLike[str], *, check: bool = True) -> Gam
     name = os.fspath(name)
     index = _index()
     key = normalize_name(name)
+    if key not in index:  # a name in other case is that game, when only one game has it
+        same = [known for known in index if known.lower() == key.lower()]
+        key = same[0] if len(same) == 1 else key
     if key in index:
         game = Game(key, index[key])
         return game.check() if check else game
@@ -426,12 +429,13 @@ def find_game(name: Game | str | os.PathLike[str], *, check: bool = True) -> Gam
     if folder.is_dir() and _is_game_folder(folder):
         game = Game(normalize_name(folder.resolve().name), (folder,))
         return game.check() if check else game
-    searched = ", ".join(str(d) for d in paths.game_search_dirs()) or "(none: is stable-retro installed?)"
+    dirs = paths.game_search_dirs()
     missing = [str(d) for d in paths.env_games_dirs() if not d.is_dir()]
     note = f" {paths.GAMES_ENV} names folders that do not exist: {', '.join(missing)}." if missing else ""
+    where = f"in the {len(dirs)} integration folders" if dirs else "(no integration folder: is stable-retro installed?)"
     raise GameNotFoundError(
-        f"Expected the name of a known game, <Name>-<System>; found {name!r}, which no folder in "
-        f"{searched} holds.{note} List the games with: retrokit games." + did_you_mean(key, index)
+        f"Expected the name of a known game, <Name>-<System>; found {name!r}, which is no game {where}.{note}"
+        + did_you_mean(key, index) + " List the games with: retrokit games [PATTERN]."
     )
 
 

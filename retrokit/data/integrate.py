@@ -288,6 +288,15 @@ def integrate(
             f"({game.state_path(shipped[0])}) but no ROM. Import the ROM, then the state plays as it is: "
             "retrokit import /path/to/your/roms"
         )
+    unknown = [n for n in names or [] if n not in known and n not in game.states]
+    if not known and unknown:  # a name that is no state at all: say so first, not that recipes are missing
+        states = ", ".join(game.states) or "none"
+        raise StateNotFoundError(
+            f"Expected a state of {game.name}; found no state {unknown[0]!r} (its states: {states}), and no recipe "
+            f"under 'integrate' in {game.info.source} to make one. Make it from a movie: retrokit integrate "
+            f"{game.name} {unknown[0]} --movie FILE.bk2, or add a recipe (retrokit docs integrate)."
+            + did_you_mean(unknown[0], game.states)
+        )
     if not known:
         raise StateNotFoundError(
             f"Expected state recipes under 'integrate' in {game.info.source}; found none. "

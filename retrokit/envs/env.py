@@ -69,6 +69,8 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
             native preprocessing (see :mod:`retrokit.envs.preprocessing`).
         noop_max: At each reset, run a random number of steps from 1 to ``noop_max`` without buttons
             (seeded); 0 runs none.
+        reset_frame: At each reset, run one emulator frame without buttons after the start state (and any
+            no-ops), as stable-retro's ``reset`` does, so its action sequences replay frame for frame here.
         reward_clip: ``True`` gives the reward's sign, a number ``c`` clips it to ``[-c, c]``.
         info_keys: The fields that ``info`` holds (``[]`` for none, the fastest); ``None`` for all.
 
@@ -105,6 +107,7 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         channels_first: bool = False,
         max_pool: bool = False,
         noop_max: int = 0,
+        reset_frame: bool = False,
         reward_clip: bool | float = False,
         info_keys: list[str] | None = None,
     ) -> None:
@@ -114,6 +117,7 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         PicklesAsArguments.__init__(self, game, state, scenario, **given)
         checked = check_options(given)  # the same rules as retrokit.make's, whichever way the env is made
         self.noop_max, self.reward_clip = checked["noop_max"], checked["reward_clip"]
+        self.reset_frame = checked["reset_frame"]
         frameskip, sticky_prob, players = checked["frameskip"], checked["sticky_prob"], checked["players"]
         max_episode_steps, scenario_every_frame = checked["max_episode_steps"], checked["scenario_every_frame"]
         skip_video, options = checked["skip_video"], checked["options"]
@@ -317,20 +321,21 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         self.emulator.forget_action()
         self.emulator.set_sticky(self.sticky_prob, int(self.np_random.integers(0, 2**63)))
         noops = int(self.np_random.integers(1, self.noop_max + 1)) if self.noop_max else 0
-        if noops:
-            self.emulator.run(self._noop, noops * self.frameskip)  # one call: only its last frame is drawn
+        frames = noops * self.frameskip + self.reset_frame
+        if frames:
+            self.emulator.run(self._noop, frames)  # one call: only its last frame is drawn
             self.emulator.forget_action()
             values = self.stepper.start()
-            obs = self._observe_first()  # the screen the last no-op drew
+            obs = self._observe_first()  # the screen the last of those frames drew
         else:
             values = self.stepper.start()
             obs = self._initial_observation()
-        self._at_start = not noops
+        self._at_start = not frames
         if self.movies is not None:
             self.movies.start()
-            if noops:
+            if frames:
                 none = (0,) * self.players
-                self.movies.frames(none, none, noops * self.frameskip)
+                self.movies.frames(none, none, frames)
         if self.info_keys is not None:
             values = {key: values[key] for key in self.info_keys}
         if self.render_mode == "human":

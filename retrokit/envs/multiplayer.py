@@ -63,7 +63,8 @@ class RetroParallelEnv(PicklesAsArguments, ParallelEnv):
         self.possible_agents = [f"player_{i + 1}" for i in range(players)]
         self.agents: list[str] = []
         self.render_mode = self._env.render_mode
-        self.metadata = {**self.metadata, **self._env.metadata}  # its frame rate, over its frame skip
+        # Its frame rate, over its frame skip; its name is the game's, as PettingZoo names each environment.
+        self.metadata = {**self.metadata, **self._env.metadata, "name": f"{self._env.game.name}_v0"}
         self._obs_space = self._env.observation_space
         self._act_space = self._env.actions.single_player_space()
 

@@ -87,11 +87,25 @@ def _choice(name: str, choices: tuple[str, ...], optional: bool = False) -> Call
             return None
         if isinstance(value, str) and value in choices:
             return value
-        hint = did_you_mean(value, choices) if isinstance(value, str) else ""
+        hint = did_you_mean(value, choices) if isinstance(value, str) else _enum_hint(name, value, choices)
         allowed = ", ".join(repr(c) for c in choices) + (" or None" if optional else "")
         raise InvalidArgumentError(f"Expected {name} to be one of {allowed}, got {shown(value)}.{hint}")
 
     return check
+
+
+#: stable-retro's enum members whose retrokit value is not their name in lower case.
+_ENUM_VALUES = {"IMAGE": "rgb"}
+
+
+def _enum_hint(name: str, value: object, choices: tuple[str, ...]) -> str:
+    """For an enum member such as stable-retro's ``Actions.DISCRETE``: the string retrokit takes instead."""
+    if not isinstance(value, enum.Enum):
+        return ""
+    equivalent = _ENUM_VALUES.get(value.name, value.name.lower())
+    if equivalent not in choices:
+        return ""
+    return f" retrokit takes strings, not stable-retro's enums: pass {name}={equivalent!r} for {type(value).__name__}.{value.name}."
 
 
 def _render_mode(value: object) -> str | None:
@@ -221,6 +235,7 @@ OPTIONS: dict[str, Callable[[Any], Any]] = {
     "max_pool": _flag("max_pool"),
     # Episodes and what a step hands back.
     "noop_max": _noop_max,
+    "reset_frame": _flag("reset_frame"),
     "reward_clip": _reward_clip,
     "info_keys": _info_keys,
 }
@@ -237,13 +252,28 @@ def check_options(options: Mapping[str, Any]) -> dict[str, Any]:
     return {name: OPTIONS[name](value) for name, value in options.items()}
 
 
+#: stable-retro's keywords of ``make`` that retrokit spells otherwise, and what to write instead.
+STABLE_RETRO_KEYWORDS = {
+    "use_restricted_actions": "use action_type='filtered', 'all', 'discrete' or 'multi_discrete' for "
+    "retro.Actions.FILTERED, ALL, DISCRETE or MULTI_DISCRETE",
+    "inttype": "leave it out: retrokit looks for a game in every integration folder, and RETROKIT_GAMES adds your "
+    "own (docs/from-stable-retro.md)",
+    "info": "leave it out: a game's RAM fields come from its game.yaml or data.json, and info holds them all",
+}
+
+
 def check_names(options: Mapping[str, Any]) -> None:
-    """Refuse a keyword that is no option of RetroEnv, with the closest one.
+    """Refuse a keyword that is no option of RetroEnv, with the closest one, or retrokit's name for stable-retro's.
 
     Raises:
         UnknownNameError: A keyword is not an option.
     """
     for name in options:
+        if name in STABLE_RETRO_KEYWORDS:
+            raise UnknownNameError(
+                f"Expected a keyword option of retrokit.make, got stable-retro's {name!r}; "
+                f"{STABLE_RETRO_KEYWORDS[name]}."
+            )
         if name not in OPTIONS:
             raise UnknownNameError(
                 f"Expected a keyword option of retrokit.make ({', '.join(OPTIONS)}), got {name!r}."

@@ -44,7 +44,7 @@ from retrokit.envs.options import check_num_envs, check_seed
 from retrokit.envs.pickling import PicklesAsArguments
 from retrokit.envs.starts import per_env_states
 from retrokit.envs.stepper import Stepping, StepResult, drive
-from retrokit.errors import EnvError, InvalidArgumentError, shown
+from retrokit.errors import EnvError, InvalidArgumentError, MissingExtraError, shown
 from retrokit.host.runner import Runner
 
 
@@ -342,6 +342,21 @@ class ThreadedVectorEnv(PicklesAsArguments, VectorEnv):
 
     def _step_threads(self, actions: Sequence[Any]) -> list[tuple]:
         return self._each(lambda i: self._step_one(i, actions[i]))
+
+    def to_sb3(self) -> Any:
+        """This vector env as Stable-Baselines3's ``VecEnv`` (:class:`~retrokit.envs.sb3.SB3VecEnv`), for its algorithms.
+
+        Raises:
+            MissingExtraError: stable-baselines3 is not installed.
+        """
+        try:
+            from retrokit.envs.sb3 import SB3VecEnv
+        except ImportError as exc:
+            raise MissingExtraError(
+                f"Expected stable-baselines3 to make an SB3 VecEnv; importing it failed ({exc}). Install it with its "
+                "CPU torch: pip install torch --index-url https://download.pytorch.org/whl/cpu stable-baselines3"
+            ) from None
+        return SB3VecEnv(self)
 
     def render(self) -> tuple[Any, ...] | None:
         return tuple(env.render() for env in self.envs)

@@ -362,8 +362,8 @@ class Emulator:
             )
         if state.system != self.system.name:
             raise StateError(
-                f"Expected a state of a {self.system.name} core; found one checked for {state.system}. "
-                f"Load it into a {state.system} emulator."
+                f"Expected a state for this emulator of {self.system.name}; found one checked for {state.system}. "
+                f"Load it into an emulator of {state.system}."
             )
         self._emu.unserialize(state)
 

@@ -99,7 +99,7 @@ class Layout:
             if mask < 0 or mask & ~self.allowed:
                 extra = get_system(self.system).buttons_of(mask & ~self.allowed) if mask >= 0 else [str(mask)]
                 raise MovieError(
-                    f"{where}: expected player {player} to press only buttons a {self.system} .bk2 movie records "
+                    f"{where}: expected player {player} to press only buttons that .bk2 movies of {self.system} record "
                     f"({self.describe()}); found mask {mask:#x}, which also presses {extra or 'unknown bits'}. "
                     "stable-retro's format has no letter for them, so the movie could not replay; leave them out."
                 )

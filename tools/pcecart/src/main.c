@@ -148,8 +148,7 @@ void main(void) {
     enter_title();
     for (;;) {
         wait_frame();
-        sprites_flush();
-        vdc_reg(VDC_BXR, CAMERA_X & 511);
+        vdc_reg(VDC_BXR, CAMERA_X & 511);  /* the scroll of the frame the sprites below show in */
         VDC_SELECT = VDC_VWR;
         read_pad();
         ++FRAME;
@@ -178,5 +177,6 @@ void main(void) {
             break;
         }
         draw_sprites();
+        sprites_flush();  /* the VDC copies the table at the next vertical blank: shown next frame */
     }
 }

@@ -29,7 +29,7 @@ def ram_h_fields(ram_h: Path) -> dict[str, int]:
     """A cartridge's src/ram.h addresses by game.yaml's names: ADDR_X -> x, ADDR_Pn + P_X -> pn_x."""
     values = {
         name: int(value, 16)
-        for name, value in re.findall(r"^#define (\w+) (0x[0-9A-Fa-f]+)\b", ram_h.read_text(), re.MULTILINE)
+        for name, value in re.findall(r"^#define (\w+) +(0x[0-9A-Fa-f]+)\b", ram_h.read_text(), re.MULTILINE)
     }
     out = {k[len("ADDR_"):].lower(): v for k, v in values.items() if k.startswith("ADDR_")}
     for player in (1, 2):

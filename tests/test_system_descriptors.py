@@ -26,6 +26,12 @@ def wheel_systems() -> dict[str, dict]:
 
 WHEEL = wheel_systems()
 
+# Where a descriptor departs from the wheel's file on purpose, the fact is checked on the real
+# core instead: the PC Engine's action groups (the wheel's repeat IV and offer III-VI, which
+# the core's 2-button pad never delivers and, for III and IV, turns into turbo switches;
+# tests/test_pcecart.py).
+CORRECTED = {("PCEngine", "actions")}
+
 
 def test_every_wheel_system_has_a_descriptor() -> None:
     assert set(WHEEL) == set(all_systems())
@@ -40,7 +46,8 @@ def test_descriptor_matches_the_wheel(name: str) -> None:
     assert ours.ram_base == (theirs.get("rambase") or 0)
     assert ours.ram_swap == (theirs["overlay"][2] if "overlay" in theirs else 1)
     assert list(ours.types) == theirs.get("types", [])
-    assert [[list(c) for c in group] for group in ours.actions] == theirs.get("actions", [])
+    if (name, "actions") not in CORRECTED:
+        assert [[list(c) for c in group] for group in ours.actions] == theirs.get("actions", [])
 
 
 @pytest.mark.parametrize("name", sorted(WHEEL))

@@ -9,7 +9,6 @@ a misaligned word access in the game would crash it (and set ``crash``).
 from __future__ import annotations
 
 import hashlib
-import re
 import struct
 from pathlib import Path
 
@@ -17,7 +16,7 @@ import numpy as np
 import pytest
 import yaml
 
-from retrokit.host.emulator import Emulator
+from cartgame import ABSENT, ALIVE, DYING, CartGame, game_fields, lose_every_life, ram_h_fields, run_into_goal, start_selected
 
 REPO = Path(__file__).resolve().parent.parent
 GAME_DIR = REPO / "games" / "Dasher-Genesis"
@@ -26,63 +25,26 @@ CART_DIR = REPO / "tools" / "testcart"
 # The acts' goal x, from tools/testcart/src/levels.c: every act has its own length.
 END_X = {(0, 0): 1600, (0, 1): 2000, (1, 0): 2400, (1, 1): 2640, (2, 0): 2960, (2, 1): 3200}
 GROUND_MAP = 0xFF0100  # one byte per 8-pixel column: height in tiles, 0 = pit, 0x20 = spikes
-MODE_TITLE, MODE_PLAY, MODE_CLEAR, MODE_GAMEOVER = 0, 1, 2, 3
-ALIVE, DYING, OUT, ABSENT = 0, 1, 2, 3
 
 
-def _fields() -> dict[str, tuple[int, str]]:
-    doc = yaml.safe_load((GAME_DIR / "game.yaml").read_text())
-    return {name: (int(f["address"]), f["type"]) for name, f in doc["fields"].items()}
+FIELDS = game_fields(GAME_DIR)
 
 
-FIELDS = _fields()
-
-
-class Dasher:
+class Dasher(CartGame):
     """An emulator running Dasher, with the game's fields by name."""
 
     def __init__(self, rom: Path, *, tmss: bool = False) -> None:
         options = {"genesis_plus_gx_addr_error": "enabled"}
         if tmss:
             options["genesis_plus_gx_bios"] = "enabled"
-        self.emu = Emulator.for_rom(rom, options=options)
-        self.mask = self.emu.system.mask
-
-    def __getitem__(self, name: str) -> int:
-        address, code = FIELDS[name]
-        return self.emu.peek(address, code)
-
-    def __setitem__(self, name: str, value: int) -> None:
-        address, code = FIELDS[name]
-        self.emu.poke(address, value, code)
-
-    def run(self, p1: list[str] = (), p2: list[str] = (), frames: int = 1) -> None:
-        self.emu.run([self.mask(p1), self.mask(p2)], frames)
-
-    def run_until(self, condition, p1: list[str] = (), p2: list[str] = (), limit: int = 600) -> int:
-        """Run frames holding the buttons until ``condition()``; return the frames run."""
-        for n in range(limit):
-            if condition():
-                return n
-            self.run(p1, p2)
-        raise AssertionError(f"condition not met within {limit} frames")
-
-    def boot(self) -> None:
-        """Run until the title screen's main loop is counting frames."""
-        self.run_until(lambda: self["frame"] >= 2, limit=300)
-        assert self["game_mode"] == MODE_TITLE
-
-    def start(self, p1: list[str] = ("START",), p2: list[str] = ()) -> None:
-        """Press START for one frame at the title and wait for the act to begin."""
-        self.run(list(p1), list(p2))
-        self.run_until(lambda: self["game_mode"] == MODE_PLAY, limit=120)
+        super().__init__(rom, FIELDS, options)
 
     def ground(self, x: int) -> int:
         return self.emu.peek(GROUND_MAP + x // 8)
 
     def close(self) -> None:
         assert self["crash"] == 0, f"the 68000 took exception vector {self['crash']}"
-        self.emu.close()
+        super().close()
 
 
 @pytest.fixture
@@ -120,21 +82,8 @@ def test_game_yaml_lists_the_committed_rom(dasher_rom: Path) -> None:
     assert doc["players"] == 2
 
 
-def _ram_h() -> dict[str, int]:
-    """The fixed addresses of src/ram.h, by game.yaml's field names."""
-    defines = dict(re.findall(r"^#define (\w+) (0x[0-9A-Fa-f]+)\b", (CART_DIR / "src" / "ram.h").read_text(), re.MULTILINE))
-    values = {name: int(v, 16) for name, v in defines.items()}
-    out = {k[len("ADDR_"):].lower(): v for k, v in values.items() if k.startswith("ADDR_")}
-    for player in (1, 2):
-        base = values[f"ADDR_P{player}"]
-        for k, v in values.items():
-            if k.startswith("P_"):
-                out[f"p{player}_{k[2:].lower()}"] = base + v
-    return out
-
-
 def test_game_yaml_addresses_match_the_source() -> None:
-    known = _ram_h()
+    known = ram_h_fields(CART_DIR / "src" / "ram.h")
     for name, (address, _) in FIELDS.items():
         assert name in known, f"game.yaml field {name!r} is not in src/ram.h"
         assert address == known[name], f"{name}: game.yaml says {address:#x}, src/ram.h {known[name]:#x}"
@@ -245,26 +194,15 @@ def test_walking_into_a_pit_loses_a_life_and_respawns(playing: Dasher) -> None:
 
 
 def test_losing_every_life_is_game_over(playing: Dasher) -> None:
-    for lives in (2, 1, 0):
-        playing.run_until(lambda: playing["p1_state"] == DYING, ["RIGHT"], limit=400)
-        assert playing["p1_lives"] == lives
-        playing.run_until(lambda: playing["p1_state"] != DYING, limit=300)
-    assert playing["p1_state"] == OUT
-    playing.run(frames=2)
-    assert playing["game_mode"] == MODE_GAMEOVER
-    playing.run_until(lambda: playing["game_mode"] == MODE_TITLE, limit=400)
+    lose_every_life(playing)
 
 
 def test_reaching_end_x_clears_the_act(playing: Dasher) -> None:
     # Put the player just before the goal (flat ground there) and run in.
     playing["p1_x"] = playing["end_x"] - 40
-    playing.run_until(lambda: playing["level_done"] == 1, ["RIGHT"], limit=120)
-    assert playing["game_mode"] == MODE_CLEAR
-    assert playing["p1_score"] >= 1000, "the act-clear bonus"
-    playing.run_until(lambda: playing["game_mode"] == MODE_PLAY, limit=300)
-    assert (playing["zone"], playing["act"], playing["level_done"]) == (0, 1, 0)
+    run_into_goal(playing)
+    assert (playing["zone"], playing["act"]) == (0, 1)
     assert playing["end_x"] == END_X[0, 1]
-    assert playing["p1_x"] == playing["start_x"]
 
 
 # --- level select ------------------------------------------------------------------------------
@@ -275,18 +213,8 @@ def test_reaching_end_x_clears_the_act(playing: Dasher) -> None:
 def test_writing_zone_and_act_selects_the_level(dasher_rom: Path, zone: int, act: int, when: str) -> None:
     game = Dasher(dasher_rom)
     try:
-        if when == "at-title":
-            game.boot()
-            game.run(frames=20)
-        game["zone"], game["act"] = zone, act  # before the first frame: the boot's RAM clear keeps them
-        if when == "before-first-frame":
-            game.boot()
-        assert (game["zone"], game["act"]) == (zone, act)
-        game.start()
-        assert (game["zone"], game["act"]) == (zone, act)
+        start_selected(game, {"zone": zone, "act": act}, when)
         assert game["end_x"] == END_X[zone, act]
-        assert game["level_width"] > game["end_x"]
-        assert game["p1_x"] == game["start_x"]
     finally:
         game.close()
 

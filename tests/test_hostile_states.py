@@ -286,3 +286,75 @@ def test_games_sharing_a_rom_may_share_states(tmp_path: Path, good_state: bytes,
     shutil.copy(DASHER / "game.yaml", twin / "game.yaml")
     (twin / "Start.state").write_bytes(compress_state(good_state))  # as stable-retro writes it: no record
     assert load_state(find_game("Dasher-Genesis"), twin / "Start.state") == good_state
+
+
+HOPPER = {"Sms": REPO / "games" / "Hopper-Sms" / "rom.sms", "GameGear": REPO / "games" / "Hopper-GameGear" / "rom.gg"}
+
+
+def wild_wave(system: str, value: int, channel: int = 0, slot: int = 0) -> bytes:
+    """Hopper's Level1 state with one YM2413 operator's sine-table offset set to ``value``."""
+    import struct
+
+    from retrokit.data.states import read_state
+    from retrokit.host.statelayout import MS_YM2413, YM2413_CHANNEL_SIZE, YM2413_SLOT_SIZE, YM2413_WAVETABLE
+
+    state = bytearray(read_state(HOPPER[system].parent / "Level1.state"))
+    at = MS_YM2413 + channel * YM2413_CHANNEL_SIZE + slot * YM2413_SLOT_SIZE + YM2413_WAVETABLE
+    struct.pack_into("<I", state, at, value)
+    return bytes(state)
+
+
+@pytest.mark.parametrize("system", ["Sms", "GameGear"])
+def test_a_wild_fm_sine_table_offset_really_crashes_the_core(tmp_path: Path, system: str) -> None:
+    # Past the layout check (the child takes the mint itself), the core reads sin_tab 4 GiB on: SIGSEGV.
+    state = tmp_path / "wild.bin"
+    state.write_bytes(wild_wave(system, 0x40000000))
+    child = run_child(f"""
+        import struct
+        from retrokit.host.emulator import Emulator, claim_mint
+        from retrokit.host.statelayout import MS_YM2413
+        state = bytearray(open({str(state)!r}, 'rb').read())
+        struct.pack_into('<ii', state, MS_YM2413 + 44, 0, 0)  # operator 1's level and envelope: loud, so it is read
+        emu = Emulator.for_rom({str(HOPPER[system])!r})
+        emu.set_state(claim_mint()(bytes(state), {system!r}))
+        emu.run([0, 0], 5)
+        print('survived')
+    """)
+    assert child.signal == "SIGSEGV", child.describe()
+
+
+@pytest.mark.parametrize("system", ["Sms", "GameGear"])
+def test_a_wild_fm_sine_table_offset_is_refused_before_any_probe_or_record(
+    tmp_path: Path, system: str, monkeypatch
+) -> None:
+    from retrokit.data import probe
+    from retrokit.host.statelayout import state_layout_problem
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    rom = HOPPER[system]
+    sha1 = cached_rom_sha1(rom, system)
+    state = wild_wave(system, 0x1000, channel=8, slot=1)
+    probe._remember(probe_key(state, system, sha1), probe.ProbeVerdict(True))  # an old probe's lucky verdict
+    monkeypatch.setattr(probe, "probe_state", lambda *a, **k: pytest.fail("probed"))
+    with pytest.raises(StateError, match=r"YM2413 sound chip indexes its sine table with 1 wild offset\(s\) \(channel 8"):
+        probe.vet_state(state, system, rom, sha1, source="x")
+    for edge in (0, 1024):  # the full and the half sine: what a core writes
+        assert state_layout_problem(system, wild_wave(system, edge)) == ""
+    assert "at 0x401" in state_layout_problem(system, wild_wave(system, 1025))
+    assert state_layout_problem("Genesis", state) != state_layout_problem(system, state)  # each system its layout
+
+
+def test_shipped_master_system_and_game_gear_states_have_their_fm_offsets_in_the_table() -> None:
+    from retrokit.data.states import read_state
+    from retrokit.host.statelayout import state_layout_problem
+    from retrokit.paths import wheel_dir
+
+    stable = wheel_dir() / "data" / "stable"
+    files = {"Sms": sorted(stable.glob("*-Sms*/*.state")), "GameGear": sorted(stable.glob("*-GameGear*/*.state"))}
+    for system, rom in HOPPER.items():
+        files[system] += sorted(rom.parent.glob("*.state"))
+    assert sum(map(len, files.values())) > 50
+    problems = {
+        f"{f.parent.name}/{f.name}": state_layout_problem(system, read_state(f)) for system in files for f in files[system]
+    }
+    assert not any(problems.values()), {k: v for k, v in problems.items() if v}

@@ -67,7 +67,7 @@ class Scripted:
 
 
 def play(env: Corridor, budget: int, rng) -> Jerk:
-    agent = Jerk(Monitor(env, "corridor", budget, 0, lambda e: None), budget, rng, press=press)
+    agent = Jerk(Monitor(env, "corridor", budget, 0, lambda e: None), budget, rng, press=press, jump="B")
     with pytest.raises(BudgetSpent):
         agent.play()
     return agent
@@ -137,7 +137,7 @@ def test_a_replay_plays_the_best_prefix_then_no_ops_and_joins_its_mean() -> None
 
 
 def test_the_best_sequence_is_the_one_of_highest_mean_reward() -> None:
-    agent = Jerk(Corridor(), 10, Scripted([]), press=press)
+    agent = Jerk(Corridor(), 10, Scripted([]), press=press, jump="B")
     lucky, steady = Solution(["a"], [10.0, 0.0, 0.0]), Solution(["b"], [6.0])
     agent.sequences = [lucky, steady]
     assert agent.best() is steady
@@ -146,7 +146,7 @@ def test_the_best_sequence_is_the_one_of_highest_mean_reward() -> None:
 
 
 def test_ties_go_to_the_later_sequence_as_the_baselines_sorted_them() -> None:
-    agent = Jerk(Corridor(), 10, Scripted([]), press=press)
+    agent = Jerk(Corridor(), 10, Scripted([]), press=press, jump="B")
     first, second = Solution(["a"], [5.0]), Solution(["b"], [5.0])
     agent.sequences = [first, second]
     assert agent.best() is second
@@ -156,7 +156,7 @@ def test_jerk_spends_exactly_its_budget() -> None:
     env = Corridor(wall=30, max_steps=300)
     monitor = Monitor(env, "corridor", 1234, 0, lambda e: None)
     with pytest.raises(BudgetSpent):
-        Jerk(monitor, 1234, random.Random(0), press=press).play()
+        Jerk(monitor, 1234, random.Random(0), press=press, jump="B").play()
     assert monitor.timesteps == len(env.log) == 1234
 
 

@@ -78,6 +78,17 @@ def test_system_passed_when_nothing_tells_it(data, tmp_path, capsys):
     assert "told by its --system" in out and find_game("Mystery-Snes").system.name == "Snes"
 
 
+def test_the_next_hint_presses_the_systems_start_button(data, tmp_path, capsys):
+    """A 2600 has no START: a game begins with the console's RESET switch (`start:` in systems.yaml)."""
+    blob = tmp_path / "game.a26"
+    blob.write_bytes(bytes(range(256)) * 16)  # 4 KiB, no header: the extension tells the system
+    status, out, err = cli(capsys, "new", str(blob), "--name", "Blob-Atari2600")
+    assert status == 0, err
+    assert "retrokit ramsearch run --script '_*20 RESET*2 _*98'" in out and "START" not in out
+    status, out, err = cli(capsys, "new", str(write_runner_rom(tmp_path / "runner.bin")), "--name", "Runner-Genesis")
+    assert status == 0 and "--script '_*20 START*2 _*98'" in out, err
+
+
 @pytest.mark.parametrize(
     ("name", "message"),
     [

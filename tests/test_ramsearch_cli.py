@@ -338,3 +338,26 @@ def test_a_session_whose_state_changed_is_probed_before_it_is_loaded(session, ca
     status, _, err = run(capsys, "show", "--session", str(tampered))
     assert probed == [len(body)]
     assert status == 2 and "SIGSEGV" in err and err.count("\n") == 1
+
+
+def test_a_bit_search_finds_a_flag_held_in_one_bit_and_saves_it_with_its_mask(tmp_path, capsys, monkeypatch):
+    """Dasher keeps the buttons held in one byte (pad1, 0xFF0014: RIGHT is 0x08): a search of `bits` finds the
+    RIGHT bit where a byte search cannot tell it from the other buttons, and saves it as |u1 with a mask."""
+    games = tmp_path / "games"
+    shutil.copytree(DASHER, games / "Dasher-Genesis")
+    game_yaml = games / "Dasher-Genesis" / "game.yaml"
+    monkeypatch.setenv("RETROKIT_GAMES", str(games))
+    monkeypatch.chdir(tmp_path)
+    status, out, err = run(capsys, "new", "Dasher-Genesis", "--types", "bits")
+    assert status == 0 and "(8 types at every address of 0xFF0000-0xFFFFFF)" in out, err
+    for press, op in (("RIGHT", "not-equal 0"), ("", "equal 0"), ("RIGHT+B", "changed"), ("B", "changed")):
+        assert run(capsys, "run", *(["--press", *press.split("+")] if press else []), "--frames", "3")[0] == 0
+        assert run(capsys, "filter", *op.split())[0] == 0
+    status, out, _ = run(capsys, "show", "--json")
+    found = {(c["address"], c["type"]) for c in json.loads(out)}
+    assert (0xFF0014, "|u1&0x08") in found and len(found) < 20
+    status, out, err = run(capsys, "save", "right_held", "0xFF0014", "|u1&0x08", "--game-file", str(game_yaml))
+    assert status == 0, err
+    assert '  right_held:  {address: 0xFF0014, type: "|u1", mask: 0x08}' in game_yaml.read_text()
+    status, _, err = run(capsys, "save", "two_bits", "0xFF0014", "|u1&0x0C", "--game-file", str(game_yaml))
+    assert status == 2 and "Expected a bit type: |u1&MASK with one bit" in err

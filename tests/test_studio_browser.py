@@ -55,11 +55,11 @@ pytestmark = pytest.mark.timeout(600)
 
 
 class Studio:
-    """A ``retrokit studio`` child process on a copy of Dasher, and where its files go."""
+    """A ``retrokit studio`` child process on a copy of a game's folder (Dasher's), and where its files go."""
 
-    def __init__(self, root: Path) -> None:
-        self.game = root / "games" / "Dasher-Genesis"
-        shutil.copytree(DASHER, self.game)
+    def __init__(self, root: Path, source: Path = DASHER) -> None:
+        self.game = root / "games" / source.name
+        shutil.copytree(source, self.game)
         self.data = root / "data"
         self.data.mkdir()
         env = {**os.environ, "RETROKIT_DATA": str(self.data)}

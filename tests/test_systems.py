@@ -1,82 +1,363 @@
-"""System descriptors agree with the facts in the stable-retro wheel's cores/*.json."""
+"""Every tool on every system we have a cartridge for (issue 29 §4), on the real cores.
+
+Parametrized over tools/cartridges.yaml: each cartridge is a small real game of ours, so each test
+here is one tool on one system's core, RAM map, byte order, buttons and screen. stable-retro is the
+reference where it has an answer (tests/stable_retro_game.py writes its integration of the cartridge):
+
+- the env matches stable-retro frame for frame: observation, reward, done and info;
+- states saved by either load in the other and play on alike; movies recorded by either play alike;
+- ``ramsearch`` finds each field, at its console address, in the system's RAM region;
+- ``validate`` passes the game, and fails it with another game's state in its folder;
+- ``render_fps`` is the descriptor's frame rate, and native preprocessing equals Gymnasium's
+  wrappers on the system's screen size;
+- JERK beats random with ``retrokit evaluate`` on the cartridge's benchmark (a small budget).
+
+The studio's part (its buttons, keys and RAM region) is in tests/test_systems_studio.py.
+Each cartridge's fixtures are module-scoped and the plays short, so the suite stays quick.
+"""
 
 from __future__ import annotations
 
+import gzip
 import json
+import shutil
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
 
+import numpy as np
 import pytest
+import yaml
 
-from retrokit.errors import InvalidArgumentError, UnknownNameError, UnsupportedSystemError
-from retrokit.host.cores import find_core
-from retrokit.host.systems import all_systems, get_system, system_for_extension
-from retrokit.paths import wheel_cores_dir
+import retrokit
+from retrokit.cli import main
+from retrokit.data.games import Game, find_game
+from retrokit.data.statecheck import load_state
+from retrokit.data.states import StateRecord, read_state, write_state
+from retrokit.host.emulator import Emulator
+from retrokit.host.memory import FieldReader
+from retrokit.host.fields import FieldSpec
+from retrokit.movie import play, read_bk2
+from retrokit.paths import wheel_dir
+from retrokit.ramsearch import RamSearch
+from retrokit.ramsearch.engine import Engine
+from retrokit.ramsearch.scales import SCALES
+from retrokit.ramsearch.types import search_type
+from stable_retro_game import Integration, pressed, wandering, write_integration
 
+stable_retro = pytest.importorskip("stable_retro")
 
-def wheel_systems() -> dict[str, dict]:
-    folder = wheel_cores_dir()
-    assert folder is not None
-    facts: dict[str, dict] = {}
-    for path in sorted(folder.glob("*.json")):
-        facts.update(json.loads(path.read_text()))
-    return facts
-
-
-WHEEL = wheel_systems()
-
-
-def test_every_wheel_system_has_a_descriptor() -> None:
-    assert set(WHEEL) == set(all_systems())
-
-
-@pytest.mark.parametrize("name", sorted(WHEEL))
-def test_descriptor_matches_the_wheel(name: str) -> None:
-    ours, theirs = get_system(name), WHEEL[name]
-    assert ours.core == theirs["lib"]
-    assert list(ours.extensions) == theirs["ext"]
-    assert list(ours.buttons) == theirs["buttons"]
-    assert ours.ram_base == (theirs.get("rambase") or 0)
-    assert ours.ram_swap == (theirs["overlay"][2] if "overlay" in theirs else 1)
-    assert list(ours.types) == theirs.get("types", [])
-    assert [[list(c) for c in group] for group in ours.actions] == theirs.get("actions", [])
+REPO = Path(__file__).resolve().parent.parent
+CARTRIDGES = yaml.safe_load((REPO / "tools" / "cartridges.yaml").read_text())
+STEPS = 600  # the differential's steps (frames: frame skip 1)
+PLAY = 240  # frames of the shorter plays (states, movies, ramsearch)
 
 
-@pytest.mark.parametrize("name", sorted(WHEEL))
-def test_each_system_core_is_installed(name: str) -> None:
-    assert find_core(get_system(name).core).is_file()
+@dataclass
+class Cartridge:
+    """One cartridge, with its stable-retro integration (written once per module)."""
+
+    name: str
+    game: Game
+    benchmark: str
+    integration: Integration
+
+    @property
+    def system(self):
+        return self.game.system
+
+    def stable_env(self, **kwargs):
+        """stable-retro's env of the cartridge, every button reaching the core as pressed."""
+        return stable_retro.make(
+            self.integration.name, inttype=stable_retro.data.Integrations.CUSTOM_ONLY,
+            use_restricted_actions=stable_retro.Actions.ALL, render_mode=None, **kwargs,
+        )  # fmt: skip
 
 
-def test_genesis_buttons_are_retropad_bits() -> None:
-    genesis = get_system("Genesis")
-    # RetroPad ids: B 0, Y 1, SELECT 2, START 3, UP 4 ... A 8, X 9, L 10, R 11.
-    assert genesis.mask(["B"]) == 1 << 0
-    assert genesis.mask(["A"]) == 1 << 1  # the core maps RetroPad Y to Genesis A
-    assert genesis.mask(["C"]) == 1 << 8  # and RetroPad A to Genesis C
-    assert genesis.mask(["MODE", "START"]) == (1 << 2) | (1 << 3)
-    assert genesis.buttons_of(genesis.mask(["RIGHT", "C"])) == ["RIGHT", "C"]
+@pytest.fixture(scope="module", params=list(CARTRIDGES), ids=list(CARTRIDGES))
+def cart(request, tmp_path_factory) -> Iterator[Cartridge]:
+    name = request.param
+    root = tmp_path_factory.mktemp(f"stable-retro-{name}")
+    integration = write_integration(find_game(name), root)
+    stable_retro.data.Integrations.add_custom_path(str(root))
+    try:
+        yield Cartridge(name, find_game(name), CARTRIDGES[name]["benchmark"], integration)
+    finally:
+        stable_retro.data.Integrations.clear_custom_paths()
 
 
-def test_system_lookup_is_case_insensitive_and_suggests() -> None:
-    assert get_system("genesis").name == "Genesis"
-    with pytest.raises(UnsupportedSystemError, match="Did you mean 'Genesis'"):
-        get_system("Genisis")
+def inputs(cart: Cartridge, seed: int, frames: int) -> list[list[str]]:
+    source = wandering(cart.system, seed)
+    return [next(source) for _ in range(frames)]
 
 
-def test_extension_lookup() -> None:
-    assert system_for_extension(".md").name == "Genesis"
-    assert system_for_extension("smd").name == "Genesis"
-    assert system_for_extension("sfc").name == "Snes"
-    with pytest.raises(UnsupportedSystemError, match=r"got '\.mdd'.*Did you mean '\.md'"):
-        system_for_extension("mdd")
+# --- the env against stable-retro ---------------------------------------------------------------------
 
 
-def test_unknown_button_suggests() -> None:
-    with pytest.raises(UnknownNameError, match="Did you mean 'START'"):
-        get_system("Genesis").mask(["STRAT"])
-    with pytest.raises(InvalidArgumentError, match=r"list of button names.*\['RIGHT'\]"):
-        get_system("Genesis").mask("RIGHT")
+def test_the_env_matches_stable_retro_frame_for_frame(cart: Cartridge) -> None:
+    ours = retrokit.make(cart.name, state=cart.integration.after_reset, scenario=cart.integration.scenario,
+                         action_type="all")  # fmt: skip
+    theirs = cart.stable_env()
+    try:
+        assert list(ours.buttons) == list(theirs.unwrapped.buttons)
+        ours.reset(seed=0)
+        theirs.reset(seed=0)
+        rewards, dones, screens = 0.0, 0, set()
+        for step, names in enumerate(inputs(cart, 0, STEPS)):
+            action = pressed(ours.buttons, names)
+            obs, reward, done, _, info = ours.step(action)
+            their_obs, their_reward, their_done, _, their_info = theirs.step(action)
+            assert obs.shape == their_obs.shape, f"step {step}"
+            assert np.array_equal(obs, their_obs), f"step {step}: {np.argwhere(obs != their_obs)[:3]}"
+            assert info == their_info, f"step {step}: {set(info.items()) ^ set(their_info.items())}"
+            assert (reward, done) == (their_reward, their_done), f"step {step}"
+            rewards += abs(reward)
+            screens.add(obs.tobytes())
+            if done:
+                dones += 1
+                ours.reset(seed=0)
+                theirs.reset(seed=0)
+        # A game in motion, scoring: not a title screen both sides would agree on.
+        assert len(screens) > STEPS // 4 and rewards > 0, (len(screens), rewards)
+    finally:
+        ours.close()
+        theirs.close()
 
 
-def test_genesis_dump_aliases_name_genesis() -> None:
-    for ext in ("gen", "smd"):
-        assert system_for_extension(ext).name == "Genesis"
-    assert system_for_extension("bin").name == "N64"  # a system's own extension wins over an alias
+# --- states and movies, both ways ---------------------------------------------------------------------
+
+
+def run_ours(emu: Emulator, cart: Cartridge, names: list[list[str]]) -> list[np.ndarray]:
+    screens = []
+    for pressed_now in names:
+        emu.run([cart.system.mask(pressed_now), 0], 1)
+        screens.append(emu.screen().copy())
+    return screens
+
+
+def run_theirs(env, names: list[list[str]]) -> list[np.ndarray]:
+    return [env.step(pressed(env.unwrapped.buttons, n))[0].copy() for n in names]
+
+
+def first_difference(ours: list[np.ndarray], theirs: list[np.ndarray]) -> int | None:
+    assert len(ours) == len(theirs)
+    return next((i for i, (a, b) in enumerate(zip(ours, theirs)) if not np.array_equal(a, b)), None)
+
+
+def stable_retro_ram(env, base: int, size: int) -> np.ndarray:
+    """stable-retro's memory blocks (keyed by console address) that cover retrokit's RAM, base to base + size.
+
+    On the NES stable-retro also maps FCEUmm's 8 KiB of cartridge RAM at 0x6000-0x7FFF (get_ram() is all its
+    blocks, 10 KiB); retrokit's Nes RAM is the console's 2 KiB at 0x0.
+    """
+    blocks = env.unwrapped.data.memory.blocks
+    return np.concatenate([np.frombuffer(blocks[o], np.uint8) for o in sorted(blocks) if base <= o < base + size])
+
+
+def test_a_state_retrokit_saved_loads_in_stable_retro(cart: Cartridge, tmp_path: Path) -> None:
+    emu = Emulator(cart.system, cart.game.require_rom())
+    try:
+        emu.set_state(load_state(cart.game, cart.game.state_path()))
+        run_ours(emu, cart, inputs(cart, 1, PLAY))
+        data = emu.get_state()
+        path = write_state(tmp_path / "Middle.state", data, record=StateRecord.of(cart.name, cart.game.sha1s[0], data))
+        env = cart.stable_env()
+        try:
+            env.load_state(str(path))
+            env.reset(seed=0)  # loads it, then runs a frame with no buttons
+            emu.run([0, 0], 1)
+            later = inputs(cart, 2, PLAY)
+            assert first_difference(run_ours(emu, cart, later), run_theirs(env, later)) is None
+            assert np.array_equal(emu.ram, stable_retro_ram(env, cart.system.ram_base, len(emu.ram)))
+        finally:
+            env.close()
+    finally:
+        emu.close()
+
+
+def test_a_state_stable_retro_saved_loads_in_retrokit(cart: Cartridge, tmp_path: Path) -> None:
+    env = cart.stable_env()
+    try:
+        env.reset(seed=0)
+        run_theirs(env, inputs(cart, 3, PLAY))
+        path = tmp_path / "Theirs.state"
+        path.write_bytes(gzip.compress(env.unwrapped.em.get_state()))  # stable-retro's .state: plain gzip
+        ours = retrokit.make(cart.name, state=path, action_type="all")
+        try:
+            ours.reset(seed=0)
+            later = inputs(cart, 4, PLAY)
+            mine = [ours.step(pressed(ours.buttons, n))[0].copy() for n in later]
+            assert first_difference(mine, run_theirs(env, later)) is None
+        finally:
+            ours.close()
+    finally:
+        env.close()
+
+
+def test_a_retrokit_movie_plays_in_stable_retro(cart: Cartridge, tmp_path: Path) -> None:
+    ours = retrokit.make(cart.name, record=tmp_path, action_type="all")
+    names = inputs(cart, 5, PLAY)
+    try:
+        ours.reset(seed=0)
+        mine = [ours.step(pressed(ours.buttons, n))[0].copy() for n in names]
+    finally:
+        ours.close()
+    (path,) = tmp_path.glob("*.bk2")
+    movie = stable_retro.Movie(str(path))
+    emulator = stable_retro.RetroEmulator(str(cart.game.require_rom()))
+    try:
+        emulator.set_state(movie.get_state())
+        width = len(cart.system.buttons)
+        theirs = []
+        for frame, now in enumerate(names):
+            assert movie.step(), f"stable-retro's movie ended at frame {frame}"
+            keys = [movie.get_key(i, 0) for i in range(width)]
+            assert keys == [bool(b) for b in pressed(list(cart.system.buttons), now)], f"frame {frame}"
+            emulator.set_button_mask(np.array(keys, dtype=np.uint8), 0)
+            emulator.step()
+            theirs.append(emulator.get_screen().copy())
+    finally:
+        del emulator
+    assert first_difference(mine, theirs) is None
+
+
+def test_a_stable_retro_movie_plays_in_retrokit(cart: Cartridge, tmp_path: Path) -> None:
+    env = cart.stable_env(record=str(tmp_path))
+    try:
+        env.reset(seed=0)
+        screens = [env.unwrapped.em.get_screen().copy()]
+        screens += run_theirs(env, inputs(cart, 6, PLAY))
+        env.unwrapped.stop_record()
+    finally:
+        env.close()
+    (path,) = tmp_path.glob("*.bk2")
+    movie = read_bk2(path)
+    assert (movie.game, movie.system) == (cart.name, cart.system.name)
+    assert first_difference(list(play(movie)), screens) is None
+
+
+# --- ramsearch ----------------------------------------------------------------------------------------
+
+
+def searched_as(spec: FieldSpec) -> str | None:
+    """The type a search finds a field as: its own, or a bit type for a one-bit flag (None: no search type reads it)."""
+    if spec.mask is None:
+        return spec.type
+    if spec.type == "|u1" and spec.mask in BIT_MASKS:
+        return f"|u1&0x{spec.mask:02X}"
+    return None
+
+
+BIT_MASKS = [1 << bit for bit in range(8)]
+
+
+def test_ramsearch_finds_each_field_at_its_console_address(cart: Cartridge, capsys, tmp_path: Path) -> None:
+    """Each field's values along a play, searched for as a user would (``equal VALUE`` at each snapshot),
+    leave its address and type among the candidates, in the system's RAM region and byte order."""
+    fields = [f for f in cart.game.fields.values() if searched_as(f)]
+    with RamSearch(cart.game) as search:
+        base = cart.system.ram_base
+        assert search.layout.regions[0][0] == base, search.layout.describe()
+        reader = FieldReader(fields, search.emulator.space)
+        snapshots, values = [], []
+        for names in [inputs(cart, 7, PLAY)[i : i + 20] for i in range(0, PLAY, 20)]:
+            for now in names:
+                search.step(now, 1)
+            search.snapshot()
+            snapshots.append(search.engine.snapshots[-1])
+            values.append(reader.read())
+        layout = search.layout
+    as_stored = 1 << next(i for i, scale in enumerate(SCALES) if not scale.label)  # the value itself
+    for spec in fields:
+        engine = Engine(layout, [search_type(searched_as(spec))])
+        for snapshot, value in zip(snapshots, values):
+            engine.add_snapshot(snapshot)
+            engine.filter("equal", value[spec.name])
+        found = engine.candidates.alive[0] & (engine.candidates.scale[0] & as_stored != 0)
+        where = f"{spec.name} ({layout.format(spec.address)}, {spec.type})"
+        assert found[layout.position(spec.address, spec.field_type.width)], f"{where} not found"
+        if len({v[spec.name] for v in values}) >= 4:  # a value that moved pins its address down
+            assert np.count_nonzero(found) <= 8, f"{where}: {np.count_nonzero(found)} candidates"
+    # The command shows the RAM region in console addresses.
+    session = tmp_path / "s.session"
+    assert main(["ramsearch", "new", cart.name, "--session", str(session)]) == 0
+    assert f"at every address of {layout.describe()})" in capsys.readouterr().out
+
+
+# --- validate -----------------------------------------------------------------------------------------
+
+
+def another_games_state(cart: Cartridge) -> Path:
+    """A state of another game of the same system, from the wheel (every system has some)."""
+    folders = sorted((wheel_dir() / "data" / "stable").glob(f"*-{cart.system.name}-v0"))
+    return next(state for folder in folders for state in sorted(folder.glob("*.state")))
+
+
+def test_validate_passes_the_game_and_catches_a_state_from_another_game(cart: Cartridge, tmp_path: Path) -> None:
+    # One run (validate plays every state, scenario and movie): the copy with a foreign state fails on
+    # that state alone, so everything of the game's own passes.
+    folder = tmp_path / cart.name
+    shutil.copytree(cart.game.folders[0], folder)
+    shutil.copy(another_games_state(cart), folder / "Foreign.state")
+    assert main(["validate", str(folder), "--quiet", "--frames", "200", "--json", str(tmp_path / "report.json")]) == 1
+    (report,) = json.loads((tmp_path / "report.json").read_text())["games"]
+    failed = [r for r in report["results"] if r["status"] == "fail"]
+    assert failed and all(r["state"] == "Foreign" for r in failed), failed
+    assert {r["state"] for r in report["results"] if r["status"] == "pass"} >= set(cart.game.states)
+
+
+# --- render_fps and preprocessing ---------------------------------------------------------------------
+
+
+def test_render_fps_is_the_descriptors_frame_rate(cart: Cartridge) -> None:
+    for frameskip in (1, 4):
+        env = retrokit.make(cart.name, frameskip=frameskip)
+        try:
+            rate = cart.system.frame_rate(env.unwrapped.emulator.av_info()["fps"])
+            assert cart.system.frame_rates, f"{cart.system.name} lists no frame_rate in systems.yaml"
+            assert rate in cart.system.frame_rates.values()
+            assert env.metadata["render_fps"] == pytest.approx(rate / frameskip)
+        finally:
+            env.close()
+
+
+def test_native_preprocessing_equals_gymnasiums_wrappers_on_its_screen(cart: Cartridge) -> None:
+    from test_preprocessing import SKIP, as_native, reference
+
+    options = {"grayscale": True, "resize": (84, 84), "frame_stack": 4, "max_pool": True}
+    native = retrokit.make(cart.name, frameskip=SKIP, sticky_prob=0.0, **options)
+    ref = reference(cart.name, grayscale=True, max_pool=True, resize=(84, 84), frame_stack=4)
+    try:
+        obs, _ = native.reset(seed=3)
+        expected, _ = ref.reset(seed=3)
+        height, width = native.unwrapped.emulator.screen_shape()
+        assert (height, width) == ref.unwrapped.observation_space.shape[:2]
+        source = wandering(cart.system, 8, hold=1)
+        for step in range(60):
+            diff = np.abs(obs.astype(int) - as_native(expected, False).astype(int))
+            assert diff.max() <= 1, f"{width}x{height}: step {step} differs by {diff.max()}"
+            action = pressed(native.buttons, next(source))
+            obs, _, done, truncated, _ = native.step(action)
+            expected, _, ref_done, ref_truncated, _ = ref.step(action)
+            if done or truncated or ref_done or ref_truncated:
+                break
+    finally:
+        native.close()
+        ref.close()
+
+
+# --- JERK beats random --------------------------------------------------------------------------------
+
+
+def test_jerk_beats_random_on_its_benchmark(cart: Cartridge, tmp_path: Path, capsys) -> None:
+    from retrokit.benchmark.definition import load_benchmark
+
+    levels = ",".join(level.name for level in load_benchmark(cart.benchmark).test[:2])
+    scores = {}
+    for agent in ("jerk", "random"):
+        out = tmp_path / agent
+        args = ["evaluate", "--benchmark", cart.benchmark, "--levels", levels,
+                "--timesteps", "600", "--no-progress", "--agent", agent, "--out", str(out)]  # fmt: skip
+        assert main(args) == 0, capsys.readouterr().err
+        scores[agent] = json.loads((out / "summary.json").read_text())["aggregate"]
+    assert scores["jerk"] > 1.5 * scores["random"], scores

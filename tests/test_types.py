@@ -57,6 +57,13 @@ CASES = [
     (">d8", 1234567890123456, bcd(1234567890123456, 8)),
     (">n8", 12345678, bytes([1, 2, 3, 4, 5, 6, 7, 8])),
     (">u3", 0x123456, (0x123456).to_bytes(3, "big")),
+    (">d3", 123456, bcd(123456, 3)),  # an Atari score: six BCD digits in three bytes
+    ("<d3", 123456, bcd(123456, 3)[::-1]),
+    ("<i3", -70000, (-70000).to_bytes(3, "little", signed=True)),
+    (">i5", -(2**33), (-(2**33)).to_bytes(5, "big", signed=True)),
+    ("<u7", 2**55 + 3, (2**55 + 3).to_bytes(7, "little")),
+    (">n5", 12345, bytes([1, 2, 3, 4, 5])),
+    ("<>d6", 123456789012, bcd(789012, 3) + bcd(123456, 3)),  # little-endian words of big-endian BCD bytes
     ("<u8", 2**63 + 5, (2**63 + 5).to_bytes(8, "little")),
     (">i8", -(2**40), (-(2**40)).to_bytes(8, "big", signed=True)),
     # big-endian words of little-endian bytes: high word first
@@ -209,3 +216,17 @@ def test_memory_maps_are_honoured() -> None:
     assert reader.read() == {"a": 0x1234, "b": 0x99}
     with pytest.raises(InvalidArgumentError, match="0x7e0000-0x7fffff, 0x700000-0x7007ff"):
         space.locate(0x000010)  # ROM is not mapped for fields
+
+
+def test_ramsearch_decodes_every_width_of_every_kind_as_the_reference() -> None:
+    """A RAM search of a 3-, 5-, 6- or 7-byte type (a signed one too: its sign bit extended) reads what fields read."""
+    from retrokit.ramsearch.types import decode_all
+
+    data = np.random.default_rng(0).integers(0, 256, 64, dtype=np.uint8)
+    data[:8] = [0xFF, 0x80, 0x81, 0x99, 0x12, 0xF0, 0x01, 0x80]  # sign bits set, BCD nibbles above 9
+    codes = [f"{order}{kind}{width}" for order in "<>" for kind in "uidn" for width in range(1, 9)]
+    types = [parse_type(code) for code in [*codes, "><u4", "<>i6", "><d8"]]
+    for ftype, values in zip(types, decode_all(data, types)):
+        for position in range(len(data) - ftype.width):
+            expected = ftype.decode(bytes(data[position : position + ftype.width]))
+            assert int(values[position]) == expected, (ftype.code, position)

@@ -39,10 +39,16 @@ class Agent(Protocol):
 
 
 def random_agent(env: gymnasium.Env, budget: int, seed: int) -> None:
-    """Sample every action uniformly from the action space (seeded by the runner)."""
+    """Sample every action uniformly from the action space (seeded by the runner).
+
+    Console switches (the 2600's SELECT and RESET, ...: ``switches`` in the system's
+    descriptor) are left alone: pressed at random they end or restart the game.
+    """
+    actions = getattr(env.unwrapped, "actions", None)
+    leave = getattr(actions, "leave_switches", lambda action: action)
     env.reset()
     while True:
-        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+        _, _, terminated, truncated, _ = env.step(leave(env.action_space.sample()))
         if terminated or truncated:
             env.reset()
 

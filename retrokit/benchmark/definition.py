@@ -28,8 +28,9 @@ from retrokit.data.yamlfile import load_yaml
 from retrokit.errors import BenchmarkFileError, RomNotFoundError, StateNotFoundError, UnknownNameError, did_you_mean
 from retrokit.paths import read_regular_file
 
-BUILTIN_FILES = {"dasher": Path(__file__).with_name("dasher.yaml")}
-BUILTINS = ("dasher", "sonic")
+# Every benchmark file beside this module is built in, by its name: each cartridge's (dasher.yaml, ...).
+BUILTIN_FILES = {path.stem: path for path in sorted(Path(__file__).parent.glob("*.yaml"))}
+BUILTINS = (*BUILTIN_FILES, "sonic")
 SPLITS = ("test", "train", "all")
 #: The RetroEnv options a benchmark may set; the action type defaults to every button.
 ENV_OPTIONS = (

@@ -8,7 +8,10 @@ episode reward, padded with no-ops until the episode ends, and the replay's
 reward joins that mean. Otherwise it explores: it runs right for Rn steps,
 jumping for Jn steps with probability Jp at each step it is not jumping, and
 when the reward did not increase over those Rn steps it runs left for Ln
-steps, jumping the same way; until the episode ends. The explored episode's
+steps, jumping the same way; until the episode ends. It jumps with the
+game's jump button (the scenario's ``jump``, else the system's descriptor's:
+``B`` on a Genesis, ``A`` on a NES, ``BUTTON`` on an Atari 2600), through any
+of the env's action types. The explored episode's
 prefix up to its best cumulative reward becomes a new sequence, whose mean
 starts at that best cumulative reward.
 
@@ -54,9 +57,12 @@ class Jerk:
         env: The level's env (its ``step`` raises when the budget is spent).
         budget: Tmax, the timesteps of the level.
         rng: Its randomness: anything with ``random()`` giving floats in [0, 1).
-        press: Returns the action pressing some named buttons; by default the
-            env's own (``env.unwrapped.actions.press``, a retrokit env with
-            ``action_type="all"``).
+        press: Returns the action pressing some named buttons (``press(["RIGHT", "B"])``);
+            by default the env's own, ``env.unwrapped.actions.press``, which works
+            with every action type of a retrokit env. Give one to run JERK on
+            another env whose actions are not retrokit's.
+        jump: The button that jumps; by default the env's ``jump_button``: the
+            scenario's ``jump``, else the system's (``retrokit/host/systems.yaml``).
         beta, jump_repeat, jump_prob, right_steps, left_steps: The paper's parameters.
     """
 
@@ -67,6 +73,7 @@ class Jerk:
         rng: Any,
         *,
         press: Callable[[Sequence[str]], Any] | None = None,
+        jump: str | None = None,
         beta: float = BETA,
         jump_repeat: int = JUMP_REPEAT,
         jump_prob: float = JUMP_PROB,
@@ -74,19 +81,24 @@ class Jerk:
         left_steps: int = LEFT_STEPS,
     ) -> None:
         if press is None:
-            actions = getattr(env.unwrapped, "actions", None)
-            if actions is None or getattr(actions, "action_type", None) not in ("all", "filtered"):
+            press = getattr(getattr(env.unwrapped, "actions", None), "press", None)
+            if press is None:
                 raise InvalidArgumentError(
-                    "Expected an env whose buttons JERK can press by name (a retrokit env with action_type='all'), "
-                    f"got {env.unwrapped!r}; pass press= to Jerk."
+                    f"Expected an env whose buttons JERK can press by name (a retrokit env), got {env.unwrapped!r}; "
+                    "pass press=, a function from button names to the env's action, to Jerk."
                 )
-            press = actions.press
+        jump = jump or getattr(env.unwrapped, "jump_button", None)
+        if not jump:
+            raise InvalidArgumentError(
+                f"Expected a button for JERK to jump with, but {env.unwrapped!r} names none; pass jump= to Jerk, "
+                "or name one in the scenario (jump: A) or the system's descriptor."
+            )
         self.env, self.budget, self.rng = env, budget, rng
         self.beta, self.jump_repeat, self.jump_prob = beta, jump_repeat, jump_prob
         self.right_steps, self.left_steps = right_steps, left_steps
         self.noop = press([])
-        self.moves = {(False, False): press(["RIGHT"]), (False, True): press(["RIGHT", "B"]),
-                      (True, False): press(["LEFT"]), (True, True): press(["LEFT", "B"])}
+        self.moves = {(False, False): press(["RIGHT"]), (False, True): press(["RIGHT", jump]),
+                      (True, False): press(["LEFT"]), (True, True): press(["LEFT", jump])}
         self.sequences: list[Solution] = []
         self.timesteps = 0  # T
         #: What it did, as (kind, T at the start): "explore", "replay", "backtrack"; for tests and curiosity.

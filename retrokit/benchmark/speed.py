@@ -91,13 +91,21 @@ def busy_workers(cores: int, levels: int = SONIC_LEVELS) -> int:
     return next(w for w in range(cores, levels + 1) if levels % w == 0 or levels % w >= cores)
 
 
-def estimate_line(speed: Speed) -> str:
-    """One line: the run's speed, and the Sonic protocol's time at it with the run's workers."""
+def estimate_line(speed: Speed, *, sonic: bool = True) -> str:
+    """One line: the run's speed and, for a run of the Sonic benchmark, the whole protocol's time at it.
+
+    Args:
+        speed: The run's speed.
+        sonic: Whether the run was of the ``sonic`` benchmark; for another, the protocol's
+            time says nothing, so the line gives the speed alone.
+    """
+    line = f"speed: {speed.level_rate:,.0f} env steps/s per level, {speed.rate:,.0f} in all with {speed.at_once} level(s) at once"
+    if not sonic:
+        return line + "."
     rounds = math.ceil(SONIC_LEVELS / speed.workers)
     minutes = protocol_minutes(speed.core_rate, speed.workers, speed.cores)
-    line = (f"speed: {speed.level_rate:,.0f} env steps/s per level, {speed.rate:,.0f} in all with {speed.at_once} "
-            f"level(s) at once; the Sonic protocol ({SONIC_LEVELS} test levels x {SONIC_BUDGET:,} timesteps) would "
-            f"take about {minutes:,.0f} minutes here with --workers {speed.workers} ({rounds} round(s) of levels)")
+    line += (f"; the Sonic protocol ({SONIC_LEVELS} test levels x {SONIC_BUDGET:,} timesteps) would "
+             f"take about {minutes:,.0f} minutes here with --workers {speed.workers} ({rounds} round(s) of levels)")
     if speed.at_once < min(speed.workers, SONIC_LEVELS):
         line += f"; measured with {speed.at_once} level(s) at once, so with {speed.workers} at once it may be slower"
     last = SONIC_LEVELS - (rounds - 1) * speed.workers

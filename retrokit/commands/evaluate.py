@@ -110,7 +110,8 @@ def run(args: argparse.Namespace) -> int:
     for evaluation in made:  # on stderr, beside the progress: stdout is the results, the same on every machine
         speed = evaluation.speed()
         if speed is not None:
-            print(("" if len(made) == 1 else f"{evaluation.agent}: ") + estimate_line(speed), file=sys.stderr)
+            line = estimate_line(speed, sonic=benchmark.name == "sonic")
+            print(("" if len(made) == 1 else f"{evaluation.agent}: ") + line, file=sys.stderr)
     return 0
 
 

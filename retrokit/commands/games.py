@@ -18,7 +18,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="list the known games, their states, and whether their ROM is available",
         description="List the known games with their states (the default one marked *), "
         "whether each game's ROM is available (bundled with the game, or imported), and whether "
-        "each of its scenarios compiles ('ok', 'none', or 'refused:' and the names of those that do not).",
+        "each of its scenarios compiles ('ok', 'none', or 'refused:' and the names of those that do not). "
+        "A game of a system nothing proves yet (no cartridge of ours, no game played against stable-retro: "
+        "retrokit docs systems) is marked 'unproven'.",
     )
     parser.add_argument("pattern", nargs="?", metavar="PATTERN",
                         help="only games whose name matches this glob, or contains this text; a game's exact name shows that game only")
@@ -43,7 +45,7 @@ def run(args: argparse.Namespace) -> int:
             + did_you_mean(args.pattern, names)
         )
     width = max(len(g.name) for g in games)
-    shown = available = refused = 0
+    shown = available = refused = unproven = 0
     for game in games:
         try:
             status, _ = rom_status(game, args.data_dir)
@@ -59,12 +61,17 @@ def run(args: argparse.Namespace) -> int:
                 scenarios = "refused: " + ", ".join(broken) if broken else "ok" if game.scenarios else "none"
                 line = f"{game.name:<{width}}  ROM {status:<8}  scenarios {scenarios}  states: {states or '(none)'}"
                 refused += bool(broken)
+                if not game.system.proven:  # nothing shows its RAM map, buttons or states are right
+                    line += f"  [unproven: {game.system.name}]"
+                    unproven += 1
             except RetrokitError as exc:
                 line = f"{game.name:<{width}}  (cannot be read: {exc})"
         shown += 1
         print(line)
     print(f"{shown} game{'s' * (shown != 1)} shown; {available} of {len(games)} have their ROM"
           + (f"; {refused} shown {'has' if refused == 1 else 'have'} a scenario that does not compile" if refused else "")
+          + (f"; {unproven} shown {'is' if unproven == 1 else 'are'} of a system nothing proves yet "
+             "(retrokit docs systems)" if unproven else "")
           + ". Import ROMs with: retrokit import /path/to/your/roms")
     return 0
 

@@ -38,7 +38,8 @@ def run(args: argparse.Namespace) -> int:
     print(f"  ROM        {made.rom}")
     print("Next: a first state, saved from a RAM search session (retrokit docs integrate: \"Your own game, from a ROM\"):")
     print(f"  retrokit ramsearch new {name}    # from power-on")
-    print("  retrokit ramsearch run --script '_*20 START*2 _*98'    # for example: play on to the first level")
+    start = made.game.system.start  # START, a PC Engine's RUN, a 2600's RESET switch
+    print(f"  retrokit ramsearch run --script '_*20 {start}*2 _*98'    # for example: play on to the first level")
     print("  retrokit ramsearch savestate Level1 --default")
     print(f"then: retrokit ramsearch new {name} --state Level1 --force    # find its fields (retrokit docs ramsearch)")
     print(f"      retrokit validate {name}")

@@ -37,6 +37,7 @@ from retrokit.errors import RetrokitError, ScenarioError, did_you_mean, shown
 
 TOP_KEYS = (
     "name", "description", "include", "tables", "define", "reward", "rewards", "done", "dones", "actions", "crop",
+    "jump",
 )
 INCLUDE_KEYS = ("description", "include", "tables", "define")
 TABLE_KEYS = ("by", "default", "values", "description")
@@ -275,6 +276,11 @@ class DocumentLoader:
             spec.dones = [reader.snippet(item, f"done of player {i + 1}") for i, item in enumerate(items)]
         if "actions" in entries:
             spec.actions = self._actions(reader, entries["actions"][1])
+        if "jump" in entries:
+            jump = reader.plain(entries["jump"][1])
+            if not isinstance(jump, str) or not jump:
+                raise reader.error(entries["jump"][1], "jump is one button name, the one JERK jumps with, such as A")
+            spec.jump = jump
         if "crop" in entries:
             crop = reader.plain(entries["crop"][1])
             if not (isinstance(crop, list) and len(crop) == 4 and all(isinstance(c, int) and not isinstance(c, bool) and c >= 0 for c in crop)):

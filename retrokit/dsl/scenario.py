@@ -38,6 +38,7 @@ class Scenario:
             list of button-name lists), or ``None``.
         crop: ``(x, y, width, height)`` of the screen to keep, or ``None``.
         fields: The fields the scenario reads.
+        jump: The button JERK jumps with in this game, or ``None`` for the system's.
     """
 
     def __init__(self, spec: ScenarioSpec, fields: Sequence[str]) -> None:
@@ -45,6 +46,7 @@ class Scenario:
         self.name = spec.name
         self.players = self._program.players
         self.actions = spec.actions
+        self.jump = spec.jump
         self.crop = spec.crop
         self.fields = self._program.fields
 

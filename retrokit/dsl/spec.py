@@ -52,6 +52,7 @@ class ScenarioSpec:
             condition holds is out of the game; the episode ends when
             ``done`` holds or every player is out.
         actions: Gym Retro-style button combinations, if given.
+        jump: The button JERK jumps with, if given (else the system's).
         crop: ``(x, y, width, height)`` of the screen to keep, if given.
     """
 
@@ -63,4 +64,5 @@ class ScenarioSpec:
     done: Snippet | None = None
     dones: list[Snippet] = field(default_factory=list)
     actions: list | None = None
+    jump: str | None = None
     crop: tuple[int, int, int, int] | None = None

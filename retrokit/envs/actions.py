@@ -100,19 +100,48 @@ class ActionMap:
     def _groups_as_names(self) -> list[list[list[str]]]:
         return [[self.system.buttons_of(m) for m in group] for group in self.combos]
 
-    def press(self, buttons: Sequence[str]) -> np.ndarray:
-        """The one-player ``"all"``/``"filtered"`` action that presses the named buttons.
+    def press(self, buttons: Sequence[str]) -> np.ndarray | int:
+        """The one-player action of this map's type that presses the named buttons.
+
+        With ``"discrete"`` and ``"multi_discrete"``, the buttons must be one listed
+        combination of each group (``["RIGHT", "B"]``: ``RIGHT`` of the D-pad's group,
+        ``B`` of the face buttons').
 
         Raises:
-            InvalidArgumentError: This map's actions are not button arrays.
+            UnknownNameError: A name is not one of the system's buttons.
+            InvalidArgumentError: The buttons are no choice of this map's groups.
         """
-        if self.action_type not in ("all", "filtered"):
-            raise InvalidArgumentError(
-                f"Expected an action type of 'all' or 'filtered' to press buttons by name, got {self.action_type!r}; "
-                f"its actions pick button combinations by index."
-            )
         mask = self.system.mask(buttons)
-        return ((mask >> np.arange(self.num_buttons)) & 1).astype(np.int8)
+        if self._packs:
+            return ((mask >> np.arange(self.num_buttons)) & 1).astype(np.int8)
+        picks = []
+        for combos, group_mask in zip(self.combos, self.group_masks):
+            if mask & group_mask not in combos:
+                break
+            picks.append(combos.index(mask & group_mask))
+        if len(picks) < len(self.combos) or mask & ~int(np.bitwise_or.reduce(self.group_masks)):
+            listed = "; ".join(" ".join("+".join(self.system.buttons_of(m)) or "none" for m in c) for c in self.combos)
+            raise InvalidArgumentError(
+                f"Expected buttons that make one listed combination of each group of the {self.action_type!r} "
+                f"actions ({listed}), got {list(buttons)}. Use action_type='all', or list the combination in "
+                f"the scenario's actions."
+            )
+        if self.action_type == "multi_discrete":
+            return np.array(picks, dtype=self.space.dtype)
+        index, radix = 0, 1
+        for pick, combos in zip(picks, self.combos):
+            index, radix = index + pick * radix, radix * len(combos)
+        return index
+
+    def leave_switches(self, action: object) -> object:
+        """``action`` with the console switches released (an agent that samples ``"all"`` leaves them alone)."""
+        if not self._packs or not self.system.switches:
+            return action  # the groups of the other types hold switches only where a scenario asked for them
+        array = np.array(action, copy=True)
+        for name in self.system.switches:
+            bit = self.system.button_bit(name)
+            array.reshape(self.players, self.num_buttons)[:, bit] = 0
+        return array
 
     def combine(self, per_player: Sequence[object]) -> object:
         """Join one action per player (each of :meth:`single_player_space`) into one action of this map."""

@@ -348,6 +348,11 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         return self.finish_step(out if step_alone(self.stepper, self.emulator, action, out) else None)
 
     @property
+    def jump_button(self) -> str | None:
+        """The button that jumps in this game (JERK's): the scenario's ``jump``, else the system's."""
+        return getattr(self.scenario, "jump", None) or self.emulator.system.jump
+
+    @property
     def stepping(self) -> Stepping | None:
         """This env's steps as a vector env runs them with others' (see :class:`~retrokit.envs.stepper.Stepping`).
 

@@ -23,6 +23,18 @@ So such a state is refused by reading those bytes, before any probe: the
 verdict does not depend on luck. No state a core writes has such a byte (the
 core maps banks only inside its ROM area): the 928 Genesis states that
 stable-retro ships all pass.
+
+In Master System and Game Gear mode the same core's states need a check of
+their own. Their cartridge mapper registers are safe: the core reduces each
+bank byte modulo the cartridge's page count when it rebuilds the map
+(``mapper_16k_w`` and its siblings), and maps nothing when no ROM is enabled.
+But the sound section holds the YM2413 (FM) chip's whole C struct, copied in
+as raw bytes, and the chip's update, which runs every frame whether a game
+uses FM or not, reads ``sin_tab[slot->wavetable + ...]``: the 18 operators'
+``wavetable`` fields are unchecked 32-bit table offsets, which the core
+itself only ever sets to 0 or ``SIN_LEN`` (1024). A state with any other value
+reads past the table: 0x40000000 kills the process with SIGSEGV
+(tests/test_hostile_states.py), smaller ones read whatever lies there.
 """
 
 from __future__ import annotations
@@ -47,18 +59,20 @@ GENESIS_ROM_BANKS = 10485760 >> 16
 _SRAM = 0xFF
 
 
-def state_layout_problem(system: str, state: bytes) -> str:
-    """Why the core would build a pointer outside its own memory from ``state`` (``""`` when it would not).
+MS_YM2413 = 16 + 0x2000 + 0x10 + 66886
+"""Where a Master System / Game Gear state's YM2413 struct begins: after the signature, the 8 KiB work RAM, the
+16 I/O registers and the VDP's context (sprite table, VRAM, CRAM, VSRAM, registers and its 38 bytes of state)."""
+YM2413_CHANNELS = 9
+YM2413_CHANNEL_SIZE = 184
+"""Bytes of one channel (two operators of 84 bytes and its own 16) in the x86-64 build of the struct."""
+YM2413_SLOT_SIZE = 84
+YM2413_WAVETABLE = 80
+"""Where an operator's ``wavetable`` (4 bytes, little-endian) is within it."""
+YM2413_WAVETABLES = (0, 1024)
+"""The offsets into ``sin_tab`` the core writes: the full sine, or the half-rectified one ``SIN_LEN`` entries on."""
 
-    Only what is known of a core's layout is checked: a Genesis state in
-    Genesis Plus GX 1.7.5's format. Anything else is left to the probe.
 
-    Args:
-        system: The system's name (``"Genesis"``).
-        state: The serialized state.
-    """
-    if system != "Genesis" or len(state) != GENESIS_STATE_SIZE or not state.startswith(GENESIS_SIGNATURE):
-        return ""
+def _genesis_problem(state: bytes) -> str:
     (z80_bank,) = struct.unpack_from("<I", state, GENESIS_Z80_BANK)
     if z80_bank & ~GENESIS_Z80_BANK_BITS:
         return (
@@ -75,3 +89,43 @@ def state_layout_problem(system: str, state: bytes) -> str:
         f"area (bank {bank:#04x} at ROM bank {value:#04x}; the area holds {GENESIS_ROM_BANKS:#04x}), which reads "
         "memory the core does not own"
     )
+
+
+def _master_system_problem(state: bytes) -> str:
+    wild = []
+    for channel in range(YM2413_CHANNELS):
+        for slot in range(2):
+            at = MS_YM2413 + channel * YM2413_CHANNEL_SIZE + slot * YM2413_SLOT_SIZE + YM2413_WAVETABLE
+            (offset,) = struct.unpack_from("<I", state, at)
+            if offset not in YM2413_WAVETABLES:
+                wild.append((channel, slot, offset))
+    if not wild:
+        return ""
+    channel, slot, offset = wild[0]
+    return (
+        f"its YM2413 sound chip indexes its sine table with {len(wild)} wild offset(s) (channel {channel} operator "
+        f"{slot + 1} at {offset:#x}; a core writes only {' or '.join(map(str, YM2413_WAVETABLES))}), which reads "
+        "memory the core does not own"
+    )
+
+
+_CHECKS = {"Genesis": _genesis_problem, "Sms": _master_system_problem, "GameGear": _master_system_problem}
+"""The systems whose states are checked, all Genesis Plus GX 1.7.5 (the same size and signature in every mode;
+the system, from the ROM's extension, decides how the core reads the rest)."""
+
+
+def state_layout_problem(system: str, state: bytes) -> str:
+    """Why the core would build a pointer outside its own memory from ``state`` (``""`` when it would not).
+
+    Only what is known of a core's layout is checked: a Genesis, Master
+    System or Game Gear state in Genesis Plus GX 1.7.5's format. Anything
+    else is left to the probe.
+
+    Args:
+        system: The system's name (``"Genesis"``).
+        state: The serialized state.
+    """
+    check = _CHECKS.get(system)
+    if check is None or len(state) != GENESIS_STATE_SIZE or not state.startswith(GENESIS_SIGNATURE):
+        return ""
+    return check(state)

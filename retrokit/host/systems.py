@@ -37,6 +37,12 @@ class System:
         frame_rates: The console's frames per second, by video standard (``"ntsc"``,
             ``"pal"``, or ``"lcd"`` for a handheld's one rate); empty where it
             depends on the game (arcade boards) or is not listed.
+        start: The button that starts a game from its title screen.
+        jump: The button JERK jumps with, unless a scenario names another.
+        switches: Console switches (not pad buttons), which default action sets, the random
+            agent, JERK and validate's smoke run leave alone.
+        proven_by: What proves retrokit runs the system right, by kind (``"cartridge"``,
+            ``"stable-retro"``, ``"ale-py"``): a game's name, or ``""``; empty if nothing does.
     """
 
     name: str
@@ -51,6 +57,19 @@ class System:
     screen: tuple[int, int] | None = None
     aliases: tuple[str, ...] = ()
     frame_rates: dict[str, float] = field(default_factory=dict)
+    start: str = "START"
+    jump: str | None = None
+    switches: tuple[str, ...] = ()
+    proven_by: dict[str, str] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for what, names in (("start", [self.start]), ("jump", [self.jump] if self.jump else []), ("switches", self.switches)):
+            for name in names:
+                if name not in self.button_names:
+                    raise DataFileError(
+                        f"{_FILE}: system {self.name!r}: expected its {what} to be one of its buttons "
+                        f"({', '.join(self.button_names)}), got {name!r}." + did_you_mean(str(name), self.button_names)
+                    )
 
     def __str__(self) -> str:
         return self.name
@@ -88,6 +107,21 @@ class System:
             return next(iter(self.frame_rates.values()))
         return min(self.frame_rates.values(), key=lambda rate: abs(rate - reported))
 
+    @property
+    def proven(self) -> bool:
+        """Whether anything proves retrokit runs this system right (``proven_by``)."""
+        return bool(self.proven_by)
+
+    @property
+    def switch_mask(self) -> int:
+        """The RetroPad bits of the console switches."""
+        return self.mask(self.switches)
+
+    @property
+    def pad_buttons(self) -> tuple[str, ...]:
+        """The buttons that exist, console switches left out, in RetroPad id order."""
+        return tuple(b for b in self.button_names if b not in self.switches)
+
     def mask(self, buttons: Iterable[str]) -> int:
         """Return the RetroPad bit mask that presses the named buttons."""
         if isinstance(buttons, str):
@@ -120,6 +154,10 @@ def _parse(name: str, entry: object) -> System:
             screen=tuple(entry["screen"]) if "screen" in entry else None,
             aliases=tuple(entry.get("aliases", ())),
             frame_rates={str(k): float(v) for k, v in (entry.get("frame_rate") or {}).items()},
+            start=str(entry.get("start", "START")),
+            jump=str(entry["jump"]) if entry.get("jump") else None,
+            switches=tuple(str(b) for b in entry.get("switches", ())),
+            proven_by={str(k): str(v or "") for k, v in (entry.get("proven_by") or {}).items()},
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise DataFileError(f"{_FILE}: system {name!r} is malformed: {exc!r}.") from exc

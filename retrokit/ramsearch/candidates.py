@@ -17,7 +17,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from retrokit.errors import InvalidArgumentError
-from retrokit.host.typecodes import FieldType, parse_type
+from retrokit.host.typecodes import FieldType
+from retrokit.ramsearch.types import search_type
 from retrokit.ramsearch.ram import RamLayout
 from retrokit.ramsearch.scales import ALL_SCALES, MASK_DTYPE, UNPINNED
 
@@ -125,12 +126,12 @@ class Candidate:
 @functools.lru_cache(maxsize=64)
 def _low_offset(code: str) -> int:
     """Where a type's least significant byte is, from its first (a listing asks once per candidate)."""
-    return parse_type(code).significance()[0]
+    return search_type(code).significance()[0]
 
 
 @functools.lru_cache(maxsize=64)
 def _width(code: str) -> int:
-    return parse_type(code).width
+    return search_type(code).width
 
 
 def group_candidates(candidates: Sequence[Candidate]) -> list[list[Candidate]]:

@@ -24,7 +24,7 @@ from retrokit.ramsearch.candidates import Candidate, Candidates, Packed
 from retrokit.ramsearch.filters import CHANGES, COMPARISONS, Filter, check_filter
 from retrokit.ramsearch.ram import RamLayout
 from retrokit.ramsearch.scales import MASK_DTYPE, SCALES, UNPINNED, scale_label, scale_labels
-from retrokit.ramsearch.types import decode_all
+from retrokit.ramsearch.types import decode_all, value_dtype
 
 # Scales that divide: a value shown through one is defined only where the division is exact.
 _DIVIDING = sum(1 << index for index, scale in enumerate(SCALES) if scale.div != 1)
@@ -337,7 +337,9 @@ def list_candidates(engine: Engine, limit: int | None = None) -> list[Candidate]
     positions, kinds = positions[order], kinds[order]
     if not len(positions):
         return []
-    values = np.empty((len(positions), len(engine.snapshots)), dtype=np.int64)  # what decode_all gives fits
+    # What decode_all gives fits in int64, but for a u8 past 2**63 (Python ints, then).
+    wide = any(value_dtype(engine.types[t]) == np.uint64 for t in np.unique(kinds).tolist())
+    values = np.empty((len(positions), len(engine.snapshots)), dtype=object if wide else np.int64)
     present = [(t, kinds == t) for t in np.unique(kinds).tolist()]
     for index in range(len(engine.snapshots)):
         decoded = engine.decoded(index)

@@ -101,11 +101,13 @@ def check_range(value_range: object, ftype: FieldType) -> tuple[int, int]:
 
 
 def field_line(
-    indent: str, name: str, address: str, type_code: str, pad_to: int = 0, value_range: tuple[int, int] | None = None
+    indent: str, name: str, address: str, type_code: str, pad_to: int = 0, value_range: tuple[int, int] | None = None,
+    mask: int | None = None,
 ) -> str:
     """One field as a flow-mapping line, its value starting at column ``pad_to`` if the name leaves room."""
     key = f"{indent}{name}:"
-    extra = "" if value_range is None else f", range: [{value_range[0]}, {value_range[1]}]"
+    extra = "" if mask is None else f", mask: 0x{mask:02X}"
+    extra += "" if value_range is None else f", range: [{value_range[0]}, {value_range[1]}]"
     return f'{key.ljust(max(pad_to, len(key) + 1))}{{address: {address}, type: "{type_code}"{extra}}}'
 
 
@@ -117,6 +119,7 @@ def add_field(
     *,
     force: bool = False,
     value_range: tuple[int, int] | None = None,
+    mask: int | None = None,
 ) -> bool:
     """Write a field ``name: {address: ..., type: "..."}`` into a game.yaml.
 
@@ -127,6 +130,7 @@ def add_field(
         type_code: The type code, e.g. ``"|u1"``.
         force: Replace a field of the same name.
         value_range: The values the field may hold, ``(lo, hi)``, written as ``range: [lo, hi]``.
+        mask: The bits kept of the value (a flag held in one bit), written as ``mask: 0x04``.
 
     Returns:
         Whether a field of that name was replaced.
@@ -145,7 +149,7 @@ def add_field(
             f"Expected no field {name!r} in {path}; found one ({line}). "
             "Choose another name, or pass --force (force=True) to replace it."
         )
-    entry = _Entry(name, address, type_code, value_range)
+    entry = _Entry(name, address, type_code, value_range, mask)
     new_text = _insert(text, doc, fields, entry)
     _check(path, text, new_text, entry)
     atomic_write(path, new_text.encode("utf-8"), overwrite=True)
@@ -160,13 +164,16 @@ class _Entry:
     address: str
     type_code: str
     value_range: tuple[int, int] | None = None
+    mask: int | None = None
 
     def line(self, indent: str, pad_to: int = 0) -> str:
-        return field_line(indent, self.name, self.address, self.type_code, pad_to, self.value_range)
+        return field_line(indent, self.name, self.address, self.type_code, pad_to, self.value_range, self.mask)
 
     def data(self) -> dict[str, Any]:
         """The field as the file's data holds it."""
         out: dict[str, Any] = {"address": int(self.address, 0), "type": self.type_code}
+        if self.mask is not None:
+            out["mask"] = self.mask
         if self.value_range is not None:
             out["range"] = list(self.value_range)
         return out

@@ -46,7 +46,7 @@ from retrokit.ramsearch.engine import Engine, list_candidates
 from retrokit.ramsearch.ram import RamLayout
 from retrokit.ramsearch.script import MAX_FRAMES, parse_script
 from retrokit.ramsearch.session import SessionData, read_session, write_session
-from retrokit.ramsearch.types import parse_search_types
+from retrokit.ramsearch.types import BitType, parse_search_types, search_type
 
 if TYPE_CHECKING:
     from retrokit.data.integrate import Outcome
@@ -560,7 +560,7 @@ class RamSearch:
         Args:
             name: The field's name.
             address: Its console address.
-            type_code: Its type code.
+            type_code: Its type code; a bit type (``|u1&0x04``) is written as ``type: "|u1", mask: 0x04``.
             game_file: The game.yaml to write (by default :meth:`default_game_file`).
             force: Replace a field of the same name.
             value_range: The values it may hold, ``(lo, hi)``, written as ``range: [lo, hi]``.
@@ -573,14 +573,16 @@ class RamSearch:
             FileConflictError: The file has a field of that name and ``force`` is false.
         """
         gamefile.check_field_name(name)  # first: a bad name is the name's fault, not the file's
-        ftype = parse_type(type_code)
+        ftype = search_type(type_code)
         self.layout.position(address, ftype.width)
         if value_range is not None:
             value_range = gamefile.check_range(value_range, ftype)
         path = Path(game_file) if game_file is not None else self.default_game_file()
         if game_file is not None:
             self._check_game_file(path)
-        gamefile.add_field(path, name, self.layout.format(address), ftype.code, force=force, value_range=value_range)
+        bit = isinstance(ftype, BitType)
+        gamefile.add_field(path, name, self.layout.format(address), ftype.base if bit else ftype.code, force=force,
+                           value_range=value_range, mask=ftype.mask if bit else None)  # fmt: skip
         return path
 
     def _check_game_file(self, path: Path) -> None:

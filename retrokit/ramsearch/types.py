@@ -7,6 +7,11 @@ bytes and low-nibble BCD (``n``, one digit a byte) of 2 to 8 bytes. The
 host-relative orders (``=``, ``>=``, ``<=``) are left out: on any one host
 each is one of the fixed orders listed.
 
+Bit types find a flag held in one bit (a game-over flag that shares its byte
+with others): ``|u1&0x04`` is a byte read through the mask ``0x04``, as a
+game.yaml field ``{type: "|u1", mask: 0x04}`` reads it (0, or 4 when the bit
+is set). ``bits`` names all eight; they are searched only when asked.
+
 :func:`decode_all` turns a snapshot into one array per type, each holding the
 value that starts at every byte position, with numpy: plain 2- and 4-byte
 integers through views of the bytes, the other types from two halves of
@@ -16,7 +21,9 @@ whole snapshot decodes in about a millisecond and a half.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
+from dataclasses import dataclass
 from itertools import pairwise
 
 import numpy as np
@@ -34,7 +41,45 @@ SEARCH_TYPES: tuple[str, ...] = (
     ">d6", ">n6", ">d8", ">n8",
 )  # fmt: skip
 
+#: The eight one-bit types a search of ``bits`` looks at, lowest bit first.
+BIT_TYPES: tuple[str, ...] = tuple(f"|u1&0x{1 << bit:02X}" for bit in range(8))
+
 MAX_WIDTH = 8
+_MASKED = re.compile(r"^(.+?)&(0[xX][0-9a-fA-F]+|[0-9]+)$")
+
+
+@dataclass(frozen=True)
+class BitType(FieldType):
+    """One bit of a byte, as a game.yaml field of type ``|u1`` with a one-bit ``mask`` reads it.
+
+    Attributes:
+        mask: The bit, e.g. ``0x04``: the value is ``byte & mask``.
+    """
+
+    mask: int = 1
+
+    @property
+    def base(self) -> str:
+        """The type code a game.yaml gives it, beside its mask: ``|u1``."""
+        return self.code.partition("&")[0]
+
+
+def search_type(code: str) -> FieldType:
+    """Parse a type code a search looks at: a Gym Retro code, or a bit type such as ``|u1&0x04``.
+
+    Raises:
+        FieldTypeError: It is neither.
+    """
+    match = _MASKED.match(code) if isinstance(code, str) else None
+    if match is None:
+        return parse_type(code)
+    base, mask = parse_type(match.group(1)), int(match.group(2), 0)
+    if base.code != "|u1" or mask <= 0 or mask & (mask - 1) or mask > 0x80:
+        raise FieldTypeError(
+            f"Expected a bit type: |u1&MASK with one bit of a byte set in MASK, such as |u1&0x04 (or 'bits' for "
+            f"all eight); got {code!r}."
+        )
+    return BitType(code=f"|u1&0x{mask:02X}", order=base.order, kind=base.kind, width=1, mask=mask)
 _BASE = {UNSIGNED: 256, SIGNED: 256, BCD: 100, LOW_BCD: 10}
 # One byte's digit value per kind: its two BCD digits (nibbles above 9 wrap
 # modulo 10, as Gym Retro's reader does), or its low nibble.
@@ -46,15 +91,15 @@ _DIGITS = {
 
 
 def _fit(high: int) -> np.dtype:
-    """The smallest unsigned dtype that holds 0 .. high."""
-    for dtype in (np.uint8, np.uint16, np.uint32):
+    """The smallest unsigned dtype that holds 0 .. high (int64 up to its top, uint64 past it: ``u8``)."""
+    for dtype in (np.uint8, np.uint16, np.uint32, np.int64):
         if high <= np.iinfo(dtype).max:
             return np.dtype(dtype)
-    return np.dtype(np.int64)
+    return np.dtype(np.uint64)
 
 
 def parse_search_types(codes: Sequence[str] | None) -> tuple[FieldType, ...]:
-    """Parse the type codes to search (by default :data:`SEARCH_TYPES`).
+    """Parse the type codes to search (by default :data:`SEARCH_TYPES`); ``bits`` is :data:`BIT_TYPES`.
 
     Raises:
         FieldTypeError: A code is not a type code, or one is given twice.
@@ -63,7 +108,8 @@ def parse_search_types(codes: Sequence[str] | None) -> tuple[FieldType, ...]:
         codes = SEARCH_TYPES
     if isinstance(codes, str):
         codes = [c.strip() for c in codes.split(",") if c.strip()]
-    types = tuple(parse_type(c) for c in codes)
+    codes = [b for c in codes for b in (BIT_TYPES if c == "bits" else [c])]
+    types = tuple(search_type(c) for c in codes)
     if not types:
         raise FieldTypeError(
             f"Expected at least one type code to search, such as {', '.join(SEARCH_TYPES[:4])}; got none."
@@ -82,7 +128,7 @@ def require_type(code: str, allowed: Sequence[str] | None = None) -> FieldType:
     Raises:
         FieldTypeError: The code is not a type code, or not one of ``allowed``.
     """
-    ftype = parse_type(code)
+    ftype = search_type(code)
     if allowed is not None and ftype.code not in allowed:
         raise FieldTypeError(
             f"Expected one of the searched types ({', '.join(allowed)}), got {code!r}." + did_you_mean(code, allowed)
@@ -146,11 +192,19 @@ class _Decoder:
         return out
 
     def decode(self, ftype: FieldType) -> np.ndarray:
+        if isinstance(ftype, BitType):
+            return self.part(UNSIGNED, (0,)) & np.uint8(ftype.mask)
         digits = UNSIGNED if ftype.kind == SIGNED else ftype.kind
         value = self.part(digits, ftype.significance())
-        if ftype.kind == SIGNED:  # the same bits, read as two's complement
+        if ftype.kind != SIGNED:
+            return value
+        bits = 8 * ftype.width
+        if bits == 8 * value.itemsize:  # the same bits, read as two's complement
             return value.view(np.dtype(f"i{value.itemsize}"))
-        return value
+        # A width without a dtype of its own (3, 5, 6, 7 bytes): extend the sign bit by hand.
+        signed = value.astype(np.int64)
+        signed -= (signed >> (bits - 1)) << bits
+        return signed.astype(value_dtype(ftype))
 
 
 def _run(offsets: tuple[int, ...]) -> bool:

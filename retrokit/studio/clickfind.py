@@ -36,7 +36,7 @@ from starlette.responses import JSONResponse
 from starlette.routing import Route
 
 from retrokit.errors import InvalidArgumentError, RamSearchError, RetrokitError
-from retrokit.host.typecodes import parse_type
+from retrokit.ramsearch.types import search_type
 from retrokit.studio.app import session_of
 from retrokit.studio.search import address_of, integer_of
 from retrokit.studio.security import json_body
@@ -113,7 +113,7 @@ def _cells(session: Session, region: object) -> list[int]:
             raise RamSearchError("Expected candidates to poke; the search has none left. Start a new search.")
         cells: set[int] = set()
         for candidate in search.candidates(limit=MAX_CELLS + 1):
-            cells.update(range(candidate.address, candidate.address + parse_type(candidate.type).width))
+            cells.update(range(candidate.address, candidate.address + search_type(candidate.type).width))
             if len(cells) > MAX_CELLS:
                 break
         what = f"the {count:,} candidates cover more than {MAX_CELLS:,} bytes"

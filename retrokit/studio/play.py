@@ -17,6 +17,7 @@ from starlette.routing import Route
 from retrokit.data.names import check_state_name
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean, shown
 from retrokit.host.systems import System
+from retrokit.ramsearch.ram import RamLayout
 from retrokit.studio.app import session_of
 from retrokit.studio.security import check_inside, expect, game_roots, json_body
 from retrokit.studio.session import MAX_SPEED, MIN_SPEED, Session
@@ -24,8 +25,12 @@ from retrokit.studio.session import MAX_SPEED, MIN_SPEED, Session
 MAX_STEP = 3600
 """The most frames one frame-advance runs (a minute of play)."""
 
-# KeyboardEvent.code of each button where the system has it: the D-pad on the arrows, START on Enter.
-_KEYS = {"UP": "ArrowUp", "DOWN": "ArrowDown", "LEFT": "ArrowLeft", "RIGHT": "ArrowRight", "START": "Enter"}
+RAM_SHOWN = 256
+"""The bytes the RAM view and click-to-find show at first (all of an Atari 2600's 128)."""
+
+# KeyboardEvent.code of each button where the system has it: the D-pad on the arrows; Enter is the system's
+# start button (START, the PC Engine's RUN, the 2600's RESET switch: `start:` in systems.yaml).
+_KEYS = {"UP": "ArrowUp", "DOWN": "ArrowDown", "LEFT": "ArrowLeft", "RIGHT": "ArrowRight"}
 _SELECT_KEYS = ("ShiftRight", "Backspace")  # SELECT, then MODE (Genesis) when both exist
 _FACE_ORDER = ("A", "B", "C", "X", "Y", "Z", "L", "R", "L2", "R2", "L3", "R3")
 _FACE_KEYS = ("KeyZ", "KeyX", "KeyC", "KeyA", "KeyS", "KeyD", "KeyQ", "KeyW", "KeyE", "KeyR", "KeyT", "KeyY")
@@ -35,10 +40,11 @@ _PAD_FACE = (0, 1, 2, 3, 4, 5, 6, 7, 10, 11)
 
 
 def key_map(system: System) -> dict[str, str]:
-    """The default keyboard map of a system: ``{KeyboardEvent.code: button}`` (arrows: D-pad, Enter: START)."""
+    """The default keyboard map of a system: ``{KeyboardEvent.code: button}`` (arrows: D-pad, Enter: its start button)."""
     names = system.button_names
     keys = {key: button for button, key in _KEYS.items() if button in names}
-    others = [b for b in ("SELECT", "MODE") if b in names]
+    keys["Enter"] = system.start
+    others = [b for b in ("SELECT", "MODE") if b in names and b != system.start]
     keys.update(zip(_SELECT_KEYS, others, strict=False))
     face = [b for b in _FACE_ORDER if b in names]
     face += [b for b in names if b not in face and b not in keys.values() and b not in others]
@@ -50,9 +56,16 @@ def pad_map(system: System) -> dict[str, str]:
     """The default Gamepad API map: ``{standard button index: button}``."""
     names = system.button_names
     pad = {str(index): button for button, index in _PAD.items() if button in names}
+    pad[str(_PAD["START"])] = system.start
     face = [b for b in _FACE_ORDER if b in names]
     pad.update((str(i), b) for i, b in zip(_PAD_FACE, face, strict=False))
     return pad
+
+
+def ram_region(layout: RamLayout) -> dict[str, int]:
+    """Where the RAM view and click-to-find start: the system's first RAM region, its first :data:`RAM_SHOWN` bytes."""
+    start, size = layout.regions[0] if layout.regions else (0, 0)
+    return {"start": start, "length": min(RAM_SHOWN, size)}
 
 
 def info(session: Session) -> dict[str, Any]:
@@ -66,6 +79,7 @@ def info(session: Session) -> dict[str, Any]:
         "buttons": list(game.system.button_names),
         "ports": search.emulator.ports,
         "keys": key_map(game.system),
+        "ram": ram_region(search.layout),
         "gamepad": pad_map(game.system),
         "frame_rate": session.rate,
         "speeds": [MIN_SPEED, MAX_SPEED],

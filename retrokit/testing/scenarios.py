@@ -7,7 +7,9 @@ For each scenario file:
   such as ``level_end[zone, act]``, has an entry (or a default) for the keys
   each state starts with;
 - **smoke run** (with the ROM), on every state: a fixed seed and scripted
-  random inputs for :data:`SMOKE_FRAMES` frames; rewards must be finite, done
+  random inputs for :data:`SMOKE_FRAMES` frames (every :data:`HOLD_STEPS` steps,
+  one combination of each group of the scenario's ``actions``, or of the
+  system's default groups, which hold no console switch); rewards must be finite, done
   must not hold at the first step, and no run-time error (a division by zero,
   a missing table entry) may happen;
 - **deterministic**: a second identical run gives the same rewards, dones and RAM.
@@ -170,8 +172,10 @@ def smoke_run(game: Game, state: str, scenario: Path, *, frames: int = SMOKE_FRA
     env = None
     step = 0
     try:
+        # The scenario's action groups, or the system's: what an agent plays with, never a console switch
+        # (a 2600's SELECT ends the game) unless the scenario lists one.
         env = make(game, state, str(scenario), obs_type="ram", frameskip=SMOKE_FRAMESKIP,
-                   sticky_prob=0.25, players=game.players, action_type="all")
+                   sticky_prob=0.25, players=game.players, action_type="multi_discrete")
         env.action_space.seed(seed)
         obs, _ = env.reset(seed=seed)
         action = env.action_space.sample()

@@ -51,15 +51,15 @@ async function start(event) {
   return `Looking for what draws (${x}, ${y}).`;
 }
 
-export async function init() {
+export async function init(info) {
   replace(byId("clickfind"),
     el("h2", {}, "Click to find"),
     el("p", { class: "dim" }, "Click a point of the game's screen: each cell of the region is poked on a copy of this moment, and the cells whose poke changes that pixel are listed."),
     el("div", { class: "row" },
       el("label", {}, el("input", { type: "radio", name: "cf-region", id: "cf-candidates", checked: true }), " the RAM search's candidates"),
       el("label", {}, el("input", { type: "radio", name: "cf-region", id: "cf-range" }), " the region "),
-      el("input", { id: "cf-start", class: "address", value: "0xFF0000", "aria-label": "region start" }),
-      el("label", {}, "length ", el("input", { id: "cf-length", type: "number", min: 1, max: 8192, value: 256 })),
+      el("input", { id: "cf-start", class: "address", value: hex(info.ram.start), "aria-label": "region start" }),
+      el("label", {}, "length ", el("input", { id: "cf-length", type: "number", min: 1, max: 8192, value: info.ram.length })),
       el("label", {}, "frames after a poke ", el("input", { id: "cf-frames", type: "number", min: 1, max: 8, value: 2 }))),
     el("div", { class: "row" },
       el("span", {}, "pixel ", el("output", { id: "cf-point" }, "–")),

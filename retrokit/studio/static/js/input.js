@@ -2,7 +2,7 @@
 // set and sent to the server only when it changes (the server holds the last set until told otherwise).
 //
 // The maps come from the server (/api/info "keys" and "gamepad") so the page and docs/studio.md agree on them:
-// the arrows are the D-pad and Enter is START on every system.
+// the arrows are the D-pad and Enter is the system's start button (START; RUN on a PC Engine, RESET on a 2600).
 
 import { send } from "./socket.js";
 

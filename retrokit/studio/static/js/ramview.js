@@ -48,7 +48,7 @@ function wanted() {
   const start = parseNumber(byId("ram-start").value, "start address");
   const length = parseNumber(byId("ram-length").value, "length") ?? 256;
   const snapshot = parseNumber(byId("ram-snapshot").value, "snapshot");
-  if (start === null) throw new Error("Expected the region's start address, e.g. 0xFF0000.");
+  if (start === null) throw new Error(`Expected the region's start address, e.g. ${byId("ram-start").defaultValue}.`);
   const body = { start: hex(start), length };
   if (snapshot !== null) body.snapshot = snapshot;
   return body;
@@ -59,12 +59,13 @@ async function watch() {
   show(await post("ram/watch", wanted()));
 }
 
-export async function init() {
+export async function init(info) {
   replace(byId("ramview"),
     el("h2", {}, "RAM view"),
     el("form", { id: "ram-form", class: "row" },
-      el("label", {}, "from ", el("input", { id: "ram-start", class: "address", value: "0xFF0000" })),
-      el("label", {}, "bytes ", el("input", { id: "ram-length", type: "number", min: 16, max: 4096, step: 16, value: 256 })),
+      // The system's RAM region (its start and first bytes, from /api/info): 0xFF0000 on a Genesis, 0x80 on a 2600.
+      el("label", {}, "from ", el("input", { id: "ram-start", class: "address", value: hex(info.ram.start) })),
+      el("label", {}, "bytes ", el("input", { id: "ram-length", type: "number", min: 16, max: 4096, step: 16, value: info.ram.length })),
       el("label", { title: "Outline the bytes that differ from this snapshot of the RAM search" }, "compare with snapshot ",
         el("input", { id: "ram-snapshot", size: 3, placeholder: "none" })),
       el("button", { type: "submit" }, "Show")),

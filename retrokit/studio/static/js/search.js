@@ -146,7 +146,7 @@ async function poke() {
   return `Poked ${hex(answer.address)} (${answer.type}): it now reads ${answer.value}.`;
 }
 
-export async function init() {
+export async function init(info) {
   const panel = byId("search");
   replace(panel,
     el("h2", {}, "RAM search"),
@@ -161,7 +161,7 @@ export async function init() {
       el("label", {}, "keep values ", el("select", { id: "search-op" })),
       el("input", { id: "search-value", size: 8, placeholder: "number", "aria-label": "the filter's number" }),
       el("label", {}, "than ", el("select", { id: "search-than" })),
-      el("input", { id: "search-than-address", class: "address", placeholder: "0xFF0000", hidden: true, "aria-label": "address compared with" }),
+      el("input", { id: "search-than-address", class: "address", placeholder: hex(info.ram.start), hidden: true, "aria-label": "address compared with" }),
       el("label", { title: "Take a snapshot of the game now before filtering, so the filter sees what the screen shows" },
         el("input", { type: "checkbox", id: "search-snap-first", checked: true }), " snapshot now"),
       el("button", { type: "submit", id: "search-apply" }, "Filter")),

@@ -1,0 +1,147 @@
+"""The studio on every system we have a cartridge for (issue 29 §4): its buttons and keys, its RAM.
+
+Parametrized over tools/cartridges.yaml as tests/test_systems.py is, in a real browser (headless
+Chromium through Selenium, with tests/test_studio_browser.py's server, page and browser):
+
+- the page shows the system's buttons, each with a key, and the keys play the game: holding them
+  moves it as the same buttons move our own emulator;
+- the RAM view and click-to-find start on the system's RAM region (not the Genesis's 0xFF0000),
+  and click-to-find over that region names the field under a pixel.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from test_studio_browser import Page, Studio, browser, click_pixel, until  # noqa: F401 (browser: a fixture)
+
+from retrokit.data.games import find_game
+from retrokit.data.statecheck import load_state
+from retrokit.host.emulator import Emulator
+from retrokit.host.memory import FieldReader
+from retrokit.ramsearch import RamSearch
+from retrokit.ramsearch.ram import RamLayout
+from retrokit.studio.play import key_map
+
+from selenium.webdriver.common.by import By  # noqa: E402 (after test_studio_browser's skip)
+from selenium.webdriver.common.keys import Keys  # noqa: E402
+
+REPO = Path(__file__).resolve().parent.parent
+CARTRIDGES = list(yaml.safe_load((REPO / "tools" / "cartridges.yaml").read_text()))
+FRAMES = 40
+VIEW = 256  # bytes the RAM view and click-to-find show by default
+
+pytestmark = pytest.mark.timeout(600)
+
+# The KeyboardEvent.code of a key, as Selenium types it.
+SELENIUM_KEYS = {"ArrowUp": Keys.ARROW_UP, "ArrowDown": Keys.ARROW_DOWN, "ArrowLeft": Keys.ARROW_LEFT,
+                 "ArrowRight": Keys.ARROW_RIGHT, "Enter": Keys.ENTER, "ShiftRight": Keys.SHIFT, "Backspace": Keys.BACKSPACE}  # fmt: skip
+
+
+def selenium_key(code: str) -> str:
+    return SELENIUM_KEYS.get(code) or code.removeprefix("Key").removeprefix("Digit").lower()
+
+
+@pytest.fixture(scope="module", params=CARTRIDGES, ids=CARTRIDGES)
+def studio(request, tmp_path_factory: pytest.TempPathFactory) -> Iterator[Studio]:
+    server = Studio(tmp_path_factory.mktemp("studio"), REPO / "games" / request.param)
+    yield server
+    err = server.stop()
+    assert server.process.returncode == 0, err
+    assert "Traceback" not in err
+
+
+@pytest.fixture
+def page(browser, studio: Studio) -> Page:  # noqa: F811
+    return Page(browser, studio)
+
+
+def fields_after(name: str, masks: int, frames: int) -> dict[str, int]:
+    """Every field of a game's default state after ``frames`` frames holding ``masks`` on port 1, on our emulator."""
+    game = find_game(name)
+    emu = Emulator(game.system, game.require_rom(), ports=max(2, game.players))
+    try:
+        emu.set_state(load_state(game, game.state_path()))
+        emu.run([masks, 0], frames)
+        return FieldReader(list(game.fields.values()), emu.space).read()
+    finally:
+        emu.close()
+
+
+def test_the_keys_play_the_systems_buttons(page: Page) -> None:
+    game = find_game(page.studio.game.name)
+    system = game.system
+    page.open("watch")
+    assert page.text("game-name") == f"{game.name} ({system.name})"
+    legend = {b.get_attribute("data-button"): b.find_element(By.TAG_NAME, "kbd").text
+              for b in page.driver.find_elements(By.CSS_SELECTOR, "#buttons .pad-button")}  # fmt: skip
+    assert set(legend) == set(system.button_names), legend
+    keys = key_map(system)
+    assert set(keys.values()) == set(system.button_names), keys  # every button has a key, each its own
+    # Hold RIGHT and a face button, paused, for FRAMES frames: the fields are what the same buttons give
+    # on our own emulator, and not what no buttons give.
+    held = ["RIGHT", *system.actions[-1][1]] if system.actions else ["RIGHT"]
+    codes = {button: code for code, button in keys.items()}
+    page.pause()
+    page.reset(game.default_state)
+    page.advance(FRAMES, *(selenium_key(codes[b]) for b in held))
+    page.settled()
+    shown = {name: int(page.field(name)) for name in game.fields}
+    expected = fields_after(game.name, system.mask(held), FRAMES)
+    assert shown == expected, {k: (shown[k], expected[k]) for k in shown if shown[k] != expected[k]}
+    assert expected != fields_after(game.name, 0, FRAMES), "the buttons held changed nothing"
+    assert not page.errors()
+
+
+def pixel_of_a_field(name: str, start: int) -> tuple[str, int, int, int]:
+    """A field in the first VIEW bytes of the RAM whose poke (+1 on its first byte) changes a pixel 2 frames on."""
+    game = find_game(name)
+    with RamSearch(game) as search:
+        begin = search.emulator.get_state()
+        search.step([], 2)
+        before = search.screen().copy()
+        for spec in sorted(game.fields.values(), key=lambda f: f.address):
+            if not start <= spec.address < start + VIEW:
+                continue
+            search.emulator.set_state(begin)
+            search.poke(spec.address, (search.emulator.peek(spec.address) + 1) % 256)
+            search.step([], 2)
+            ys, xs = np.nonzero((search.screen() != before).any(axis=2))
+            if len(xs):
+                return spec.name, spec.address, int(xs[0]), int(ys[0])
+    raise AssertionError(f"no field of {name} in the first {VIEW} bytes of RAM changes the screen when poked")
+
+
+def test_ram_view_and_click_to_find_start_on_the_systems_ram(page: Page) -> None:
+    game = find_game(page.studio.game.name)
+    emu = Emulator(game.system, game.require_rom())
+    layout = RamLayout.of(emu.space)
+    emu.close()
+    start, size = layout.regions[0]
+    assert start == game.system.ram_base
+    length = min(VIEW, size)
+    page.open("ramview")
+    assert int(page.el("ram-start").get_attribute("value"), 16) == start
+    assert int(page.el("ram-length").get_attribute("value")) == length
+    until("the grid", lambda: len(page.driver.find_elements(By.CSS_SELECTOR, "#ram-grid td")) == length)
+    first = page.driver.find_element(By.CSS_SELECTOR, "#ram-grid td").get_attribute("title")
+    assert int(first, 16) == start
+    # Click-to-find over its default region names a field under the pixel the field draws.
+    field, address, x, y = pixel_of_a_field(game.name, start)
+    page.open("clickfind")
+    page.pause()
+    page.reset(game.default_state)
+    assert int(page.el("cf-start").get_attribute("value"), 16) == start
+    assert int(page.el("cf-length").get_attribute("value")) == length
+    page.el("cf-range").click()
+    click_pixel(page, x, y)
+    until("the search to finish", lambda: "done in" in page.text("cf-state"))
+    assert page.text("cf-state").startswith(f"{length} of {length} cells poked")
+    hits = {int(row.get_attribute("data-address"), 16): row.text
+            for row in page.driver.find_elements(By.CSS_SELECTOR, "#cf-rows tr")}  # fmt: skip
+    assert address in hits and field in hits[address], (field, hex(address), hits)
+    assert not page.errors()

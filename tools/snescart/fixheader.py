@@ -13,22 +13,23 @@ scoring check both.
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 HEADER = 0x7FC0
 SIZE = 0x8000  # one 32 KiB bank, the header's ROM size byte 0x05 (2**5 KiB)
 
 
 def main() -> None:
-    data = bytearray(open(sys.argv[1], "rb").read())
+    data = bytearray(Path(sys.argv[1]).read_bytes())
     if len(data) != SIZE:
         raise SystemExit(f"fixheader.py: expected a {SIZE}-byte image, got {len(data)} bytes: check snes.cfg")
     if data[HEADER + 0x15] != 0x20:
         raise SystemExit("fixheader.py: expected map mode 0x20 (LoROM) at 0x7FD5: check the HEADER segment")
-    data[HEADER + 0x1C:HEADER + 0x20] = b"\xff\xff\x00\x00"
+    data[HEADER + 0x1C : HEADER + 0x20] = b"\xff\xff\x00\x00"
     checksum = sum(data) & 0xFFFF
-    data[HEADER + 0x1C:HEADER + 0x1E] = (checksum ^ 0xFFFF).to_bytes(2, "little")
-    data[HEADER + 0x1E:HEADER + 0x20] = checksum.to_bytes(2, "little")
-    open(sys.argv[2], "wb").write(data)
+    data[HEADER + 0x1C : HEADER + 0x1E] = (checksum ^ 0xFFFF).to_bytes(2, "little")
+    data[HEADER + 0x1E : HEADER + 0x20] = checksum.to_bytes(2, "little")
+    Path(sys.argv[2]).write_bytes(data)
 
 
 if __name__ == "__main__":

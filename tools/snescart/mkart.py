@@ -16,6 +16,7 @@ The output depends only on the art, so the ROM builds byte for byte.
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 BG_TILES = 128
 SPRITE_TILES = 32
@@ -50,21 +51,21 @@ def parse(text: str) -> tuple[bytearray, bytearray]:
         kind, _, name = lines[i].partition(" ")
         name = name.split()[0]
         if kind == "bg":
-            rows = [pixels(ln) for ln in lines[i + 1:i + 9]]
+            rows = [pixels(ln) for ln in lines[i + 1 : i + 9]]
             n = int(name)
-            bg[16 * n:16 * n + 16] = planes(rows, 2)
+            bg[16 * n : 16 * n + 16] = planes(rows, 2)
             i += 9
         elif kind == "glyph":
-            rows = [[1 if ch == "#" else 0 for ch in ln] + [0, 0, 0] for ln in lines[i + 1:i + 8]] + [[0] * 8]
+            rows = [[1 if ch == "#" else 0 for ch in ln] + [0, 0, 0] for ln in lines[i + 1 : i + 8]] + [[0] * 8]
             n = ord(name)
-            bg[16 * n:16 * n + 16] = planes(rows, 2)
+            bg[16 * n : 16 * n + 16] = planes(rows, 2)
             i += 8
         elif kind == "sprite":
-            rows = [pixels(ln) for ln in lines[i + 1:i + 17]]
+            rows = [pixels(ln) for ln in lines[i + 1 : i + 17]]
             n = int(name)
             for k, (dy, dx) in enumerate(((0, 0), (0, 8), (8, 0), (8, 8))):
                 tile = n + (k & 1) + 16 * (k >> 1)
-                spr[32 * tile:32 * tile + 32] = planes([r[dx:dx + 8] for r in rows[dy:dy + 8]], 4)
+                spr[32 * tile : 32 * tile + 32] = planes([r[dx : dx + 8] for r in rows[dy : dy + 8]], 4)
             i += 17
         else:
             raise SystemExit(f"art.txt: expected 'bg N', 'glyph C' or 'sprite N', got {lines[i]!r}")
@@ -74,16 +75,14 @@ def parse(text: str) -> tuple[bytearray, bytearray]:
 def emit(label: str, data: bytes) -> str:
     rows = [f"{label}:"]
     for k in range(0, len(data), 16):
-        rows.append("  .byte " + ",".join(f"${b:02X}" for b in data[k:k + 16]))
+        rows.append("  .byte " + ",".join(f"${b:02X}" for b in data[k : k + 16]))
     return "\n".join(rows) + "\n"
 
 
 def main() -> None:
-    bg, spr = parse(open(sys.argv[1]).read())
-    with open(sys.argv[2], "w") as f:
-        f.write("; Made by mkart.py from src/art.txt: do not edit.\n")
-        f.write(emit("bg_tiles", bg))
-        f.write(emit("sprite_tiles", spr))
+    bg, spr = parse(Path(sys.argv[1]).read_text())
+    text = "; Made by mkart.py from src/art.txt: do not edit.\n" + emit("bg_tiles", bg) + emit("sprite_tiles", spr)
+    Path(sys.argv[2]).write_text(text)
 
 
 if __name__ == "__main__":

@@ -77,6 +77,7 @@ def test_core_reports_256x224_and_128_kib_of_little_endian_ram(playing: CartGame
     assert len(emu.ram) == 0x20000
     playing["p1_x"] = 0x1234
     assert emu.ram[0x40] == 0x34 and emu.ram[0x41] == 0x12
+    assert emu.peek(0x0040, "<u2") == 0x1234, "snes9x maps bank 0's $0000-$1FFF onto the same RAM"
 
 
 def test_title_shows_level_select_and_start_begins(game: CartGame) -> None:

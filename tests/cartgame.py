@@ -33,6 +33,8 @@ def ram_h_fields(ram_h: Path) -> dict[str, int]:
     }
     out = {k[len("ADDR_"):].lower(): v for k, v in values.items() if k.startswith("ADDR_")}
     for player in (1, 2):
+        if f"ADDR_P{player}" not in values:
+            continue  # a one-player cartridge (a Game Boy has one pad)
         for k, v in values.items():
             if k.startswith("P_"):
                 out[f"p{player}_{k[2:].lower()}"] = values[f"ADDR_P{player}"] + v
@@ -68,8 +70,12 @@ class CartGame:
         raise AssertionError(f"condition not met within {limit} frames")
 
     def boot(self) -> None:
-        """Run until the title's main loop is counting frames (from 2: a core may power on with RAM full of 0xFF)."""
-        self.run_until(lambda: 2 <= self["frame"] < 100, limit=300)
+        """Run until the title's main loop is counting frames.
+
+        From 2, and after the first frame: a core may power on with RAM full of 0xFF, or of a pattern
+        (gambatte's work RAM reads ``frame`` 8 before the boot code has run).
+        """
+        self.run_until(lambda: self.emu.frame > 0 and 2 <= self["frame"] < 100, limit=300)
         assert self["game_mode"] == MODE_TITLE
 
     def start(self, p1: Sequence[str] = ("START",), p2: Sequence[str] = ()) -> None:

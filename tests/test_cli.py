@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import yaml
 
 from retrokit import cli, paths
 from retrokit.commands import command_modules
@@ -61,8 +62,10 @@ def test_games_imported_only(capsys, tmp_path):
     status, out, _ = run(capsys, "games", "--imported")
     assert status == 0
     # With nothing imported, only the free ROMs that ship are available:
-    # Airstriker in the wheel and our own test cartridge in games/.
-    assert [line.split()[0] for line in out.splitlines()[:-1]] == ["Airstriker-Genesis", "Dasher-Genesis"]
+    # Airstriker in the wheel and our own cartridges in games/ (tools/cartridges.yaml).
+    cartridges = yaml.safe_load((REPO / "tools" / "cartridges.yaml").read_text())
+    expected = sorted(["Airstriker-Genesis", *cartridges])
+    assert [line.split()[0] for line in out.splitlines()[:-1]] == expected
 
 
 def test_games_with_no_match_suggests(capsys):

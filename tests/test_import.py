@@ -52,7 +52,7 @@ def test_import_from_a_folder(src, data_dir):
     dest = imported(data_dir, "Airstriker-Genesis", "md")
     assert [(r.game, r.path) for r in report.imported] == [("Airstriker-Genesis", dest)]
     assert dest.read_bytes() == AIRSTRIKER_ROM.read_bytes()
-    assert [u.source for u in report.unmatched] == [str(src / "notes.txt")]
+    assert report.unmatched == [] and report.not_roms == [str(src / "notes.txt")]  # a .txt is listed as no ROM
     assert report.conflicts == [] and report.already_present == [] and report.broken_games == []
     assert sorted(p.name for p in dest.parent.iterdir()) == ["rom.md"]  # no temp file left
 
@@ -75,7 +75,7 @@ def test_import_from_a_zip(src, data_dir, nested):
     assert [r.game for r in report.imported] == ["Airstriker-Genesis"]
     assert report.imported[0].source.endswith("!Airstriker/Airstriker.md")
     assert imported(data_dir, "Airstriker-Genesis", "md").read_bytes() == AIRSTRIKER_ROM.read_bytes()
-    assert [u.source.rsplit("!", 1)[-1] for u in report.unmatched] == ["readme.txt"]
+    assert report.unmatched == [] and [u.rsplit("!", 1)[-1] for u in report.not_roms] == ["readme.txt"]
     assert not list(src.glob("**/*.md"))  # zip members are never extracted to disk
 
 
@@ -157,7 +157,9 @@ def test_an_unmatched_file_has_its_sha1_and_likely_system(src, data_dir):
     assert by_source["runner.bin"].sha1 == hashlib.sha1(runner.read_bytes()).hexdigest()
     assert by_source["runner.bin"].system == "Genesis"  # told by its header: .bin says nothing
     assert by_source["FakeQuest-headered.bin"].system == "Nes"
-    assert by_source["notes.txt"].system is None
+    assert "notes.txt" not in by_source and str(src / "notes.txt") in report.not_roms
+    (src / "mystery.bin").write_bytes(b"\x01" * 1000)  # a .bin of no system's size or header: listed, system unknown
+    assert {Path(u.source).name: u for u in import_roms([src]).unmatched}["mystery.bin"].system is None
 
 
 @pytest.mark.parametrize("nested", [False, True], ids=["zip", "zip-in-zip"])
@@ -169,4 +171,5 @@ def test_a_zip_holding_no_rom_is_listed_once(src, data_dir, nested):
     (src / "empty.zip").write_bytes(_zip({}))
     report = import_roms([src / "docs.zip", src / "empty.zip"])
     inner = "!inner.zip" if nested else ""
-    assert [u.source for u in report.unmatched] == [f"{src / 'docs.zip'}{inner}!readme.txt", str(src / "empty.zip")]
+    assert [u.source for u in report.unmatched] == [str(src / "empty.zip")]
+    assert report.not_roms == [f"{src / 'docs.zip'}{inner}!readme.txt"]

@@ -25,9 +25,9 @@ CART_DIR = REPO / "tools" / "nescart"
 ROM = GAME_DIR / "rom.nes"
 
 # The stages' goal x, from tools/nescart/src/world.c: five columns before each stage's end.
-END_X = {(0, 0): 2248, (0, 1): 2280, (1, 0): 2568, (1, 1): 2840, (2, 0): 3192, (2, 1): 3416}
+END_X = {(0, 0): 2248, (0, 1): 2312, (1, 0): 2568, (1, 1): 2840, (2, 0): 3192, (2, 1): 3416}
 GROUND = 0x0400  # one byte per 16-pixel column: height 0-4 (0 = pit), bit 7 = a coin
-ENEMIES, ENEMY_SIZE = 0x0380, 10
+ENEMIES, ENEMY_SIZE = 0x0300, 10
 FIELDS = game_fields(GAME_DIR)
 
 
@@ -228,6 +228,34 @@ def test_reaching_end_x_clears_the_stage(playing: Hopper) -> None:
     run_into_goal(playing)
     assert (playing["world"], playing["stage"]) == (0, 1)
     assert playing["end_x"] == END_X[0, 1]
+
+
+def _runner(game: Hopper) -> list[str]:
+    """A scripted player 1: hold RIGHT; jump (a fresh press) from the ground when a pit or a wall is
+    10-18 pixels ahead or a crawler 16-36 pixels ahead, and hold the jump while rising."""
+    x, y = game["p1_x"], game["p1_y"]
+    ahead = [game.column(x + d) & 7 for d in (10, 18)]
+    danger = any(h == 0 or 224 - 16 * h < y for h in ahead) or any(
+        game.enemy(i, 7) and 16 < game.enemy(i, 0, "<u2") - x < 36 for i in range(game["enemy_count"])
+    )
+    fresh = not game["pad1"] & 0x80
+    jump = (game["p1_on_ground"] and danger and fresh) or (not game["p1_on_ground"] and game["p1_jump_held"])
+    return ["RIGHT", "A"] if jump else ["RIGHT"]
+
+
+@pytest.mark.parametrize("world,stage", list(END_X), ids=[f"level{w + 1}-{s + 1}" for w, s in END_X])
+def test_every_stage_can_be_cleared(world: int, stage: int) -> None:
+    # The level design holds: a simple scripted runner reaches every goal pole within its three lives.
+    game = Hopper()
+    try:
+        start_selected(game, {"world": world, "stage": stage}, "at-title")
+        for _ in range(4000):
+            if game["level_done"] or game["game_mode"] != 1:
+                break
+            game.run(_runner(game))
+        assert game["level_done"] == 1 and game["p1_x"] >= END_X[world, stage], (game["p1_x"], game["p1_lives"])
+    finally:
+        game.close()
 
 
 # --- level select ------------------------------------------------------------------------------

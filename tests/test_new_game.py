@@ -68,14 +68,42 @@ def test_the_header_tells_the_system_whatever_the_extension(tmp_path):
     assert roms.guess_system(b"just some notes\n", "notes.txt") == (None, "")
 
 
-def test_system_passed_when_nothing_tells_it(data, tmp_path, capsys):
+def test_the_descriptors_detect_rules_tell_the_rest():
+    gb = bytearray(0x8000)
+    gb[0x104:0x11C] = bytes.fromhex("CEED6666CC0D000B03730083000C000D0008111F8889000E")
+    assert roms.header_system(bytes(gb)) == "GameBoy"
+    gb[0x143] = 0xC0  # the CGB flag
+    assert roms.header_system(bytes(gb)) == "GbColor"
+    x32 = bytearray(0x200)
+    x32[0x100:0x108] = b"SEGA 32X"
+    assert roms.header_system(bytes(x32)) == "32x"  # the longer mark wins over the Genesis's SEGA
+    sms = bytearray(0x4000)
+    sms[0x3FF0:0x3FF8], sms[0x3FFF] = b"TMR SEGA", 0x9C  # a region no console has: the extension tells
+    assert roms.header_system(bytes(sms)) is None and roms.guess_system(bytes(sms), "x.gg")[0].name == "GameGear"
+    for size in (2048, 4096, 8192, 16384, 32768):
+        assert roms.guess_system(bytes(size), "x.bin") == (roms.get_system("Atari2600"), "size")
+    assert roms.guess_system(bytes(4096), "x.gb") == (roms.get_system("GameBoy"), "extension")  # size needs .bin/.a26
+    assert roms.guess_system(bytes(3000), "x.bin") == (None, "")
+    snes = bytearray(0x10000)
+    snes[0xFFD5], snes[0xFFDC:0xFFE0] = 0x21, bytes.fromhex("34125BED")  # HiROM, a wrong complement
+    assert roms.header_system(bytes(snes)) is None  # a complement that does not complement the checksum
+    snes[0xFFDC:0xFFE0] = (0x1234 ^ 0xFFFF).to_bytes(2, "little") + (0x1234).to_bytes(2, "little")
+    assert roms.guess_system(bytes(snes), "x.bin") == (roms.get_system("Snes"), "header")
+    snes[0xFFD5] = 0x00  # no map mode there: not a header
+    assert roms.header_system(bytes(snes)) is None
+
+
+def test_system_told_by_the_name_or_passed_when_the_rom_tells_nothing(data, tmp_path, capsys):
     blob = tmp_path / "mystery.rom"
     blob.write_bytes(bytes(range(256)) * 64)
-    status, _, err = cli(capsys, "new", str(blob), "--name", "Mystery-Snes")
-    assert status == 2 and "found neither in" in err and "--system" in err
-    status, out, err = cli(capsys, "new", str(blob), "--name", "Mystery-Snes", "--system", "Snes")
+    status, out, err = cli(capsys, "new", str(blob), "--name", "Mystery-Snes")
     assert status == 0, err
-    assert "told by its --system" in out and find_game("Mystery-Snes").system.name == "Snes"
+    assert "told by its name" in out and find_game("Mystery-Snes").system.name == "Snes"
+    other = tmp_path / "other.rom"
+    other.write_bytes(bytes(range(255, -1, -1)) * 64)
+    status, out, err = cli(capsys, "new", str(other), "--name", "Other-Snes", "--system", "Snes")
+    assert status == 0, err
+    assert "told by its --system" in out and find_game("Other-Snes").system.name == "Snes"
 
 
 def test_the_next_hint_presses_the_systems_start_button(data, tmp_path, capsys):
@@ -123,7 +151,7 @@ def test_a_known_rom_or_a_file_that_is_no_rom_is_refused(data, tmp_path, capsys)
     huge = tmp_path / "huge.md"
     with open(huge, "wb") as f:  # sparse: 40 MiB on paper, nothing on disk
         f.truncate(40 * 2**20)
-    for path, message in [(notes, "found neither"), (empty, "found an empty file"), (fifo, "found a FIFO"),
+    for path, message in [(notes, "found none in"), (empty, "found an empty file"), (fifo, "found a FIFO"),
                           (zero, "found a device"), (huge, "at most 32 MiB"),
                           (tmp_path / "missing.md", "No such file"), (tmp_path, "found a folder")]:
         status, _, err = cli(capsys, "new", str(path), "--name", "Junk-Genesis")
@@ -192,3 +220,43 @@ def test_games_with_an_exact_name_shows_that_game_only(capsys):
 def test_new_help_shows_examples(capsys):
     status, out, _ = cli(capsys, "new", "--help")
     assert status == 0 and "retrokit new ~/roms/runner.bin --name Runner-Genesis" in out
+
+
+def _ines(mapper: int, prg: int = 2, chr_: int = 1, cut: int = 0) -> bytes:
+    header = bytes([0x4E, 0x45, 0x53, 0x1A, prg, chr_, (mapper & 0xF) << 4, mapper & 0xF0]) + bytes(8)
+    body = bytes(prg * 16384 + chr_ * 8192)
+    return header + body[: len(body) - cut]
+
+
+@pytest.mark.parametrize(
+    "rom,message",
+    [
+        pytest.param(_ines(0, cut=1), "it is truncated: its iNES header gives 2 x 16 KiB", id="truncated"),
+        pytest.param(_ines(0)[:10], "shorter than the 16-byte iNES header", id="header-only"),
+        pytest.param(_ines(0, prg=0), "no program ROM", id="no-program"),
+        pytest.param(_ines(20), "iNES mapper 20 is one the fceumm core cannot run", id="mapper-20-famicom-disk"),
+    ],
+)
+def test_an_ines_rom_the_core_cannot_run_is_refused_in_one_line(data, tmp_path, capsys, rom: bytes, message: str):
+    path = tmp_path / "broken.nes"
+    path.write_bytes(rom)
+    status, _, err = cli(capsys, "new", str(path), "--name", "Broken-Nes")
+    assert status == 2 and message in err and err.count("\n") == 1, err
+
+
+def test_missing_mappers_are_the_ones_the_core_says_it_lacks(tmp_path, caplog) -> None:
+    # The descriptor's list is a measurement of this fceumm build: a ROM of a listed mapper makes the core say
+    # "not supported at all", one of a mapper off the list does not.
+    import logging
+
+    from retrokit.host.emulator import Emulator
+
+    nes = roms.get_system("Nes")
+    for mapper in (4, min(nes.missing_mappers), max(nes.missing_mappers)):
+        path = tmp_path / f"m{mapper}.nes"
+        path.write_bytes(_ines(mapper))
+        caplog.clear()
+        with caplog.at_level(logging.INFO, logger="retrokit.core"), Emulator("Nes", path):
+            pass
+        said = any("not supported at all" in r.getMessage() for r in caplog.records)
+        assert said == (mapper in nes.missing_mappers), mapper

@@ -39,7 +39,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     parser = subparsers.add_parser(
         "evaluate",
-        help="run a benchmark (sonic, dasher or a YAML file) with one agent or several; write scores, a report and plots",
+        help="run a benchmark (sonic, dasher, trekker, ... or a YAML file) with one agent or several; write scores, a report and plots",
         description="Play each level of a benchmark for its budget of timesteps with an agent, each level in a worker "
         "process, and write episodes.jsonl, summary.json, summary.csv, report.md (beside the paper's scores) and "
         "PNG plots into --out. Progress shows as a bar per level on a terminal, else as a line per finished level. "
@@ -47,7 +47,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         epilog=AGENT_NOTE,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("--benchmark", default="dasher", help="sonic, dasher, or a benchmark YAML file (default: dasher)")
+    parser.add_argument("--benchmark", default="dasher", help="sonic, dasher, trekker, trekker-color (the cartridges' benchmarks), or a benchmark YAML file (default: dasher)")
     parser.add_argument("--agent", action="append", default=None, metavar="AGENT",
                         help="random, jerk, or MODULE:CALLABLE; repeat it to compare agents (default: jerk)")
     add_evaluation_options(parser, "processes (or Ray CPUs) sharing the levels (default: up to 2)")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 import shlex
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from retrokit.commands._common import add_data_dir_option, add_force_option, rom_status
@@ -26,6 +27,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "the files searched, on standard error (none in a pipe or a log file).",
     )
     parser.add_argument("paths", nargs="*", metavar="PATH", help="files, folders or zip files to search")
+    parser.add_argument("--from", dest="package", metavar="PACKAGE",
+                        help="also search the ROMs an installed Python package ships (ale-py: Atari 2600 ROMs)")
     parser.add_argument("--game", metavar="NAME", help="show the SHA-1s this game expects, and whether its ROM is present")
     add_force_option(parser, "replace a different ROM already imported")
     parser.add_argument("-v", "--verbose", action="store_true", help="list every file that matched nothing")
@@ -52,12 +55,14 @@ def run(args: argparse.Namespace) -> int:
     """Import ROMs, and/or show what a game expects."""
     from retrokit.benchmark.progress import is_terminal
     from retrokit.data.games import find_game
-    from retrokit.data.importer import import_roms
+    from retrokit.data.importer import import_roms, package_roms
     from retrokit.errors import FileSystemError, InvalidArgumentError
 
+    if args.package:
+        args.paths = [*args.paths, str(package_roms(args.package))]
     if not args.paths and not args.game:
         raise InvalidArgumentError(
-            "Expected at least one PATH to search (or --game NAME); found none. "
+            "Expected at least one PATH to search (or --game NAME, or --from PACKAGE); found none. "
             "Run, for example: retrokit import ~/roms"
         )
     game = find_game(args.game) if args.game else None
@@ -79,6 +84,10 @@ def run(args: argparse.Namespace) -> int:
         )
         _section("Matched no known game (SHA-1, likely system)", [_unmatched(u) for u in report.unmatched], args.verbose)
         _section("Skipped", [f"{label}: {why}" for label, why in report.skipped], args.verbose)
+        if report.not_roms:
+            exts = sorted({Path(label).suffix or "(none)" for label in report.not_roms})
+            print(f"Left out {len(report.not_roms)} file{'s' * (len(report.not_roms) != 1)} that are no ROMs "
+                  f"(extension {', '.join(exts)}; no header or size of a system's ROMs).")
         _section("Games whose data files cannot be read", [f"{n}: {e}" for n, e in report.broken_games], args.verbose)
         likely = [u for u in report.unmatched if u.system is not None]
         if likely:
@@ -103,4 +112,5 @@ EXAMPLES = [
     "retrokit import ~/roms                              # search a folder (and the .zip files in it)",
     "retrokit import Sonic.zip Airstriker.md -v",
     "retrokit import --game SonicTheHedgehog-Genesis     # which ROM that game expects",
+    "retrokit import --from ale-py                       # the Atari 2600 ROMs ale-py ships",
 ]

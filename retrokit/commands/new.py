@@ -14,7 +14,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="start integrating a game nobody has: a game.yaml in your games folder, and its ROM imported",
         description="Make a new game from a ROM that no known game matches (retrokit import lists those, with "
         "their SHA-1 and likely system). The ROM's system is told from its header (a Genesis ROM says SEGA at "
-        "0x100, even as a .bin), else from its extension, else from --system. The game is made in your games "
+        "0x100, even as a .bin), else from its size (an Atari 2600 .bin of 2 to 32 KiB), else from its extension, "
+        "else from the name's system suffix or --system. The game is made in your games "
         "folder, <data>/games/NAME-SYSTEM/ (every command looks there, and in the folders of $RETROKIT_GAMES), "
         "with a game.yaml holding the system and the ROM's SHA-1 and no fields yet; the ROM is imported into "
         "<data>/roms/NAME-SYSTEM/. The next commands are printed; retrokit docs integrate walks through the rest.",

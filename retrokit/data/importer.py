@@ -28,9 +28,19 @@ from tqdm import tqdm
 from retrokit import paths
 from retrokit.data import roms
 from retrokit.data.games import Game, list_games
-from retrokit.errors import FileConflictError, RetrokitError, RomError
+from retrokit.errors import (
+    FileConflictError,
+    MissingExtraError,
+    RetrokitError,
+    RomError,
+    UnknownNameError,
+    did_you_mean,
+)
 from retrokit.host.systems import extension_of
 
+ROM_PACKAGES: dict[str, tuple[str, str]] = {"ale-py": ("ale_py", "roms")}
+"""Python packages that ship ROMs: the package's name on the index, its import name and its ROM folder
+(``retrokit import --from ale-py``)."""
 MAX_ZIP_DEPTH = 3
 MAX_NESTED_ZIP_SIZE = 256 * 2**20
 """The largest zip inside a zip that is searched (spooled to a temporary file, never held in memory)."""
@@ -101,6 +111,7 @@ class ImportReport:
         unmatched: Candidates whose SHA-1 matches no known game.
         skipped: Candidates not hashed, with the reason (unreadable, too big, bad zip).
         broken_games: Games whose data file could not be read, with the error.
+        not_roms: Candidates that matched no game and look like no ROM (by extension, header and size).
     """
 
     data_dir: Path
@@ -110,6 +121,28 @@ class ImportReport:
     unmatched: list[UnmatchedFile] = field(default_factory=list)
     skipped: list[tuple[str, str]] = field(default_factory=list)
     broken_games: list[tuple[str, str]] = field(default_factory=list)
+    not_roms: list[str] = field(default_factory=list)
+
+
+def package_roms(package: str) -> Path:
+    """The ROM folder of an installed Python package that ships ROMs (``"ale-py"``).
+
+    Raises:
+        UnknownNameError: retrokit knows no such package.
+        MissingExtraError: The package is not installed.
+    """
+    import importlib.util
+
+    if package not in ROM_PACKAGES:
+        raise UnknownNameError(
+            f"Expected a package that ships ROMs ({', '.join(ROM_PACKAGES)}), got {package!r}."
+            + did_you_mean(package, ROM_PACKAGES)
+        )
+    module, folder = ROM_PACKAGES[package]
+    spec = importlib.util.find_spec(module)
+    if spec is None or not spec.submodule_search_locations:
+        raise MissingExtraError(f"Expected the package {package} to be installed; found it missing. Run: pip install {package}")
+    return Path(next(iter(spec.submodule_search_locations))) / folder
 
 
 def known_hashes(games: Iterable[Game] | None = None) -> tuple[dict[str, list[Game]], list[tuple[str, str]]]:
@@ -316,21 +349,24 @@ def import_roms(
             matches = table.get(sha1)
             if not matches:
                 system, _ = roms.guess_system(data, label)
+                if system is None and not roms.may_be_rom(label):  # a package's __init__.py, a readme.txt
+                    report.not_roms.append(label)
+                    continue
                 report.unmatched.append(UnmatchedFile(label, sha1, system.name if system is not None else None))
                 continue
             for game in matches:
                 _store(game, label, data, sha1, report, overwrite)
-    report.unmatched = _once_per_zip(report.unmatched)
+    report.unmatched = _once_per_zip(report.unmatched, report.not_roms)
     return report
 
 
-def _once_per_zip(unmatched: list[UnmatchedFile]) -> list[UnmatchedFile]:
-    """Leave out a zip whose members are listed: a zip is searched whole (an arcade set) and by member.
+def _once_per_zip(unmatched: list[UnmatchedFile], not_roms: list[str]) -> list[UnmatchedFile]:
+    """Leave out a zip whose members are listed or left out: a zip is searched whole (an arcade set) and by member.
 
     Listing both would show a zip holding no ROM twice; its members say more.
     """
     parents = set()
-    for entry in unmatched:
-        parts = entry.source.split("!")
+    for source in [entry.source for entry in unmatched] + not_roms:
+        parts = source.split("!")
         parents.update("!".join(parts[:i]) for i in range(1, len(parts)))
     return [entry for entry in unmatched if entry.source not in parents]

@@ -2,8 +2,9 @@
 
 ``retrokit new ROM --name NAME-SYSTEM`` is the first step of integrating a
 game nobody has integrated: the ROM's system is told from its header (a
-Genesis cartridge says ``SEGA`` at 0x100 whatever the file is called) or else
-from its file extension; a folder ``<data>/games/NAME-SYSTEM/`` is made in
+Genesis cartridge says ``SEGA`` at 0x100 whatever the file is called), its size
+(an Atari 2600 cartridge has no header), its file extension, or the name's
+system suffix (:func:`retrokit.data.roms.guess_system`); a folder ``<data>/games/NAME-SYSTEM/`` is made in
 the user's games folder (:func:`retrokit.paths.user_games_dir`, searched by
 every command) with a ``game.yaml`` that holds the system and the ROM's SHA-1
 and no fields yet; and the ROM is imported into ``<data>/roms/NAME-SYSTEM/``
@@ -73,7 +74,7 @@ class NewGame:
         folder: Its folder in the user's games, holding ``game.yaml``.
         rom: Where its ROM was imported.
         sha1: The ROM's SHA-1 (by stable-retro's rules).
-        told_by: How the system was told: ``"header"``, ``"extension"`` or ``"--system"``.
+        told_by: How the system was told: ``"header"``, ``"size"``, ``"extension"``, ``"name"`` or ``"--system"``.
     """
 
     game: Game
@@ -135,12 +136,25 @@ def new_game(
         chosen = get_system(system)
     else:
         chosen, told_by = roms.guess_system(roms.deinterleave_smd(data) if extension_of(rom) == "smd" else data, rom)
+        suffix = name.rsplit("-", 1)[-1] if isinstance(name, str) else ""
+        if chosen is None and suffix in all_systems() and roms.may_be_rom(rom):  # the name says it: Galaxian-Atari2600
+            chosen, told_by = get_system(suffix), "name"
         if chosen is None:
             raise RomError(
-                f"Expected a ROM whose header or file extension tells its system; found neither in {str(rom)!r} "
-                f"(extension {'.' + extension_of(rom) if extension_of(rom) else 'none'}, no known header). If it "
-                f"is a ROM, pass its system: --system {'|'.join(all_systems())}."
+                f"Expected a ROM whose header, size or file extension tells its system; found none in {str(rom)!r} "
+                f"({len(data)} bytes, extension {'.' + extension_of(rom) if extension_of(rom) else 'none'}, no "
+                f"known header). If it is a ROM, end --name with its system (as in Galaxian-Atari2600), "
+                f"or pass --system {'|'.join(all_systems())}."
             )
+    problem = roms.rom_problem(chosen, data)
+    if problem:
+        raise RomError(f"Expected a {chosen.name} ROM the {chosen.core} core runs; found that {str(rom)!r}: {problem}.")
+    sizes = sorted(size for rule in chosen.detect for size in rule.sizes)
+    if sizes and not sizes[0] <= len(data) <= sizes[-1]:  # a system whose ROMs have no header: only sizes tell
+        raise RomError(
+            f"Expected a ROM of {sizes[0]} to {sizes[-1]} bytes for {chosen.name}; found {len(data)} bytes in "
+            f"{str(rom)!r}. It is no {chosen.name} cartridge: check the file."
+        )
     _, sha1 = roms.groom_rom(data, extension_of(rom) if extension_of(rom) == "smd" else chosen.extensions[0])
     check_new_name(name, chosen)
     owners = known_hashes()[0].get(sha1, [])

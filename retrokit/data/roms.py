@@ -25,6 +25,7 @@ from pathlib import Path
 
 from retrokit.errors import InvalidArgumentError, RomError
 from retrokit.host.systems import (
+    DetectRule,
     System,
     all_systems,
     extension_of,
@@ -139,56 +140,114 @@ def _rule(form: System | str) -> str:
     return get_system(form).extensions[0]
 
 
-# Header signatures: (system, offset, bytes). A match names the system whatever the file's extension,
-# so a Genesis ROM dumped as .bin (an extension N64 dumps use too) is still a Genesis ROM.
-_SIGNATURES: tuple[tuple[str, int, bytes], ...] = (
-    ("32x", 0x100, b"SEGA 32X"),
-    ("Genesis", 0x100, b"SEGA"),
-    ("Genesis", 0x101, b"SEGA"),  # " SEGA MEGA DRIVE": some headers start with a space
-    ("Nes", 0, b"NES\x1a"),
-    ("N64", 0, bytes.fromhex("80371240")),
-    ("GbAdvance", 0xB2, b"\x96"),  # the fixed byte of every GBA header; checked with the logo below
-)
-_GB_LOGO = bytes.fromhex("CEED6666CC0D000B03730083000C000D0008111F8889000E")  # the start of the Nintendo logo at 0x104
-_SMS_MARK = b"TMR SEGA"
-_SMS_MARK_OFFSETS = (0x7FF0, 0x3FF0, 0x1FF0)
-_GG_REGIONS = (5, 6, 7)  # the region nibble of a Game Gear header
-_GBA_LOGO = bytes.fromhex("24FFAE51699AA2213D84820A")  # the start of the GBA's logo at 0x04
+ROM_EXTENSIONS = frozenset({"bin", "rom", "zip"})
+"""Extensions a ROM dump may have beyond the systems' own."""
+
+
+def may_be_rom(filename: str | os.PathLike[str]) -> bool:
+    """Whether a file's extension is one a ROM dump has (a system's, ``.bin``, ``.rom``, ``.zip``): not ``.py``, ``.txt``."""
+    ext = extension_of(filename)
+    return ext in ROM_EXTENSIONS or ext in systems_by_extension()
+
+
+def _rule_score(rule: DetectRule, data: bytes) -> int:
+    """How many bytes of ``data`` a header rule compared and found (0: it does not hold)."""
+    size = 4 if rule.complement else len(rule.mark)
+    for offset in rule.at:
+        found = data[offset : offset + size]
+        if rule.complement:
+            if len(found) < size or int.from_bytes(found[:2], "little") ^ int.from_bytes(found[2:], "little") != 0xFFFF:
+                continue
+        elif found != rule.mark:
+            continue
+        if rule.byte_at is None:
+            return size
+        where = offset + rule.byte_at
+        if 0 <= where < len(data) and data[where] >> rule.byte_shift in rule.byte_in:
+            return size + 1
+    return 0
 
 
 def header_system(data: bytes) -> str | None:
-    """The system a ROM's header names, or ``None`` if no header retrokit knows is there.
+    """The system a ROM's header names (``detect:`` in systems.yaml), or ``None`` if no header rule holds.
+
+    Where several hold, the one that compared the most bytes names it (a 32X
+    ROM's header also says ``SEGA`` where a Genesis ROM's does).
 
     Args:
         data: The ROM, in its stored form (an ``.smd`` dump de-interleaved).
     """
-    for system, offset, mark in _SIGNATURES:
-        if system == "GbAdvance":
-            if data[0x04 : 0x04 + len(_GBA_LOGO)] == _GBA_LOGO and data[offset : offset + 1] == mark:
+    best, named = 0, None
+    for system in all_systems().values():
+        for rule in system.detect:
+            score = _rule_score(rule, data) if rule.at else 0
+            if score > best:
+                best, named = score, system.name
+    return named
+
+
+def size_system(size: int, filename: str | os.PathLike[str]) -> System | None:
+    """The system whose header-less ROMs have this file size and extension (an Atari 2600 ``.bin``), or ``None``."""
+    ext = extension_of(filename)
+    for system in all_systems().values():
+        for rule in system.detect:
+            if size in rule.sizes and ext in rule.extensions:
                 return system
-            continue
-        if data[offset : offset + len(mark)] == mark:
-            return system
-    if data[0x104 : 0x104 + len(_GB_LOGO)] == _GB_LOGO:
-        return "GbColor" if len(data) > 0x143 and data[0x143] in (0x80, 0xC0) else "GameBoy"
-    for offset in _SMS_MARK_OFFSETS:
-        if data[offset : offset + len(_SMS_MARK)] == _SMS_MARK:
-            region = data[offset + 0xF] >> 4 if len(data) > offset + 0xF else 0
-            return "GameGear" if region in _GG_REGIONS else "Sms"
     return None
 
 
+INES_PRG_UNIT = 16 * 1024
+INES_CHR_UNIT = 8 * 1024
+INES_TRAINER = 512
+
+
+def _ines_problem(system: System, data: bytes) -> str:
+    """What is wrong with an iNES ROM for ``system``'s core: too short for its header's sizes, or an unknown mapper."""
+    if len(data) < NES_HEADER_SIZE:
+        return f"it is {len(data)} bytes, shorter than the {NES_HEADER_SIZE}-byte iNES header"
+    prg, chr_, flags6, flags7 = data[4], data[5], data[6], data[7]
+    need = NES_HEADER_SIZE + (INES_TRAINER if flags6 & 0x04 else 0) + prg * INES_PRG_UNIT + chr_ * INES_CHR_UNIT
+    if prg == 0:
+        return "its iNES header gives it no program ROM (byte 4 is 0)"
+    if len(data) < need:
+        return (f"it is truncated: its iNES header gives {prg} x 16 KiB of program ROM and {chr_} x 8 KiB of "
+                f"character ROM, {need} bytes with the header, and the file has {len(data)}")
+    mapper = (flags6 >> 4) | (flags7 & 0xF0)
+    if flags7 & 0x0C == 0x08:  # NES 2.0: 4 more bits of mapper in byte 8 (numbers past 255 are left to the core)
+        mapper |= (data[8] & 0x0F) << 8
+    if mapper in system.missing_mappers:
+        return f"its iNES mapper {mapper} is one the {system.core} core cannot run (it has no such board)"
+    return ""
+
+
+_FORMATS = {"ines": _ines_problem}
+
+
+def rom_problem(system: System, data: bytes) -> str:
+    """Why ``data`` cannot be a ROM ``system``'s core runs, by what its header says (``""``: nothing known).
+
+    Only systems whose descriptor names a ``rom.format`` are checked (the NES's iNES header).
+    """
+    check = _FORMATS.get(system.rom_format)
+    return check(system, data) if check else ""
+
+
 def guess_system(data: bytes, filename: str | os.PathLike[str]) -> tuple[System | None, str]:
-    """The likely system of a file: from its header, else its extension; and how it was told.
+    """The likely system of a file: from its header, else its size, else its extension; and how it was told.
+
+    This is the one place a ROM's system is told from the file (retrokit new, retrokit import).
 
     Returns:
-        The system (``None`` if neither tells it) and ``"header"``, ``"extension"`` or ``""``.
+        The system (``None`` if nothing tells it) and ``"header"``, ``"size"``, ``"extension"`` or ``""``.
     """
     named = header_system(data)
-    if named is not None and named in all_systems():
+    if named is not None:
         return get_system(named), "header"
+    by_size = size_system(len(data), filename)
+    if by_size is not None:
+        return by_size, "size"
     ext = extension_of(filename)
     known = systems_by_extension()
-    if ext in known and ext != "bin":  # .bin is any dump: only a header tells what it is
+    if ext in known and ext != "bin":  # .bin is any dump: only a header or a size tells what it is
         return known[ext], "extension"
     return None, ""

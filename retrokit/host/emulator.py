@@ -365,7 +365,9 @@ class Emulator:
                 f"Expected a state for this emulator of {self.system.name}; found one checked for {state.system}. "
                 f"Load it into an emulator of {state.system}."
             )
-        self._emu.unserialize(state)
+        if self.system.reset_before_state:
+            self._emu.reset()
+        self._emu.unserialize(state, self.system.state_length == "exact")
 
     def av_info(self) -> dict[str, float | int]:
         """Return the frame rate, sample rate and geometry."""

@@ -35,11 +35,21 @@ uses FM or not, reads ``sin_tab[slot->wavetable + ...]``: the 18 operators'
 itself only ever sets to 0 or ``SIN_LEN`` (1024). A state with any other value
 reads past the table: 0x40000000 kills the process with SIGSEGV
 (tests/test_hostile_states.py), smaller ones read whatever lies there.
+
+Stella (stable-retro's 3.9 build) restores a bank-switched cartridge's banks
+from a state as 16-bit numbers (``CartridgeF8::load`` and its kin) and maps
+the bank at ``myImage + (bank << 12)`` (1 KiB slices for E0, 2 KiB for E7)
+without checking the number against the ROM's banks. The cartridge's part of a
+state begins with its class name (a 4-byte length, then the name), which the
+core checks before reading on; so every place the name occurs is checked, and a
+name planted earlier in the state cannot hide the one the core reads (but the
+copy of the name in the state's header, which the core only compares).
 """
 
 from __future__ import annotations
 
 import struct
+from collections.abc import Callable
 
 GENESIS_STATE_SIZE = 1036288
 """Bytes of a Genesis Plus GX 1.7.5 state (its ``STATE_SIZE``, 0xFD000)."""
@@ -57,6 +67,15 @@ GENESIS_BANKS = 0x40
 GENESIS_ROM_BANKS = 10485760 >> 16
 """Banks of 64 KiB in the core's ROM area (``MAXROMSIZE``, 10 MiB): a bank byte must be below this, or 0xFF."""
 _SRAM = 0xFF
+
+
+STELLA_BANKS: dict[bytes, tuple[int, ...]] = {
+    b"CartridgeF8": (2,), b"CartridgeF8SC": (2,), b"CartridgeF6": (4,), b"CartridgeF6SC": (4,),
+    b"CartridgeF4": (8,), b"CartridgeF4SC": (8,), b"CartridgeFA": (3,), b"CartridgeUA": (2,),
+    b"CartridgeEF": (16,), b"CartridgeF0": (16,), b"CartridgeE0": (8, 8, 8, 8), b"CartridgeE7": (8, 8, 4),
+}
+"""Stella's bank-switched cartridge classes whose state holds bank numbers it uses unchecked: for each 16-bit
+number that follows the class name, the banks (slices, RAM pages) of that kind the cartridge has."""
 
 
 MS_YM2413 = 16 + 0x2000 + 0x10 + 66886
@@ -109,23 +128,59 @@ def _master_system_problem(state: bytes) -> str:
     )
 
 
-_CHECKS = {"Genesis": _genesis_problem, "Sms": _master_system_problem, "GameGear": _master_system_problem}
-"""The systems whose states are checked, all Genesis Plus GX 1.7.5 (the same size and signature in every mode;
-the system, from the ROM's extension, decides how the core reads the rest)."""
+def _stella_problem(state: bytes) -> str:
+    """The stella check: every bank number after a bank-switched cartridge's class name is one of its banks."""
+    # A state begins with two strings: the format's header, then the cartridge's class name, which the core only
+    # compares; the name's copy that holds the banks comes after the console's chips.
+    header = 4 + struct.unpack_from("<I", state)[0] if len(state) >= 4 else 0
+    for name, limits in STELLA_BANKS.items():
+        marker = struct.pack("<I", len(name)) + name
+        at = state.find(marker)
+        while at >= 0:
+            start = at + len(marker)
+            if at != header and start + 2 * len(limits) <= len(state):  # a shorter state fails the load before any bank is mapped
+                numbers = struct.unpack_from(f"<{len(limits)}H", state, start)
+                for number, banks in zip(numbers, limits, strict=True):
+                    if number >= banks:
+                        return (
+                            f"its {name.decode()} cartridge is in bank {number}, of the {banks} it has there, "
+                            "which maps memory the core does not own"
+                        )
+            at = state.find(marker, at + 1)
+    return ""
+
+
+def _genesis_plus_gx(check: Callable[[bytes], str]) -> Callable[[bytes], str]:
+    """``check``, on a state in Genesis Plus GX 1.7.5's format only (the same size and signature in every mode; the
+    system, from the ROM's extension, decides how the core reads the rest)."""
+
+    def checked(state: bytes) -> str:
+        if len(state) != GENESIS_STATE_SIZE or not state.startswith(GENESIS_SIGNATURE):
+            return ""
+        return check(state)
+
+    return checked
+
+
+_CHECKS: dict[str, Callable[[bytes], str]] = {
+    "Genesis": _genesis_plus_gx(_genesis_problem),
+    "Sms": _genesis_plus_gx(_master_system_problem),
+    "GameGear": _genesis_plus_gx(_master_system_problem),
+    "Atari2600": _stella_problem,
+}
+"""The systems whose states are checked, by their core's layout."""
 
 
 def state_layout_problem(system: str, state: bytes) -> str:
     """Why the core would build a pointer outside its own memory from ``state`` (``""`` when it would not).
 
     Only what is known of a core's layout is checked: a Genesis, Master
-    System or Game Gear state in Genesis Plus GX 1.7.5's format. Anything
-    else is left to the probe.
+    System or Game Gear state in Genesis Plus GX 1.7.5's format, an Atari 2600
+    state in stella's. Anything else is left to the probe.
 
     Args:
         system: The system's name (``"Genesis"``).
         state: The serialized state.
     """
     check = _CHECKS.get(system)
-    if check is None or len(state) != GENESIS_STATE_SIZE or not state.startswith(GENESIS_SIGNATURE):
-        return ""
-    return check(state)
+    return check(state) if check else ""

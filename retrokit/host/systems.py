@@ -10,12 +10,39 @@ import os
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypeVar
 
 import yaml
 
 from retrokit.errors import DataFileError, InvalidArgumentError, UnknownNameError, UnsupportedSystemError, did_you_mean
 
 _FILE = Path(__file__).with_name("systems.yaml")
+_T = TypeVar("_T")
+
+
+@dataclass(frozen=True)
+class DetectRule:
+    """One way a ROM's bytes tell its system (``detect:`` in systems.yaml; read by :mod:`retrokit.data.roms`).
+
+    Attributes:
+        at: Offsets where the mark may be (the first where it is counts).
+        mark: The bytes there; empty for a rule by size or checksum.
+        complement: The mark is a checksum's complement: two little-endian words whose XOR is 0xFFFF.
+        byte_at: An offset, after the mark's start, of one more byte to check (``None``: none).
+        byte_shift: Bits to drop from that byte (4: its high nibble).
+        byte_in: The values it may have, once shifted.
+        sizes: For a system whose ROMs have no header: the file sizes its ROMs have.
+        extensions: The file extensions a rule by size needs.
+    """
+
+    at: tuple[int, ...] = ()
+    mark: bytes = b""
+    complement: bool = False
+    byte_at: int | None = None
+    byte_shift: int = 0
+    byte_in: frozenset[int] = frozenset()
+    sizes: frozenset[int] = frozenset()
+    extensions: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -37,6 +64,17 @@ class System:
         frame_rates: The console's frames per second, by video standard (``"ntsc"``,
             ``"pal"``, or ``"lcd"`` for a handheld's one rate); empty where it
             depends on the game (arcade boards) or is not listed.
+        state_length: ``"exact"``: the core reads its ``retro_serialize_size``
+            bytes of a state whatever length it is given, so a state of another
+            length is refused before it; ``"parsed"``: the core reads a state
+            within the length it is given, so any length goes to it as it is.
+        detect: How its ROMs' bytes tell the system, for ROMs no game knows.
+        rom_format: The layout a ROM's header describes (``"ines"``), checked by
+            :func:`retrokit.data.roms.rom_problem`; ``""``: none.
+        missing_mappers: Mapper numbers of that format the core cannot run.
+        reset_before_state: The core restores some state only partly (so a
+            load's outcome would depend on what ran before it): the console is
+            reset before each state is loaded, so every load starts alike.
         start: The button that starts a game from its title screen.
         jump: The button JERK jumps with, unless a scenario names another.
         switches: Console switches (not pad buttons), which default action sets, the random
@@ -57,6 +95,11 @@ class System:
     screen: tuple[int, int] | None = None
     aliases: tuple[str, ...] = ()
     frame_rates: dict[str, float] = field(default_factory=dict)
+    state_length: str = "exact"
+    reset_before_state: bool = False
+    detect: tuple[DetectRule, ...] = ()
+    rom_format: str = ""
+    missing_mappers: frozenset[int] = frozenset()
     start: str = "START"
     jump: str | None = None
     switches: tuple[str, ...] = ()
@@ -154,6 +197,11 @@ def _parse(name: str, entry: object) -> System:
             screen=tuple(entry["screen"]) if "screen" in entry else None,
             aliases=tuple(entry.get("aliases", ())),
             frame_rates={str(k): float(v) for k, v in (entry.get("frame_rate") or {}).items()},
+            state_length=_one_of(entry.get("state_length", "exact"), ("exact", "parsed"), "state_length"),
+            reset_before_state=_one_of(entry.get("reset_before_state", False), (False, True), "reset_before_state"),
+            detect=tuple(_detect_rule(rule) for rule in entry.get("detect") or ()),
+            rom_format=_one_of(str((entry.get("rom") or {}).get("format", "")), ("", "ines"), "rom.format"),
+            missing_mappers=frozenset(int(m) for m in (entry.get("rom") or {}).get("missing_mappers", ())),
             start=str(entry.get("start", "START")),
             jump=str(entry["jump"]) if entry.get("jump") else None,
             switches=tuple(str(b) for b in entry.get("switches", ())),
@@ -161,6 +209,32 @@ def _parse(name: str, entry: object) -> System:
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise DataFileError(f"{_FILE}: system {name!r} is malformed: {exc!r}.") from exc
+
+
+def _detect_rule(rule: dict) -> DetectRule:
+    at = rule.get("at", ())
+    mark = bytes.fromhex(rule["hex"]) if "hex" in rule else str(rule.get("text", "")).encode("ascii")
+    byte = rule.get("byte") or {}
+    made = DetectRule(
+        at=tuple(at) if isinstance(at, list) else (int(at),) if at != () else (),
+        mark=mark,
+        complement=_one_of(rule.get("complement", False), (False, True), "complement"),
+        byte_at=int(byte["at"]) if byte else None,
+        byte_shift=int(byte.get("shift", 0)),
+        byte_in=frozenset(int(v) for v in byte.get("in", ())),
+        sizes=frozenset(int(v) for v in rule.get("sizes", ())),
+        extensions=tuple(str(e) for e in rule.get("extensions", ())),
+    )
+    marked = bool(made.mark) or made.complement
+    if marked == bool(made.sizes) or marked != bool(made.at):
+        raise ValueError(f"a detect rule holds a mark (at + text, hex or complement) or sizes, not both: {rule!r}")
+    return made
+
+
+def _one_of(value: _T, allowed: tuple[_T, ...], key: str) -> _T:
+    if value not in allowed or type(value) is not type(allowed[0]):
+        raise ValueError(f"{key} must be one of {', '.join(map(str, allowed))}, not {value!r}")
+    return value
 
 
 @functools.cache

@@ -435,18 +435,22 @@ static PyObject *emulator_serialize(EmulatorObject *self, PyObject *unused) {
     return out;
 }
 
-static PyObject *emulator_unserialize(EmulatorObject *self, PyObject *arg) {
+/* exact: the core reads retro_serialize_size bytes whatever length it is given, so only a state of that length
+   may reach it. Otherwise (a core that parses the state within the length it is given, as stella does) the state
+   goes as it is, and the core refuses what it cannot read. */
+static PyObject *emulator_unserialize(EmulatorObject *self, PyObject *args) {
     Py_buffer buf;
-    if (PyObject_GetBuffer(arg, &buf, PyBUF_SIMPLE) < 0) return NULL;
+    int exact = 1;
+    if (!PyArg_ParseTuple(args, "y*|p", &buf, &exact)) return NULL;
     if (rk_py_enter(self, 1)) return rk_py_release(&buf, NULL);
     rk_enter(&self->core);
     size_t size = self->core.api.serialize_size();
     rk_leave();
-    bool fits = (size_t)buf.len == size, ok = false;
+    bool fits = exact ? (size_t)buf.len == size : buf.len > 0, ok = false;
     if (fits) {
         Py_BEGIN_ALLOW_THREADS
         rk_enter(&self->core);
-        ok = self->core.api.unserialize(buf.buf, size);
+        ok = self->core.api.unserialize(buf.buf, (size_t)buf.len);
         rk_leave();
         Py_END_ALLOW_THREADS
         self->core.have_held = 0;
@@ -458,7 +462,7 @@ static PyObject *emulator_unserialize(EmulatorObject *self, PyObject *arg) {
                      size, buf.len);
     else if (!ok)
         PyErr_Format(StateError, "the core refused the state (%zu bytes): it is corrupt or was made by another core; "
-                     "make it again with this core", size);
+                     "make it again with this core", (size_t)buf.len);
     return rk_py_release(&buf, ok ? Py_NewRef(Py_None) : NULL);
 }
 
@@ -486,7 +490,8 @@ static PyMethodDef emulator_methods[] = {
     {"capture_audio", (PyCFunction)emulator_capture_audio, METH_O, "Start or stop keeping audio samples."},
     {"take_audio", (PyCFunction)emulator_take_audio, METH_NOARGS, "Return and clear the captured int16 stereo samples."},
     {"serialize", (PyCFunction)emulator_serialize, METH_NOARGS, "The core's state as bytes."},
-    {"unserialize", (PyCFunction)emulator_unserialize, METH_O, "Restore a state made by serialize."},
+    {"unserialize", (PyCFunction)emulator_unserialize, METH_VARARGS,
+     "unserialize(data, exact=True): restore a state; exact: only one of the core's serialize size."},
     {"close", (PyCFunction)emulator_close, METH_NOARGS, "Unload the game and the core."},
     {NULL, NULL, 0, NULL},
 };

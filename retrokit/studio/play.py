@@ -62,9 +62,11 @@ def pad_map(system: System) -> dict[str, str]:
     return pad
 
 
-def ram_region(layout: RamLayout) -> dict[str, int]:
-    """Where the RAM view and click-to-find start: the system's first RAM region, its first :data:`RAM_SHOWN` bytes."""
-    start, size = layout.regions[0] if layout.regions else (0, 0)
+def ram_region(layout: RamLayout, system: System) -> dict[str, int]:
+    """Where the RAM view and click-to-find start: the system RAM's region (at the descriptor's base; a Game Boy's
+    core maps HRAM and VRAM too), its first :data:`RAM_SHOWN` bytes."""
+    regions = sorted(layout.regions, key=lambda region: region[0] != system.ram_base)  # that region first
+    start, size = regions[0] if regions else (system.ram_base, 0)
     return {"start": start, "length": min(RAM_SHOWN, size)}
 
 
@@ -79,7 +81,7 @@ def info(session: Session) -> dict[str, Any]:
         "buttons": list(game.system.button_names),
         "ports": search.emulator.ports,
         "keys": key_map(game.system),
-        "ram": ram_region(search.layout),
+        "ram": ram_region(search.layout, game.system),
         "gamepad": pad_map(game.system),
         "frame_rate": session.rate,
         "speeds": [MIN_SPEED, MAX_SPEED],

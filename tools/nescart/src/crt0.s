@@ -9,13 +9,14 @@
 .import __STACK_START__, __STACKSIZE__
 .importzp sp
 
-ADDR_STAGE      = $0301
-ADDR_VBLANKS    = $0312
-ADDR_NMI_READY  = $031C
-ADDR_PPU_CTRL   = $031D
-ADDR_PPU_MASK   = $031E
-ADDR_SCROLL_X   = $031F
-ADDR_QUEUE_LEN  = $0322
+ADDR_WORLD      = $0040
+ADDR_STAGE      = $0041
+ADDR_VBLANKS    = $0052
+ADDR_NMI_READY  = $005C
+ADDR_PPU_CTRL   = $005D
+ADDR_PPU_MASK   = $005E
+ADDR_SCROLL_X   = $005F
+ADDR_QUEUE_LEN  = $0062
 ADDR_OAM        = $0200
 ADDR_QUEUE      = $0500
 
@@ -53,17 +54,20 @@ reset:
     bit PPUSTATUS
     bpl @vblank1
     ; Clear RAM while the PPU warms up, except the level select (world and
-    ; stage at $0300-$0301), so a tool may write it before the first frame.
+    ; stage at $0040-$0041), so a tool may write it before the first frame.
     lda #0
     tax
 @clear:
-    sta $0000,x
-    sta $0100,x
-    sta $0200,x
+    cpx #<ADDR_WORLD
+    bcc @zero
     cpx #<(ADDR_STAGE + 1)
     bcc @keep
-    sta $0300,x
+@zero:
+    sta $0000,x
 @keep:
+    sta $0100,x
+    sta $0200,x
+    sta $0300,x
     sta $0400,x
     sta $0500,x
     sta $0600,x

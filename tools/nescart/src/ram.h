@@ -14,9 +14,12 @@
  * most NES games keep theirs.
  *
  *   0x0000-0x003F  cc65's zero-page registers
+ *   0x0040-0x007F  game state (this file), in the zero page as NES games keep
+ *                  theirs: the 6502 reaches it with shorter, faster instructions
+ *   0x0080-0x00BF  two players
  *   0x0100-0x01FF  6502 stack
  *   0x0200-0x02FF  sprite table (OAM shadow, copied by DMA every frame)
- *   0x0300-0x03FF  game state: globals, two players, crawlers (this file)
+ *   0x0300-0x034F  crawlers
  *   0x0400-0x04FF  ground map, one byte per 16-pixel column
  *   0x0500-0x057F  PPU write queue, emptied by the NMI handler
  *   0x0580-0x05FF  the compiler's own data
@@ -26,36 +29,36 @@
 #define HOPPER_RAM_H
 
 /* --- Level select: kept by the boot-time RAM clear (see crt0.s) ----------- */
-#define ADDR_WORLD 0x0300       /* |u1 world 0-2: at the title, the world START begins */
-#define ADDR_STAGE 0x0301       /* |u1 stage 0-1: likewise */
+#define ADDR_WORLD 0x0040       /* |u1 world 0-2: at the title, the world START begins */
+#define ADDR_STAGE 0x0041       /* |u1 stage 0-1: likewise */
 /* --- Game state ------------------------------------------------------------ */
-#define ADDR_GAME_MODE 0x0302   /* |u1 MODE_* below */
-#define ADDR_LEVEL_DONE 0x0303  /* |u1 1 from reaching end_x until the next stage */
-#define ADDR_FRAME 0x0304       /* <u4 main-loop frames since power-on */
-#define ADDR_RNG 0x0308         /* <u2 random state, stirred with the frame counter and pads */
-#define ADDR_END_X 0x030A       /* <u2 x of the goal pole */
-#define ADDR_START_X 0x030C     /* <u2 x where players (re)spawn */
-#define ADDR_CAMERA_X 0x030E    /* <u2 left edge of the screen in level pixels */
-#define ADDR_MODE_TIMER 0x0310  /* <u2 frames left on the clear / game-over screen */
-#define ADDR_VBLANKS 0x0312     /* <u2 incremented by the NMI handler */
-#define ADDR_PAD1 0x0314        /* |u1 port 1 held: PAD_* bits below */
-#define ADDR_PAD2 0x0315        /* |u1 port 2 held */
-#define ADDR_PAD1_NEW 0x0316    /* |u1 port 1 newly pressed this frame */
-#define ADDR_PAD2_NEW 0x0317    /* |u1 port 2 newly pressed this frame */
-#define ADDR_LEVEL_WIDTH 0x0318 /* <u2 width of the stage in pixels */
-#define ADDR_ENEMY_COUNT 0x031A /* |u1 crawlers in the stage */
-#define ADDR_COIN_COUNT 0x031B  /* |u1 coins in the stage at its start */
-#define ADDR_NMI_READY 0x031C   /* |u1 1: the NMI handler may copy OAM, the queue and scroll */
-#define ADDR_PPU_CTRL 0x031D    /* |u1 value the NMI handler writes to PPUCTRL */
-#define ADDR_PPU_MASK 0x031E    /* |u1 value the NMI handler writes to PPUMASK */
-#define ADDR_SCROLL_X 0x031F    /* |u1 value the NMI handler writes to PPUSCROLL */
-#define ADDR_DRAW_COL 0x0320    /* <u2 next 8-pixel column of the stage to draw */
-#define ADDR_QUEUE_LEN 0x0322   /* |u1 bytes in the PPU write queue */
-#define ADDR_PLAYERS 0x0323     /* |u1 players in the game, 1 or 2 */
+#define ADDR_GAME_MODE 0x0042   /* |u1 MODE_* below */
+#define ADDR_LEVEL_DONE 0x0043  /* |u1 1 from reaching end_x until the next stage */
+#define ADDR_FRAME 0x0044       /* <u4 main-loop frames since power-on */
+#define ADDR_RNG 0x0048         /* <u2 random state, stirred with the frame counter and pads */
+#define ADDR_END_X 0x004A       /* <u2 x of the goal pole */
+#define ADDR_START_X 0x004C     /* <u2 x where players (re)spawn */
+#define ADDR_CAMERA_X 0x004E    /* <u2 left edge of the screen in level pixels */
+#define ADDR_MODE_TIMER 0x0050  /* <u2 frames left on the clear / game-over screen */
+#define ADDR_VBLANKS 0x0052     /* <u2 incremented by the NMI handler */
+#define ADDR_PAD1 0x0054        /* |u1 port 1 held: PAD_* bits below */
+#define ADDR_PAD2 0x0055        /* |u1 port 2 held */
+#define ADDR_PAD1_NEW 0x0056    /* |u1 port 1 newly pressed this frame */
+#define ADDR_PAD2_NEW 0x0057    /* |u1 port 2 newly pressed this frame */
+#define ADDR_LEVEL_WIDTH 0x0058 /* <u2 width of the stage in pixels */
+#define ADDR_ENEMY_COUNT 0x005A /* |u1 crawlers in the stage */
+#define ADDR_COIN_COUNT 0x005B  /* |u1 coins in the stage at its start */
+#define ADDR_NMI_READY 0x005C   /* |u1 1: the NMI handler may copy OAM, the queue and scroll */
+#define ADDR_PPU_CTRL 0x005D    /* |u1 value the NMI handler writes to PPUCTRL */
+#define ADDR_PPU_MASK 0x005E    /* |u1 value the NMI handler writes to PPUMASK */
+#define ADDR_SCROLL_X 0x005F    /* |u1 value the NMI handler writes to PPUSCROLL */
+#define ADDR_DRAW_COL 0x0060    /* <u2 next 8-pixel column of the stage to draw */
+#define ADDR_QUEUE_LEN 0x0062   /* |u1 bytes in the PPU write queue */
+#define ADDR_PLAYERS 0x0063     /* |u1 players in the game, 1 or 2 */
 
 /* --- Players: two 32-byte records ------------------------------------------ */
-#define ADDR_P1 0x0340
-#define ADDR_P2 0x0360
+#define ADDR_P1 0x0080
+#define ADDR_P2 0x00A0
 #define PLAYER_SIZE 0x20
 #define P_X 0x00         /* <u2 x of the feet centre, level pixels */
 #define P_Y 0x02         /* <i2 y of the feet; the lowest floor is 208, below 248 is a fall */
@@ -74,7 +77,7 @@
 #define P_JUMP_HELD 0x15 /* |u1 jump held since the jump began */
 
 /* --- Crawlers: eight 10-byte records --------------------------------------- */
-#define ADDR_ENEMIES 0x0380
+#define ADDR_ENEMIES 0x0300
 #define ENEMY_SIZE 10
 #define MAX_ENEMIES 8
 #define E_X 0x00     /* <u2 centre x */

@@ -8,7 +8,8 @@ retrokit`` and ``retrokit --help`` stay fast:
   threads (:class:`ThreadedVectorEnv`); ``State``: where an env starts.
 - ``multiplayer``: the PettingZoo envs of two-player games; ``sonic``: the
   Sonic benchmark preset; ``register_envs``: the Gymnasium ids
-  (``gymnasium.make("retrokit/Dasher-Genesis-v0")``), registered at import.
+  (``gymnasium.make("retrokit/Dasher-Genesis-v0")``), registered at import
+  (when Gymnasium is imported, if it is not yet).
 - ``movie``: ``.bk2`` movies, read, written, recorded and played back.
 - ``testing``: ``check_game``, behind ``retrokit validate``.
 - ``Emulator``: one console running one game, below the envs.
@@ -79,11 +80,12 @@ def __dir__() -> list[str]:
 
 def _register() -> None:
     # Gymnasium ids must exist as soon as retrokit is imported, since
-    # ``gymnasium.make("retrokit/<Game>-v0")`` is how many users reach us; this
-    # costs Gymnasium's import and a scan of the game folders, not the envs'.
-    from retrokit.envs.registration import register_envs
+    # ``gymnasium.make("retrokit/<Game>-v0")`` is how many users reach us. They
+    # are registered when Gymnasium is imported (now, if it is already), so that
+    # ``import retrokit`` and every command that needs no env skip its import.
+    from retrokit.envs.registration import register_when_gymnasium_loads
 
-    register_envs()
+    register_when_gymnasium_loads()
 
 
 _register()

@@ -24,7 +24,6 @@ from __future__ import annotations
 import contextlib
 import errno
 import functools
-import importlib.metadata
 import importlib.util
 import os
 import stat
@@ -53,9 +52,11 @@ def wheel_dir() -> Path | None:
         spec = None
     if spec is not None and spec.submodule_search_locations:
         return Path(next(iter(spec.submodule_search_locations)))
+    from importlib import metadata  # a tenth of `retrokit --help`'s time, for this fallback only
+
     try:
-        located = importlib.metadata.distribution("stable-retro").locate_file("stable_retro")
-    except importlib.metadata.PackageNotFoundError:
+        located = metadata.distribution("stable-retro").locate_file("stable_retro")
+    except metadata.PackageNotFoundError:
         return None
     path = Path(str(located))
     return path if path.is_dir() else None

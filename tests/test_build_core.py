@@ -53,10 +53,15 @@ def tools(tmp_path: Path, make: str | None = "ok", cc: bool = True) -> Path:
     return folder
 
 
-def original_source() -> bytes:
-    """A libretro.c holding exactly the lines the patch expects (its hunks' old side)."""
-    (patch,) = parse_patch(build.patch_text(RECIPE))
-    return "".join(line for hunk in patch.hunks for line in hunk.old).encode()
+def original_sources(end: str = "\n") -> dict[str, bytes]:
+    """The files the patch changes, in the sdist, each holding exactly the lines it expects (its hunks' old
+    sides), with ``end`` line ends."""
+    return {
+        f"{RECIPE.folder}/{patch.path}": "".join(
+            line.rstrip("\n") + end for hunk in patch.hunks for line in hunk.old
+        ).encode()
+        for patch in parse_patch(build.patch_text(RECIPE))
+    }
 
 
 def fake_sdist(tmp_path: Path, files: dict[str, bytes], version: str = "1.0.1") -> Path:
@@ -193,7 +198,7 @@ def test_the_stock_pip_downloads_the_source_with_progress(monkeypatch, tmp_path,
     """The whole command against an index over HTTP, with the pip this venv has (a stock venv's: 23.0 or later)."""
     monkeypatch.setenv("PATH", f"{tools(tmp_path)}{os.pathsep}{os.environ['PATH']}")
     padding = os.urandom(300_000)  # incompressible, so pip announces a size in kB and the download takes a while
-    sdist = fake_sdist(tmp_path, {**METADATA_ONLY_BACKEND, f"{RECIPE.folder}/{PATCHED_FILE}": original_source(),
+    sdist = fake_sdist(tmp_path, {**METADATA_ONLY_BACKEND, **original_sources(),
                                   "cores/nes/blob": padding})  # fmt: skip
     status, out, err = run_cli(capsys, "--index-url", http_index(sdist), "--stable-retro", "1.0.1")
     assert status == 0, err
@@ -227,15 +232,17 @@ def test_a_python_without_pip_says_how_to_get_it(monkeypatch, tmp_path, capsys) 
 
 def test_a_patch_against_a_modified_source(monkeypatch, tmp_path, capsys) -> None:
     monkeypatch.setenv("PATH", str(tools(tmp_path)))
-    source = original_source().replace(b"system_frame_gen(0);", b"system_frame_gen(frameskip);")
-    sdist = fake_sdist(tmp_path, {f"{RECIPE.folder}/{PATCHED_FILE}": source})
+    sources = original_sources()
+    key = f"{RECIPE.folder}/{PATCHED_FILE}"
+    sources[key] = sources[key].replace(b"system_frame_gen(0);", b"system_frame_gen(frameskip);")
+    sdist = fake_sdist(tmp_path, sources)
     status, _, err = run_cli(capsys, "--sdist", str(sdist))
     assert_one_line_error(status, err, "hunk 1 of genesis_plus_gx-av-enable.patch", PATCHED_FILE, "not the one")
 
 
 def test_make_failing_quotes_its_error_and_keeps_the_log(monkeypatch, tmp_path, capsys, isolated) -> None:
     monkeypatch.setenv("PATH", str(tools(tmp_path, make="fails")))
-    sdist = fake_sdist(tmp_path, {f"{RECIPE.folder}/{PATCHED_FILE}": original_source()})
+    sdist = fake_sdist(tmp_path, original_sources())
     status, _, err = run_cli(capsys, "--sdist", str(sdist))
     log = built_cores_dir(isolated) / "genesis_plus_gx.build.log"
     assert_one_line_error(status, err, "exit 2", "core/vdp.c:12: error: boom", f"Full log: {log}")
@@ -275,7 +282,7 @@ def test_an_unknown_core_suggests_the_known_one(capsys) -> None:
 def test_a_build_is_installed_recorded_and_found_first(monkeypatch, tmp_path, capsys, isolated) -> None:
     path = os.environ["PATH"]
     monkeypatch.setenv("PATH", str(tools(tmp_path)))
-    sdist = fake_sdist(tmp_path, {f"{RECIPE.folder}/{PATCHED_FILE}": original_source(), "cores/nes/x.c": b"x"})
+    sdist = fake_sdist(tmp_path, {**original_sources(), "cores/nes/x.c": b"x"})
     status, out, err = run_cli(capsys, "--sdist", str(sdist))
     installed = built_cores_dir(isolated) / "genesis_plus_gx_libretro.so"
     assert status == 0 and out.strip() == str(installed), err
@@ -294,7 +301,7 @@ def test_a_build_is_installed_recorded_and_found_first(monkeypatch, tmp_path, ca
 
 def test_a_build_for_another_stable_retro_version_is_not_used(monkeypatch, tmp_path, capsys, isolated) -> None:
     monkeypatch.setenv("PATH", str(tools(tmp_path)))
-    sdist = fake_sdist(tmp_path, {f"{RECIPE.folder}/{PATCHED_FILE}": original_source()}, version="0.9.9")
+    sdist = fake_sdist(tmp_path, original_sources(), version="0.9.9")
     assert run_cli(capsys, "--sdist", str(sdist), "--stable-retro", "0.9.9")[0] == 0
     assert locate_core("genesis_plus_gx").origin == "wheel"  # its states would not fit the installed wheel's
 
@@ -304,7 +311,7 @@ def test_a_core_retrokit_did_not_build_is_not_replaced(monkeypatch, tmp_path, ca
     mine = built_cores_dir(isolated) / "genesis_plus_gx_libretro.so"
     mine.parent.mkdir(parents=True)
     mine.write_bytes(b"the user's own core")
-    sdist = fake_sdist(tmp_path, {f"{RECIPE.folder}/{PATCHED_FILE}": original_source()})
+    sdist = fake_sdist(tmp_path, original_sources())
     assert_one_line_error(*run_cli(capsys, "--sdist", str(sdist))[::2], "retrokit did not build", "--force")
     assert mine.read_bytes() == b"the user's own core"
     assert run_cli(capsys, "--sdist", str(sdist), "--force")[0] == 0
@@ -361,3 +368,17 @@ def test_a_build_with_an_unreadable_record_is_not_used(isolated, record: bytes) 
     (folder / "genesis_plus_gx_libretro.so").write_bytes(b"whatever")
     (folder / "genesis_plus_gx.build.json").write_bytes(record)
     assert locate_core("genesis_plus_gx").origin == "wheel"
+
+
+def test_the_patch_applies_to_sources_with_crlf_line_ends_and_keeps_them(tmp_path) -> None:
+    """Genesis Plus GX's core/ files end their lines in CRLF, libretro.c in LF; the patch is kept in LF."""
+    for name, data in original_sources("\r\n").items():
+        path = tmp_path / name.removeprefix(f"{RECIPE.folder}/")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_bytes(data)
+    changed = apply_patch(build.patch_text(RECIPE), tmp_path)
+    assert len(changed) == len(original_sources()) > 1
+    for path in changed:
+        text = path.read_bytes()
+        assert text.count(b"\n") == text.count(b"\r\n") > 0, path
+    assert b"sound_skip = !(av_enable & 2)" in (tmp_path / PATCHED_FILE).read_bytes()

@@ -25,7 +25,7 @@ from test_build_core import (
     RECIPE,
     assert_one_line_error,
     fake_sdist,
-    original_source,
+    original_sources,
     pip_without_config,  # noqa: F401 (a fixture the index tests use)
     tools,
 )
@@ -129,7 +129,7 @@ def test_a_killed_build_leaves_a_named_folder_the_next_build_removes(tmp_path, c
     (tmp_path / "sleepy").mkdir()
     sleepy = tools(tmp_path / "sleepy")  # a make that hangs until killed (its dry run answers at once)
     (sleepy / "make").write_text('#!/bin/sh\nfor a in "$@"; do [ "$a" = -n ] && exit 0; done\nexec /bin/sleep 120\n')
-    sdist = fake_sdist(tmp_path, {f"{RECIPE.folder}/libretro/libretro.c": original_source()})
+    sdist = fake_sdist(tmp_path, original_sources())
     env = {**os.environ, "PATH": str(sleepy)}
     code = f"from retrokit.cli import main; main(['build-core', 'genesis_plus_gx', '--sdist', {str(sdist)!r}])"
     proc = subprocess.Popen([sys.executable, "-c", code], env=env, start_new_session=True,

@@ -14,7 +14,11 @@ SMALL = ["demo", "--levels", "Zone2.Act2", "--timesteps", "400", "--workers", "1
 def test_demo_evaluates_jerk_and_random_and_saves_the_report_plots_and_a_gif(tmp_path, capsys) -> None:
     out = tmp_path / "demo"
     assert main([*SMALL, "--out", str(out)]) == 0
-    printed = capsys.readouterr().out
+    captured = capsys.readouterr()
+    printed = captured.out
+    for agent in ("jerk", "random"):  # the speed line `retrokit evaluate` prints, on stderr, per agent
+        line = next(line for line in captured.err.splitlines() if line.startswith(f"{agent}: speed: "))
+        assert "env steps/s per level" in line and "the Sonic protocol" in line and "minutes" in line
     table = printed[printed.index("level "):]
     assert "jerk" in table and "random" in table and "aggregate" in table and "Dasher-Genesis/Zone2.Act2" in table
     for agent in ("jerk", "random"):

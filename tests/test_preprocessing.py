@@ -17,6 +17,7 @@ from gymnasium.wrappers import FrameStackObservation, GrayscaleObservation, Resi
 
 import retrokit
 from retrokit.envs import env as env_module
+from retrokit.envs import sonic
 from retrokit.errors import InvalidArgumentError, RetrokitError, UnknownNameError
 from retrokit.host.cores import built_core
 
@@ -128,10 +129,80 @@ def test_native_preprocessing_equals_gymnasiums_wrappers(config: str) -> None:
     ref.close()
 
 
-def test_a_vector_env_gets_the_same_preprocessed_observations_as_single_envs() -> None:
+class FrameButtons:
+    """A stepper observer: player 1's buttons on every frame the env ran, sticky draws included."""
+
+    def __init__(self) -> None:
+        self.masks: list[int] = []
+
+    def frames(self, first: tuple[int, ...], applied: tuple[int, ...], count: int) -> None:
+        self.masks += [first[0]] + [applied[0]] * (count - 1)
+
+
+class PooledFrames(gymnasium.Wrapper):
+    """MaxAndSkip's pool over given frames: a step is a list of per-frame button arrays, run until the scenario
+    ends the episode; the observation is the max of the last two frames run."""
+
+    def step(self, frames):
+        seen, total = [], 0.0
+        for buttons in frames:
+            obs, reward, terminated, truncated, info = self.env.step(buttons)
+            seen.append(obs)
+            total += reward
+            if terminated or truncated:
+                break
+        obs = np.maximum(seen[-2], seen[-1]) if len(seen) > 1 else seen[-1]
+        return obs, total, terminated, truncated, {**info, "frames": len(seen)}
+
+
+# Ends the episode on the frame player 1 gets 24 pixels right of the start, which is most often not a step's last.
+REACH = {"reward": "p1_x", "done": "p1_x > initial(p1_x) + 24"}
+
+
+def test_max_pool_with_the_sonic_presets_rules_equals_gymnasiums_wrappers_over_frames_run_one_by_one() -> None:
+    """The preset's rules (sticky frame skip 4, scenario every frame) and the RL preprocessing, on Dasher.
+
+    The reference runs the very frames the env ran (its sticky draws included), one env step each, in
+    Gymnasium's wrappers; where the scenario ends an episode inside a step, both end there, and the
+    observation is the max of the frame that ended it and the one before.
+    """
+    options = {"grayscale": True, "resize": (84, 84), "frame_stack": 4, "max_pool": True}
+    native = sonic.Discretizer(
+        retrokit.make(DASHER, "Zone1.Act1", REACH, **sonic.RULES, **options, action_type="all"), sonic.ACTIONS
+    )
+    frame_env = retrokit.make(DASHER, "Zone1.Act1", REACH, frameskip=1, sticky_prob=0.0, action_type="all")
+    ref = FrameStackObservation(ResizeObservation(PooledFrames(GrayscaleObservation(frame_env, keep_dim=True)), (84, 84)), 4)
+    buttons = FrameButtons()
+    base = native.unwrapped
+    base.stepper.observers.append(buttons)
+    width = base.actions.num_buttons
+    obs, _ = native.reset(seed=1)
+    expected, _ = ref.reset(seed=1)
+    native.action_space.seed(1)
+    ends_inside_a_step = episodes = 0
+    for step in range(700):
+        diff = np.abs(obs.astype(int) - as_native(expected, False).astype(int))
+        assert diff.max() <= 1, f"step {step} differs by {diff.max()} at {np.argwhere(diff > 1)[:4]}"
+        buttons.masks.clear()
+        obs, reward, terminated, truncated, _ = native.step(native.action_space.sample())
+        frames = [((mask >> np.arange(width)) & 1).astype(np.int8) for mask in buttons.masks]
+        expected, ref_reward, ref_terminated, ref_truncated, info = ref.step(frames)
+        assert (reward, terminated, info["frames"]) == (ref_reward, ref_terminated, len(frames))
+        if terminated:
+            episodes += 1
+            ends_inside_a_step += len(frames) < sonic.FRAMESKIP
+            obs, _ = native.reset()
+            expected, _ = ref.reset()
+    assert episodes >= 2 and ends_inside_a_step >= 1, (episodes, ends_inside_a_step)
+    native.close()
+    ref.close()
+
+
+@pytest.mark.parametrize("every_frame", [False, True], ids=["scenario-once-a-step", "scenario-every-frame"])
+def test_a_vector_env_gets_the_same_preprocessed_observations_as_single_envs(every_frame: bool) -> None:
     """Through autoresets too (max_episode_steps ends episodes): each episode's stack starts anew."""
     options = {"frameskip": SKIP, "sticky_prob": 0.25, "grayscale": True, "resize": (84, 84), "frame_stack": 4,
-               "max_pool": True, "noop_max": 5, "max_episode_steps": 20}  # fmt: skip
+               "max_pool": True, "noop_max": 5, "max_episode_steps": 20, "scenario_every_frame": every_frame}  # fmt: skip
     vec = retrokit.make_vec(DASHER, 2, **options)
     singles = [retrokit.make(DASHER, **options) for _ in range(2)]
     assert vec.single_observation_space == singles[0].observation_space
@@ -200,7 +271,6 @@ HOSTILE = {
     "frame-stack-float": {"frame_stack": 4.0},
     "observation-too-large": {"resize": (4096, 4096), "frame_stack": 64},
     "channels-first-none": {"channels_first": None},
-    "max-pool-every-frame": {"max_pool": True, "scenario_every_frame": True},
     "preprocessing-ram": {"grayscale": True, "obs_type": "ram"},
     "noop-max-negative": {"noop_max": -1},
     "noop-max-huge": {"noop_max": 10**9},

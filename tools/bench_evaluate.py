@@ -26,6 +26,10 @@ Each round runs every configuration once; the order flips from one round to
 the next, so both sides of a ratio saw the same machine. The medians over
 the rounds are reported. A loaded machine lowers every rate; compare ratios.
 
+Last, a level's worker start: the seconds from starting the evaluator's own
+worker process to its message that the env is made and the agent called,
+against a spawned process that does nothing, in the same run.
+
 Usage: python tools/bench_evaluate.py [--timesteps 10000] [--rounds 1] [--agent jerk] [--levels test]
 """
 
@@ -114,6 +118,37 @@ def evaluation_run(levels: list[str], workers: int, timesteps: int, agent: str) 
     return speed.level_rate, speed.steps / wall
 
 
+def nothing() -> None:
+    """A spawned process that does nothing: the baseline of a worker's start."""
+
+
+def worker_start(level: str) -> tuple[float, float]:
+    """Seconds from starting a level's worker process (the evaluator's own, spawned) to its Started message,
+    when its env is made and its agent is called; and the same for a spawned process that does nothing."""
+    from retrokit.benchmark import local
+    from retrokit.benchmark.definition import load_benchmark
+    from retrokit.benchmark.level import LevelTask, Started
+
+    context = multiprocessing.get_context("spawn")
+    benchmark = load_benchmark("dasher")
+    task = LevelTask(benchmark, benchmark.select(level)[0], "random", 10**9, 0)
+    reader, writer = context.Pipe(duplex=False)
+    began = time.perf_counter()
+    process = context.Process(target=local._work, args=(task, writer, os.getpid()), daemon=True)
+    process.start()
+    writer.close()
+    while not isinstance(reader.recv(), Started):
+        pass
+    started = time.perf_counter() - began
+    process.kill()
+    process.join()
+    began = time.perf_counter()
+    process = context.Process(target=nothing)
+    process.start()
+    process.join()
+    return started, time.perf_counter() - began
+
+
 def main() -> None:
     from retrokit.benchmark.definition import load_benchmark
     from retrokit.benchmark.speed import SONIC_BUDGET, SONIC_LEVELS, busy_workers, ceiling_minutes, protocol_minutes
@@ -160,6 +195,10 @@ def main() -> None:
           f"plays one level alone): about {protocol_minutes(median('eval', 2, 0), busy, TARGET_CORES):,.0f} minutes")
     print(f"machine's ceiling: bare env {median('bare', 1, 0):,.0f} steps/s x {cores} usable core(s) = "
           f"{ceiling_rate:,.0f} steps/s, the protocol in {ceiling_minutes(median('bare', 1, 0), cores):,.0f} minutes")
+    starts = [worker_start(levels[0]) for _ in range(5)]
+    level_start, empty_start = statistics.median(s for s, _ in starts), statistics.median(e for _, e in starts)
+    print(f"a level's worker start (spawned, imports, env made, agent called; median of 5): {level_start * 1000:,.0f} ms, "
+          f"against {empty_start * 1000:,.0f} ms for a spawned process that does nothing ({level_start / empty_start:.1f}x)")
 
 
 if __name__ == "__main__":

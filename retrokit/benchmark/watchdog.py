@@ -15,8 +15,10 @@ finished is kept, and ``--resume`` plays the level again.
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING
 
-from retrokit.benchmark.level import Message, Progress, Started
+if TYPE_CHECKING:  # the level runner imports Gymnasium: `retrokit evaluate --help` needs only the default below
+    from retrokit.benchmark.level import Message
 
 #: The default stall timeout, in seconds: far above a step of any agent that learns as it plays.
 DEFAULT_STALL_SECONDS = 600.0
@@ -46,6 +48,8 @@ class Watchdog:
 
     def see(self, message: Message) -> None:
         """Note a level's message: a start resets its clock, and so does a grown count of timesteps."""
+        from retrokit.benchmark.level import Progress, Started
+
         if isinstance(message, Started):
             self._seen[message.level] = (0, time.monotonic(), self.timeout)
         elif isinstance(message, Progress) and message.level in self._seen \

@@ -5,9 +5,12 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from retrokit import paths
-from retrokit.data.games import Game
+
+if TYPE_CHECKING:  # every command's register() imports this module: --help must not read the games
+    from retrokit.data.games import Game
 
 
 def rom_status(game: Game, data_dir: str | os.PathLike[str] | None = None) -> tuple[str, Path | None]:

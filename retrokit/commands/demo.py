@@ -62,15 +62,18 @@ def run(args: argparse.Namespace) -> int:
     from retrokit.benchmark.comparison import agent_folders, compare
     from retrokit.benchmark.definition import load_benchmark
     from retrokit.benchmark.evaluation import Evaluation, level_file_name
-    from retrokit.commands.evaluate import print_table
+    from retrokit.commands.evaluate import print_speed, print_table
 
     benchmark = load_benchmark("dasher")
     levels = benchmark.select(args.levels)
     out = free_folder(args.out)
 
+    made: list[Evaluation] = []
+
     def make(agent: str, folder: Path) -> Evaluation:
-        return Evaluation(benchmark=benchmark, levels=levels, agent=agent, out=folder, budget=args.timesteps,
-                          seed=args.seed, workers=args.workers, gif=agent == "jerk", progress=not args.no_progress)
+        made.append(Evaluation(benchmark=benchmark, levels=levels, agent=agent, out=folder, budget=args.timesteps,
+                               seed=args.seed, workers=args.workers, gif=agent == "jerk", progress=not args.no_progress))
+        return made[-1]
 
     summaries = compare(make, list(AGENTS), out, announce=print)
     print_table(summaries)
@@ -86,6 +89,7 @@ def run(args: argparse.Namespace) -> int:
         shutil.copyfile(gif, out / "jerk-best.gif")
         written.append(f"{out / 'jerk-best.gif'} (JERK's best episode, on {best})")
     print("wrote " + "\n      ".join(written))
+    print_speed(made)  # as `retrokit evaluate` prints it: each agent's speed
     return 0
 
 

@@ -71,7 +71,6 @@ def run(args: argparse.Namespace) -> int:
     from retrokit.benchmark.comparison import compare
     from retrokit.benchmark.definition import load_benchmark
     from retrokit.benchmark.evaluation import Evaluation, evaluate
-    from retrokit.benchmark.speed import estimate_line
     from retrokit.errors import InvalidArgumentError
 
     benchmark = load_benchmark(args.benchmark)
@@ -107,12 +106,19 @@ def run(args: argparse.Namespace) -> int:
     print(f"wrote {args.out}/: " + ("episodes.jsonl, summary.json, summary.csv, report.md, learning-curves.png, "
                                     "scores.png" if len(agents) == 1 else
                                     "report.md, scores.png, and a run folder per agent"))
+    print_speed(made)
+    return 0
+
+
+def print_speed(made: list) -> None:  # retrokit.benchmark.evaluation.Evaluation
+    """Print each evaluation's speed and the Sonic protocol's estimated time, named by agent if several."""
+    from retrokit.benchmark.speed import estimate_line
+
     for evaluation in made:  # on stderr, beside the progress: stdout is the results, the same on every machine
         speed = evaluation.speed()
         if speed is not None:
-            line = estimate_line(speed, sonic=benchmark.name == "sonic")
+            line = estimate_line(speed, sonic=evaluation.benchmark.name == "sonic")
             print(("" if len(made) == 1 else f"{evaluation.agent}: ") + line, file=sys.stderr)
-    return 0
 
 
 def print_table(summaries: dict) -> None:  # agent -> retrokit.benchmark.scores.Summary

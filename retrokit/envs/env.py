@@ -148,9 +148,7 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         known_screen = get_system(self.game.system).screen
         self.preprocessing: Preprocessing | None = None
         if known_screen is not None:  # checked before any core is loaded
-            self.preprocessing = preprocessing(
-                observation, known_screen, obs_type=obs_type, every_frame=scenario_every_frame, scenario_crop=self._crop
-            )
+            self.preprocessing = preprocessing(observation, known_screen, obs_type=obs_type, scenario_crop=self._crop)
         self.emulator = Emulator(self.game.system, setup.rom, options=options, ports=max(players, 2))
         self.reader = FieldReader(self.game.fields, self.emulator.space)
         rate = self.emulator.system.frame_rate(self.emulator.av_info()["fps"])  # the core says NTSC or PAL
@@ -170,8 +168,7 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         check_crop(self._crop, self._screen_shape)
         if known_screen is None:
             self.preprocessing = preprocessing(
-                observation, self._screen_shape, obs_type=obs_type, every_frame=scenario_every_frame,
-                scenario_crop=self._crop,
+                observation, self._screen_shape, obs_type=obs_type, scenario_crop=self._crop
             )
         if self.preprocessing is not None:
             self.emulator.set_preprocess(self.preprocessing.native())

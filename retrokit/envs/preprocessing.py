@@ -12,7 +12,9 @@ The steps, in this order, each optional:
 1. ``crop=(top, bottom, left, right)``: pixels cut off each edge of the screen;
 2. ``grayscale``: Gymnasium's ``GrayscaleObservation`` luma, truncated to uint8;
 3. ``max_pool``: the pixel-wise max of a step's last two frames (as Atari's
-   ``MaxAndSkip``); with the patched core only those two are drawn;
+   ``MaxAndSkip``); with the patched core only those two are drawn. With
+   ``scenario_every_frame=True`` (the Sonic preset) too: a step that the
+   scenario ends early maxes the frame that ended it with the one before;
 4. ``resize=(height, width)`` with ``resize_method`` ``"area"`` (OpenCV's
    INTER_AREA, what ``ResizeObservation`` uses), ``"bilinear"`` or ``"nearest"``;
 5. ``frame_stack=N``: the last N frames, oldest first, along the channel axis,
@@ -111,7 +113,6 @@ def preprocessing(
     screen: tuple[int, int],
     *,
     obs_type: str,
-    every_frame: bool,
     scenario_crop: object,
 ) -> Preprocessing | None:
     """The preprocessing that checked options (``envs/options.py``) ask of a screen, or ``None`` for plain RGB.
@@ -120,7 +121,6 @@ def preprocessing(
         options: The observation options (:data:`OBSERVATION_OPTIONS`), checked one by one already.
         screen: The screen's ``(height, width)``.
         obs_type: The env's ``obs_type``; preprocessing needs ``"rgb"``.
-        every_frame: Whether the scenario runs every frame (then a step's frames run one call each).
         scenario_crop: The scenario's own ``crop``, if it has one.
 
     Raises:
@@ -138,11 +138,6 @@ def preprocessing(
         raise InvalidArgumentError(
             f"Expected either the scenario's crop or make()'s {asked}, got both; remove 'crop' from the scenario "
             "and pass crop=(top, bottom, left, right) to make() instead."
-        )
-    if given["max_pool"] and every_frame:
-        raise InvalidArgumentError(
-            "Expected max_pool without scenario_every_frame=True (the step's frames then run one call each, so "
-            "the next-to-last is not kept); pass one or the other."
         )
     height, width = screen
     crop = given["crop"] or (0, 0, 0, 0)

@@ -38,6 +38,14 @@ ACTIONS_WITH_NOOP = ((),) + ACTIONS
 FRAMESKIP = 4
 STICKY_PROB = 0.25
 MAX_EPISODE_STEPS = 4500
+#: The benchmark's rules, as ``make()`` options: what :func:`make` gives every level (its options may
+#: add to them, e.g. ``grayscale=True, resize=(84, 84), frame_stack=4, max_pool=True``).
+RULES = {
+    "frameskip": FRAMESKIP,
+    "sticky_prob": STICKY_PROB,
+    "max_episode_steps": MAX_EPISODE_STEPS,
+    "scenario_every_frame": True,
+}
 
 
 class Discretizer(gymnasium.ActionWrapper):
@@ -111,14 +119,7 @@ def make(
     states = find_game(game).states
     if state not in states:
         raise StateNotFoundError(f"Expected a level of {game} ({', '.join(sorted(states))}), got {state!r}." + did_you_mean(state, states))
-    settings = {
-        "frameskip": FRAMESKIP,
-        "sticky_prob": STICKY_PROB,
-        "max_episode_steps": MAX_EPISODE_STEPS,
-        "scenario_every_frame": True,
-        **options,
-        "action_type": "all",
-    }
+    settings = {**RULES, **options, "action_type": "all"}
     env: gymnasium.Env = RetroEnv(game, state, scenario, **check_options(settings))
     env = Discretizer(env, ACTIONS_WITH_NOOP if noop else ACTIONS)
     if allow_backtracking:

@@ -110,9 +110,9 @@ class Stepper:
         return self._left > 0
 
     @property
-    def final(self) -> bool:
-        """Whether the next frames are the step's last (unless the episode ends before)."""
-        return self._left == self._chunk
+    def after(self) -> int:
+        """Frames of the step planned after the next ones: 0 when they are its last (unless the episode ends before)."""
+        return self._left - self._chunk
 
     def prepare(self) -> int:
         """Before the step's next frames run: return how many to run (0 once the step is over)."""
@@ -192,15 +192,16 @@ def step_alone(stepper: Stepper, emulator: Emulator, action: Any, out: np.ndarra
     stepper.begin(action)
     run = emulator.run
 
-    def frames(live: list[int], count: int, last: bool) -> tuple[bool | None]:
-        return (run(stepper.masks, count, out if last else None),)
+    def frames(live: list[int], count: int, after: int) -> tuple[bool | None]:
+        return (run(stepper.masks, count, None if after else out, after),)
 
     return drive((stepper,), frames)[0]
 
 
-#: ``run(live, frames, last)``: run ``frames`` frames of the steppers at indices ``live``,
-#: converting their screens if ``last``; return, per index, whether its screen was converted.
-RunFrames = Callable[[list[int], int, bool], Sequence[Any]]
+#: ``run(live, frames, after)``: run ``frames`` frames of the steppers at indices ``live``, ``after`` more
+#: of the step planned past them, converting their screens if ``after`` is 0 (the step's last frames);
+#: return, per index, whether its screen was converted.
+RunFrames = Callable[[list[int], int, int], Sequence[Any]]
 
 
 def drive(steppers: Sequence[Stepper], run: RunFrames) -> list[bool]:
@@ -219,8 +220,9 @@ def drive(steppers: Sequence[Stepper], run: RunFrames) -> list[bool]:
         frames = 0
         for i in live:
             frames = steppers[i].prepare()
-        last = steppers[live[0]].final
-        done = run(live, frames, last)
+        after = steppers[live[0]].after
+        last = after == 0
+        done = run(live, frames, after)
         for k, i in enumerate(live):
             steppers[i].ran()
             if last:

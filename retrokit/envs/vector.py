@@ -319,11 +319,11 @@ class ThreadedVectorEnv(PicklesAsArguments, VectorEnv):
         steppers = [self._steppers[i] for i in stepping]
         screens = [views[i] for i in stepping] if self._direct_screens else None
 
-        def frames(live: list[int], count: int, last: bool) -> tuple[bool, ...]:
+        def frames(live: list[int], count: int, after: int) -> tuple[bool, ...]:
             envs_live = [stepping[k] for k in live]
             rows = self._actions if len(envs_live) == self.num_envs else self._actions[envs_live]
-            converted = screens is not None and last
-            return self._runner.run(envs_live, rows, count, [screens[k] for k in live] if converted else None)
+            converted = screens is not None and after == 0
+            return self._runner.run(envs_live, rows, count, [screens[k] for k in live] if converted else None, after)
 
         converted = drive(steppers, frames)
         finishing = self._steppings

@@ -180,7 +180,11 @@ class Emulator:
     # --- running ---------------------------------------------------------------------
 
     def run(
-        self, actions: Sequence[int] | np.ndarray | int = 0, frames: int = 1, screen: np.ndarray | None = None
+        self,
+        actions: Sequence[int] | np.ndarray | int = 0,
+        frames: int = 1,
+        screen: np.ndarray | None = None,
+        after: int = 0,
     ) -> bool | None:
         """Emulate frames holding one RetroPad button mask per port.
 
@@ -190,6 +194,9 @@ class Emulator:
             frames: How many frames to run.
             screen: A ``(H, W, 3)`` uint8 buffer to convert the last frame
                 into while it is still in cache, if the shapes match.
+            after: Frames of the same step that later calls will run (a
+                step run a frame at a time): with ``max_pool``, the frame
+                before the step's last is kept wherever it runs.
 
         Returns:
             With ``screen``, whether the frame was converted into it (its
@@ -197,7 +204,7 @@ class Emulator:
         """
         if type(actions) is not np.ndarray or actions.dtype != np.uint16:  # the exact type is the fast path
             actions = self._as_actions(actions)
-        return self._emu.run(actions, frames, screen)
+        return self._emu.run(actions, frames, screen, after)
 
     def _as_actions(self, actions: Sequence[int] | np.ndarray | int) -> np.ndarray:
         values = [actions] if isinstance(actions, (int, np.integer)) else list(np.asarray(actions).ravel())

@@ -8,7 +8,9 @@ nothing is written and the error names the hunk.
 
 Only what ``diff -u`` writes is understood: ``--- a/path``, ``+++ b/path``,
 ``@@ -l,n +l,n @@`` hunks of `` ``, ``-`` and ``+`` lines. Text before the
-first ``---`` (a description) is ignored.
+first ``---`` (a description) is ignored. Lines match whatever their ends
+(a patch kept with LF ends applies to a source file with CRLF ends), and
+the lines written end as the file's first line does.
 """
 
 from __future__ import annotations
@@ -85,11 +87,21 @@ def parse_patch(text: str, name: str = "the patch") -> list[FilePatch]:
     return files
 
 
+def _bare(lines: list[str]) -> list[str]:
+    """The lines without their line ends: a patch's lines end in LF whatever the file's (CRLF) end in."""
+    return [line.rstrip("\r\n") for line in lines]
+
+
 def _find(lines: list[str], old: list[str], near: int) -> int:
-    """The index where ``old`` occurs in ``lines``, the nearest to ``near``; -1 if nowhere."""
-    n = len(old)
-    starts = [s for s in range(len(lines) - n + 1) if lines[s : s + n] == old]
+    """The index where ``old`` occurs in ``lines`` (line ends aside), the nearest to ``near``; -1 if nowhere."""
+    n, bare, wanted = len(old), _bare(lines), _bare(old)
+    starts = [s for s in range(len(lines) - n + 1) if bare[s : s + n] == wanted]
     return min(starts, key=lambda s: abs(s - near)) if starts else -1
+
+
+def _with_ends(new: list[str], end: str) -> list[str]:
+    """A hunk's new lines ending as the file's do (a last line without an end keeps none)."""
+    return [line.rstrip("\r\n") + end if line.endswith("\n") else line for line in new]
 
 
 def apply_patch(text: str, tree: Path, name: str = "the patch") -> list[Path]:
@@ -107,6 +119,7 @@ def apply_patch(text: str, tree: Path, name: str = "the patch") -> list[Path]:
         if not path.is_file():
             raise PatchError(f"Expected {patch.path} in {tree} for {name}; found no such file.")
         lines = path.read_bytes().decode("latin-1").splitlines(keepends=True)  # bytes kept as they are
+        end = "\r\n" if lines and lines[0].endswith("\r\n") else "\n"
         shift = 0
         for number, hunk in enumerate(patch.hunks, 1):
             at = _find(lines, hunk.old, hunk.start - 1 + shift)
@@ -116,7 +129,7 @@ def apply_patch(text: str, tree: Path, name: str = "the patch") -> list[Path]:
                     f"found them nowhere, so this source is not the one the patch was made for. "
                     f"Build from the stable-retro version the patch names, or update the patch."
                 )
-            lines[at : at + len(hunk.old)] = hunk.new
+            lines[at : at + len(hunk.old)] = _with_ends(hunk.new, end)
             shift = at - (hunk.start - 1) + len(hunk.new) - len(hunk.old)
         results.append((path, "".join(lines)))
     for path, content in results:

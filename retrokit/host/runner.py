@@ -48,6 +48,7 @@ class Runner:
         actions: np.ndarray,
         frames: int,
         screens: Sequence[np.ndarray] | None = None,
+        after: int = 0,
     ) -> tuple[bool, ...]:
         """Run some of the emulators for ``frames`` frames, the GIL released.
 
@@ -57,6 +58,7 @@ class Runner:
             frames: Frames each runs.
             screens: One ``(H, W, 3)`` buffer per emulator run, to convert its
                 last frame into, or ``None``.
+            after: Frames of the same step that later calls will run (see :meth:`Emulator.run`).
 
         Returns:
             Per emulator run, whether its screen was converted (it fitted).
@@ -64,4 +66,4 @@ class Runner:
         if not which:
             return ()
         handles = self._handles
-        return self._native.run([handles[i] for i in which], actions, frames, screens)
+        return self._native.run([handles[i] for i in which], actions, frames, screens, after)

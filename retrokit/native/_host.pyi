@@ -65,9 +65,14 @@ class Emulator:
     def forget_action(self) -> None:
         """Make the next ``run`` apply its action from the first frame, as after a reset."""
     def run(
-        self, actions: npt.NDArray[np.uint16], frames: int, screen: npt.NDArray[np.uint8] | None = None
+        self,
+        actions: npt.NDArray[np.uint16],
+        frames: int,
+        screen: npt.NDArray[np.uint8] | None = None,
+        after: int = 0,
     ) -> bool | None:
-        """Run frames; with ``screen``, convert the last frame into it and return whether it fitted."""
+        """Run frames (``after`` more of the step follow in later calls); with ``screen``, convert the last
+        frame into it and return whether it fitted."""
     def screen_shape(self) -> tuple[int, int]: ...
     def screen(self, out: npt.NDArray[np.uint8]) -> None: ...
     def memory(self, kind: int) -> memoryview | None: ...
@@ -101,6 +106,7 @@ class Runner:
         actions: npt.NDArray[np.uint16],
         frames: int,
         screens: Sequence[npt.NDArray[np.uint8]] | None = None,
+        after: int = 0,
     ) -> tuple[bool, ...]:
         """Run every emulator's frames, the GIL released, on the calling thread and the workers.
 
@@ -108,7 +114,8 @@ class Runner:
         none is left. ``actions`` has one row of port masks per emulator. Each
         screen is converted into its buffer when its shape fits the frame (or,
         for an emulator with a preprocessing, its observation is made into it:
-        always); the result says, per emulator, whether it was.
+        always); the result says, per emulator, whether it was. ``after`` is
+        as :meth:`Emulator.run`'s.
         """
 
 def pack_buttons(

@@ -216,7 +216,7 @@ void rk_core_seed(rk_core *core, double prob, uint64_t seed) {
     for (int i = 0; i < 4; i++) core->rng[i] = splitmix64(&seed);
 }
 
-void rk_core_run(rk_core *core, const uint16_t *actions, int n_ports, int frames) {
+void rk_core_run(rk_core *core, const uint16_t *actions, int n_ports, int frames, int after) {
     uint16_t action[RK_MAX_PORTS] = {0};
     memcpy(action, actions, sizeof(uint16_t) * (size_t)n_ports);
     int stick = 0;
@@ -236,7 +236,10 @@ void rk_core_run(rk_core *core, const uint16_t *actions, int n_ports, int frames
                           (all || core->capture_audio) << 1;
         core->api.run();
         core->frame++;
-        if (keep && f == frames - 2) rk_prep_keep(core->prep, core); /* before the last frame overwrites it */
+        /* Keep the frame before the step's last, before the last overwrites it. A step run one frame a
+         * call keeps each of its frames but the planned last: if the scenario ends the episode early,
+         * the observation is the max of the frame that ended it and the one before, as MaxAndSkip's. */
+        if (keep && f == frames - (after > 0 ? 1 : 2)) rk_prep_keep(core->prep, core);
     }
     rk_leave();
     if (frames > 0) {

@@ -147,7 +147,10 @@ int rk_core_set_option(rk_core *core, const char *key, const char *value);
 /* Running: enter/leave set the calling thread's current core for the callbacks. */
 void rk_enter(rk_core *core);
 void rk_leave(void);
-void rk_core_run(rk_core *core, const uint16_t *actions, int n_ports, int frames);
+/* Run `frames` frames; `after` is how many frames of the same step the caller will run after these
+ * (one call per frame when a scenario is asked after every frame), so that with max_pool the frame
+ * before the step's last is kept wherever it runs. */
+void rk_core_run(rk_core *core, const uint16_t *actions, int n_ports, int frames, int after);
 void rk_core_seed(rk_core *core, double prob, uint64_t seed);
 /* Convert the last frame into an RGB buffer of height x width x 3, if the
  * frame has that size; returns whether it did. With a preprocessor, make the

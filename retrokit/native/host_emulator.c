@@ -234,12 +234,15 @@ static PyObject *emulator_forget_action(EmulatorObject *self, PyObject *unused) 
 }
 
 static PyObject *emulator_run(EmulatorObject *self, PyObject *const *args, Py_ssize_t nargs) {
-    if (nargs != 2 && nargs != 3)
-        return PyErr_Format(PyExc_TypeError, "run() takes (actions, frames[, screen]), got %zd arguments", nargs);
-    long frames = PyLong_AsLong(args[1]);
-    if (frames == -1 && PyErr_Occurred()) return NULL;
+    if (nargs < 2 || nargs > 4)
+        return PyErr_Format(PyExc_TypeError, "run() takes (actions, frames[, screen[, after]]), got %zd arguments",
+                            nargs);
+    long frames = PyLong_AsLong(args[1]), after = nargs == 4 ? PyLong_AsLong(args[3]) : 0;
+    if ((frames == -1 || after == -1) && PyErr_Occurred()) return NULL;
     if (frames < 0 || frames > INT_MAX) /* the core loop counts in an int: never wrap to 0 or a few frames */
         return PyErr_Format(InvalidArgumentError, "frames must be 0 or more and at most %d, got %ld", INT_MAX, frames);
+    if (after < 0 || after > INT_MAX)
+        return PyErr_Format(InvalidArgumentError, "after must be 0 or more and at most %d, got %ld", INT_MAX, after);
     Py_buffer buf, screen = {0};
     if (PyObject_GetBuffer(args[0], &buf, PyBUF_FORMAT | PyBUF_C_CONTIGUOUS) < 0) return NULL;
     const char *f = buf.format ? buf.format : "B";
@@ -251,13 +254,13 @@ static PyObject *emulator_run(EmulatorObject *self, PyObject *const *args, Py_ss
     uint16_t actions[RK_MAX_PORTS] = {0};
     memcpy(actions, buf.buf, (size_t)n * 2);
     PyBuffer_Release(&buf);
-    int want_screen = nargs == 3 && args[2] != Py_None;
+    int want_screen = nargs >= 3 && args[2] != Py_None;
     if (want_screen && rk_py_get_obs(self, args[2], &screen)) return NULL;
     if (rk_py_enter(self, 1)) return rk_py_release(&screen, NULL);
     int converted = 0;
     rk_core *c = &self->core;
     Py_BEGIN_ALLOW_THREADS
-    rk_core_run(c, actions, c->n_ports, (int)frames);
+    rk_core_run(c, actions, c->n_ports, (int)frames, (int)after);
     /* Convert while the frame is still in the cache, if it fits the buffer. */
     if (want_screen)
         converted = rk_core_screen_into(c, screen.buf, screen.ndim == 3 ? (unsigned)screen.shape[1] : 0,
@@ -425,6 +428,9 @@ static PyObject *emulator_serialize(EmulatorObject *self, PyObject *unused) {
     bool ok = false;
     if (out) {
         Py_BEGIN_ALLOW_THREADS
+        /* A core may write less than its size (Genesis Plus GX: a quarter): the rest is zeros, not whatever
+         * the allocator left there, so that a state's bytes depend on the game alone. */
+        memset(dst, 0, size);
         rk_enter(&self->core);
         ok = self->core.api.serialize(dst, size);
         rk_leave();
@@ -481,7 +487,8 @@ static PyMethodDef emulator_methods[] = {
     {"forget_action", (PyCFunction)emulator_forget_action, METH_NOARGS, "Apply the next action from its first frame."},
     {"held", (PyCFunction)emulator_held, METH_NOARGS, "The buttons of the last frame run, one mask per port."},
     {"run", (PyCFunction)(void (*)(void))emulator_run, METH_FASTCALL,
-     "run(actions, frames[, screen]): run frames; convert the last into screen and say if it fitted."},
+     "run(actions, frames[, screen[, after]]): run frames (`after` more of the step follow); convert the last "
+     "into screen and say if it fitted."},
     {"reset", (PyCFunction)emulator_reset, METH_NOARGS, "Hard-reset the console."},
     {"screen_shape", (PyCFunction)emulator_screen_shape, METH_NOARGS, "(height, width) of the last frame."},
     {"screen", (PyCFunction)emulator_screen, METH_O, "Write the last frame as RGB into a uint8 array."},

@@ -41,11 +41,12 @@ static void runner_dealloc(RunnerObject *self) {
 
 static PyObject *runner_run(RunnerObject *self, PyObject *args) {
     PyObject *emus, *actions_obj, *screens = Py_None;
-    int frames;
-    if (!PyArg_ParseTuple(args, "OOi|O", &emus, &actions_obj, &frames, &screens)) return NULL;
+    int frames, after = 0;
+    if (!PyArg_ParseTuple(args, "OOi|Oi", &emus, &actions_obj, &frames, &screens, &after)) return NULL;
     if (self->pid != getpid())
         return PyErr_Format(CoreError, "this runner was made in another process; make a new one after fork");
     if (frames < 0) return PyErr_Format(InvalidArgumentError, "frames must be 0 or more, got %d", frames);
+    if (after < 0) return PyErr_Format(InvalidArgumentError, "after must be 0 or more, got %d", after);
     int expected = 0, ports = 0;
     if (!atomic_compare_exchange_strong(&self->busy, &expected, 1))
         return PyErr_Format(CoreError, "this runner is running in another thread; use one runner per thread");
@@ -80,6 +81,7 @@ static PyObject *runner_run(RunnerObject *self, PyObject *args) {
         claimed++;
         tasks[i].core = &emu->core;
         tasks[i].frames = frames;
+        tasks[i].after = after;
     }
     RK_CHECK(actions.itemsize == 2 && actions.ndim == 2 && actions.shape[0] == n && actions.shape[1] == ports,
              InvalidArgumentError, "actions must be a uint16 array of shape (%zd, %d): one mask per port per emulator",
@@ -114,7 +116,7 @@ static PyGetSetDef runner_getset[] = {
 
 static PyMethodDef runner_methods[] = {
     {"run", (PyCFunction)runner_run, METH_VARARGS,
-     "run(emulators, actions, frames, screens=None): run them all; return whether each screen was converted."},
+     "run(emulators, actions, frames, screens=None, after=0): run them all; return whether each screen was converted."},
     {NULL, NULL, 0, NULL},
 };
 

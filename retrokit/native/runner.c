@@ -89,7 +89,7 @@ static void take_tasks(rk_runner *r, uint32_t call, rk_worker *w) {
         rk_task *task = &r->tasks[(uint32_t)work - 1]; /* the call cannot end while one of its tasks runs */
         int n = r->n_tasks;                            /* (so this is still the call's) */
         if (w) atomic_store(&w->working, 1);
-        rk_core_run(task->core, task->actions, task->core->n_ports, task->frames);
+        rk_core_run(task->core, task->actions, task->core->n_ports, task->frames, task->after);
         task->converted =
             task->screen && rk_core_screen_into(task->core, task->screen, task->screen_width, task->screen_height);
         if (w) atomic_store(&w->working, 0);

@@ -13,7 +13,7 @@
 typedef struct {
     rk_core *core;
     const uint16_t *actions; /* one mask per port */
-    int frames;
+    int frames, after;       /* frames to run, and frames of the step after them (rk_core_run) */
     uint8_t *screen;         /* where to put the RGB frame, or NULL */
     unsigned screen_width, screen_height;
     int converted;           /* set: whether the frame fitted and was converted */

@@ -16,13 +16,30 @@ See ``docs/ramsearch.md``.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from retrokit.lazy import lazy_names
-from retrokit.ramsearch.candidates import Candidate, group_candidates, list_groups
-from retrokit.ramsearch.filters import OPS
-from retrokit.ramsearch.search import RamSearch
-from retrokit.ramsearch.session import DEFAULT_SESSION
-from retrokit.ramsearch.types import SEARCH_TYPES
 
 __all__ = ["DEFAULT_SESSION", "OPS", "SEARCH_TYPES", "Candidate", "RamSearch", "group_candidates", "list_groups"]
 
-__getattr__ = lazy_names(__name__)  # its submodules, on first use: retrokit.ramsearch.<module>
+if TYPE_CHECKING:
+    from retrokit.ramsearch.candidates import Candidate, group_candidates, list_groups
+    from retrokit.ramsearch.filters import OPS
+    from retrokit.ramsearch.search import RamSearch
+    from retrokit.ramsearch.session import DEFAULT_SESSION
+    from retrokit.ramsearch.types import SEARCH_TYPES
+
+# Its names and submodules, on first use, so that `retrokit ramsearch --help` (which imports .filters) does
+# not import the search, numpy and the emulator.
+__getattr__ = lazy_names(
+    __name__,
+    {
+        "Candidate": "retrokit.ramsearch.candidates",
+        "group_candidates": "retrokit.ramsearch.candidates",
+        "list_groups": "retrokit.ramsearch.candidates",
+        "OPS": "retrokit.ramsearch.filters",
+        "RamSearch": "retrokit.ramsearch.search",
+        "DEFAULT_SESSION": "retrokit.ramsearch.session",
+        "SEARCH_TYPES": "retrokit.ramsearch.types",
+    },
+)

@@ -13,14 +13,18 @@ parts fit together; :mod:`retrokit.ramsearch.engine` runs them.
 
 from __future__ import annotations
 
+import numbers
 import operator
 from collections.abc import Callable
 from dataclasses import dataclass
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from retrokit.errors import InvalidArgumentError, did_you_mean, shown
-from retrokit.ramsearch.ram import RamLayout
+
+if TYPE_CHECKING:  # `retrokit ramsearch --help` names the operations: it must not import numpy for them
+    import numpy as np
+
+    from retrokit.ramsearch.ram import RamLayout
 
 COMPARISONS: dict[str, Callable[[np.ndarray, object], np.ndarray]] = {
     "equal": operator.eq,
@@ -85,7 +89,7 @@ class Filter:
 
 
 def _is_int(value: object) -> bool:
-    return isinstance(value, (int, np.integer)) and not isinstance(value, bool)
+    return isinstance(value, numbers.Integral) and not isinstance(value, bool)  # numpy's integers are Integral
 
 
 def check_filter(op: str, value: int | None = None, than: str | int | None = None) -> Filter:

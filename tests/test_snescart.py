@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from cartgame import ABSENT, ALIVE, DYING, OUT, CartGame, game_fields, lose_every_life, run_into_goal, start_selected
 
+from retrokit.data.roms import guess_system
 from retrokit.host.systems import get_system
 
 REPO = Path(__file__).resolve().parent.parent
@@ -24,7 +25,8 @@ ROM = GAME_DIR / "rom.sfc"
 RAM_INC = REPO / "tools" / "snescart" / "src" / "ram.inc"
 FIELDS = game_fields(GAME_DIR)
 WRAM = 0x7E0000
-FIRST_PIT = (352, 376)  # level 1's first pit: columns 44-46, past where 240 frames of test_systems' wandering inputs reach
+# Level 1's first pit, columns 44-46: past where 240 frames of test_systems' wandering inputs reach.
+FIRST_PIT = (352, 376)
 JUMP_BUTTONS = ["B", "Y", "A", "X"]
 
 
@@ -54,6 +56,8 @@ def test_lorom_header_checksum_and_vectors() -> None:
     assert sum(rom) & 0xFFFF == checksum
     reset = int.from_bytes(rom[0x7FFC:0x7FFE], "little")
     assert 0x8000 <= reset < 0xFFC0
+    system, how = guess_system(rom, "skipper.bin")  # the Snes descriptor's detect rule, not the extension
+    assert (system.name if system else None, how) == ("Snes", "header")
 
 
 def test_game_yaml_addresses_match_ram_inc() -> None:

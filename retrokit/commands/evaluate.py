@@ -47,7 +47,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         epilog=AGENT_NOTE,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("--benchmark", default="dasher", help="sonic, dasher, trekker, trekker-color (the cartridges' benchmarks), or a benchmark YAML file (default: dasher)")
+    parser.add_argument("--benchmark", default="dasher", help="sonic, dasher, or another cartridge's benchmark (hopper-nes, hopper-sms, hopper-gg, trekker, trekker-color, skipper-pce, skipper-snes: tools/cartridges.yaml), or a benchmark YAML file (default: dasher)")
     parser.add_argument("--agent", action="append", default=None, metavar="AGENT",
                         help="random, jerk, or MODULE:CALLABLE; repeat it to compare agents (default: jerk)")
     add_evaluation_options(parser, "processes (or Ray CPUs) sharing the levels (default: up to 2)")

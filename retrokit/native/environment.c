@@ -203,6 +203,10 @@ static void set_memory_maps(rk_core *core, const struct rk_retro_memory_map *map
         m->select = d->select;
         m->disconnect = d->disconnect;
         m->len = d->len;
+        /* A descriptor may leave len 0 and give its size by the address bits select
+         * decodes (snes9x's work RAM: 0x7E0000, select 0xFE0000, 128 KiB); size it from
+         * them as Gym Retro does, or the RAM gets no view and no console address finds it. */
+        if (!m->len && d->select) m->len = ((~d->select & ~d->start) + 1) & d->select;
         snprintf(m->addrspace, sizeof m->addrspace, "%s", d->addrspace ? d->addrspace : "");
     }
 }

@@ -48,10 +48,14 @@ class StudioProcess:
     def request(
         self, method: str, route: str, body: Any = None, headers: dict[str, str] | None = None
     ) -> tuple[int, Any, dict[str, str]]:
-        """Send a request as the page's scripts do (the token header, a JSON body); return status, JSON, headers."""
+        """Send a request as the page's scripts do (the token header, a JSON body); return status, JSON, headers.
+
+        ``headers`` are added to those, or replace them (a value of ``None`` leaves that header out).
+        """
         data = None if body is None else json.dumps(body).encode()
         sent = {TOKEN_HEADER: self.token, **({"Content-Type": "application/json"} if data is not None else {})}
         sent.update(headers or {})
+        sent = {name: value for name, value in sent.items() if value is not None}  # None: leave that header out
         req = urllib.request.Request(self.origin + route, data=data, method=method, headers=sent)
         try:
             with urllib.request.urlopen(req, timeout=120) as answer:

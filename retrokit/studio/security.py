@@ -78,17 +78,22 @@ class Guard:
         headers = {k.decode("latin-1").lower(): v.decode("latin-1") for k, v in scope.get("headers", [])}
         problem = self._problem(scope, headers)
         if problem:
-            await _refuse(scope, receive, send, 403, problem, "AccessDeniedError")
+            sending = send if scope["type"] == "websocket" else self._with_headers(send, cookie=False)
+            await _refuse(scope, receive, sending, 403, problem, "AccessDeniedError")
             return
         if scope["type"] == "websocket":
             await self.app(scope, receive, send)
+            return
+        send = self._with_headers(send, cookie=_query_token(scope) is not None)
+        problem = _forged(scope["method"], headers, self.port)
+        if problem:
+            await _refuse(scope, receive, send, 403, problem, "AccessDeniedError")
             return
         length = headers.get("content-length", "0")
         if not length.isdigit() or int(length) > MAX_BODY:
             await _refuse(scope, receive, send, 413, _too_large(length), "RequestTooLargeError")
             return
-        query_token = _query_token(scope)
-        await self.app(scope, _capped(receive), self._with_cookie(send) if query_token else send)
+        await self.app(scope, _capped(receive), send)
 
     def _problem(self, scope: Scope, headers: dict[str, str]) -> str:
         host = headers.get("host", "")
@@ -109,15 +114,72 @@ class Guard:
             )
         return ""
 
-    def _with_cookie(self, send: Send) -> Send:
-        cookie = f"{cookie_name(self.port)}={self.token}; Path=/; HttpOnly; SameSite=Strict".encode()
+    def _with_headers(self, send: Send, *, cookie: bool) -> Send:
+        """``send`` adding the security headers to every response, and the token cookie if ``cookie``."""
+        added = [(name.encode(), value.encode()) for name, value in security_headers(self.port).items()]
+        if cookie:
+            added.append((b"set-cookie", f"{cookie_name(self.port)}={self.token}; Path=/; HttpOnly; SameSite=Strict".encode()))
 
         async def sending(message: Message) -> None:
             if message["type"] == "http.response.start":
-                message = {**message, "headers": [*message.get("headers", []), (b"set-cookie", cookie)]}
+                message = {**message, "headers": [*message.get("headers", []), *added]}
             await send(message)
 
         return sending
+
+
+def security_headers(port: int) -> dict[str, str]:
+    """The headers on every HTTP response: no framing, no sniffing, no referrer, no cache; scripts only from the studio."""
+    sockets = " ".join(f"ws://{host}:{port}" for host in _HOSTS)
+    return {
+        "Content-Security-Policy": (
+            "default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; img-src 'self' data: blob:; "
+            f"connect-src 'self' {sockets}; object-src 'none'; base-uri 'none'; form-action 'self'; "
+            "frame-ancestors 'none'"
+        ),
+        "X-Content-Type-Options": "nosniff",
+        "Referrer-Policy": "no-referrer",
+        "Cache-Control": "no-store",
+        "X-Frame-Options": "DENY",  # frame-ancestors' older twin, for browsers without CSP level 2
+    }
+
+
+SAFE_METHODS = ("GET", "HEAD")
+"""Methods that change nothing: every other request must show it comes from the studio's own page."""
+
+
+def _forged(method: str, headers: dict[str, str], port: int) -> str:
+    """Why a state-changing request may come from another page (a forged one), or ``""``.
+
+    Another page on 127.0.0.1 (another port: the same *site*, so the browser
+    sends the token cookie) can post a form or a no-cors ``fetch``. Such a
+    request says where it comes from (``Sec-Fetch-Site``, ``Origin``), and it
+    can carry neither a custom header nor ``Content-Type: application/json``
+    without a CORS preflight, which the studio never grants. The page's
+    scripts send both.
+    """
+    if method in SAFE_METHODS:
+        return ""
+    site = headers.get("sec-fetch-site")
+    if site is not None and site not in ("same-origin", "none"):
+        return (
+            f"Expected a request from the studio's own page; found one from another page (Sec-Fetch-Site {shown(site)}). "
+            "Use the studio's page, or send the request without a browser."
+        )
+    origin = headers.get("origin")
+    if origin is not None and origin not in allowed_origins(port):
+        return (
+            f"Expected a request from the studio's page ({' or '.join(allowed_origins(port))}); found Origin "
+            f"{shown(origin)}. Use the studio's page."
+        )
+    content_type = headers.get("content-type", "").split(";")[0].strip().lower()
+    if not headers.get(TOKEN_HEADER) and content_type != "application/json":
+        return (
+            f"Expected a JSON request (Content-Type: application/json) or the {TOKEN_HEADER} header; found "
+            f"{'Content-Type ' + shown(content_type) if content_type else 'no Content-Type'}. "
+            "Send JSON, as the studio's page does."
+        )
+    return ""
 
 
 def _query_token(scope: Scope) -> str | None:

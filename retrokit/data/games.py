@@ -423,7 +423,7 @@ def find_game(name: Game | str | os.PathLike[str], *, check: bool = True) -> Gam
         game = Game(key, index[key])
         return game.check() if check else game
     folder = Path(name)
-    if folder.is_dir() and _is_game_folder(folder):
+    if os.path.isdir(folder) and _is_game_folder(folder):  # os.path's: False, not an error, for a name too long
         game = Game(normalize_name(folder.resolve().name), (folder,))
         return game.check() if check else game
     searched = ", ".join(str(d) for d in paths.game_search_dirs()) or "(none: is stable-retro installed?)"

@@ -40,6 +40,8 @@ TOKEN_HEADER = "x-retrokit-token"
 MAX_BODY = 1 << 20
 """The largest request body, in bytes: a scenario or a game.yaml is far smaller."""
 _HOSTS = ("127.0.0.1", "localhost")
+NAME_MAX = 250
+"""The longest file name a request may give, in bytes: file systems hold 255, and the studio adds a suffix."""
 
 
 def new_token() -> str:
@@ -299,11 +301,23 @@ def resolve_path(name: str, base: Path, roots: Iterable[Path], *, what: str = "f
     if not isinstance(name, str) or not name:
         raise InvalidArgumentError(f"Expected a {what} name as a non-empty string, got {shown(name)}.")
     decoded = name
-    for _ in range(8):  # %25 nests: decode until the text is stable
-        step = unquote(decoded, errors="strict") if "%" in decoded else decoded
-        if step == decoded:
-            break
-        decoded = step
+    try:
+        for _ in range(8):  # %25 nests: decode until the text is stable
+            step = unquote(decoded, errors="strict") if "%" in decoded else decoded
+            if step == decoded:
+                break
+            decoded = step
+    except UnicodeDecodeError:
+        raise InvalidArgumentError(
+            f"Expected a {what} name in UTF-8; got {shown(name)}, whose percent-escapes are other bytes. "
+            "Name a file by its plain name."
+        ) from None
+    longest = max(len(part.encode("utf-8", "surrogatepass")) for part in decoded.replace("\\", "/").split("/"))
+    if longest > NAME_MAX:
+        raise InvalidArgumentError(
+            f"Expected a {what} name of at most {NAME_MAX} bytes (what a file system holds); got {shown(name)}, "
+            f"of {longest} bytes. Pick a shorter name."
+        )
     problem = _path_problem(decoded)
     allowed = [Path(os.path.realpath(r)) for r in roots]
     if not problem:
@@ -323,6 +337,8 @@ def _path_problem(text: str) -> str:
         return "is still percent-encoded after 8 rounds of decoding"
     if any(ord(c) < 32 or ord(c) == 127 for c in text):
         return "holds a NUL or a control character"
+    if any("\ud800" <= c <= "\udfff" for c in text):  # JSON's lone surrogates: no file name holds one
+        return "holds a character that is not UTF-8"
     if text.startswith(("/", "\\", "~")) or (len(text) > 1 and text[1] == ":"):
         return "is an absolute path"
     if any(part == ".." for part in text.replace("\\", "/").split("/")):

@@ -168,6 +168,8 @@ class Game:
                     f"Pass a state name: one of {', '.join(self.states) or '(no states)'}."
                 )
         key = name.removesuffix(STATE_SUFFIX)
+        if key not in self._state_files:  # a file copied in since the folders were listed: list them again
+            self.__dict__.pop("_state_files", None)
         if key in self._state_files:
             return self._state_files[key]
         if name.endswith(STATE_SUFFIX) and (os.sep in name or "/" in name) and Path(name).is_file():

@@ -15,12 +15,17 @@ and these functions are how one is made from a file or from bytes:
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import os
 from pathlib import Path
+
+from retrokit import paths
 
 from retrokit.data.games import Game, cached_rom_sha1, load_game
 from retrokit.data.probe import remember
 from retrokit.data.probe import vet_state as _vet
+from retrokit.data.shipped import STATE_HASHES
 from retrokit.data.states import StateRecord, read_state_file
 from retrokit.errors import RetrokitError, StateError
 from retrokit.host.emulator import VettedState
@@ -54,7 +59,61 @@ def check_state(
             f"recorded on another ROM (SHA-1 {record.rom_sha1}{of}). Load it with the game of that ROM, "
             f"or pick a state of {game.name}."
         )
+    _check_identity(game, data, record, rom_sha1, source)
     return _vet(data, game.system, rom, rom_sha1, source=source, shipped=shipped)
+
+
+def _check_identity(game: Game, data: bytes, record: StateRecord | None, rom_sha1: str, source: str) -> None:
+    """Refuse a state known to be another game's: by the digest its record (or movie header) gives, or a shipped one's.
+
+    A record, or a movie's ``StateSHA256`` line, that names another digest
+    says the state is not the one recorded (a movie's ``Core.bin`` swapped).
+    A state retrokit ships is known by its digest, whatever file it is in
+    and whether or not its record was stripped.
+    """
+    digest = hashlib.sha256(data).hexdigest()
+    if record is not None and record.sha256 and record.sha256 != digest:
+        raise StateError(
+            f"{source}: expected the state its record names (SHA-256 {record.sha256[:16]}…); found another "
+            f"(SHA-256 {digest[:16]}…), changed or swapped since it was recorded. Record it again, or pick a state "
+            f"of {game.name}."
+        )
+    owner = _shipped_owners().get(digest)
+    if owner is None or owner == game.name:
+        return
+    try:
+        owner_sha1s = set(load_game(paths.repo_games_dir() / owner).sha1s)  # type: ignore[operator]
+    except RetrokitError:
+        return
+    if owner_sha1s & ({rom_sha1} | set(game.sha1s)):
+        return  # two games on one ROM: the state fits both
+    raise StateError(
+        f"{source}: expected a state of {game.name}; found {owner}'s state (retrokit ships it, SHA-256 "
+        f"{digest[:16]}…), made on another ROM, where it plays garbage. Load it with {owner}, or pick a state "
+        f"of {game.name}."
+    )
+
+
+@functools.cache
+def _shipped_owners() -> dict[str, str]:
+    """The digest of the state in every ``.state`` file retrokit's ``games/`` ships, to its game's name."""
+    games = paths.repo_games_dir()
+    owners: dict[str, str] = {}
+    if games is None:
+        return owners
+    try:
+        listed = (games / STATE_HASHES).read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError):
+        return owners
+    for line in listed:
+        parts = line.split(maxsplit=1)
+        if len(parts) != 2 or "/" not in parts[1]:
+            continue
+        try:
+            owners[hashlib.sha256(read_state_file(games / parts[1]).data).hexdigest()] = parts[1].split("/")[0]
+        except RetrokitError:
+            continue  # a shipped file missing or damaged here: it identifies nothing
+    return owners
 
 
 def load_state(game: Game, path: str | os.PathLike[str]) -> VettedState:

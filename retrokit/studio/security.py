@@ -18,6 +18,7 @@ types, so hostile input ends in a 4xx JSON error, never a 500.
 
 from __future__ import annotations
 
+import asyncio
 import json
 import os
 import secrets
@@ -95,7 +96,12 @@ class Guard:
         if not length.isdigit() or int(length) > MAX_BODY:
             await _refuse(scope, receive, send, 413, _too_large(length), "RequestTooLargeError")
             return
-        await self.app(scope, _capped(receive), send)
+        try:
+            await self.app(scope, _capped(receive), send)
+        except asyncio.CancelledError:  # Ctrl-C cancels what still runs: a stop, not an error to print
+            if scope["type"] == "http":
+                return
+            raise
 
     def _problem(self, scope: Scope, headers: dict[str, str]) -> str:
         host = headers.get("host", "")

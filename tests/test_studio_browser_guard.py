@@ -14,48 +14,20 @@ import hashlib
 import http.server
 import shutil
 import threading
-import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-
+from chromium import chrome, until  # first: it skips this module where Chromium is missing
+from selenium import webdriver
+from selenium.webdriver.common.action_chains import ActionChains
+from selenium.webdriver.common.by import By
+from selenium.webdriver.common.keys import Keys
 from studioproc import StudioProcess
 
 REPO = Path(__file__).resolve().parent.parent
 DASHER = REPO / "games" / "Dasher-Genesis"
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-CHROMEDRIVER = shutil.which("chromedriver")
-WAIT = 120.0  # seconds: the machine running the suite may be loaded
-
-selenium = pytest.importorskip("selenium", reason="selenium is not installed (pip install -e '.[test]')")
-if CHROMIUM is None or CHROMEDRIVER is None:
-    pytest.skip(
-        "headless Chromium is not installed (Debian: apt-get install chromium chromium-driver; .ci/run does)",
-        allow_module_level=True,
-    )
-
-from selenium import webdriver
-from selenium.webdriver.chrome.service import Service
-from selenium.webdriver.common.action_chains import ActionChains
-from selenium.webdriver.common.by import By
-from selenium.webdriver.common.keys import Keys
-
 pytestmark = pytest.mark.timeout(900)
-
-
-def until(what: str, check: Callable[[], object], timeout: float = WAIT) -> object:
-    deadline = time.monotonic() + timeout
-    while True:
-        try:
-            value = check()
-        except Exception:  # noqa: BLE001 - not there yet
-            value = None
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"waited {timeout:.0f} s for {what}")
-        time.sleep(0.1)
 
 
 @pytest.fixture
@@ -69,16 +41,8 @@ def studio(tmp_path: Path) -> Iterator[StudioProcess]:
 
 @pytest.fixture
 def browser() -> Iterator[webdriver.Chrome]:
-    options = webdriver.ChromeOptions()
-    for argument in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                     "--window-size=1400,1000", "--force-device-scale-factor=1"):  # fmt: skip
-        options.add_argument(argument)
-    options.binary_location = CHROMIUM
-    driver = webdriver.Chrome(service=Service(CHROMEDRIVER), options=options)
-    try:
+    with chrome() as driver:
         yield driver
-    finally:
-        driver.quit()
 
 
 def open_studio(driver: webdriver.Chrome, studio: StudioProcess) -> None:

@@ -59,25 +59,19 @@ def check_state(
             f"recorded on another ROM (SHA-1 {record.rom_sha1}{of}). Load it with the game of that ROM, "
             f"or pick a state of {game.name}."
         )
-    _check_identity(game, data, record, rom_sha1, source)
+    _check_identity(game, data, rom_sha1, source)
     return _vet(data, game.system, rom, rom_sha1, source=source, shipped=shipped)
 
 
-def _check_identity(game: Game, data: bytes, record: StateRecord | None, rom_sha1: str, source: str) -> None:
-    """Refuse a state known to be another game's: by the digest its record (or movie header) gives, or a shipped one's.
+def _check_identity(game: Game, data: bytes, rom_sha1: str, source: str) -> None:
+    """Refuse a state retrokit ships for another game (on another ROM), known by its digest.
 
-    A record, or a movie's ``StateSHA256`` line, that names another digest
-    says the state is not the one recorded (a movie's ``Core.bin`` swapped).
-    A state retrokit ships is known by its digest, whatever file it is in
-    and whether or not its record was stripped.
+    Whatever file holds it, with its record stripped or a movie's header
+    rewritten around it, a shipped state is known by its digest. (A record
+    that no longer describes its state only loses its say: the state is
+    probed, as a state changed since is.)
     """
     digest = hashlib.sha256(data).hexdigest()
-    if record is not None and record.sha256 and record.sha256 != digest:
-        raise StateError(
-            f"{source}: expected the state its record names (SHA-256 {record.sha256[:16]}…); found another "
-            f"(SHA-256 {digest[:16]}…), changed or swapped since it was recorded. Record it again, or pick a state "
-            f"of {game.name}."
-        )
     owner = _shipped_owners().get(digest)
     if owner is None or owner == game.name:
         return

@@ -23,11 +23,13 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import fcntl
 import functools
 import importlib.util
 import os
 import stat
 import tempfile
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 from typing import BinaryIO
@@ -260,6 +262,60 @@ def atomic_output(path: Path | str, *, overwrite: bool = False, hint: str = REPL
         raise _cannot(path, "written", exc) from None
     finally:
         tmp.unlink(missing_ok=True)
+
+
+_held = threading.local()  # the folders this thread holds the lock of, with how many times it took each
+_thread_locks: dict[str, threading.Lock] = {}
+_thread_locks_guard = threading.Lock()
+
+
+@contextlib.contextmanager
+def locked(path: Path | str) -> Iterator[None]:
+    """Hold the lock of the folder that holds ``path`` for a read-modify-write of it.
+
+    Every edit of a file others edit too (a game.yaml the CLI and two
+    studios change at once) reads, changes and writes it inside this block,
+    so no acknowledged edit is lost to a writer that read the file before
+    it. The lock is the OS's (``flock``) on the folder itself, so it needs no
+    lock file, leaves nothing behind and dies with its process; the folder
+    is that of the file's target, so writers through a symlink and writers of
+    the target share it. Threads of one process take a thread lock first
+    (``flock`` is per open file, not per process), and a thread that holds
+    the lock may take it again.
+
+    Raises:
+        FileSystemError: The folder cannot be opened to lock.
+    """
+    folder = os.path.dirname(os.path.realpath(path)) or "."
+    depth = getattr(_held, "folders", None)
+    if depth is None:
+        depth = _held.folders = {}
+    if depth.get(folder):  # this thread holds it already: an edit within an edit
+        depth[folder] += 1
+        try:
+            yield
+        finally:
+            depth[folder] -= 1
+        return
+    with _thread_locks_guard:
+        thread_lock = _thread_locks.setdefault(folder, threading.Lock())
+    with thread_lock:
+        try:
+            fd = os.open(folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0) | getattr(os, "O_CLOEXEC", 0))
+        except OSError as exc:
+            raise FileSystemError(
+                f"Expected a folder at {folder!r} to lock while {os.path.basename(path)} is edited; found "
+                f"{exc.strerror or exc}. Check the path and its permissions."
+            ) from None
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)  # waits for the other writer: each edit takes milliseconds
+            depth[folder] = 1
+            try:
+                yield
+            finally:
+                depth[folder] = 0
+        finally:
+            os.close(fd)  # releases the flock
 
 
 def _conflict(path: Path, hint: str) -> FileConflictError:

@@ -386,3 +386,32 @@ def test_a_dict_scenario_may_share_a_value(tmp_path) -> None:
     shared = {"values": {1: 2}}
     scenario = load_scenario({"reward": "t[x] + u[x]", "tables": {"t": shared, "u": shared}}, FIELDS)
     assert _step(scenario, x=1) == 4.0
+
+
+BOUNDED = """
+from retrokit.dsl.scenario import scenario_from_text
+from retrokit.errors import ScenarioError
+shape = {shape!r}
+if shape == "chain":  # 40,000 chained definitions: 0.94 MB, under the studio's 1 MiB body cap
+    lines = ["define:", "  d0: x"] + [f"  d{{i}}: d{{i - 1}} + 1" for i in range(1, 40000)] + ["reward: d39999"]
+else:  # one flat sum of 200,000 names: a megabyte in one expression
+    lines = ["reward: " + "+".join(["x"] * 200000)]
+text = "\\n".join(lines) + "\\n"
+assert len(text) < 2**20
+try:
+    scenario_from_text(text, ["x"], source="big.yaml", name="big")
+except ScenarioError as exc:
+    print(str(exc).splitlines()[0])
+"""
+
+
+@pytest.mark.parametrize("shape, message", [
+    ("chain", "big.yaml:4002:3: expected at most 4000 definitions in a scenario"),
+    ("flat", "big.yaml:1:9: expected at most 50000 operators, names and numbers"),
+], ids=["40000-definitions", "200000-names-in-one-sum"])
+def test_a_scenario_under_the_body_cap_compiles_in_bounded_memory(shape: str, message: str) -> None:
+    from childproc import run_child
+
+    child = run_child(BOUNDED.format(shape=shape), timeout=300)
+    assert child.returncode == 0 and child.stdout.startswith(message), child.describe()
+    assert child.peak_rss_mb < 200, child.describe()

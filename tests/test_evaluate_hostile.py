@@ -303,3 +303,23 @@ def test_a_level_an_older_run_finished_early_is_played_again(finished, tmp_path)
     _edit_run(lambda d: d["finished"][LEVEL].update(timesteps=10))(out)
     assert main([*FAST, "--levels", LEVEL, "--agent", "jerk", "--out", str(out), "--resume"]) == 0
     assert (out / "summary.json").read_bytes() == (finished / "summary.json").read_bytes()
+
+
+AT_IMPORT = {
+    "sys-exit-0": "import sys\nsys.exit(0)\n",
+    "os-exit-0": "import os\nos._exit(0)\n",
+    "sys-exit-3": "import sys\nsys.exit(3)\n",
+    "keyboard-interrupt": "raise KeyboardInterrupt\n",
+}
+
+
+@pytest.mark.parametrize("case", AT_IMPORT, ids=list(AT_IMPORT))
+def test_an_agent_module_that_exits_at_import_is_one_line_and_a_failure(tmp_path, case) -> None:
+    agent = tmp_path / "quits.py"
+    agent.write_text(AT_IMPORT[case] + "def agent(env, budget, seed):\n    pass\n")
+    out = tmp_path / "run"
+    child = run_cli([*FAST, "--levels", "Zone1.Act1", "--agent", f"{agent}:agent", "--out", str(out)],
+                    timeout=240, cwd=tmp_path)  # fmt: skip
+    assert child.returncode == 2 and child.signal is None, child.describe()
+    assert child.stderr.count("\n") == 1 and "Traceback" not in child.stderr, child.describe()
+    assert "quits.py:agent" in child.stderr and not out.exists(), child.describe()

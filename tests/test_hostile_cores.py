@@ -217,3 +217,13 @@ def test_every_wheel_core_passes_the_elf_check(core: Path) -> None:
     from retrokit.host.elf import check_core_file
 
     check_core_file(core)
+
+
+def test_the_probe_keeps_under_a_users_memory_limit(tmp_path: Path) -> None:
+    """Under ``ulimit -v`` (1 GiB) the probe's child starts within the user's limit: a verdict, never a raw error."""
+    limited = "import resource\nresource.setrlimit(resource.RLIMIT_AS, (2**30, 2**30))\n" + OPEN
+    child = run_child(limited, env=_install(tmp_path, PROBED["dynamic-section-zeroed"]), timeout=120)
+    assert child.returncode == 0 and child.signal is None, child.describe()
+    (line,) = child.stdout.splitlines()
+    assert line.startswith("refused: ") and "is not a core retrokit can load" in line, line
+    assert "preexec_fn" not in line and "Traceback" not in child.stderr, child.describe()

@@ -55,7 +55,7 @@ CASES = {
     "import-a-folder-named-rom.md": (_import_a_folder_named_rom_md, "no such path"),
     "data-folder-is-a-file": (lambda place, mp: mp.setenv("RETROKIT_DATA", str(place / "afile"))
                               or ["import", str(AIRSTRIKER_ROM)], "a file where one of its parent folders should be"),
-    "output-without-suffix-is-a-file": (lambda place, mp: ["playback", "m.bk2", "afile"], "a file without a suffix"),
+    "output-without-suffix-is-a-file": (lambda place, mp: ["playback", "m.bk2", "afile"], "a file that is none of them"),
     "gif-output-under-a-file": (lambda place, mp: ["playback", "m.bk2", "afile/out.gif"], "a file, not a folder"),
     "png-output-under-a-file": (lambda place, mp: ["playback", "m.bk2", "afile/frames"], "parent folders"),
     "unwritable-output-folder": (lambda place, mp: ["playback", "m.bk2", "/proc/out.gif"], "cannot be written"),

@@ -143,5 +143,24 @@ def test_a_forked_child_does_not_write_its_parents_movie(tmp_path: Path) -> None
         atexit._run_exitfuncs()
         os._exit(0)
     os.waitpid(pid, 0)
-    assert not (tmp_path / "m.bk2").exists()
+    assert read_bk2(tmp_path / "m.bk2").frames == []  # as the recorder wrote it when made: the child wrote nothing
     assert recorder.close() == tmp_path / "m.bk2" and len(read_bk2(tmp_path / "m.bk2").frames) == 1
+
+
+def test_a_recorder_killed_in_its_first_second_leaves_a_movie_that_plays(tmp_path: Path) -> None:
+    """Killed right after reset(), before any flush: the movie already holds its header and start state."""
+    folder = tmp_path / "movies"
+    code = (
+        "import os, signal, retrokit\n"
+        f"env = retrokit.make('Dasher-Genesis', record={str(folder)!r})\n"
+        "env.reset(seed=0)\n"
+        "env.step(env.action_space.sample())\n"
+        "os.kill(os.getpid(), signal.SIGKILL)\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO, timeout=120)
+    assert done.returncode == -signal.SIGKILL, done.stderr
+    (movie_file,) = sorted(folder.glob("*.bk2"))
+    assert movie_file.stat().st_size > 0
+    movie = read_bk2(movie_file)
+    assert movie.state and sum(1 for _ in play(movie)) == len(movie.frames)
+    assert not [p for p in folder.iterdir() if p.suffix != ".bk2"]

@@ -17,36 +17,24 @@ from __future__ import annotations
 
 import os
 import shutil
-import signal
-import subprocess
 import sys
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 import yaml
-
-REPO = Path(__file__).resolve().parent.parent
-DASHER = REPO / "games" / "Dasher-Genesis"
-IMAGES = REPO / "docs" / "images"
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
-CHROMEDRIVER = shutil.which("chromedriver")
-WAIT = 60.0  # seconds: the machine running the suite may be loaded
-
-selenium = pytest.importorskip("selenium", reason="selenium is not installed (pip install -e '.[test]')")
-if CHROMIUM is None or CHROMEDRIVER is None:
-    pytest.skip(
-        "headless Chromium is not installed (Debian: apt-get install chromium chromium-driver; .ci/run does)",
-        allow_module_level=True,
-    )
-
+from chromium import WAIT, chrome, until  # first: it skips this module where Chromium is missing
 from selenium import webdriver
-from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 from selenium.webdriver.support.ui import Select
+from studioproc import StudioProcess
+
+REPO = Path(__file__).resolve().parent.parent
+DASHER = REPO / "games" / "Dasher-Genesis"
+IMAGES = REPO / "docs" / "images"
 
 pytestmark = pytest.mark.timeout(600)
 
@@ -62,27 +50,12 @@ class Studio:
         shutil.copytree(source, self.game)
         self.data = root / "data"
         self.data.mkdir()
-        env = {**os.environ, "RETROKIT_DATA": str(self.data)}
-        self.process = subprocess.Popen(
-            [sys.executable, "-m", "retrokit", "studio", str(self.game), "--port", "0", "--no-browser"],
-            cwd=root, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        )  # fmt: skip
-        line = self.process.stdout.readline()
-        if not line.startswith("retrokit studio: http://127.0.0.1:"):
-            self.process.kill()
-            raise AssertionError(f"the studio printed {line!r}; stderr: {self.process.stderr.read()}")
-        self.url = line.split(": ", 1)[1].strip()
+        self.server = StudioProcess(self.game, self.data, root)
+        self.process, self.url = self.server.process, self.server.url
 
     def stop(self) -> str:
         """Ctrl-C, as a user stops it; return what it printed on stderr."""
-        self.process.send_signal(signal.SIGINT)
-        try:
-            _, err = self.process.communicate(timeout=30)
-        except subprocess.TimeoutExpired:
-            self.process.kill()
-            _, err = self.process.communicate()
-            raise AssertionError(f"the studio did not stop on Ctrl-C: {err}") from None
-        return err
+        return self.server.stop()
 
 
 @pytest.fixture(scope="module")
@@ -96,32 +69,8 @@ def studio(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Studio]:
 
 @pytest.fixture(scope="module")
 def browser() -> Iterator[webdriver.Chrome]:
-    options = webdriver.ChromeOptions()
-    for argument in ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage",
-                     "--window-size=1400,1000", "--force-device-scale-factor=1"):  # fmt: skip
-        options.add_argument(argument)
-    options.binary_location = CHROMIUM
-    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    driver = webdriver.Chrome(service=Service(CHROMEDRIVER), options=options)
-    try:
+    with chrome() as driver:
         yield driver
-    finally:
-        driver.quit()
-
-
-def until(what: str, check: Callable[[], object], timeout: float = WAIT) -> object:
-    """Wait for ``check()`` to return something true; fail saying ``what`` was awaited."""
-    deadline = time.monotonic() + timeout
-    while True:
-        try:
-            value = check()
-        except Exception:  # an element not there yet  # noqa: BLE001
-            value = None
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"waited {timeout:.0f} s for {what}")
-        time.sleep(0.1)
 
 
 class Page:

@@ -214,7 +214,9 @@ def test_a_failing_step_is_raised_by_recv_and_leaves_the_env_usable() -> None:
     vec.send([1, 2])
     with pytest.raises(InvalidArgumentError, match="a test's wrapper"):
         vec.recv()
-    vec.send([1], env_ids=[0])  # the failed env is no longer in flight, nor is the one beside it
+    assert vec.in_flight == 1  # the failed env is no longer in flight; the one beside it stepped, and waits
+    assert list(vec.recv()[5]) == [0]
+    vec.send([1], env_ids=[0])
     assert list(vec.recv()[5]) == [0]
     vec.close()
 
@@ -225,3 +227,66 @@ def test_close_with_envs_in_flight_waits_for_them() -> None:
     vec.send([1, 2])
     vec.close()  # the steps in flight finish before the emulators close: no crash, no hang
     assert vec.in_flight == 0
+
+
+TWO_THREADS = """
+import threading
+import numpy as np
+import retrokit
+from retrokit.errors import EnvError
+
+vec = retrokit.make_vec("Airstriker-Genesis", 4, frameskip=1, action_type="discrete")
+vec.reset(seed=0)
+wrong = []
+
+def drive(ids):
+    for _ in range(400):
+        vec.send(np.zeros(len(ids), dtype=np.int64), env_ids=ids)
+        got = []
+        while len(got) < len(ids):
+            got += list(vec.recv()[5])
+        if sorted(got) != ids:
+            wrong.append((ids, got))
+
+threads = [threading.Thread(target=drive, args=(ids,)) for ids in ([0, 1], [2, 3])]
+for t in threads:
+    t.start()
+for t in threads:
+    t.join()
+assert not wrong, wrong[:3]
+vec.send([0], env_ids=[0])
+outside = []
+side = threading.Thread(target=lambda: outside.append(pytest_raises(vec.recv)))
+def pytest_raises(call):
+    try:
+        call()
+    except EnvError as exc:
+        return str(exc)
+side.start()
+side.join()
+assert "sent by another thread" in outside[0], outside
+assert list(vec.recv()[5]) == [0]
+vec.close()
+print("both threads got their own envs, 400 rounds each")
+"""
+
+
+def test_two_threads_each_receive_the_envs_they_sent() -> None:
+    """Two threads drive their own envs of one vector env: neither takes the other's results, neither hangs."""
+    from childproc import run_child
+
+    child = run_child(TWO_THREADS, timeout=300)
+    assert child.returncode == 0 and "400 rounds each" in child.stdout, child.describe()
+
+
+def test_one_bad_action_loses_none_of_the_other_envs_steps() -> None:
+    vec = retrokit.make_vec(GAME, 4, **OPTIONS)
+    vec.reset(seed=0)
+    vec.send([1, 2, 10_000, 3])
+    with pytest.raises(InvalidArgumentError) as raised:
+        vec.recv()
+    assert vec.in_flight == 3
+    rest = vec.recv()
+    assert sorted(rest[5]) == [0, 1, 3] and rest[0].shape[0] == 3 and vec.in_flight == 0
+    assert any("next recv() returns them" in note for note in raised.value.__notes__)
+    vec.close()

@@ -17,6 +17,9 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import json
+import signal
+import subprocess
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -67,7 +70,7 @@ def resolve_agent(spec: str) -> Callable[..., None]:
         )
     try:
         module = _load_module(module_name)
-    except Exception as exc:  # noqa: BLE001 - any import failure of user code is the user's to see
+    except (Exception, SystemExit, KeyboardInterrupt) as exc:  # noqa: BLE001 - user code: its failure is its own
         raise UnknownNameError(
             f"Expected the agent {spec!r} to name an importable module, but importing {module_name!r} failed: "
             f"{type(exc).__name__}: {exc}. Check the name, or give a path to a .py file."
@@ -80,6 +83,59 @@ def resolve_agent(spec: str) -> Callable[..., None]:
             + did_you_mean(attribute, names)
         )
     return agent
+
+
+_CHECK = """
+import json, sys
+sys.path[:] = json.loads(sys.argv[2])
+from retrokit.benchmark.agents import resolve_agent
+from retrokit.errors import RetrokitError
+try:
+    resolve_agent(sys.argv[1])
+except RetrokitError as exc:
+    print(exc, file=sys.stderr)
+    sys.exit(2)
+print("agent ok", flush=True)
+"""
+AGENT_IMPORT_TIMEOUT = 600.0
+"""Seconds an agent's module may take to import in the check (a deep-learning library takes tens)."""
+
+
+def check_agent(spec: str) -> None:
+    """Import the agent ``spec`` names in a child process first: an import that exits or dies ends only the child.
+
+    A module that calls ``sys.exit``, ``os._exit`` or crashes when imported
+    would otherwise end ``evaluate`` silently (status 0, no run folder).
+
+    Raises:
+        UnknownNameError: The agent cannot be resolved, or importing it ended the process, with how it ended.
+    """
+    if spec in BUILTINS:
+        resolve_agent(spec)
+        return
+    try:
+        done = subprocess.run(
+            [sys.executable, "-c", _CHECK, spec, json.dumps(sys.path)], capture_output=True, text=True,
+            timeout=AGENT_IMPORT_TIMEOUT, check=False, stdin=subprocess.DEVNULL,
+        )  # fmt: skip
+    except subprocess.TimeoutExpired:
+        raise UnknownNameError(
+            f"Expected the agent {spec!r} to import within {AGENT_IMPORT_TIMEOUT:.0f} s; it was still importing. "
+            "Does its module run something at import?"
+        ) from None
+    if done.returncode == 0 and "agent ok" in done.stdout:
+        return
+    if done.returncode == 2 and done.stderr.strip():
+        raise UnknownNameError(done.stderr.strip().splitlines()[-1])
+    ended = (
+        f"was killed by {signal.Signals(-done.returncode).name}" if done.returncode < 0
+        else f"exited with status {done.returncode}"
+    )
+    raise UnknownNameError(
+        f"Expected the agent {spec!r} to define a callable when imported; importing its module {ended} "
+        "instead. Remove the exit (sys.exit, os._exit, a KeyboardInterrupt) from its top level, or put it under "
+        "if __name__ == '__main__':."
+    )
 
 
 def _load_module(name: str):  # a module

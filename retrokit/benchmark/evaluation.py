@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from retrokit.benchmark import plots
-from retrokit.benchmark.agents import resolve_agent
+from retrokit.benchmark.agents import check_agent
 from retrokit.benchmark.definition import Benchmark, Level
 from retrokit.benchmark.level import (
     EpisodeEnded,
@@ -103,7 +103,7 @@ class Evaluation:
         if self.ray_address is not None and self.backend != "ray":
             raise InvalidArgumentError(f"Expected --backend ray with --ray-address, got --backend {self.backend}.")
         self.benchmark.check_levels(self.levels)
-        resolve_agent(self.agent)
+        check_agent(self.agent)  # in a child: an agent module that exits at import must not end this process
 
     def settings(self) -> dict[str, Any]:
         """What determines the results; ``--resume`` requires the same."""

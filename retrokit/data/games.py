@@ -168,6 +168,8 @@ class Game:
                     f"Pass a state name: one of {', '.join(self.states) or '(no states)'}."
                 )
         key = name.removesuffix(STATE_SUFFIX)
+        if key not in self._state_files:  # a file copied in since the folders were listed: list them again
+            self.__dict__.pop("_state_files", None)
         if key in self._state_files:
             return self._state_files[key]
         if name.endswith(STATE_SUFFIX) and (os.sep in name or "/" in name) and Path(name).is_file():
@@ -426,7 +428,7 @@ def find_game(name: Game | str | os.PathLike[str], *, check: bool = True) -> Gam
         game = Game(key, index[key])
         return game.check() if check else game
     folder = Path(name)
-    if folder.is_dir() and _is_game_folder(folder):
+    if os.path.isdir(folder) and _is_game_folder(folder):  # os.path's: False, not an error, for a name too long
         game = Game(normalize_name(folder.resolve().name), (folder,))
         return game.check() if check else game
     dirs = paths.game_search_dirs()

@@ -16,8 +16,10 @@ from __future__ import annotations
 import json
 import os
 import re
+import shutil
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from retrokit import paths
 from retrokit.data import roms
@@ -87,20 +89,29 @@ class NewGame:
 def read_rom(path: str | os.PathLike[str]) -> bytes:
     """Read a ROM file: a regular file, not empty, at most :data:`retrokit.data.roms.MAX_FILE_SIZE` bytes.
 
+    A file that reads otherwise than its size says (``/proc/self/environ``
+    says 0 bytes, then gives the process's environment) is no ROM either.
+
     Raises:
         FileSystemError: The path is missing or not a regular file.
-        RomError: The file is empty or too big.
+        RomError: The file is empty or too big, or its contents are not the size it says.
     """
     path = paths.require_regular_file(path, "a ROM file")
-    if path.stat().st_size > roms.MAX_FILE_SIZE:
+    size = path.stat().st_size
+    if size > roms.MAX_FILE_SIZE:
         raise RomError(
-            f"Expected a ROM of at most {roms.MAX_ROM_SIZE // 2**20} MiB; found {path.stat().st_size} bytes in "
+            f"Expected a ROM of at most {roms.MAX_ROM_SIZE // 2**20} MiB; found {size} bytes in "
             f"{str(path)!r}. This file is not a ROM retrokit supports."
         )
     with open(path, "rb") as f:
         data = f.read(roms.MAX_FILE_SIZE + 1)
-    if not data or len(data) > roms.MAX_FILE_SIZE:
-        raise RomError(f"Expected a ROM in {str(path)!r}; found {'an empty file' if not data else 'a file that grew'}.")
+    if not data:
+        raise RomError(f"Expected a ROM in {str(path)!r}; found an empty file.")
+    if len(data) != size:
+        raise RomError(
+            f"Expected a ROM file of the {size} bytes its size says; found {len(data)} bytes in {str(path)!r} "
+            "(a file that changed as it was read, or not a file on a disk). Copy the ROM to a file and pass that."
+        )
     return data
 
 
@@ -171,15 +182,33 @@ def new_game(
     paths.atomic_write(folder / "game.yaml", game_yaml(name, chosen, sha1, Path(rom).name).encode(),
                        hint="Pick another name, or work on that game.")
     game = Game(name, (folder,))
-    report = import_roms([rom], data_dir=data_dir, games=[game])
-    stored = [r.path for r in (*report.imported, *report.already_present)]
-    if not stored:
-        why = "; ".join(f"{c.path} has SHA-1 {c.existing_sha1}" for c in report.conflicts) or "nothing was imported"
-        raise RomError(
-            f"Expected the ROM imported into {game.imported_rom_path(data_dir)}; found {why}. "
-            f"Move that file away, then run: retrokit import {rom}"
-        )
+    try:  # a game without its ROM is half made: nothing is left of it
+        report = import_roms([rom], data_dir=data_dir, games=[game])
+        stored = [r.path for r in (*report.imported, *report.already_present)]
+        if not stored:
+            raise RomError(_not_imported(rom, chosen, sha1, game.imported_rom_path(data_dir), report))
+    except BaseException:
+        shutil.rmtree(folder, ignore_errors=True)
+        raise
     return NewGame(game, folder, stored[0], sha1, told_by)
+
+
+def _not_imported(rom: str | os.PathLike[str], chosen: System, sha1: str, target: Path, report: Any) -> str:
+    """Why ``new`` could not import the ROM it made a game for (the game's folder is removed)."""
+    if report.conflicts:
+        found = "; ".join(f"{c.path} has SHA-1 {c.existing_sha1}" for c in report.conflicts)
+        return (
+            f"Expected to import the ROM into {target}; found another file there ({found}). Nothing was made. "
+            f"Move that file away, then run `retrokit new` again."
+        )
+    ext = extension_of(rom)
+    return (
+        f"Expected {str(rom)!r} to import as a {chosen.name} ROM (SHA-1 {sha1}); found that its file, read as the "
+        f".{ext or '(no extension)'} file it is, gives another SHA-1, so it is not a {chosen.name} ROM. Nothing was "
+        "made. Leave out --system (its header or extension tells the system), or pass the ROM of that system."
+    )
+
+
 
 
 def game_yaml(name: str, system: System, sha1: str, source: str) -> str:

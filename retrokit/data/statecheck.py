@@ -15,12 +15,17 @@ and these functions are how one is made from a file or from bytes:
 
 from __future__ import annotations
 
+import functools
+import hashlib
 import os
 from pathlib import Path
+
+from retrokit import paths
 
 from retrokit.data.games import Game, cached_rom_sha1, load_game
 from retrokit.data.probe import remember
 from retrokit.data.probe import vet_state as _vet
+from retrokit.data.shipped import STATE_HASHES
 from retrokit.data.states import StateRecord, read_state_file
 from retrokit.errors import RetrokitError, StateError
 from retrokit.host.emulator import VettedState
@@ -54,7 +59,55 @@ def check_state(
             f"recorded on another ROM (SHA-1 {record.rom_sha1}{of}). Load it with the game of that ROM, "
             f"or pick a state of {game.name}."
         )
+    _check_identity(game, data, rom_sha1, source)
     return _vet(data, game.system, rom, rom_sha1, source=source, shipped=shipped)
+
+
+def _check_identity(game: Game, data: bytes, rom_sha1: str, source: str) -> None:
+    """Refuse a state retrokit ships for another game (on another ROM), known by its digest.
+
+    Whatever file holds it, with its record stripped or a movie's header
+    rewritten around it, a shipped state is known by its digest. (A record
+    that no longer describes its state only loses its say: the state is
+    probed, as a state changed since is.)
+    """
+    digest = hashlib.sha256(data).hexdigest()
+    owner = _shipped_owners().get(digest)
+    if owner is None or owner == game.name:
+        return
+    try:
+        owner_sha1s = set(load_game(paths.repo_games_dir() / owner).sha1s)  # type: ignore[operator]
+    except RetrokitError:
+        return
+    if owner_sha1s & ({rom_sha1} | set(game.sha1s)):
+        return  # two games on one ROM: the state fits both
+    raise StateError(
+        f"{source}: expected a state of {game.name}; found {owner}'s state (retrokit ships it, SHA-256 "
+        f"{digest[:16]}…), made on another ROM, where it plays garbage. Load it with {owner}, or pick a state "
+        f"of {game.name}."
+    )
+
+
+@functools.cache
+def _shipped_owners() -> dict[str, str]:
+    """The digest of the state in every ``.state`` file retrokit's ``games/`` ships, to its game's name."""
+    games = paths.repo_games_dir()
+    owners: dict[str, str] = {}
+    if games is None:
+        return owners
+    try:
+        listed = (games / STATE_HASHES).read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError):
+        return owners
+    for line in listed:
+        parts = line.split(maxsplit=1)
+        if len(parts) != 2 or "/" not in parts[1]:
+            continue
+        try:
+            owners[hashlib.sha256(read_state_file(games / parts[1]).data).hexdigest()] = parts[1].split("/")[0]
+        except RetrokitError:
+            continue  # a shipped file missing or damaged here: it identifies nothing
+    return owners
 
 
 def load_state(game: Game, path: str | os.PathLike[str]) -> VettedState:

@@ -13,6 +13,7 @@ a :class:`Slot`; equal calls share one.
 from __future__ import annotations
 
 import operator
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -116,6 +117,25 @@ def constant(node: n.Node) -> int | float | None:
     return None
 
 
+MAX_DEFINES = 4000
+"""The most definitions a scenario may hold: hand-written ones have tens; each costs its own generated code."""
+MAX_NODES = 50_000
+"""The most nodes (operators, names, numbers) in all of a scenario's expressions: the Sonic contest's hold a few hundred."""
+
+
+_ATOM = re.compile(r"[A-Za-z_0-9][A-Za-z_0-9.]*")
+
+
+def _count(root: n.Node) -> int:
+    """How many nodes an expression holds."""
+    count, stack = 0, [root]
+    while stack:
+        node = stack.pop()
+        count += 1
+        stack.extend(node.children())
+    return count
+
+
 class Checker:
     """Resolve names, check arity and constants, collect slots, infer types."""
 
@@ -125,11 +145,18 @@ class Checker:
         self._field_set = set(fields)
         self._used_fields: dict[str, None] = {}
         self.slots: dict[str, Slot] = {}
+        self._nodes = 0  # in the expressions parsed so far
 
     def run(self) -> Analysis:
         """Check everything and return the analysis (types included)."""
         spec = self.spec
-        for name, where in spec.define_names.items():
+        for count, (name, where) in enumerate(spec.define_names.items(), 1):
+            if count > MAX_DEFINES:  # each costs its own code: 40,000 took a gigabyte to compile
+                raise where.error(
+                    ScenarioCompileError, 0, len(where.text),
+                    f"expected at most {MAX_DEFINES} definitions in a scenario; found more (this is number {count}). "
+                    "Use tables for long lists of values, or fewer steps",
+                )
             self._check_define_name(name, where)
         defines = {name: self._parse(snippet) for name, snippet in spec.defines.items()}
         rewards = [self._parse(snippet) for snippet in spec.rewards]
@@ -152,9 +179,18 @@ class Checker:
             raise where.error(ScenarioCompileError, 0, len(where.text), f"{name!r} is already a table; choose another name")
 
     def _parse(self, snippet: Snippet) -> n.Node:
-        root = parse(snippet)
-        self._resolve(root, snippet)
-        return root
+        # Each name or number is a node: counted in the text first, as parsing a megabyte of them takes 500 MB.
+        atoms = sum(1 for word in _ATOM.findall(snippet.text) if word != "else")  # `a if c else b`: 4 nodes
+        root = parse(snippet) if self._nodes + atoms <= MAX_NODES else None
+        self._nodes += atoms if root is None else _count(root)
+        if self._nodes > MAX_NODES:  # the generated code, and Python's compile of it, grows with them
+            raise snippet.error(
+                ScenarioCompileError, 0, len(snippet.text),
+                f"expected at most {MAX_NODES} operators, names and numbers in a scenario's expressions; found more "
+                "by this one. Split the scenario, or use tables",
+            )
+        self._resolve(root, snippet)  # type: ignore[arg-type] - not None: the count is within the cap
+        return root  # type: ignore[return-value]
 
     def _resolve(self, node: n.Node, sn: Snippet) -> None:
         for child in node.children():

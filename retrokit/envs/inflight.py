@@ -5,7 +5,9 @@ each thread runs one env's whole step (its frames with the GIL released,
 then its fields and scenario), and whichever thread is free takes the next
 env waiting, so a descheduled thread holds up only the step it is running.
 ``recv`` returns the first steps that are done, as many as the vector env's
-``batch_size`` (or all in flight, if fewer), in the order they finished.
+``batch_size`` (or all in flight, if fewer), in the order they finished,
+of the steps the calling thread sent: two threads may drive their own envs
+of one vector env, each receiving its own.
 
 An env is in flight from its ``send`` to the ``recv`` that returns it; it
 cannot be sent again in between, and every misuse (``recv`` with nothing in
@@ -16,8 +18,10 @@ flight, an env sent twice, an id out of range) is a one-line
 
 from __future__ import annotations
 
+import collections
 import numbers
 import queue
+import threading
 from collections import Counter
 from collections.abc import Callable, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -30,10 +34,18 @@ from retrokit.errors import EnvError, InvalidArgumentError, shown
 
 #: Runs one env's step: ``step(env_id, action)`` returns its 5-tuple.
 StepOne = Callable[[int, Any], tuple]
+#: A finished step: ``(env_id, result, None)``, or ``(env_id, None, error)`` for one that raised.
+_Done = tuple[int, "tuple | None", "BaseException | None"]
 
 
 class InFlight:
-    """Envs whose steps were sent and not yet received.
+    """Envs whose steps were sent and not yet received, per thread that sent them.
+
+    Each thread's ``recv`` returns the steps that thread sent, never another
+    thread's: two threads may each drive their own envs of one vector env.
+    A step that fails is raised by the ``recv`` that meets it; the other
+    steps done meanwhile are kept, still in flight, and the next ``recv``
+    returns them, so no env's step is lost with the one that failed.
 
     Args:
         num_envs: The vector env's envs; ids go from 0 to ``num_envs - 1``.
@@ -43,20 +55,21 @@ class InFlight:
     def __init__(self, num_envs: int, threads: int) -> None:
         self.num_envs, self.threads = num_envs, threads
         self._pool: ThreadPoolExecutor | None = None  # started at the first send: a sync-only user needs no threads
-        self._sent: set[int] = set()
-        self._done: queue.SimpleQueue[tuple[int, tuple | None, BaseException | None]] = queue.SimpleQueue()
+        self._lock = threading.Lock()  # guards the maps below: two threads may send and receive at once
+        self._sender: dict[int, int] = {}  # env id in flight -> the thread that sent it
+        self._done: dict[int, queue.SimpleQueue[_Done]] = {}  # per sending thread: its steps, as they finish
+        self._kept: dict[int, collections.deque[_Done]] = {}  # per thread: steps done, kept back by a failed one
 
     @property
     def count(self) -> int:
-        """How many envs are in flight."""
-        return len(self._sent)
+        """How many envs are in flight (sent by any thread)."""
+        return len(self._sender)
 
     def check_ids(self, env_ids: Any) -> list[int]:
-        """The env ids a ``send`` names, checked: whole numbers in range, each once, none in flight.
+        """The env ids a ``send`` names, checked: whole numbers in range, each once.
 
         Raises:
             InvalidArgumentError: An id is not a whole number, out of range, or named twice.
-            EnvError: An env is still in flight (sent and not received).
         """
         if env_ids is None:
             ids = list(range(self.num_envs))
@@ -94,12 +107,6 @@ class InFlight:
             )
         if not checked:
             raise InvalidArgumentError("Expected at least one env id in a send; found none.")
-        busy = sorted(self._sent.intersection(checked))
-        if busy:
-            raise EnvError(
-                f"Expected envs that are not in flight; envs {busy} were sent and not yet received. "
-                f"Call recv() until they come back before sending them again."
-            )
         return checked
 
     def send(self, env_ids: Sequence[int], actions: Sequence[Any], step: StepOne) -> None:
@@ -109,52 +116,79 @@ class InFlight:
         the vector env (whose method it is) and this object make no cycle:
         closing the vector env frees its emulators without waiting for the
         garbage collector.
-        """
-        if self._pool is None:
-            self._pool = ThreadPoolExecutor(max_workers=self.threads, thread_name_prefix="retrokit-async")
-        for env_id, action in zip(env_ids, actions):
-            self._sent.add(env_id)
-            self._pool.submit(self._run, step, env_id, action)
-
-    def _run(self, step: StepOne, env_id: int, action: Any) -> None:
-        try:
-            self._done.put((env_id, step(env_id, action), None))
-        except BaseException as exc:  # noqa: BLE001 - any failure, raised by recv() in the caller's thread: never a hang
-            self._done.put((env_id, None, exc))
-
-    def recv(self, batch_size: int) -> list[tuple[int, tuple]]:
-        """Wait for the first ``batch_size`` steps to finish (all in flight, if fewer); return ``(env_id, result)``s.
 
         Raises:
-            EnvError: Nothing is in flight (no ``send`` since the last ``recv`` of every env).
-            RetrokitError: A step failed; its error is raised once the batch is in (the failed env is no
-                longer in flight).
+            EnvError: An env is still in flight (sent by this thread or another, and not received).
         """
-        if not self._sent:
+        me = threading.get_ident()
+        with self._lock:
+            busy = sorted(i for i in env_ids if i in self._sender)
+            if busy:
+                raise EnvError(
+                    f"Expected envs that are not in flight; envs {busy} were sent and not yet received. "
+                    f"Call recv() until they come back before sending them again (from the thread that sent them)."
+                )
+            if self._pool is None:
+                self._pool = ThreadPoolExecutor(max_workers=self.threads, thread_name_prefix="retrokit-async")
+            done = self._done.setdefault(me, queue.SimpleQueue())
+            self._kept.setdefault(me, collections.deque())
+            for env_id in env_ids:
+                self._sender[env_id] = me
+        for env_id, action in zip(env_ids, actions):
+            self._pool.submit(self._run, step, env_id, action, done)
+
+    @staticmethod
+    def _run(step: StepOne, env_id: int, action: Any, done: queue.SimpleQueue[_Done]) -> None:
+        try:
+            done.put((env_id, step(env_id, action), None))
+        except BaseException as exc:  # noqa: BLE001 - any failure, raised by recv() in the caller's thread: never a hang
+            done.put((env_id, None, exc))
+
+    def recv(self, batch_size: int) -> list[tuple[int, tuple]]:
+        """Wait for the first ``batch_size`` steps this thread sent to finish (all, if fewer); return ``(env_id, result)``s.
+
+        Raises:
+            EnvError: This thread has nothing in flight (no ``send`` since the last ``recv`` of every env it sent).
+            RetrokitError: A step failed; its error is raised once the batch is in (the failed env is no
+                longer in flight; the batch's other steps stay in flight, and the next ``recv`` returns them).
+        """
+        me = threading.get_ident()
+        with self._lock:
+            mine = sum(1 for sender in self._sender.values() if sender == me)
+            others = len(self._sender) - mine
+        if not mine:
+            elsewhere = f" ({others} envs are in flight, sent by another thread: its recv() returns them)"
             raise EnvError(
-                "Expected a send() before recv(): no env is in flight. Call vec.send(actions) (or "
-                "vec.send(actions, env_ids)) first, then recv()."
+                f"Expected a send() before recv(): no env is in flight from this thread{elsewhere if others else ''}. "
+                "Call vec.send(actions) (or vec.send(actions, env_ids)) first, then recv()."
             )
-        want = min(batch_size, len(self._sent))
-        got: list[tuple[int, tuple]] = []
-        error: BaseException | None = None
-        for _ in range(want):
-            env_id, result, exc = self._done.get()
-            self._sent.discard(env_id)
-            if exc is not None:
-                error = error or exc
-            else:
-                got.append((env_id, result))  # type: ignore[arg-type]
-        if error is not None:
-            raise error
-        return got
+        kept, done = self._kept[me], self._done[me]
+        batch = [kept.popleft() if kept else done.get() for _ in range(min(batch_size, mine))]
+        failed = [exc for _, _, exc in batch if exc is not None]
+        good = [(env_id, result) for env_id, result, exc in batch if exc is None]
+        if failed:
+            with self._lock:
+                for env_id, _, exc in batch:
+                    if exc is not None:
+                        del self._sender[env_id]
+            kept.extendleft(reversed([entry for entry in batch if entry[2] is None]))
+            if good:
+                failed[0].add_note(f"The steps of envs {[e for e, _ in good]} are done; the next recv() returns them.")
+            raise failed[0]
+        with self._lock:
+            for env_id, _ in good:
+                del self._sender[env_id]
+        return good  # type: ignore[return-value]
 
     def close(self) -> None:
         """Let the steps in flight finish, and stop the threads."""
         if self._pool is not None:
             self._pool.shutdown(wait=True)
             self._pool = None
-        self._sent.clear()
+        with self._lock:
+            self._sender.clear()
+            self._done.clear()
+            self._kept.clear()
 
 
 class _Rows(VectorEnv):

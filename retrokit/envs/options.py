@@ -69,6 +69,17 @@ def _max_episode_steps(value: object) -> int | None:
     return None if value is None else _integer("max_episode_steps", value, 1, MAX_STEPS)
 
 
+def finite_real(value: object) -> float | None:
+    """``value`` as a finite float, or ``None``: a bool, no real number, infinite, NaN, or an int past a float's range."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        return None
+    try:
+        number = float(value)
+    except OverflowError:  # float(10**400)
+        return None
+    return number if math.isfinite(number) else None
+
+
 def _sticky_prob(value: object) -> float:
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
         raise InvalidArgumentError(
@@ -192,10 +203,11 @@ def _reward_clip(value: object) -> bool | float:
     """False (off), True (the reward's sign, as Atari agents clip) or a bound c > 0 (clip to [-c, c])."""
     if isinstance(value, (bool, np.bool_)):
         return bool(value)
-    if isinstance(value, numbers.Real) and math.isfinite(float(value)) and float(value) > 0:
-        return float(value)
+    bound = finite_real(value)
+    if bound is not None and bound > 0:
+        return bound
     raise InvalidArgumentError(
-        f"Expected reward_clip to be False, True (the reward's sign) or a bound above 0, got {shown(value)}; "
+        f"Expected reward_clip to be False, True (the reward's sign) or a finite bound above 0, got {shown(value)}; "
         f"pass e.g. reward_clip=True or reward_clip=1.0."
     )
 

@@ -9,7 +9,6 @@ a name, a path, ``None`` or such a mapping): env ``i`` starts at the ``i``-th.
 
 from __future__ import annotations
 
-import math
 import numbers
 import os
 from collections.abc import Mapping, Sequence
@@ -17,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from retrokit.envs.options import finite_real
 from retrokit.errors import InvalidArgumentError, shown
 
 
@@ -42,10 +42,11 @@ def check_weights(state: Mapping[Any, Any]) -> dict[str, float]:
             raise InvalidArgumentError(
                 f"Expected the weight of state {os.fspath(name)!r} to be a number of 0 or more, got {shown(weight)}."
             )
-        value = float(weight)
-        if not (math.isfinite(value) and value >= 0):
+        value = finite_real(weight)
+        if value is None or value < 0:
             raise InvalidArgumentError(
-                f"Expected the weight of state {os.fspath(name)!r} to be a finite number of 0 or more, got {value}."
+                f"Expected the weight of state {os.fspath(name)!r} to be a finite number of 0 or more, got "
+                f"{shown(weight)}."
             )
         weights[os.fspath(name)] = value
     if sum(weights.values()) <= 0:
@@ -58,6 +59,7 @@ def check_weights(state: Mapping[Any, Any]) -> dict[str, float]:
 def probabilities(weights: Mapping[str, float]) -> np.ndarray:
     """The weights as probabilities that sum to 1."""
     values = np.array(list(weights.values()), dtype=np.float64)
+    values = values / values.max()  # first: weights near the float's limit would sum to infinity
     return values / values.sum()
 
 

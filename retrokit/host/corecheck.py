@@ -195,8 +195,9 @@ def probe_core(core: Path, system: str, rom: str | os.PathLike[str], *, timeout:
         )  # fmt: skip
     except subprocess.TimeoutExpired:
         return ProbeVerdict(False, f"it still ran {timeout:.0f} s after loading (it hangs)", lasting=False)
-    except OSError as exc:
-        return ProbeVerdict(False, f"the probe could not start: {exc.strerror or exc}", lasting=False)
+    except (OSError, subprocess.SubprocessError) as exc:  # a child that failed before it ran (its limits)
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        return ProbeVerdict(False, f"the probe could not start: {reason}", lasting=False)
     if done.returncode in (0, _REFUSED):
         return ProbeVerdict(True)
     if done.returncode < 0:
@@ -208,7 +209,20 @@ def probe_core(core: Path, system: str, rom: str | os.PathLike[str], *, timeout:
 
 def _child_limits() -> None:
     resource.setrlimit(resource.RLIMIT_CORE, (0, 0))  # a crashing probe leaves no core file
-    resource.setrlimit(resource.RLIMIT_AS, (PROBE_ADDRESS_SPACE, PROBE_ADDRESS_SPACE))
+    resource.setrlimit(resource.RLIMIT_AS, lowered(resource.RLIMIT_AS, PROBE_ADDRESS_SPACE))
+
+
+def lowered(kind: int, cap: int) -> tuple[int, int]:
+    """The limits ``kind`` may take to stay at or under ``cap``: never above the limits the user set already.
+
+    Raising a limit above the hard one fails (under ``ulimit -v``), and above
+    the soft one would undo what the user asked for.
+    """
+    soft, hard = resource.getrlimit(kind)
+    for limit in (soft, hard):
+        if limit != resource.RLIM_INFINITY:
+            cap = min(cap, limit)
+    return cap, cap
 
 
 def _verdict_file(digest: str) -> Path:

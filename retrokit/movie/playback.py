@@ -209,20 +209,20 @@ def _counted(screens: Iterator[np.ndarray], bar: tqdm) -> Iterator[np.ndarray]:
 
 
 def _output_kind(out: Path) -> str | None:
-    """Return ``".gif"`` or ``".mp4"`` for a video file, ``None`` for a folder of PNGs."""
+    """Return ``".gif"`` or ``".mp4"`` for a video file, ``None`` for a folder of PNGs.
+
+    Only ``.gif`` and ``.mp4`` name files: anything else is a folder, dots
+    and all (``out/Zone1.Act1`` is a folder named after a state).
+    """
     if out.is_dir():
         return None
     suffix = out.suffix.lower()
     if suffix in VIDEO_SUFFIXES:
         return suffix
-    if suffix:
-        raise InvalidArgumentError(
-            f"Expected the output to be a folder (for PNG frames), a .gif or an .mp4 file; found {str(out)!r}."
-        )
     if out.exists():
         raise InvalidArgumentError(
             f"Expected the output to be a folder (for PNG frames), a .gif or an .mp4 file; found {str(out)!r}, "
-            "a file without a suffix. Name a folder, or a file ending in .gif or .mp4."
+            "a file that is none of them. Name a folder, or a file ending in .gif or .mp4."
         )
     return None
 

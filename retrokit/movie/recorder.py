@@ -129,7 +129,8 @@ class MovieRecorder:
     exactly. stable-retro's own recordings begin with the frame its ``reset``
     runs with no buttons pressed.
 
-    Nothing recorded is lost to a process that ends badly: while it records,
+    Nothing recorded is lost to a process that ends badly: the movie (its
+    header and start state) is written when the recorder is made; while it records,
     the movie is written out whole (atomically, so the file is always a
     playable movie) every :data:`FLUSH_SECONDS`, so a process killed with
     SIGKILL leaves a movie of all but its last second; and a script that exits,
@@ -171,6 +172,7 @@ class MovieRecorder:
         self._layout = layout(self.movie.system)
         self._players = self.movie.players
         self._file = _MovieFile(path, self.movie, overwrite)
+        self._file.write()  # now: a recorder killed before its first flush leaves a movie that plays, not 0 bytes
         self._finalizer = weakref.finalize(self, self._file.write_at_exit)
         self._next_flush = time.monotonic() + FLUSH_SECONDS
         self._closed = False

@@ -103,7 +103,19 @@ def check_filter(op: str, value: int | None = None, than: str | int | None = Non
             raise InvalidArgumentError(f"Expected a whole number as the filter's {what}, got {number!r}.")
     value = None if value is None else int(value)  # numpy integers become plain ones
     than = int(than) if _is_int(than) else than
+    for what, number in (("number", value), ("address", than)):
+        # RAM holds at most 8-byte values at 64-bit addresses; a longer number cannot even be printed (Python
+        # refuses to turn more than 4,300 digits into text), so it is refused by its size, before any message.
+        if isinstance(number, int) and number.bit_length() > 64:
+            raise InvalidArgumentError(
+                f"Expected the filter's {what} to fit in 64 bits; got a number of {number.bit_length()} bits."
+            )
     if isinstance(than, str) and than.isdigit():
+        if len(than.lstrip("0")) > 20:
+            raise InvalidArgumentError(
+                f"Expected --than N to be a snapshot's number (retrokit ramsearch history lists them); got a number "
+                f"of {len(than)} digits."
+            )
         than = str(int(than))  # "007" is snapshot 7
     if op not in OPS:
         raise InvalidArgumentError(

@@ -7,7 +7,9 @@ written in the style of its neighbours (flow mapping, column of the values,
 hex addresses) and inserted after the last field, or in place of the field it
 replaces. Every other byte stays as it was. The result is parsed again and
 checked to hold exactly the old data plus the new field before it is written,
-through a temporary file renamed into place. A game.yaml that is a symlink is
+through a temporary file renamed into place, all under the folder's lock
+(:func:`retrokit.paths.locked`), so edits made at once by several commands
+and studios are each kept. A game.yaml that is a symlink is
 written through to the file it names, so the link stays and its target is
 the file updated.
 """
@@ -24,7 +26,7 @@ from typing import Any
 
 from retrokit.errors import DataFileError, FileConflictError, FileSystemError, InvalidArgumentError, shown
 from retrokit.host.typecodes import FieldType
-from retrokit.paths import atomic_write, require_regular_file
+from retrokit.paths import atomic_write, locked, require_regular_file
 
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 MAX_NAME = 64  # a field name is a scenario's variable: longer is a mistake (and YAML keys stop at 1024)
@@ -141,6 +143,14 @@ def add_field(
         DataFileError: The file is missing, is not YAML, or its ``fields`` is not a mapping.
     """
     check_field_name(name)
+    with locked(path):  # read, edit and write as one step: a writer beside us would lose this field, or we its
+        return _add_field(path, name, address, type_code, force, value_range)
+
+
+def _add_field(
+    path: str | os.PathLike[str], name: str, address: str, type_code: str, force: bool,
+    value_range: tuple[int, int] | None,
+) -> bool:
     path, text, doc, fields = _open_section(path, "fields")
     replaced = bool(fields) and name in fields
     if replaced and not force:
@@ -232,6 +242,11 @@ def set_default_state(path: str | os.PathLike[str], name: str) -> None:
         DataFileError: The file is missing or not YAML, its ``states`` is not a mapping, or its
             layout defeats a one-line edit.
     """
+    with locked(path):  # as add_field: the whole read-modify-write under the folder's lock
+        _set_default_state(path, name)
+
+
+def _set_default_state(path: str | os.PathLike[str], name: str) -> None:
     path, text, doc, states = _open_section(path, "states")
     value = _scalar(name)
     lines = text.splitlines(keepends=True)

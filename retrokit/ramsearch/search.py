@@ -39,7 +39,7 @@ from retrokit.data.states import StateRecord
 from retrokit.errors import DataFileError, FileConflictError, InvalidArgumentError, MovieError, SessionError, StateError
 from retrokit.host.emulator import Emulator
 from retrokit.host.typecodes import parse_type
-from retrokit.paths import atomic_write, wheel_dir
+from retrokit.paths import atomic_write, ensure_folder, locked, wheel_dir
 from retrokit.ramsearch import gamefile
 from retrokit.ramsearch.candidates import Candidate
 from retrokit.ramsearch.engine import Engine, list_candidates
@@ -512,9 +512,11 @@ class RamSearch:
         return game_file
 
     def _write_default_state(self, game_file: Path, name: str) -> None:
-        if not game_file.exists():
-            atomic_write(game_file, self.game.info.source.read_bytes())
-        gamefile.set_default_state(game_file, name)
+        ensure_folder(game_file.parent, "to write the game's game.yaml into")
+        with locked(game_file):  # two writers making the copy at once: the second edits the first's copy
+            if not game_file.exists():
+                atomic_write(game_file, self.game.info.source.read_bytes())
+            gamefile.set_default_state(game_file, name)
 
     def restart_inputs(self) -> None:
         """Begin the inputs played afresh from now, so :meth:`movie` records from this moment (a movie's start)."""

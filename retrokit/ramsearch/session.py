@@ -49,6 +49,7 @@ FORMAT = "retrokit-ramsearch-session"
 VERSION = 2  # 2: scale masks, and the inputs played
 MAX_FILE = 1 << 26  # 64 MiB compressed: a session of a thousand snapshots of 64 KiB takes a few
 MAX_UNPACKED = 1 << 28  # 256 MiB: a bigger archive is not one this tool wrote for a console's RAM
+MAX_META = 1 << 22  # 4 MiB of JSON: labels and filter names of tens of thousands of snapshots
 MAX_CANDIDATES = 1 << 27  # 4 MiB of RAM as 32 types: their flags and scales take 256 MiB
 _START = "Start a new search with: retrokit ramsearch new GAME"
 
@@ -219,6 +220,12 @@ def _decode(blob: bytes) -> SessionData:
         if unpacked > MAX_UNPACKED:
             raise SessionError(
                 f"expected a session of at most {MAX_UNPACKED >> 20} MiB unpacked; found {unpacked >> 20} MiB. {_START}"
+            )
+        meta_info = next((info for info in archive.infolist() if info.filename == "meta.npy"), None)
+        if meta_info is not None and meta_info.file_size > MAX_META:
+            raise SessionError(  # its JSON becomes Python objects, tens of times its size
+                f"expected a session's description (meta) of at most {MAX_META >> 20} MiB; found "
+                f"{meta_info.file_size:,} bytes. {_START}"
             )
         _check_arrays(archive)
     with np.load(io.BytesIO(blob), allow_pickle=False) as archive:

@@ -130,6 +130,9 @@ async def socket(websocket: WebSocket) -> None:
             text = await websocket.receive_text()
             try:
                 message = json.loads(text)
+                if isinstance(message, dict) and message.get("type") == "ack":  # the page handled this many
+                    subscriber.ack(message.get("received"))
+                    continue
                 reply = await handle_message(session, message)
             except (errors.RetrokitError, ValueError, RecursionError) as exc:
                 kind = type(exc).__name__ if isinstance(exc, errors.RetrokitError) else "InvalidArgumentError"
@@ -158,11 +161,15 @@ async def _send(websocket: WebSocket, subscriber: Subscriber) -> None:
                 if now - sent_at.get(kind, -1.0) < MESSAGE_PERIOD:
                     later.append(kind)
                     continue
+                if not subscriber.may_send():  # the page's ack wakes us: by then a newer one may replace it
+                    break
                 subscriber.messages.pop(kind, None)
                 sent_at[kind] = now
+                subscriber.sent += 1
                 await websocket.send_text(json.dumps(message, default=_plain))
-            screen, subscriber.screen = subscriber.screen, None  # after the messages: the status comes first
-            if screen is not None:
+            if subscriber.screen is not None and subscriber.may_send():  # after the messages: the status first
+                screen, subscriber.screen = subscriber.screen, None
+                subscriber.sent += 1
                 await websocket.send_bytes(pack_screen(screen))
             if later:  # come back for them when their period is over
                 loop.call_later(MESSAGE_PERIOD, subscriber.wake)

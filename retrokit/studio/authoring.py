@@ -79,7 +79,34 @@ async def validate_route(request: Request) -> Response:
     frames = expect(body, "frames", int, None)
     if frames is not None and not 1 <= frames <= MAX_VALIDATE_FRAMES:
         raise InvalidArgumentError(f"Expected 'frames' from 1 to {MAX_VALIDATE_FRAMES:,}, got {frames}.")
-    return JSONResponse(await asyncio.to_thread(validate, session_of(request), frames))
+    return JSONResponse(await in_daemon(validate, session_of(request), frames))
+
+
+async def in_daemon(fn: Any, *args: Any) -> Any:
+    """``fn(*args)`` on a daemon thread: Ctrl-C ends the studio at once, not after a validation's tens of seconds.
+
+    ``asyncio.to_thread``'s threads are joined when the interpreter exits, so
+    the studio waited for the validation to end before it stopped.
+    """
+    loop = asyncio.get_running_loop()
+    future = loop.create_future()
+
+    def settle(result: Any, exc: BaseException | None) -> None:
+        if not future.done():
+            future.set_exception(exc) if exc is not None else future.set_result(result)
+
+    def run() -> None:
+        try:
+            result, exc = fn(*args), None
+        except BaseException as error:  # noqa: BLE001 - handed to the awaiting request
+            result, exc = None, error
+        try:
+            loop.call_soon_threadsafe(settle, result, exc)
+        except RuntimeError:  # the loop closed: the studio is stopping, nobody waits for it
+            pass
+
+    threading.Thread(target=run, name="retrokit-studio-job", daemon=True).start()
+    return await future
 
 
 async def new_game_route(request: Request) -> Response:

@@ -2,7 +2,14 @@
 
 The session offers from its emulator thread; the page's WebSocket sender
 (:mod:`retrokit.studio.app`) awaits on the event loop and takes what is there,
-so a slow page skips screens instead of queueing them.
+so a slow page skips screens and messages instead of queueing them.
+
+A page that says how many messages it has handled (``{"type": "ack",
+"received": N}`` after each, as the studio's page does) is sent at most
+:data:`WINDOW` messages ahead of it. Without that, the operating system's and
+the browser's buffers between them hold many megabytes: a page slower than
+the game (a long candidates list to show, a loaded machine) fell seconds
+behind the server, and a Pause waited behind the backlog.
 """
 
 from __future__ import annotations
@@ -12,6 +19,11 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
+from retrokit.errors import InvalidArgumentError, shown
+
+WINDOW = 3
+"""The most messages (screens and JSON) sent to a page that acknowledges them and not yet handled there."""
 
 
 @dataclass
@@ -34,7 +46,26 @@ class Subscriber:
         self.loop = loop
         self.screen: Screen | None = None
         self.messages: dict[str, dict[str, Any]] = {}
+        self.sent = 0  # messages sent on the socket, screens included
+        self.acked: int | None = None  # how many of them the page says it handled; None: it does not say
         self._ready = asyncio.Event()
+
+    def ack(self, received: object) -> None:
+        """Note that the page has handled ``received`` messages (on the event loop's thread).
+
+        Raises:
+            InvalidArgumentError: ``received`` is not a whole number from 0 to the messages sent.
+        """
+        if isinstance(received, bool) or not isinstance(received, int) or not 0 <= received <= self.sent:
+            raise InvalidArgumentError(
+                f"Expected 'received' to be how many messages the page handled, 0 to {self.sent}; got {shown(received)}."
+            )
+        self.acked = max(self.acked or 0, received)
+        self._ready.set()
+
+    def may_send(self) -> bool:
+        """Whether another message may go now: always, to a page that does not acknowledge; else within the window."""
+        return self.acked is None or self.sent - self.acked < WINDOW
 
     def offer_screen(self, screen: Screen) -> None:
         """Make ``screen`` the next one to send (called from any thread)."""

@@ -44,7 +44,7 @@ from retrokit.errors import DataFileError, InvalidArgumentError, ScenarioError, 
 from retrokit.studio.app import session_of
 from retrokit.studio.fields import field_reader
 from retrokit.studio.search import Pacer
-from retrokit.studio.security import expect, json_body, resolve_path
+from retrokit.studio.security import check_inside, expect, game_roots, json_body, resolve_path
 
 if TYPE_CHECKING:
     from retrokit.studio.session import Session
@@ -95,7 +95,12 @@ def where(session: Session, name: object) -> Where:
         target, why_not = search.default_game_file().parent / f"{name}.yaml", None
     except DataFileError as exc:  # a shipped game: its scenarios compile and run, and are not saved
         target, why_not = None, str(exc)
-    return Where(game, name, game.scenarios.get(name), target, why_not)
+    place = Where(game, name, game.scenarios.get(name), target, why_not)
+    roots = game_roots(game)  # a planted link (the file, the drafts folder, game.yaml's) reaches nothing outside
+    for path, what in ((place.path, "scenario file"), (place.target, "scenario file"), (place.draft, "scenario draft")):
+        if path is not None:
+            check_inside(path, roots, what=what)
+    return place
 
 
 def _read_text(path: Path) -> str:

@@ -37,7 +37,7 @@ from retrokit.errors import InvalidArgumentError, RamSearchError, shown
 from retrokit.ramsearch.candidates import Candidate, list_groups
 from retrokit.ramsearch.filters import OPS, THAN_FORMS
 from retrokit.studio.app import session_of
-from retrokit.studio.security import expect, json_body
+from retrokit.studio.security import check_inside, expect, game_roots, json_body
 
 if TYPE_CHECKING:
     from retrokit.studio.session import Session
@@ -203,6 +203,7 @@ def save_field(session: Session, name: object, address: object, type_code: objec
         value_range = tuple(integer_of(v, "range") for v in value_range)
     search = session.search
     where = address_of(address)
+    check_inside(search.default_game_file(), game_roots(search.game), what="game.yaml")  # not a planted link
     path = search.save_field(name, where, type_code, force=force, value_range=value_range)
     search.reload_game()
     spec = search.game.fields[name]

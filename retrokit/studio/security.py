@@ -18,6 +18,7 @@ types, so hostile input ends in a 4xx JSON error, never a 500.
 
 from __future__ import annotations
 
+import asyncio
 import json
 import os
 import secrets
@@ -40,6 +41,8 @@ TOKEN_HEADER = "x-retrokit-token"
 MAX_BODY = 1 << 20
 """The largest request body, in bytes: a scenario or a game.yaml is far smaller."""
 _HOSTS = ("127.0.0.1", "localhost")
+NAME_MAX = 250
+"""The longest file name a request may give, in bytes: file systems hold 255, and the studio adds a suffix."""
 
 
 def new_token() -> str:
@@ -78,17 +81,27 @@ class Guard:
         headers = {k.decode("latin-1").lower(): v.decode("latin-1") for k, v in scope.get("headers", [])}
         problem = self._problem(scope, headers)
         if problem:
-            await _refuse(scope, receive, send, 403, problem, "AccessDeniedError")
+            sending = send if scope["type"] == "websocket" else self._with_headers(send, cookie=False)
+            await _refuse(scope, receive, sending, 403, problem, "AccessDeniedError")
             return
         if scope["type"] == "websocket":
             await self.app(scope, receive, send)
+            return
+        send = self._with_headers(send, cookie=_query_token(scope) is not None)
+        problem = _forged(scope["method"], headers, self.port)
+        if problem:
+            await _refuse(scope, receive, send, 403, problem, "AccessDeniedError")
             return
         length = headers.get("content-length", "0")
         if not length.isdigit() or int(length) > MAX_BODY:
             await _refuse(scope, receive, send, 413, _too_large(length), "RequestTooLargeError")
             return
-        query_token = _query_token(scope)
-        await self.app(scope, _capped(receive), self._with_cookie(send) if query_token else send)
+        try:
+            await self.app(scope, _capped(receive), send)
+        except asyncio.CancelledError:  # Ctrl-C cancels what still runs: a stop, not an error to print
+            if scope["type"] == "http":
+                return
+            raise
 
     def _problem(self, scope: Scope, headers: dict[str, str]) -> str:
         host = headers.get("host", "")
@@ -109,15 +122,72 @@ class Guard:
             )
         return ""
 
-    def _with_cookie(self, send: Send) -> Send:
-        cookie = f"{cookie_name(self.port)}={self.token}; Path=/; HttpOnly; SameSite=Strict".encode()
+    def _with_headers(self, send: Send, *, cookie: bool) -> Send:
+        """``send`` adding the security headers to every response, and the token cookie if ``cookie``."""
+        added = [(name.encode(), value.encode()) for name, value in security_headers(self.port).items()]
+        if cookie:
+            added.append((b"set-cookie", f"{cookie_name(self.port)}={self.token}; Path=/; HttpOnly; SameSite=Strict".encode()))
 
         async def sending(message: Message) -> None:
             if message["type"] == "http.response.start":
-                message = {**message, "headers": [*message.get("headers", []), (b"set-cookie", cookie)]}
+                message = {**message, "headers": [*message.get("headers", []), *added]}
             await send(message)
 
         return sending
+
+
+def security_headers(port: int) -> dict[str, str]:
+    """The headers on every HTTP response: no framing, no sniffing, no referrer, no cache; scripts only from the studio."""
+    sockets = " ".join(f"ws://{host}:{port}" for host in _HOSTS)
+    return {
+        "Content-Security-Policy": (
+            "default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; img-src 'self' data: blob:; "
+            f"connect-src 'self' {sockets}; object-src 'none'; base-uri 'none'; form-action 'self'; "
+            "frame-ancestors 'none'"
+        ),
+        "X-Content-Type-Options": "nosniff",
+        "Referrer-Policy": "no-referrer",
+        "Cache-Control": "no-store",
+        "X-Frame-Options": "DENY",  # frame-ancestors' older twin, for browsers without CSP level 2
+    }
+
+
+SAFE_METHODS = ("GET", "HEAD")
+"""Methods that change nothing: every other request must show it comes from the studio's own page."""
+
+
+def _forged(method: str, headers: dict[str, str], port: int) -> str:
+    """Why a state-changing request may come from another page (a forged one), or ``""``.
+
+    Another page on 127.0.0.1 (another port: the same *site*, so the browser
+    sends the token cookie) can post a form or a no-cors ``fetch``. Such a
+    request says where it comes from (``Sec-Fetch-Site``, ``Origin``), and it
+    can carry neither a custom header nor ``Content-Type: application/json``
+    without a CORS preflight, which the studio never grants. The page's
+    scripts send both.
+    """
+    if method in SAFE_METHODS:
+        return ""
+    site = headers.get("sec-fetch-site")
+    if site is not None and site not in ("same-origin", "none"):
+        return (
+            f"Expected a request from the studio's own page; found one from another page (Sec-Fetch-Site {shown(site)}). "
+            "Use the studio's page, or send the request without a browser."
+        )
+    origin = headers.get("origin")
+    if origin is not None and origin not in allowed_origins(port):
+        return (
+            f"Expected a request from the studio's page ({' or '.join(allowed_origins(port))}); found Origin "
+            f"{shown(origin)}. Use the studio's page."
+        )
+    content_type = headers.get("content-type", "").split(";")[0].strip().lower()
+    if not headers.get(TOKEN_HEADER) and content_type != "application/json":
+        return (
+            f"Expected a JSON request (Content-Type: application/json) or the {TOKEN_HEADER} header; found "
+            f"{'Content-Type ' + shown(content_type) if content_type else 'no Content-Type'}. "
+            "Send JSON, as the studio's page does."
+        )
+    return ""
 
 
 def _query_token(scope: Scope) -> str | None:
@@ -237,11 +307,23 @@ def resolve_path(name: str, base: Path, roots: Iterable[Path], *, what: str = "f
     if not isinstance(name, str) or not name:
         raise InvalidArgumentError(f"Expected a {what} name as a non-empty string, got {shown(name)}.")
     decoded = name
-    for _ in range(8):  # %25 nests: decode until the text is stable
-        step = unquote(decoded, errors="strict") if "%" in decoded else decoded
-        if step == decoded:
-            break
-        decoded = step
+    try:
+        for _ in range(8):  # %25 nests: decode until the text is stable
+            step = unquote(decoded, errors="strict") if "%" in decoded else decoded
+            if step == decoded:
+                break
+            decoded = step
+    except UnicodeDecodeError:
+        raise InvalidArgumentError(
+            f"Expected a {what} name in UTF-8; got {shown(name)}, whose percent-escapes are other bytes. "
+            "Name a file by its plain name."
+        ) from None
+    longest = max(len(part.encode("utf-8", "surrogatepass")) for part in decoded.replace("\\", "/").split("/"))
+    if longest > NAME_MAX:
+        raise InvalidArgumentError(
+            f"Expected a {what} name of at most {NAME_MAX} bytes (what a file system holds); got {shown(name)}, "
+            f"of {longest} bytes. Pick a shorter name."
+        )
     problem = _path_problem(decoded)
     allowed = [Path(os.path.realpath(r)) for r in roots]
     if not problem:
@@ -261,6 +343,8 @@ def _path_problem(text: str) -> str:
         return "is still percent-encoded after 8 rounds of decoding"
     if any(ord(c) < 32 or ord(c) == 127 for c in text):
         return "holds a NUL or a control character"
+    if any("\ud800" <= c <= "\udfff" for c in text):  # JSON's lone surrogates: no file name holds one
+        return "holds a character that is not UTF-8"
     if text.startswith(("/", "\\", "~")) or (len(text) > 1 and text[1] == ":"):
         return "is an absolute path"
     if any(part == ".." for part in text.replace("\\", "/").split("/")):

@@ -23,7 +23,7 @@ from retrokit import paths
 from retrokit.data.names import check_state_name
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean
 from retrokit.studio.app import session_of
-from retrokit.studio.security import expect, game_roots, json_body, resolve_path
+from retrokit.studio.security import check_inside, expect, game_roots, json_body, resolve_path
 from retrokit.studio.session import Session
 
 MOVIES = "movies"
@@ -100,6 +100,10 @@ def _save(session: Session, name: str, default: bool, force: bool) -> dict[str, 
 
 
 def _set_default(session: Session, name: str) -> dict[str, Any]:
+    from retrokit.data.integrate import target_folder
+
+    game = session.search.game
+    check_inside(target_folder(game) / "game.yaml", roots(session), what="game.yaml")  # not a planted link
     written = session.search.set_default_state(name)
     session.refresh_game()
     return {"game_file": str(written), **list_states(session)}

@@ -65,18 +65,14 @@ export function connect() {
     for (const text of queue) ws.send(text);
     queue = [];
   });
+  let received = 0; // messages handled on this socket: the server sends only a few ahead of it (push.py)
+  const socket = ws;
   ws.addEventListener("message", (event) => {
-    if (typeof event.data === "string") {
-      let message;
-      try {
-        message = JSON.parse(event.data);
-      } catch {
-        return; // not ours to show
-      }
-      if (message && typeof message.type === "string") emit(message.type, message);
-    } else if (screenListener) {
-      const screen = decodeScreen(event.data);
-      if (screen) screenListener(screen);
+    try {
+      handle(event);
+    } finally {
+      received += 1;
+      if (socket.readyState === WebSocket.OPEN) socket.send(JSON.stringify({ type: "ack", received }));
     }
   });
   ws.addEventListener("close", (event) => {
@@ -85,4 +81,20 @@ export function connect() {
     setTimeout(connect, retry);
     retry = Math.min(retry * 2, 5000);
   });
+}
+
+/** Hand one message to its listeners: a screen to the screen's, JSON to its type's. */
+function handle(event) {
+  if (typeof event.data === "string") {
+    let message;
+    try {
+      message = JSON.parse(event.data);
+    } catch {
+      return; // not ours to show
+    }
+    if (message && typeof message.type === "string") emit(message.type, message);
+  } else if (screenListener) {
+    const screen = decodeScreen(event.data);
+    if (screen) screenListener(screen);
+  }
 }

@@ -1,0 +1,92 @@
+"""Writers that race on one game.yaml: every edit a command or a studio acknowledged is in the file after.
+
+Each writer reads game.yaml, inserts its line and writes the file back; two
+that read it at once would each write a file missing the other's line, so
+every read-modify-write holds the folder's lock (retrokit.paths.locked).
+The writers are real processes started together: 10 ``retrokit ramsearch
+save`` commands, and two studios on one game adding 15 fields each.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import pytest
+import yaml
+
+from studioproc import StudioProcess
+
+REPO = Path(__file__).resolve().parent.parent
+DASHER = REPO / "games" / "Dasher-Genesis"
+
+pytestmark = pytest.mark.timeout(600)
+
+
+@pytest.fixture
+def game(tmp_path: Path) -> Path:
+    """A copy of Dasher's folder, found by name through RETROKIT_GAMES."""
+    folder = tmp_path / "games" / "Dasher-Genesis"
+    shutil.copytree(DASHER, folder)
+    return folder
+
+
+def fields_of(game: Path) -> dict:
+    return yaml.safe_load((game / "game.yaml").read_text())["fields"]
+
+
+def test_ten_ramsearch_saves_at_once_each_keep_their_field(tmp_path, game):
+    env = {**os.environ, "RETROKIT_GAMES": str(game.parent), "RETROKIT_DATA": str(tmp_path / "data")}
+    before = fields_of(game)
+    made = subprocess.run(
+        [sys.executable, "-m", "retrokit", "ramsearch", "new", "Dasher-Genesis", "--state", "Zone1.Act1"],
+        cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120, check=False,
+    )  # fmt: skip
+    assert made.returncode == 0, made.stderr
+    writers = [
+        subprocess.Popen(
+            [sys.executable, "-m", "retrokit", "ramsearch", "save", f"found_{i}", hex(0xFF0100 + i), "|u1"],
+            cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        )  # fmt: skip
+        for i in range(10)
+    ]
+    for writer in writers:
+        out, err = writer.communicate(timeout=300)
+        assert writer.returncode == 0 and out.startswith("Wrote field"), err
+    after = fields_of(game)
+    assert {name: after[name] for name in before} == before  # nothing of the author's lost
+    assert sorted(set(after) - set(before)) == sorted(f"found_{i}" for i in range(10))
+    assert all(after[f"found_{i}"] == {"address": 0xFF0100 + i, "type": "|u1"} for i in range(10))
+
+
+def test_two_studios_on_one_game_keep_every_field_either_added(tmp_path, game):
+    studios = [StudioProcess(game, tmp_path / "data", tmp_path) for _ in range(2)]
+    failures: list[str] = []
+
+    def add(studio: StudioProcess, which: int) -> None:
+        for i in range(15):
+            name = f"s{which}_field_{i}"
+            status, body, _ = studio.request(
+                "POST", "/api/search/field", {"name": name, "address": 0xFF0200 + 16 * which + i, "type": "|u1"}
+            )
+            if status != 200:
+                failures.append(f"{name}: {status} {body}")
+
+    try:
+        threads = [threading.Thread(target=add, args=(studio, n)) for n, studio in enumerate(studios)]
+        for thread in threads:
+            thread.start()
+        for thread in threads:
+            thread.join(timeout=300)
+    finally:
+        errors = [studio.stop() for studio in studios]
+    assert not failures, failures
+    assert all("Traceback" not in err for err in errors), errors
+    after = fields_of(game)
+    added = {name: spec for name, spec in after.items() if "_field_" in name}
+    assert len(added) == 30
+    assert all(added[f"s{w}_field_{i}"]["address"] == 0xFF0200 + 16 * w + i for w in range(2) for i in range(15))

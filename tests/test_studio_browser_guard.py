@@ -1,0 +1,182 @@
+"""The studio in headless Chromium against another local page, and a fresh studio's canvas (issue 31, items 1 and 7).
+
+Another page served from 127.0.0.1 on another port is the same *site* as the
+studio, so the browser sends it the studio's token cookie: a form posted as
+``text/plain`` or a no-cors ``fetch`` from it reached the studio's routes.
+Here a second local server serves such pages to the same browser that opened
+the studio, and the studio must refuse them, change nothing, and keep every
+response out of frames.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import http.server
+import shutil
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from chromium import chrome, until  # first: it skips this module where Chromium is missing
+from selenium import webdriver
+from selenium.webdriver.common.action_chains import ActionChains
+from selenium.webdriver.common.by import By
+from selenium.webdriver.common.keys import Keys
+from studioproc import StudioProcess
+
+REPO = Path(__file__).resolve().parent.parent
+DASHER = REPO / "games" / "Dasher-Genesis"
+pytestmark = pytest.mark.timeout(900)
+
+
+@pytest.fixture
+def studio(tmp_path: Path) -> Iterator[StudioProcess]:
+    shutil.copytree(DASHER, tmp_path / "Dasher-Genesis")
+    server = StudioProcess(tmp_path / "Dasher-Genesis", tmp_path / "data", tmp_path)
+    yield server
+    err = server.stop()
+    assert "Traceback" not in err, err
+
+
+@pytest.fixture
+def browser() -> Iterator[webdriver.Chrome]:
+    with chrome() as driver:
+        yield driver
+
+
+def open_studio(driver: webdriver.Chrome, studio: StudioProcess) -> None:
+    driver.get(studio.url)
+    until("the page to start", lambda: driver.execute_script("return document.body.dataset.ready"))
+    until("the socket", lambda: driver.find_element(By.ID, "connection").text == "connected")
+
+
+# --- another local page ----------------------------------------------------------------------------------
+
+ATTACKS = {
+    # A form posts text/plain whose body reads as JSON: {"value": 4, "x": "="}
+    "form.html": """<form id=f method=POST enctype=text/plain action="{studio}/api/play/speed">
+<input name='{{"value": 4, "x": "' value='"}}'></form><script>document.getElementById("f").submit()</script>""",
+    # A no-cors fetch, with the cookie: text/plain, and a Blob with no type at all.
+    "fetch.html": """<script>
+const post = (route, body) => fetch("{studio}/api/" + route, {{method: "POST", mode: "no-cors",
+  credentials: "include", body}});
+Promise.allSettled([
+  post("states/save", JSON.stringify({{name: "Planted"}})),
+  post("states/save", new Blob([JSON.stringify({{name: "Planted2"}})])),
+  post("play/speed", JSON.stringify({{value: 8}})),
+]).then(() => {{ document.title = "sent"; }});
+</script>""",
+    "frame.html": """<iframe id=f src="{studio_url}" width=600 height=400></iframe>""",
+}
+
+
+@pytest.fixture
+def other_page(tmp_path: Path, studio: StudioProcess) -> Iterator[str]:
+    """A second local server, on another port of 127.0.0.1, serving pages that try to drive the studio."""
+    folder = tmp_path / "other"
+    folder.mkdir()
+    for name, page in ATTACKS.items():
+        (folder / name).write_text(page.format(studio=studio.origin, studio_url=studio.url))
+
+    class Quiet(http.server.SimpleHTTPRequestHandler):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, directory=str(folder), **kwargs)
+
+        def log_message(self, *args) -> None:
+            pass
+
+    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Quiet)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    try:
+        yield f"http://127.0.0.1:{server.server_address[1]}"
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+def test_another_local_page_cannot_drive_the_studio(browser, studio, other_page, tmp_path):
+    open_studio(browser, studio)  # the browser now holds the token cookie, as the user's does
+    assert studio.request("GET", "/api/status")[1]["speed"] == 1
+    browser.get(f"{other_page}/form.html")
+    until("the form's answer", lambda: "/api/play/speed" in browser.current_url and browser.page_source)
+    assert "AccessDeniedError" in browser.page_source
+    browser.get(f"{other_page}/fetch.html")
+    until("the fetches to settle", lambda: browser.title == "sent")
+    assert studio.request("GET", "/api/status")[1]["speed"] == 1  # no speed changed
+    made = [p.name for p in tmp_path.rglob("Planted*")]
+    assert not made, made  # no state saved
+    # In a frame of another page, the studio's page is not shown at all.
+    browser.get(f"{other_page}/frame.html")
+    browser.switch_to.frame(until("the frame", lambda: browser.find_element(By.ID, "f")))
+    until("the frame to settle", lambda: browser.execute_script("return document.readyState") == "complete")
+    assert not browser.find_elements(By.ID, "screen")
+    browser.switch_to.default_content()
+    # The studio's own page still works under its content security policy.
+    open_studio(browser, studio)
+    browser.find_element(By.ID, "speed").send_keys("2")
+    until("the speed to change from the page", lambda: studio.request("GET", "/api/status")[1]["speed"] == 2)
+
+
+def test_every_response_carries_the_security_headers(studio):
+    for method, route, body in (("GET", "/", None), ("GET", "/api/status", None), ("POST", "/api/play/pause", {}),
+                                ("GET", "/api/nowhere", None)):  # fmt: skip
+        _, _, headers = studio.request(method, route, body)
+        assert "frame-ancestors 'none'" in headers["content-security-policy"], (route, headers)
+        assert headers["x-content-type-options"] == "nosniff"
+        assert headers["referrer-policy"] == "no-referrer"
+        assert headers["cache-control"] == "no-store"
+
+
+@pytest.mark.parametrize(
+    "headers, status",
+    [
+        ({"Origin": "http://127.0.0.1:9"}, 403),
+        ({"Sec-Fetch-Site": "same-site"}, 403),
+        ({"Sec-Fetch-Site": "cross-site"}, 403),
+        ({"Origin": "null"}, 403),
+        ({"Sec-Fetch-Site": "same-origin"}, 200),
+    ],
+    ids=["other-origin", "same-site", "cross-site", "null-origin", "same-origin"],
+)
+def test_a_state_change_must_come_from_the_studios_own_origin(studio, headers, status):
+    assert studio.request("POST", "/api/play/pause", {}, headers)[0] == status
+
+
+def test_a_state_change_without_the_token_header_must_be_json(studio):
+    cookie = {"X-Retrokit-Token": None, "Cookie": f"retrokit-studio-{studio.origin.rsplit(':', 1)[1]}={studio.token}"}
+    assert studio.request("POST", "/api/play/pause", {}, {**cookie, "Content-Type": "text/plain"})[0] == 403
+    assert studio.request("POST", "/api/play/pause", {}, {**cookie, "Content-Type": "application/json"})[0] == 200
+
+
+# --- a fresh studio's canvas -------------------------------------------------------------------------------
+
+
+def canvas_hash(driver: webdriver.Chrome) -> str:
+    return hashlib.sha1(driver.execute_script("return document.getElementById('screen').toDataURL()").encode()).hexdigest()
+
+
+def test_a_fresh_studio_draws_what_is_played(browser, studio):
+    """Open a fresh studio and play at once, without Reset or Resume: the canvas shows the game moving."""
+    open_studio(browser, studio)
+    until("a first picture", lambda: int(browser.find_element(By.ID, "screen").get_attribute("data-frame") or 0) > 0)
+    first = canvas_hash(browser)
+    start = studio.request("GET", "/api/screen.png")[1]
+    browser.find_element(By.ID, "screen").click()
+    ActionChains(browser).key_down(Keys.ARROW_RIGHT).perform()
+    try:
+        until("the RIGHT button to light up",
+              lambda: "held" in browser.find_element(By.CSS_SELECTOR, '[data-button="RIGHT"]').get_attribute("class"))
+        until("the server's frames to run on", lambda: studio.request("GET", "/api/status")[1]["frame"] > 300)
+        until("the canvas to show another picture", lambda: canvas_hash(browser) != first)
+    finally:
+        ActionChains(browser).key_up(Keys.ARROW_RIGHT).perform()
+    assert studio.request("GET", "/api/screen.png")[1] != start
+
+    def close_behind() -> bool:
+        # The canvas is at most a second of frames behind the server, however long it played.
+        page = int(browser.find_element(By.ID, "screen").get_attribute("data-frame"))
+        return studio.request("GET", "/api/status")[1]["frame"] - page < 60
+
+    until("the canvas to keep up with the server", close_behind)

@@ -1,0 +1,45 @@
+"""Ctrl-C during a validation ends the studio at once and cleanly (issue 31 item 6, validation).
+
+The studio used to wait for the validation to end (28 s), then print a
+CancelledError traceback.
+"""
+
+from __future__ import annotations
+
+import shutil
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from studioproc import StudioProcess
+
+DASHER = Path(__file__).resolve().parent.parent / "games" / "Dasher-Genesis"
+
+pytestmark = pytest.mark.timeout(600)
+
+
+def test_ctrl_c_during_a_validation_stops_the_studio_at_once(tmp_path):
+    shutil.copytree(DASHER, tmp_path / "Dasher-Genesis")
+    studio = StudioProcess(tmp_path / "Dasher-Genesis", tmp_path / "data", tmp_path)
+    try:
+        long_one = threading.Thread(
+            target=studio.request, args=("POST", "/api/validate", {"frames": 100_000}), daemon=True
+        )
+        long_one.start()
+        deadline = time.monotonic() + 400  # a short validation of ours may run first: a loaded machine takes minutes
+        while True:  # under way once a second one is refused as running
+            status, body, _ = studio.request("POST", "/api/validate", {"frames": 1})
+            if status >= 400 and "one is running" in str(body):
+                break
+            assert time.monotonic() < deadline, (status, body)
+        asked = time.monotonic()
+        err = studio.stop(timeout=60)
+        took = time.monotonic() - asked
+    finally:
+        if studio.process.poll() is None:
+            studio.process.kill()
+    assert studio.process.returncode == 0, err
+    assert "Traceback" not in err and "CancelledError" not in err, err
+    assert took < 10, f"Ctrl-C took {took:.1f} s"  # the validation alone runs for minutes

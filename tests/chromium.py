@@ -23,8 +23,8 @@ if CHROMIUM is None or CHROMEDRIVER is None:
         allow_module_level=True,
     )
 
-from selenium import webdriver  # noqa: E402 - only once it is known to be there
-from selenium.webdriver.chrome.service import Service  # noqa: E402
+from selenium import webdriver
+from selenium.webdriver.chrome.service import Service
 
 
 @contextlib.contextmanager

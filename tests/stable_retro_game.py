@@ -24,8 +24,8 @@ import numpy as np
 
 from retrokit.data.games import Game
 from retrokit.data.roms import rom_sha1
-from retrokit.data.states import read_state
 from retrokit.data.statecheck import load_state
+from retrokit.data.states import read_state
 from retrokit.dsl.scenario import load_scenario
 from retrokit.host.emulator import Emulator
 from retrokit.host.memory import FieldReader

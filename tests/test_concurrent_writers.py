@@ -18,7 +18,6 @@ from pathlib import Path
 
 import pytest
 import yaml
-
 from studioproc import StudioProcess
 
 REPO = Path(__file__).resolve().parent.parent
@@ -51,7 +50,7 @@ def test_ten_ramsearch_saves_at_once_each_keep_their_field(tmp_path, game):
         subprocess.Popen(
             [sys.executable, "-m", "retrokit", "ramsearch", "save", f"found_{i}", hex(0xFF0100 + i), "|u1"],
             cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        )  # fmt: skip
+        )
         for i in range(10)
     ]
     for writer in writers:

@@ -76,9 +76,10 @@ def test_press_names_buttons_in_gym_retros_order() -> None:
     env = retrokit.make(AIRSTRIKER, action_type="all")
     assert env.actions.press(["B", "RIGHT", "Z"]).tolist() == [1, 0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1]
     env.close()
-    env = retrokit.make(AIRSTRIKER, action_type="discrete")
-    with pytest.raises(InvalidArgumentError, match="by index"):
-        env.actions.press(["B"])
+    env = retrokit.make(AIRSTRIKER, action_type="discrete")  # the index of the combination, as JERK presses it
+    assert env.get_action_meaning(env.actions.press(["B"])) == ["B"]
+    with pytest.raises(InvalidArgumentError, match="one listed combination of each group"):
+        env.actions.press(["UP", "DOWN"])
     env.close()
 
 

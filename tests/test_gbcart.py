@@ -14,7 +14,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-
 from cartgame import ALIVE, DYING, CartGame, game_fields, lose_every_life, ram_h_fields, run_into_goal, start_selected
 
 REPO = Path(__file__).resolve().parent.parent

@@ -81,8 +81,11 @@ def test_a_fifo_named_on_the_command_line_is_skipped(tmp_path: Path) -> None:
     assert "not a regular file" in child.stdout, child.describe()
 
 
-def test_import_shows_a_progress_bar(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_import_shows_a_progress_bar_on_a_terminal(tmp_path: Path, capsys, monkeypatch) -> None:
+    from retrokit.benchmark import progress
     from retrokit.cli import main
+
+    monkeypatch.setattr(progress, "is_terminal", lambda: True)  # capsys is no terminal; tests/test_cli_pipes.py: no bar
 
     folder = tmp_path / "roms"
     folder.mkdir()

@@ -14,8 +14,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from cartgame import (
+    ABSENT,
+    ALIVE,
+    DYING,
+    CartGame,
+    game_fields,
+    lose_every_life,
+    ram_h_fields,
+    run_into_goal,
+    start_selected,
+)
 
-from cartgame import ABSENT, ALIVE, DYING, CartGame, game_fields, lose_every_life, ram_h_fields, run_into_goal, start_selected
 from retrokit.data.roms import rom_sha1
 from retrokit.host.systems import get_system
 
@@ -83,7 +93,7 @@ def test_game_yaml_and_crt0_addresses_match_ram_h() -> None:
     for name, (address, _) in FIELDS.items():
         assert name in known, f"game.yaml field {name!r} is not in src/ram.h"
         assert address == known[name], f"{name}: game.yaml says {address:#x}, src/ram.h {known[name]:#x}"
-    crt0 = re.findall(r"^(ADDR_\w+)\s*=\s*\$([0-9A-Fa-f]+)", (CART_DIR / "src" / "crt0.s").read_text(), re.M)
+    crt0 = re.findall(r"^(ADDR_\w+)\s*=\s*\$([0-9A-Fa-f]+)", (CART_DIR / "src" / "crt0.s").read_text(), re.MULTILINE)
     assert len(crt0) >= 8
     for name, value in crt0:
         assert int(value, 16) == known[name[len("ADDR_"):].lower()], f"crt0.s {name} disagrees with src/ram.h"
@@ -208,7 +218,7 @@ def _near_first_crawler(game: Hopper) -> tuple[int, int]:
 
 
 def test_landing_on_a_crawler_defeats_it(playing: Hopper) -> None:
-    x, y = _near_first_crawler(playing)
+    _x, y = _near_first_crawler(playing)
     playing["p1_x"], playing["p1_y"] = playing.enemy(0, 0, "<u2"), y - 30  # drop onto it from above
     playing.run_until(lambda: playing.enemy(0, 7) == 0, limit=60)
     assert playing["p1_state"] == ALIVE and playing["p1_vy"] < 0, "the player bounces off"

@@ -184,9 +184,9 @@ def test_max_pool_with_the_sonic_presets_rules_equals_gymnasiums_wrappers_over_f
         diff = np.abs(obs.astype(int) - as_native(expected, False).astype(int))
         assert diff.max() <= 1, f"step {step} differs by {diff.max()} at {np.argwhere(diff > 1)[:4]}"
         buttons.masks.clear()
-        obs, reward, terminated, truncated, _ = native.step(native.action_space.sample())
+        obs, reward, terminated, _truncated, _ = native.step(native.action_space.sample())
         frames = [((mask >> np.arange(width)) & 1).astype(np.int8) for mask in buttons.masks]
-        expected, ref_reward, ref_terminated, ref_truncated, info = ref.step(frames)
+        expected, ref_reward, ref_terminated, _ref_truncated, info = ref.step(frames)
         assert (reward, terminated, info["frames"]) == (ref_reward, ref_terminated, len(frames))
         if terminated:
             episodes += 1

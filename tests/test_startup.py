@@ -31,7 +31,7 @@ def run_python(code: str, env: dict[str, str] | None = None) -> str:
     """Run ``code`` in a fresh interpreter; return its stdout (the test fails with its stderr if it fails)."""
     done = subprocess.run(
         [sys.executable, "-c", textwrap.dedent(code)],
-        capture_output=True, text=True, timeout=300, env={**os.environ, **(env or {})}, cwd=REPO,
+        capture_output=True, text=True, timeout=300, env={**os.environ, **(env or {})}, cwd=REPO, check=False,
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     return done.stdout

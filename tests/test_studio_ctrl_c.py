@@ -6,13 +6,13 @@ CancelledError traceback.
 
 from __future__ import annotations
 
+import re
 import shutil
 import threading
 import time
 from pathlib import Path
 
 import pytest
-
 from studioproc import StudioProcess
 
 DASHER = Path(__file__).resolve().parent.parent / "games" / "Dasher-Genesis"
@@ -21,8 +21,11 @@ pytestmark = pytest.mark.timeout(600)
 
 
 def test_ctrl_c_during_a_validation_stops_the_studio_at_once(tmp_path):
-    shutil.copytree(DASHER, tmp_path / "Dasher-Genesis")
-    studio = StudioProcess(tmp_path / "Dasher-Genesis", tmp_path / "data", tmp_path)
+    game = shutil.copytree(DASHER, tmp_path / "Dasher-Genesis")
+    # A scenario that never ends an episode: validate's smoke run then plays all its frames on every state (minutes).
+    scenario = game / "scenario.yaml"
+    scenario.write_text(re.sub(r"^done: .*$", "done: frame < 0", scenario.read_text(), flags=re.MULTILINE))
+    studio = StudioProcess(game, tmp_path / "data", tmp_path)
     try:
         long_one = threading.Thread(
             target=studio.request, args=("POST", "/api/validate", {"frames": 100_000}), daemon=True

@@ -14,7 +14,6 @@ import time
 from pathlib import Path
 
 import pytest
-
 from studioproc import StudioProcess
 
 websockets = pytest.importorskip("websockets.sync.client", reason="websockets is not installed")

@@ -111,11 +111,11 @@ def test_each_cartridge_proves_its_system_and_each_proof_exists() -> None:
 
 def systems_page() -> dict[str, dict[str, str]]:
     """docs/systems.md: each system's table, row name -> text."""
-    sections = re.split(r"^## ", (REPO / "docs" / "systems.md").read_text(), flags=re.M)[1:]
+    sections = re.split(r"^## ", (REPO / "docs" / "systems.md").read_text(), flags=re.MULTILINE)[1:]
     out = {}
     for section in sections:
         name, _, body = section.partition("\n")
-        out[name.strip()] = dict(re.findall(r"^\| ([^|]+?) \| (.+) \|$", body, flags=re.M))
+        out[name.strip()] = dict(re.findall(r"^\| ([^|]+?) \| (.+) \|$", body, flags=re.MULTILINE))
     return out
 
 

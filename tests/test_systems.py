@@ -28,23 +28,23 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from stable_retro_game import Integration, pressed, wandering, write_integration
 
 import retrokit
 from retrokit.cli import main
 from retrokit.data.games import Game, find_game
 from retrokit.data.statecheck import load_state
-from retrokit.data.states import StateRecord, read_state, write_state
+from retrokit.data.states import StateRecord, write_state
 from retrokit.host.emulator import Emulator
+from retrokit.host.fields import FieldSpec
 from retrokit.host.memory import FieldReader
 from retrokit.host.systems import all_systems
-from retrokit.host.fields import FieldSpec
 from retrokit.movie import layout, play, read_bk2
 from retrokit.paths import wheel_dir
 from retrokit.ramsearch import RamSearch
 from retrokit.ramsearch.engine import Engine
 from retrokit.ramsearch.scales import SCALES
 from retrokit.ramsearch.types import search_type
-from stable_retro_game import Integration, pressed, wandering, write_integration
 
 stable_retro = pytest.importorskip("stable_retro")
 

@@ -17,6 +17,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from selenium.webdriver.common.by import By
+from selenium.webdriver.common.keys import Keys
 from test_studio_browser import Page, Studio, browser, click_pixel, until  # noqa: F401 (browser: a fixture)
 
 from retrokit.data.games import find_game
@@ -26,9 +28,6 @@ from retrokit.host.memory import FieldReader
 from retrokit.ramsearch import RamSearch
 from retrokit.ramsearch.ram import RamLayout
 from retrokit.studio.play import key_map
-
-from selenium.webdriver.common.by import By  # noqa: E402 (after test_studio_browser's skip)
-from selenium.webdriver.common.keys import Keys  # noqa: E402
 
 REPO = Path(__file__).resolve().parent.parent
 CARTRIDGES = list(yaml.safe_load((REPO / "tools" / "cartridges.yaml").read_text()))

@@ -21,11 +21,11 @@ import yaml
 REPO = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(REPO / "tests"))  # the integration writer the system tests use
 
-import stable_retro  # noqa: E402
-from stable_retro_game import pressed, wandering, write_integration  # noqa: E402
+import stable_retro
+from stable_retro_game import pressed, wandering, write_integration
 
-import retrokit  # noqa: E402
-from retrokit.data.games import find_game  # noqa: E402
+import retrokit
+from retrokit.data.games import find_game
 
 
 def rate(env, steps: int, buttons: list, source, frameskip: int) -> float:

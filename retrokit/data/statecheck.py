@@ -21,7 +21,6 @@ import os
 from pathlib import Path
 
 from retrokit import paths
-
 from retrokit.data.games import Game, cached_rom_sha1, load_game
 from retrokit.data.probe import remember
 from retrokit.data.probe import vet_state as _vet

@@ -18,9 +18,9 @@ import numpy as np
 
 from retrokit.errors import InvalidArgumentError
 from retrokit.host.typecodes import FieldType
-from retrokit.ramsearch.types import search_type
 from retrokit.ramsearch.ram import RamLayout
 from retrokit.ramsearch.scales import ALL_SCALES, MASK_DTYPE, UNPINNED
+from retrokit.ramsearch.types import search_type
 
 
 @dataclass(frozen=True)

@@ -144,12 +144,12 @@ def add_field(
     """
     check_field_name(name)
     with locked(path):  # read, edit and write as one step: a writer beside us would lose this field, or we its
-        return _add_field(path, name, address, type_code, force, value_range)
+        return _add_field(path, name, address, type_code, force, value_range, mask)
 
 
 def _add_field(
     path: str | os.PathLike[str], name: str, address: str, type_code: str, force: bool,
-    value_range: tuple[int, int] | None,
+    value_range: tuple[int, int] | None, mask: int | None,
 ) -> bool:
     path, text, doc, fields = _open_section(path, "fields")
     replaced = bool(fields) and name in fields

@@ -103,3 +103,13 @@ def studio_session(studio_game: Path):
     session = Session(str(studio_game), "Zone1.Act1", grace=0.5)
     yield session
     session.close()
+
+
+@pytest.fixture(scope="session")
+def wheel() -> Path:
+    """The stable-retro wheel's own Genesis Plus GX, which the patched build is compared against."""
+    from retrokit.host.cores import wheel_core
+
+    path = wheel_core("genesis_plus_gx")
+    assert path is not None, "the stable-retro wheel ships genesis_plus_gx"
+    return path

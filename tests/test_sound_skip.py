@@ -23,7 +23,7 @@ import retrokit
 from retrokit.data.games import find_game
 from retrokit.data.statecheck import vet_state
 from retrokit.host import build
-from retrokit.host.cores import CORES_ENV, built_core, stable_retro_version, wheel_core
+from retrokit.host.cores import CORES_ENV, built_core, stable_retro_version
 from retrokit.host.emulator import Emulator
 from retrokit.host.statelayout import GENESIS_Z80_BANK
 from retrokit.movie.bk2 import read_bk2
@@ -46,13 +46,6 @@ def patched():
     if found is None or current is None:
         pytest.skip("the patched Genesis Plus GX is not built with today's patch: run `retrokit build-core genesis_plus_gx`")
     return found.path
-
-
-@pytest.fixture(scope="module")
-def wheel():
-    path = wheel_core("genesis_plus_gx")
-    assert path is not None, "the stable-retro wheel ships genesis_plus_gx"
-    return path
 
 
 def starts(airstriker_dir) -> dict[str, tuple]:

@@ -17,7 +17,7 @@ import pytest
 import retrokit
 from retrokit.data.games import find_game
 from retrokit.errors import InvalidArgumentError
-from retrokit.host.cores import CORES_ENV, built_core, wheel_core
+from retrokit.host.cores import CORES_ENV, built_core
 from retrokit.host.emulator import Emulator
 
 FRAMES = 10_000
@@ -32,13 +32,6 @@ def patched():
     if found is None:
         pytest.skip("the patched Genesis Plus GX is not built: run `retrokit build-core genesis_plus_gx` (CI does)")
     return found.path
-
-
-@pytest.fixture(scope="module")
-def wheel():
-    path = wheel_core("genesis_plus_gx")
-    assert path is not None, "the stable-retro wheel ships genesis_plus_gx"
-    return path
 
 
 def make_env(monkeypatch: pytest.MonkeyPatch, core, game: str, state: str | None = None, **options):

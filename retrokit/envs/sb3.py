@@ -18,13 +18,14 @@ This module imports ``stable_baselines3``: it is loaded only by
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from stable_baselines3.common.vec_env import VecEnv
 from stable_baselines3.common.vec_env.base_vec_env import VecEnvIndices, VecEnvStepReturn
 
-from retrokit.envs.vector import ThreadedVectorEnv
+if TYPE_CHECKING:  # a name for the annotations only: vector imports this module, in to_sb3
+    from retrokit.envs.vector import ThreadedVectorEnv
 
 
 def _env_infos(infos: dict[str, Any], count: int) -> list[dict[str, Any]]:

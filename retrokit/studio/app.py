@@ -33,8 +33,9 @@ from starlette.staticfiles import StaticFiles
 from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from retrokit import errors
+from retrokit.studio.play import handle_message
 from retrokit.studio.push import Screen, Subscriber
-from retrokit.studio.security import Guard
+from retrokit.studio.security import Guard, session_of
 from retrokit.studio.session import Session
 
 ROUTE_MODULES: tuple[str, ...] = (
@@ -69,11 +70,6 @@ def error_response(exc: BaseException) -> JSONResponse:
     """The JSON error of an exception, with its status."""
     status = next((code for kind, code in _STATUS if isinstance(exc, kind)), 400)
     return JSONResponse({"error": str(exc), "kind": type(exc).__name__}, status_code=status)
-
-
-def session_of(request: Request | WebSocket) -> Session:
-    """The session a request is for."""
-    return request.app.state.session
 
 
 def create_app(session: Session, *, token: str, port: int) -> Starlette:
@@ -118,8 +114,6 @@ def create_app(session: Session, *, token: str, port: int) -> Starlette:
 
 async def socket(websocket: WebSocket) -> None:
     """``/ws``: screens and messages out, commands in, until the page goes."""
-    from retrokit.studio.play import handle_message
-
     session = session_of(websocket)
     await websocket.accept()
     subscriber = Subscriber(asyncio.get_running_loop())

@@ -18,8 +18,7 @@ from starlette.responses import JSONResponse, Response
 from starlette.routing import Route
 
 from retrokit.errors import AccessDeniedError, FileConflictError, InvalidArgumentError, shown
-from retrokit.studio.app import session_of
-from retrokit.studio.security import expect, json_body
+from retrokit.studio.security import expect, json_body, session_of
 from retrokit.studio.session import Session
 
 MAX_VALIDATE_FRAMES = 100_000

@@ -37,9 +37,8 @@ from starlette.routing import Route
 
 from retrokit.errors import InvalidArgumentError, RamSearchError, RetrokitError
 from retrokit.ramsearch.types import search_type
-from retrokit.studio.app import session_of
 from retrokit.studio.search import address_of, integer_of
-from retrokit.studio.security import json_body
+from retrokit.studio.security import json_body, session_of
 
 if TYPE_CHECKING:
     from retrokit.studio.session import Session

@@ -25,9 +25,8 @@ from starlette.routing import Route
 
 from retrokit.errors import InvalidArgumentError
 from retrokit.host.memory import FieldReader
-from retrokit.studio.app import session_of
 from retrokit.studio.search import Pacer, save_field
-from retrokit.studio.security import json_body
+from retrokit.studio.security import json_body, session_of
 
 if TYPE_CHECKING:
     from retrokit.studio.session import Session

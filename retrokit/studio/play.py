@@ -18,8 +18,7 @@ from retrokit.data.names import check_state_name
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean, shown
 from retrokit.host.systems import System
 from retrokit.ramsearch.ram import RamLayout
-from retrokit.studio.app import session_of
-from retrokit.studio.security import check_inside, expect, game_roots, json_body
+from retrokit.studio.security import check_inside, expect, game_roots, json_body, session_of
 from retrokit.studio.session import MAX_SPEED, MIN_SPEED, Session
 
 MAX_STEP = 3600

@@ -27,9 +27,8 @@ from starlette.responses import JSONResponse
 from starlette.routing import Route
 
 from retrokit.errors import RamSearchError
-from retrokit.studio.app import session_of
 from retrokit.studio.search import Pacer, address_of, integer_of
-from retrokit.studio.security import json_body
+from retrokit.studio.security import json_body, session_of
 
 if TYPE_CHECKING:
     from retrokit.studio.session import Session

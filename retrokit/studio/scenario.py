@@ -41,10 +41,9 @@ from retrokit.data.names import check_state_name
 from retrokit.dsl.scenario import Run, Scenario, scenario_from_text
 from retrokit.dsl.source import read_source
 from retrokit.errors import DataFileError, InvalidArgumentError, ScenarioError, ScenarioRuntimeError
-from retrokit.studio.app import session_of
 from retrokit.studio.fields import field_reader
 from retrokit.studio.search import Pacer
-from retrokit.studio.security import check_inside, expect, game_roots, json_body, resolve_path
+from retrokit.studio.security import check_inside, expect, game_roots, json_body, resolve_path, session_of
 
 if TYPE_CHECKING:
     from retrokit.studio.session import Session

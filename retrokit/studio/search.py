@@ -36,8 +36,7 @@ from starlette.routing import Route
 from retrokit.errors import InvalidArgumentError, RamSearchError, shown
 from retrokit.ramsearch.candidates import Candidate, list_groups
 from retrokit.ramsearch.filters import OPS, THAN_FORMS
-from retrokit.studio.app import session_of
-from retrokit.studio.security import check_inside, expect, game_roots, json_body
+from retrokit.studio.security import check_inside, expect, game_roots, json_body, session_of
 
 if TYPE_CHECKING:
     from retrokit.studio.session import Session

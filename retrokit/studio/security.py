@@ -13,7 +13,9 @@ localhost, which stops DNS rebinding.
 :func:`resolve_path` is the one function through which a request may name a
 file: it refuses whatever would leave the game's folders and the data folder.
 The request helpers (:func:`json_body`, :func:`expect`) cap bodies and check
-types, so hostile input ends in a 4xx JSON error, never a 500.
+types, so hostile input ends in a 4xx JSON error, never a 500; :func:`session_of`
+gives every route its session (here, below the app and its routes, so no
+route imports the app that mounts it).
 """
 
 from __future__ import annotations
@@ -35,7 +37,10 @@ from retrokit.errors import AccessDeniedError, InvalidArgumentError, RequestTooL
 from retrokit.paths import data_dir
 
 if TYPE_CHECKING:
+    from starlette.websockets import WebSocket
+
     from retrokit.data.games import Game
+    from retrokit.studio.session import Session
 
 TOKEN_HEADER = "x-retrokit-token"
 MAX_BODY = 1 << 20
@@ -238,7 +243,13 @@ async def _refuse(scope: Scope, receive: Receive, send: Send, status: int, error
     await send({"type": "http.response.body", "body": body})
 
 
-# --- request bodies ---------------------------------------------------------------------------------
+# --- requests ---------------------------------------------------------------------------------------
+
+
+def session_of(request: Request | WebSocket) -> Session:
+    """The session a request is for."""
+    return request.app.state.session
+
 
 
 async def json_body(request: Request) -> dict[str, Any]:

@@ -22,8 +22,7 @@ from starlette.routing import Route
 from retrokit import paths
 from retrokit.data.names import check_state_name
 from retrokit.errors import InvalidArgumentError, UnknownNameError, did_you_mean
-from retrokit.studio.app import session_of
-from retrokit.studio.security import check_inside, expect, game_roots, json_body, resolve_path
+from retrokit.studio.security import check_inside, expect, game_roots, json_body, resolve_path, session_of
 from retrokit.studio.session import Session
 
 MOVIES = "movies"

@@ -1,6 +1,7 @@
 """RAM search: find a game's variables in RAM and write them into its game.yaml.
 
 - :class:`RamSearch` (:mod:`.search`): the search on a running game, its moves and its session file.
+- :mod:`.keeping`: what the search writes out: the movie of the inputs played, the game's state, a field.
 - :mod:`.engine`: snapshots and candidates, narrowed by filters, with undo and redo.
 - :mod:`.filters`: the operations and references a filter compares with.
 - :mod:`.candidates`: the candidate set, packed for undo, and grouped for ``show``.

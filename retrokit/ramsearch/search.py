@@ -18,6 +18,8 @@ and the state it reached as a state of the game::
     search.save_field("lives", 0xFF002B, "|u1", game_file="my-games/Dasher-Genesis/game.yaml")
     search.save("dasher.session")              # resume with RamSearch.load
     search.write_movie("to-the-pit.bk2")       # the inputs played, from Zone1.Act1
+
+What it writes out of the search (the movie, a state, a field) is in :mod:`retrokit.ramsearch.keeping`.
 """
 
 from __future__ import annotations
@@ -30,33 +32,30 @@ from typing import TYPE_CHECKING, Self
 
 import numpy as np
 
-from retrokit import paths
 from retrokit.data import statecheck
 from retrokit.data.games import Game, find_game
-from retrokit.data.names import check_state_name
 from retrokit.data.roms import rom_sha1
 from retrokit.data.states import StateRecord
-from retrokit.errors import DataFileError, FileConflictError, InvalidArgumentError, MovieError, SessionError, StateError
+from retrokit.errors import InvalidArgumentError, MovieError, SessionError, StateError
 from retrokit.host.emulator import Emulator
 from retrokit.host.typecodes import parse_type
-from retrokit.paths import atomic_write, ensure_folder, locked, wheel_dir
-from retrokit.ramsearch import gamefile
+from retrokit.paths import atomic_write
 from retrokit.ramsearch.candidates import Candidate
 from retrokit.ramsearch.engine import Engine, list_candidates
+from retrokit.ramsearch.keeping import Keeping
 from retrokit.ramsearch.ram import RamLayout
 from retrokit.ramsearch.script import MAX_FRAMES, parse_script
 from retrokit.ramsearch.session import SessionData, read_session, write_session
-from retrokit.ramsearch.types import BitType, parse_search_types, search_type
+from retrokit.ramsearch.types import parse_search_types
 
 if TYPE_CHECKING:
-    from retrokit.data.integrate import Outcome
     from retrokit.movie import Movie
 
 
 _LABEL_SCRIPT = 80  # a snapshot's label shows this much of a script
 
 
-class RamSearch:
+class RamSearch(Keeping):
     """A RAM search on one game.
 
     Args:
@@ -217,6 +216,10 @@ class RamSearch:
         """Put the game in one of its save states (no snapshot is taken)."""
         self.emulator.set_state(statecheck.load_state(self.game, self.game.state_path(name)))
         self.emulator.forget_action()
+        self._restart()
+
+    def restart_inputs(self) -> None:
+        """Begin the inputs played afresh from now, so :meth:`movie` records from this moment (a movie's start)."""
         self._restart()
 
     def snapshot(self, label: str = "snapshot") -> int:
@@ -416,187 +419,3 @@ class RamSearch:
     def candidates(self, limit: int | None = None) -> list[Candidate]:
         """The candidates by address (then simplest type first), at most ``limit`` of them."""
         return list_candidates(self.engine, limit)
-
-    # --- saving the game's state and the inputs played ------------------------------------------------
-
-    def movie(self) -> Movie:
-        """The inputs played since the last state loaded (or the start), as a movie from that state.
-
-        Raises:
-            MovieError: A poke changed RAM since that state, which no input can reproduce.
-        """
-        from retrokit.movie import Movie
-
-        if self.unreplayable is not None:
-            raise MovieError(
-                f"Expected inputs that lead to the game's state now; the session changed RAM by hand since its "
-                f"start state ({self.unreplayable}), which a movie cannot reproduce. Start from a state again "
-                "(ramsearch run --state NAME), play without poking, then write the movie."
-            )
-        total = sum(count for count, _ in self.inputs)
-        if total > MAX_FRAMES:
-            raise MovieError(
-                f"Expected at most {MAX_FRAMES:,} frames for a movie; the session played {total:,} since its start "
-                "state. Save a state on the way (ramsearch savestate) and start from it."
-            )
-        used = [port for _, masks in self.inputs for port, mask in enumerate(masks, 1) if mask]
-        players = max([self.game.players, *used])
-        frames = [masks[:players] for count, masks in self.inputs for _ in range(count)]
-        return Movie(self.game.name, self.game.system.name, players, self.start_state or None, frames)
-
-    def write_movie(self, path: str | os.PathLike[str], *, overwrite: bool = False) -> Path:
-        """Write :meth:`movie` as a stable-retro ``.bk2`` (for ``retrokit integrate --movie`` and ``validate``).
-
-        Raises:
-            MovieError: A poke changed RAM since the start state.
-            FileConflictError: A different file is at ``path`` and ``overwrite`` is false.
-        """
-        from retrokit.movie import write_bk2
-
-        write_bk2(path, self.movie(), overwrite=overwrite)
-        return Path(path)
-
-    def save_state(self, name: str, *, default: bool = False, force: bool = False) -> Outcome:
-        """Save the emulator's state now as state ``name`` of the game, where ``retrokit integrate`` writes.
-
-        It goes to ``<data>/games/<Game>/NAME.state`` (with its record), or next to a game.yaml of
-        the user's own outside every games folder. With ``default``, ``states: default: NAME`` is
-        written into that folder's game.yaml, so ``make(game)`` starts from it; a game whose
-        game.yaml is elsewhere gets a copy of it there first (which then overrides it).
-
-        Returns:
-            What was done: ``"made"``, ``"up to date"`` or ``"replaced"`` (see :func:`~retrokit.data.integrate.place_state`).
-
-        Raises:
-            InvalidArgumentError: ``name`` is not a valid state name.
-            FileConflictError: A different state of that name exists and ``force`` is false.
-            DataFileError: ``default`` and the game's data file is not a game.yaml.
-        """
-        from retrokit.data.integrate import place_state, target_folder
-
-        check_state_name(name)
-        folder = target_folder(self.game)
-        game_file = folder / "game.yaml"
-        if default and not game_file.exists():
-            self._check_own_game_yaml()
-        outcome = place_state(self.game, name, self.emulator.get_state(), folder, force=force)
-        if outcome.status in ("differs", "damaged"):
-            kind = "a different state" if outcome.status == "differs" else "a file the core cannot load"
-            raise FileConflictError(
-                f"Expected no state {name!r} of {self.game.name} or the same one; found {kind} at {outcome.path}. "
-                "Pass --force (force=True) to replace it, or choose another name."
-            )
-        if default:
-            self._write_default_state(game_file, name)
-        return outcome
-
-    def set_default_state(self, name: str) -> Path:
-        """Make state ``name`` the game's default (``states: default: NAME``), as ``save_state(default=True)`` does.
-
-        Returns:
-            The game.yaml written.
-
-        Raises:
-            InvalidArgumentError: ``name`` is not a valid state name.
-            StateNotFoundError: The game has no state of that name.
-            DataFileError: The game's data file is not a game.yaml.
-        """
-        from retrokit.data.integrate import target_folder
-
-        check_state_name(name)
-        self.game.state_path(name)  # one of its states, or a StateNotFoundError with a did-you-mean
-        game_file = target_folder(self.game) / "game.yaml"
-        if not game_file.exists():
-            self._check_own_game_yaml()
-        self._write_default_state(game_file, name)
-        return game_file
-
-    def _write_default_state(self, game_file: Path, name: str) -> None:
-        ensure_folder(game_file.parent, "to write the game's game.yaml into")
-        with locked(game_file):  # two writers making the copy at once: the second edits the first's copy
-            if not game_file.exists():
-                atomic_write(game_file, self.game.info.source.read_bytes())
-            gamefile.set_default_state(game_file, name)
-
-    def restart_inputs(self) -> None:
-        """Begin the inputs played afresh from now, so :meth:`movie` records from this moment (a movie's start)."""
-        self._restart()
-
-    def _check_own_game_yaml(self) -> None:
-        if self.game.info.source.name != "game.yaml":
-            raise DataFileError(
-                f"Expected {self.game.name} to have a game.yaml to write its default state into; its data file is "
-                f"{self.game.info.source}, in Gym Retro's format. Pass the state by name instead: make(game, state=NAME)."
-            )
-
-    # --- saving a find --------------------------------------------------------------------------
-
-    def default_game_file(self) -> Path:
-        """The game.yaml ``save_field`` writes to by default: the game's own.
-
-        Raises:
-            DataFileError: The game's data file is not a game.yaml (a Gym Retro folder), or is inside stable-retro.
-        """
-        source = self.game.info.source
-        installed = [p.resolve() for p in (wheel_dir(), Path(paths.__file__).parent) if p is not None]
-        if source.name != "game.yaml" or any(source.resolve().is_relative_to(p) for p in installed):
-            raise DataFileError(
-                f"Expected {self.game.name} to have its own game.yaml; its data file is {source}, inside an "
-                "installed package or in Gym Retro's format, which this tool does not edit. Copy the game's folder "
-                f"into a folder named in {paths.GAMES_ENV} and pass --game-file PATH (game_file=) to its game.yaml."
-            )
-        return source
-
-    def save_field(
-        self,
-        name: str,
-        address: int,
-        type_code: str,
-        *,
-        game_file: str | os.PathLike[str] | None = None,
-        force: bool = False,
-        value_range: tuple[int, int] | None = None,
-    ) -> Path:
-        """Write a field into a game.yaml, keeping its comments and layout; return the file.
-
-        Args:
-            name: The field's name.
-            address: Its console address.
-            type_code: Its type code; a bit type (``|u1&0x04``) is written as ``type: "|u1", mask: 0x04``.
-            game_file: The game.yaml to write (by default :meth:`default_game_file`).
-            force: Replace a field of the same name.
-            value_range: The values it may hold, ``(lo, hi)``, written as ``range: [lo, hi]``.
-
-        Raises:
-            FieldTypeError: The type code is unknown.
-            InvalidArgumentError: The address is outside RAM, the name is not a valid field name, or
-                the range is not two whole numbers ``lo <= hi`` the type can hold.
-            SessionError: ``game_file`` is the data file of another game.
-            FileConflictError: The file has a field of that name and ``force`` is false.
-        """
-        gamefile.check_field_name(name)  # first: a bad name is the name's fault, not the file's
-        ftype = search_type(type_code)
-        self.layout.position(address, ftype.width)
-        if value_range is not None:
-            value_range = gamefile.check_range(value_range, ftype)
-        path = Path(game_file) if game_file is not None else self.default_game_file()
-        if game_file is not None:
-            self._check_game_file(path)
-        bit = isinstance(ftype, BitType)
-        gamefile.add_field(path, name, self.layout.format(address), ftype.base if bit else ftype.code, force=force,
-                           value_range=value_range, mask=ftype.mask if bit else None)  # fmt: skip
-        return path
-
-    def _check_game_file(self, path: Path) -> None:
-        from retrokit.data.gamefiles import read_game_yaml
-
-        if not path.is_file():  # a FIFO or a device is not one either
-            raise DataFileError(
-                f"Expected a game.yaml at {path}; found no file. Give the path of an existing game.yaml."
-            )
-        sha1s = read_game_yaml(path).sha1s
-        if sha1s and self.rom_sha1 not in sha1s:
-            raise SessionError(
-                f"Expected a game.yaml of {self.game.name} (ROM SHA-1 {self.rom_sha1}); {path} lists other ROMs "
-                f"({', '.join(sha1s)}): it is another game's. Pass the game.yaml of {self.game.name}."
-            )

@@ -224,7 +224,7 @@ def test_a_python_without_pip_says_how_to_get_it(monkeypatch, tmp_path, capsys) 
 
     subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(tmp_path / "bare")], check=True)
     bare = tmp_path / "bare" / "bin" / "python"
-    monkeypatch.setattr(build.sys, "executable", str(bare))
+    monkeypatch.setattr(sys, "executable", str(bare))  # the one sys, which retrokit.host.sdist runs pip with
     monkeypatch.setenv("PATH", f"{tools(tmp_path)}{os.pathsep}{os.environ['PATH']}")
     status, _, err = run_cli(capsys, "--stable-retro", "1.0.1")
     assert_one_line_error(status, err, f"Expected pip in {bare}", "-m ensurepip", "--sdist FILE")

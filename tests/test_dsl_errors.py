@@ -1,23 +1,19 @@
-"""Every bad input is refused with a message naming the file, line and column, with a caret.
+"""Every bad scenario is refused with a message naming the file, line and column, with a caret.
 
 Compile-time checks (unknown names with did-you-mean, argument counts, types,
 constant zero division, cycles, syntax, file structure) are shown by loading a
-scenario file and comparing the whole message. Run-time failures (division by
-zero, a missing table key) name the scenario and the expression.
+scenario file and comparing the whole message. Run-time failures are in
+test_dsl_runtime_errors.py, Gym Retro scenario.json files' in test_dsl_json_errors.py.
 """
 
 from __future__ import annotations
-
-import json
 
 import pytest
 
 from retrokit.dsl.scenario import load_scenario
 from retrokit.errors import (
-    InvalidArgumentError,
     ScenarioCompileError,
     ScenarioError,
-    ScenarioRuntimeError,
     ScenarioSyntaxError,
 )
 
@@ -460,106 +456,3 @@ def test_not_a_scenario_file(tmp_path) -> None:
         load_scenario(tmp_path / "s.txt", FIELDS)
     with pytest.raises(ScenarioError, match="Expected a scenario file at .*missing.yaml.; found No such file"):
         load_scenario(tmp_path / "missing.yaml", FIELDS)
-
-
-# --- Run time --------------------------------------------------------------------------------------
-
-
-def test_division_by_zero_at_run_time(tmp_path) -> None:
-    path = tmp_path / "ratio.yaml"
-    path.write_text("define:\n  ratio: x / (y - 2)\nreward: ratio\n")
-    run = load_scenario(path, FIELDS).start()
-    run.reset({"x": 1, "y": 3})
-    assert run.step({"x": 4, "y": 4}, 4, 1)[0] == (2.0,)
-    with pytest.raises(ScenarioRuntimeError) as info:
-        run.step({"x": 4, "y": 2}, 8, 2)
-    assert str(info.value) == (
-        f"{path}:2:10: scenario 'ratio': division by zero: the divisor (y - 2) is 0 (in define 'ratio')\n"
-        "      ratio: x / (y - 2)\n"
-        "             ^^^^^^^^^^^"
-    )
-    assert isinstance(info.value, ArithmeticError)
-
-
-@pytest.mark.parametrize("op,what", [("//", "floor division"), ("%", "remainder"), ("/", "division")])
-def test_every_division_checks_its_divisor(op: str, what: str) -> None:
-    run = load_scenario({"reward": f"x {op} y"}, FIELDS, name="t").start()
-    with pytest.raises(ScenarioRuntimeError, match="division by zero: the divisor y is 0"):
-        run.reset({"x": 1, "y": 0})
-
-
-def test_decimal_zero_divisor_is_an_error_not_nan() -> None:
-    run = load_scenario({"reward": "x / (y / 2)"}, FIELDS, name="t").start()
-    with pytest.raises(ScenarioRuntimeError, match=r"the divisor \(y / 2\) is 0"):
-        run.reset({"x": 0, "y": 0})
-
-
-def test_missing_table_key_at_run_time(tmp_path) -> None:
-    path = tmp_path / "levels.yaml"
-    path.write_text("tables:\n  level_end:\n    by: [zone, act]\n    values:\n      0, 0: 100\nreward: level_end[zone, act] - x\n")
-    run = load_scenario(path, FIELDS).start()
-    run.reset({"x": 1, "zone": 0, "act": 0})
-    with pytest.raises(ScenarioRuntimeError) as info:
-        run.step({"x": 1, "zone": 5, "act": 2}, 4, 1)
-    assert str(info.value) == (
-        f"{path}:6:9: scenario 'levels': table 'level_end' has no entry for zone=5, act=2; "
-        f"add one (at {path}:2:3) or give the table a default (in reward)\n"
-        "    reward: level_end[zone, act] - x\n"
-        "            ^^^^^^^^^^^^^^^^^^^^"
-    )
-
-
-def test_other_arithmetic_failures_name_the_scenario() -> None:
-    run = load_scenario({"reward": "x >> y"}, FIELDS, name="shifty").start()
-    with pytest.raises(ScenarioRuntimeError, match="scenario 'shifty': ValueError while computing a step: negative shift count"):
-        run.reset({"x": 1, "y": -1})
-
-
-def test_missing_value_is_an_argument_error() -> None:
-    run = load_scenario({"reward": "x"}, FIELDS, name="t").start()
-    with pytest.raises(InvalidArgumentError, match="scenario 't' reads field 'x'"):
-        run.step({"y": 1}, 4, 1)
-
-
-# --- Gym Retro scenario.json --------------------------------------------------------------------------
-
-
-def test_json_unknown_variable_points_into_the_json(tmp_path) -> None:
-    path = tmp_path / "scenario.json"
-    path.write_text(json.dumps({"reward": {"variables": {"scroe": {"reward": 1}}}, "done": {}}, indent=2))
-    with pytest.raises(ScenarioCompileError) as info:
-        load_scenario(path, FIELDS)
-    assert str(info.value) == (
-        f"{path}:4:7: unknown variable 'scroe': the game has no such field. Did you mean 'score'?\n"
-        '          "scroe": {\n'
-        "          ^^^^^^^"
-    )
-
-
-@pytest.mark.parametrize(
-    "data,message",
-    [
-        ({"done": {"variables": {"lives": {"op": "equals"}}}}, "unknown op 'equals'. Did you mean 'equal'?"),
-        ({"done": {"variables": {"lives": {"measurement": "relative"}}}}, "unknown measurement 'relative'; use 'absolute' or 'delta'"),
-        ({"done": {"condition": "some"}}, "unknown condition 'some'; use 'any' or 'all'"),
-        ({"reward": {"script": "lua:f"}, "scripts": ["s.lua"]}, "Lua scripts cannot be converted"),
-        ({"crops": [[0, 0, 1, 1]]}, "per-player crops are not supported"),
-        ({"rewrd": {}}, "unknown key 'rewrd'. Did you mean 'reward'?"),
-        ({"done": {"variables": {"lives": {"op": "zero", "refrence": 1}}}}, "unknown key 'refrence'. Did you mean 'reference'?"),
-    ],
-    ids=["op", "measurement", "condition", "script", "crops", "top_key", "variable_key"],
-)
-def test_json_bad_inputs(tmp_path, data: dict, message: str) -> None:
-    path = tmp_path / "scenario.json"
-    path.write_text(json.dumps(data, indent=2))
-    with pytest.raises(ScenarioError) as info:
-        load_scenario(path, FIELDS)
-    assert message in str(info.value)
-    assert str(info.value).startswith(f"{path}:") and "^" in str(info.value)
-
-
-def test_json_syntax_error(tmp_path) -> None:
-    path = tmp_path / "scenario.json"
-    path.write_text('{"done": {,}}')
-    with pytest.raises(ScenarioError, match=r"scenario.json:1:11: this is not valid JSON: Expecting property name"):
-        load_scenario(path, FIELDS)

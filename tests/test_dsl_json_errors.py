@@ -1,0 +1,53 @@
+"""A bad Gym Retro scenario.json is refused with a message pointing into the JSON, with a caret."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from retrokit.dsl.scenario import load_scenario
+from retrokit.errors import ScenarioCompileError, ScenarioError
+
+FIELDS = ["x", "y", "xpos", "lives", "zone", "act", "score", "length"]
+
+
+def test_json_unknown_variable_points_into_the_json(tmp_path) -> None:
+    path = tmp_path / "scenario.json"
+    path.write_text(json.dumps({"reward": {"variables": {"scroe": {"reward": 1}}}, "done": {}}, indent=2))
+    with pytest.raises(ScenarioCompileError) as info:
+        load_scenario(path, FIELDS)
+    assert str(info.value) == (
+        f"{path}:4:7: unknown variable 'scroe': the game has no such field. Did you mean 'score'?\n"
+        '          "scroe": {\n'
+        "          ^^^^^^^"
+    )
+
+
+@pytest.mark.parametrize(
+    "data,message",
+    [
+        ({"done": {"variables": {"lives": {"op": "equals"}}}}, "unknown op 'equals'. Did you mean 'equal'?"),
+        ({"done": {"variables": {"lives": {"measurement": "relative"}}}}, "unknown measurement 'relative'; use 'absolute' or 'delta'"),
+        ({"done": {"condition": "some"}}, "unknown condition 'some'; use 'any' or 'all'"),
+        ({"reward": {"script": "lua:f"}, "scripts": ["s.lua"]}, "Lua scripts cannot be converted"),
+        ({"crops": [[0, 0, 1, 1]]}, "per-player crops are not supported"),
+        ({"rewrd": {}}, "unknown key 'rewrd'. Did you mean 'reward'?"),
+        ({"done": {"variables": {"lives": {"op": "zero", "refrence": 1}}}}, "unknown key 'refrence'. Did you mean 'reference'?"),
+    ],
+    ids=["op", "measurement", "condition", "script", "crops", "top_key", "variable_key"],
+)
+def test_json_bad_inputs(tmp_path, data: dict, message: str) -> None:
+    path = tmp_path / "scenario.json"
+    path.write_text(json.dumps(data, indent=2))
+    with pytest.raises(ScenarioError) as info:
+        load_scenario(path, FIELDS)
+    assert message in str(info.value)
+    assert str(info.value).startswith(f"{path}:") and "^" in str(info.value)
+
+
+def test_json_syntax_error(tmp_path) -> None:
+    path = tmp_path / "scenario.json"
+    path.write_text('{"done": {,}}')
+    with pytest.raises(ScenarioError, match=r"scenario.json:1:11: this is not valid JSON: Expecting property name"):
+        load_scenario(path, FIELDS)

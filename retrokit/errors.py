@@ -91,6 +91,16 @@ class CoreNotFoundError(CoreError):
     """No libretro core for a system was found in any search location."""
 
 
+class ChildStartError(RetrokitError, OSError):
+    """The child process a core or a state is tried in could not start (no memory, no processes left).
+
+    Attributes:
+        reason: Why, as the system said it.
+    """
+
+    reason: str = ""
+
+
 class CoreBuildError(RetrokitError):
     """Building a core from source failed (retrokit build-core)."""
 

@@ -28,17 +28,16 @@ The child (``python -m retrokit.data.probe``, reading a JSON request on
 stdin) is shared with ``retrokit validate`` (:mod:`retrokit.testing.states`),
 which wants a report per state rather than a cached verdict: the child loads
 each state of the request in turn and prints one JSON line before and one
-after each, with the fields' values. It runs under a memory cap, leaves no
-core file, and imports the retrokit its parent imported.
+after each, with the fields' values. It runs as every risky child does
+(:mod:`retrokit.host.child`): under a memory cap, with no core file,
+importing the retrokit its parent imported, killed with its process group if
+it hangs.
 """
 
 from __future__ import annotations
 
 import json
 import os
-import selectors
-import signal
-import subprocess
 import sys
 import tempfile
 from collections.abc import Mapping, Sequence
@@ -50,6 +49,7 @@ from retrokit import paths
 from retrokit.data.shipped import is_shipped_blob
 from retrokit.data.states import MAX_STATE_FILE_SIZE, decompress_state
 from retrokit.errors import RetrokitError, StateError
+from retrokit.host.child import Child
 from retrokit.host.emulator import VettedState, claim_mint
 from retrokit.host.statelayout import state_layout_problem
 from retrokit.host.systems import System, get_system
@@ -98,33 +98,15 @@ class ChildResult:
     detail: str = ""
 
 
-def _child_env() -> dict[str, str]:
-    """This process's environment, with the folder retrokit was imported from first on the path."""
-    root = str(Path(__file__).resolve().parents[2])
-    path = os.environ.get("PYTHONPATH")
-    return {**os.environ, "PYTHONPATH": root + (os.pathsep + path if path else "")}
-
-
-def _child_limits() -> None:
-    """In the child, before it loads a core: no core file from a crash, and a cap on memory."""
-    import resource
-
-    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
-    try:
-        resource.setrlimit(resource.RLIMIT_AS, (CHILD_MEMORY, CHILD_MEMORY))
-    except (ValueError, OSError):  # a lower hard limit already
-        pass
-
-
 def run_child(
     system: str, rom: str | os.PathLike[str], states: Sequence[tuple[str, str]], *, frames: int,
     input_frames: int, fields: Sequence[Mapping[str, Any]] = (), timeout: float = PROBE_TIMEOUT,
 ) -> tuple[dict[str, ChildResult], str | None, str]:
     """Run one child over ``states``; return the results it finished, the state it was on when it stopped, and why.
 
-    The child prints a line before and after each state; a state that prints
-    nothing for ``timeout`` seconds has hung the core, and the child is killed.
-    Its log goes to a file, so a chatty core cannot fill a pipe.
+    The child (run as every risky child is: :mod:`retrokit.host.child`) prints a
+    line before and after each state; a state that prints nothing for ``timeout``
+    seconds has hung the core, and the child is killed.
 
     Args:
         system: The system's name.
@@ -134,58 +116,35 @@ def run_child(
         input_frames: Frames of random input to run after loading it again.
         fields: RAM fields (``name``, ``address``, ``type``, ``mask``) to read after loading.
         timeout: Seconds one state may take.
+
+    Raises:
+        ChildStartError: The child could not start.
     """
     request = {"system": system, "rom": os.fspath(rom), "frames": frames, "input_frames": input_frames,
                "fields": list(fields),
                "states": [list(s) for s in states]}
     results: dict[str, ChildResult] = {}
-    current, failure = None, ""
-    with tempfile.TemporaryFile("w+") as log:
-        proc = subprocess.Popen(
-            [sys.executable, "-m", "retrokit.data.probe"], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-            stderr=log, bufsize=0, env=_child_env(),
-        )
-        try:
-            proc.stdin.write(json.dumps(request).encode())  # type: ignore[union-attr]
-            proc.stdin.close()  # type: ignore[union-attr]
-        except BrokenPipeError:  # it died at once; its status says why
-            pass
-        # Raw reads, split here: a buffered reader could hold a line that select() then waits for.
-        fd = proc.stdout.fileno()  # type: ignore[union-attr]
-        pending = b""
-        with selectors.DefaultSelector() as selector:
-            selector.register(fd, selectors.EVENT_READ)
-            wait = CHILD_STARTUP + timeout
-            while True:
-                if not selector.select(timeout=wait):
-                    proc.kill()
-                    failure = f"the emulator still ran {timeout:g} s after loading it (it hangs the core)"
-                    break
-                chunk = os.read(fd, 1 << 16)
-                if not chunk:
-                    break
-                wait = timeout
-                *lines, pending = (pending + chunk).split(b"\n")
-                for line in lines:
-                    try:
-                        message = json.loads(line)
-                    except json.JSONDecodeError:
-                        continue
-                    if "begin" in message:
-                        current = message["begin"]
-                    else:
-                        results[message["name"]] = ChildResult(**message)
-                        current = None
-        proc.stdout.close()  # type: ignore[union-attr]
-        status = proc.wait()
-        if not failure and status != 0:
-            if status < 0:
-                name = signal.Signals(-status).name if -status in signal.valid_signals() else f"signal {-status}"
-                failure = f"the emulator crashed ({name}) within {frames + input_frames} frames of loading it"
+    current = None
+    with Child("retrokit.data.probe", request, memory=CHILD_MEMORY) as child:
+        for line in child.lines(first=CHILD_STARTUP + timeout, each=timeout):
+            try:
+                message = json.loads(line)
+            except json.JSONDecodeError:
+                continue
+            if "begin" in message:
+                current = message["begin"]
             else:
-                log.seek(0)
-                last = log.read().strip().splitlines()[-1:] or ["no message"]
-                failure = f"the state loader exited with status {status}: {last[0]}"
+                results[message["name"]] = ChildResult(**message)
+                current = None
+        end = child.end()
+    if end.hung:
+        failure = f"the emulator still ran {timeout:g} s after loading it (it hangs the core)"
+    elif end.signal is not None:
+        failure = f"the emulator crashed ({end.signal}) within {frames + input_frames} frames of loading it"
+    elif end.status != 0:
+        failure = f"the state loader exited with status {end.status}: {end.last_words}"
+    else:
+        failure = ""
     return results, current, failure
 
 
@@ -352,8 +311,7 @@ def _child_main() -> int:
     from retrokit.host.fields import FieldSpec
     from retrokit.host.memory import FieldReader
 
-    _child_limits()
-    request = json.load(sys.stdin)
+    request = json.load(sys.stdin)  # its limits are set by now (retrokit.host.child)
     frames, input_frames = int(request["frames"]), int(request["input_frames"])
     emu = Emulator(request["system"], request["rom"])
     specs = [FieldSpec(f["name"], f["address"], f["type"], f["mask"]) for f in request["fields"]]

@@ -21,7 +21,7 @@ Trust comes only from what the package installed or this machine wrote, never
 from the bytes of the core itself. A file is hashed once per process (cached
 by path, size, modification time and inode).
 
-Run as ``python -m retrokit.host.corecheck SYSTEM ROM CORE``, this module is the probe's child.
+The probe's child is :mod:`retrokit.host.coreprobe`, run as every risky child is (:mod:`retrokit.host.child`).
 """
 
 from __future__ import annotations
@@ -29,18 +29,14 @@ from __future__ import annotations
 import base64
 import functools
 import hashlib
-import importlib
 import importlib.metadata
 import json
 import os
-import resource
-import signal
-import subprocess
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from retrokit.errors import CoreError, RetrokitError
+from retrokit.errors import ChildStartError, CoreError, RetrokitError
+from retrokit.host.child import Child
 from retrokit.host.cores import built_cores_dir, core_filename
 from retrokit.host.elf import check_core_file
 from retrokit.paths import atomic_write, data_dir
@@ -51,7 +47,8 @@ PROBE_TIMEOUT = 30.0
 """Seconds a probe may take before the core counts as one that hangs."""
 PROBE_ADDRESS_SPACE = 3 * 2**30
 """The probe's address-space cap: far above what Python, numpy and a core map, far below a runaway."""
-_REFUSED = 3  # the child's exit status when retrokit refused the core with its own error
+REFUSED = 3
+"""The child's exit status when retrokit refused the core with its own error."""
 _SAFE = "safe"
 
 _StatKey = tuple[str, int, int, int]
@@ -184,45 +181,21 @@ class ProbeVerdict:
 
 def probe_core(core: Path, system: str, rom: str | os.PathLike[str], *, timeout: float = PROBE_TIMEOUT) -> ProbeVerdict:
     """Load ``core`` with ``rom`` in a child process and run :data:`PROBE_FRAMES` frames; report how it ended."""
-    command = [sys.executable, "-m", "retrokit.host.corecheck", system, os.fspath(rom), os.fspath(core)]
-    root = str(Path(__file__).resolve().parents[2])  # the child imports this same retrokit
-    path = os.environ.get("PYTHONPATH")
-    env = {**os.environ, "PYTHONPATH": root + (os.pathsep + path if path else "")}
+    request = {"system": system, "rom": os.fspath(rom), "core": os.fspath(core)}
     try:
-        done = subprocess.run(
-            command, capture_output=True, text=True, timeout=timeout, check=False, stdin=subprocess.DEVNULL,
-            preexec_fn=_child_limits, env=env,
-        )  # fmt: skip
-    except subprocess.TimeoutExpired:
+        with Child("retrokit.host.coreprobe", request, memory=PROBE_ADDRESS_SPACE) as child:
+            for _ in child.lines(first=timeout):  # it prints nothing: all of it must be done in time
+                pass
+            end = child.end()
+    except ChildStartError as exc:  # a child that failed before it ran (no memory, no processes)
+        return ProbeVerdict(False, f"the probe could not start: {exc.reason}", lasting=False)
+    if end.hung:
         return ProbeVerdict(False, f"it still ran {timeout:.0f} s after loading (it hangs)", lasting=False)
-    except (OSError, subprocess.SubprocessError) as exc:  # a child that failed before it ran (its limits)
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        return ProbeVerdict(False, f"the probe could not start: {reason}", lasting=False)
-    if done.returncode in (0, _REFUSED):
+    if end.status in (0, REFUSED):
         return ProbeVerdict(True)
-    if done.returncode < 0:
-        name = signal.Signals(-done.returncode).name
-        return ProbeVerdict(False, f"it crashed the probe ({name}) while loading or within {PROBE_FRAMES} frames")
-    last = (done.stderr.strip().splitlines() or ["no message"])[-1]
-    return ProbeVerdict(False, f"the probe failed (exit {done.returncode}: {last})", lasting=False)
-
-
-def _child_limits() -> None:
-    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))  # a crashing probe leaves no core file
-    resource.setrlimit(resource.RLIMIT_AS, lowered(resource.RLIMIT_AS, PROBE_ADDRESS_SPACE))
-
-
-def lowered(kind: int, cap: int) -> tuple[int, int]:
-    """The limits ``kind`` may take to stay at or under ``cap``: never above the limits the user set already.
-
-    Raising a limit above the hard one fails (under ``ulimit -v``), and above
-    the soft one would undo what the user asked for.
-    """
-    soft, hard = resource.getrlimit(kind)
-    for limit in (soft, hard):
-        if limit != resource.RLIM_INFINITY:
-            cap = min(cap, limit)
-    return cap, cap
+    if end.signal is not None:
+        return ProbeVerdict(False, f"it crashed the probe ({end.signal}) while loading or within {PROBE_FRAMES} frames")
+    return ProbeVerdict(False, f"the probe failed (exit {end.status}: {end.last_words})", lasting=False)
 
 
 def _verdict_file(digest: str) -> Path:
@@ -247,23 +220,3 @@ def _remember(digest: str, verdict: ProbeVerdict) -> None:
 def mark_probing(core: Path) -> None:
     """Let this process load ``core`` unvetted: only the probe's child does, since it is the probe."""
     _vetted.add(_stat_key(core))
-
-
-def _child(argv: list[str]) -> int:
-    """The probe: open the emulator with the core, run the frames; exit 0, or _REFUSED on retrokit's error."""
-    from retrokit.host.emulator import Emulator
-
-    system, rom, core = argv
-    # Run with -m, this file is __main__: mark the core in the module the emulator calls, not in this copy.
-    importlib.import_module(__spec__.name).mark_probing(Path(core))
-    try:
-        with Emulator(system, rom, core_path=core) as emulator:
-            emulator.run(0, PROBE_FRAMES)
-    except RetrokitError as exc:
-        print(exc, file=sys.stderr)
-        return _REFUSED
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(_child(sys.argv[1:]))

@@ -1,0 +1,214 @@
+"""The one way retrokit runs risky work in a child process: :class:`Child`.
+
+Some work may take down the process that does it: loading a core whose bytes
+nobody vouches for (:mod:`retrokit.host.corecheck`), running a state the core
+may crash on (:mod:`retrokit.data.probe`). Such work runs in a child,
+``python -m MODULE`` of the retrokit this process imported, and every such
+child is run the same way, here:
+
+- **Limits.** No core file, and an address space of at most ``memory``
+  bytes, never above the limits this process runs under: raising a limit
+  past the hard one fails (under ``ulimit -v``), and past the soft one would
+  undo what the user asked for. They are set on the child (``prlimit``)
+  before it is given its request, so nothing it is asked to load runs
+  without them; no ``preexec_fn``, which may deadlock a child forked from a
+  threaded process (the studio, a vector env).
+- **Request.** One JSON object on the child's stdin, which it reads before it loads anything.
+- **Answer.** Lines on its stdout, read with deadlines (:meth:`Child.lines`);
+  past one, its whole process group is killed (it leads a session of its own).
+  Leaving the ``with`` block early (an error, Ctrl-C) kills it too.
+- **Log.** Its stderr goes to a file, so a chatty core cannot fill a pipe; its last line says why it failed.
+- **Start.** A child that cannot start (no memory, no processes left) is one
+  :class:`~retrokit.errors.ChildStartError` line, never a raw ``OSError``.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import resource
+import selectors
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Self
+
+from retrokit.errors import ChildStartError
+
+_LOG_TAIL = 1 << 16  # the bytes of a child's log read for its last words
+
+
+def lowered(kind: int, cap: int) -> tuple[int, int]:
+    """The limits ``kind`` may take to stay at or under ``cap``: never above the limits the user set already.
+
+    Raising a limit above the hard one fails (under ``ulimit -v``), and above
+    the soft one would undo what the user asked for.
+    """
+    soft, hard = resource.getrlimit(kind)
+    for limit in (soft, hard):
+        if limit != resource.RLIM_INFINITY:
+            cap = min(cap, limit)
+    return cap, cap
+
+
+def child_env() -> dict[str, str]:
+    """This process's environment, with the folder retrokit was imported from first on the path.
+
+    The child does no linear algebra: one BLAS thread (unless the user chose
+    otherwise) keeps numpy's thread stacks, one per CPU, out of its memory cap.
+    """
+    root = str(Path(__file__).resolve().parents[2])
+    path = os.environ.get("PYTHONPATH")
+    threads = {name: "1" for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS") if name not in os.environ}
+    return {**os.environ, **threads, "PYTHONPATH": root + (os.pathsep + path if path else "")}
+
+
+def signal_name(number: int) -> str:
+    """``SIGSEGV`` for 11; ``signal 40`` for a signal without a name (a real-time one)."""
+    try:
+        return signal.Signals(number).name
+    except ValueError:
+        return f"signal {number}"
+
+
+@dataclass(frozen=True)
+class ChildEnd:
+    """How a child ended.
+
+    Attributes:
+        status: Its exit status; negative when a signal killed it.
+        hung: It missed a deadline of :meth:`Child.lines`, and was killed for it.
+        last_words: The last line of its log (``"no message"`` when it wrote none).
+    """
+
+    status: int
+    hung: bool
+    last_words: str
+
+    @property
+    def signal(self) -> str | None:
+        """The signal that killed it, by name, unless it exited (or was killed for a deadline)."""
+        return signal_name(-self.status) if self.status < 0 and not self.hung else None
+
+
+class Child:
+    """``python -m MODULE`` in a child process, with limits, given ``request``; use it in a ``with`` block.
+
+    Args:
+        module: The module the child runs (it reads ``request`` as JSON from its stdin).
+        request: What it is asked to do.
+        memory: Its address-space cap in bytes (lowered to this process's own limits).
+
+    Raises:
+        ChildStartError: The child could not start, or its limits could not be set.
+    """
+
+    def __init__(self, module: str, request: Mapping[str, Any], *, memory: int) -> None:
+        self.module = module
+        self.hung = False
+        self._log = tempfile.TemporaryFile()  # noqa: SIM115 (closed by close(), as the child ends)
+        try:
+            self._proc = subprocess.Popen(
+                [sys.executable, "-m", module], stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self._log,
+                bufsize=0, env=child_env(), start_new_session=True,
+            )  # fmt: skip
+        except (OSError, subprocess.SubprocessError) as exc:
+            self._log.close()
+            raise self._start_failed(exc) from None
+        try:
+            self._limit(memory)
+        except OSError as exc:
+            self.close()
+            raise self._start_failed(exc) from None
+        try:
+            self._proc.stdin.write(json.dumps(request).encode())  # type: ignore[union-attr]
+            self._proc.stdin.close()  # type: ignore[union-attr]
+        except BrokenPipeError:  # it died at once; its status says why
+            pass
+
+    def _limit(self, memory: int) -> None:
+        """No core file from a crash, and the memory cap: on the child, before it reads its request."""
+        pid = self._proc.pid
+        try:
+            resource.prlimit(pid, resource.RLIMIT_CORE, (0, 0))
+            resource.prlimit(pid, resource.RLIMIT_AS, lowered(resource.RLIMIT_AS, memory))
+        except ProcessLookupError:  # it is gone already: it loaded nothing, and its status says why
+            pass
+
+    def _start_failed(self, exc: BaseException) -> ChildStartError:
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
+        error = ChildStartError(
+            f"Expected to start a child process (python -m {self.module}) to try a core or a state in; it could not start: "
+            f"{reason}. Free some memory or processes (or raise ulimit -v / -u), then run the command again."
+        )
+        error.reason = reason
+        return error
+
+    def lines(self, *, first: float, each: float | None = None) -> Iterator[bytes]:
+        """The lines the child prints, as they come, until it ends; past a deadline it is killed (:attr:`hung`).
+
+        Args:
+            first: Seconds it may take to print anything, its start included
+                (with ``each`` ``None``: to finish).
+            each: Seconds it may then take between two outputs.
+        """
+        # Raw reads, split here: a buffered reader could hold a line that select() then waits for.
+        fd = self._proc.stdout.fileno()  # type: ignore[union-attr]
+        pending = b""
+        deadline = time.monotonic() + first
+        with selectors.DefaultSelector() as selector:
+            selector.register(fd, selectors.EVENT_READ)
+            while True:
+                if not selector.select(timeout=max(0.0, deadline - time.monotonic())):
+                    self._expire()
+                    return
+                chunk = os.read(fd, 1 << 16)
+                if not chunk:
+                    break
+                if each is not None:
+                    deadline = time.monotonic() + each
+                *done, pending = (pending + chunk).split(b"\n")
+                yield from done
+        try:  # its stdout closed: it must end within the same deadline
+            self._proc.wait(timeout=max(0.0, deadline - time.monotonic()))
+        except subprocess.TimeoutExpired:
+            self._expire()
+
+    def end(self) -> ChildEnd:
+        """Wait for the child to end; return how it did."""
+        self._proc.stdout.close()  # type: ignore[union-attr]
+        status = self._proc.wait()
+        size = self._log.seek(0, os.SEEK_END)
+        self._log.seek(max(0, size - _LOG_TAIL))
+        text = self._log.read().decode("utf-8", errors="replace")
+        return ChildEnd(status, self.hung, (text.strip().splitlines() or ["no message"])[-1])
+
+    def _expire(self) -> None:
+        self.hung = True
+        self._kill()
+
+    def _kill(self) -> None:
+        with contextlib.suppress(ProcessLookupError):  # its group: whatever it started goes with it
+            os.killpg(self._proc.pid, signal.SIGKILL)
+
+    def close(self) -> None:
+        """Kill the child if it still runs, and wait for it: it never runs on alone."""
+        if self._proc.poll() is None:
+            self._kill()
+            self._proc.wait()
+        for stream in (self._proc.stdin, self._proc.stdout):
+            if stream is not None:
+                stream.close()
+        self._log.close()
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -1,0 +1,127 @@
+"""The one runner of risky children (retrokit.host.child): limits, request, deadlines, a killed group, a failed start.
+
+The core probe and the state probe both run through it; their own tests
+(test_hostile_cores.py, test_hostile_states.py, test_validate.py) show the
+verdicts. These show the runner's promises on a child of the test's own.
+"""
+
+from __future__ import annotations
+
+import json
+import resource
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from childproc import run_child
+
+from retrokit.errors import ChildStartError
+from retrokit.host.child import Child
+
+MODULE = "house_child"
+CHILD = """
+import json, resource, subprocess, sys, time
+
+request = json.load(sys.stdin)
+if request["do"] == "limits":
+    limits = {"as": resource.getrlimit(resource.RLIMIT_AS), "core": resource.getrlimit(resource.RLIMIT_CORE)}
+    print(json.dumps({**limits, "echo": request["echo"]}), flush=True)
+elif request["do"] == "hang":  # a grandchild in its group, then silence
+    sleeper = subprocess.Popen(["sleep", "600"])
+    print(sleeper.pid, flush=True)
+    time.sleep(600)
+elif request["do"] == "fail":
+    print("first words\\nlast words", file=sys.stderr)
+    sys.exit(5)
+"""
+
+
+@pytest.fixture
+def child_module(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """A module the child runs, on the child's path."""
+    (tmp_path / f"{MODULE}.py").write_text(CHILD)
+    monkeypatch.setenv("PYTHONPATH", str(tmp_path))
+    return tmp_path
+
+
+def test_the_child_reads_its_request_and_runs_under_the_cap_with_no_core_file(child_module: Path) -> None:
+    with Child(MODULE, {"do": "limits", "echo": "hello"}, memory=1 << 30) as child:
+        (line,) = list(child.lines(first=120))
+        end = child.end()
+    answer = json.loads(line)
+    assert answer == {"as": [1 << 30, 1 << 30], "core": [0, 0], "echo": "hello"}
+    assert (end.status, end.hung, end.signal) == (0, False, None)
+
+
+def test_the_cap_never_exceeds_the_users_own_limit(child_module: Path) -> None:
+    """Under ``ulimit -v`` of 1 GiB, a cap of 3 GiB becomes 1 GiB: raising a hard limit would fail."""
+    code = f"""
+        import resource
+        resource.setrlimit(resource.RLIMIT_AS, (2**30, 2**30))
+        from retrokit.host.child import Child
+        with Child({MODULE!r}, {{"do": "limits", "echo": ""}}, memory=3 * 2**30) as child:
+            print(b"".join(child.lines(first=120)).decode())
+            print("status", child.end().status)
+    """
+    done = run_child(code, env={"PYTHONPATH": str(child_module)}, timeout=180)
+    assert done.returncode == 0, done.describe()
+    answer, status = done.stdout.splitlines()
+    assert json.loads(answer)["as"] == [2**30, 2**30] and status == "status 0", done.describe()
+
+
+def _gone(pid: int) -> bool:
+    """Whether ``pid`` is dead: no such process, or a zombie nobody reaped yet."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] in "ZX"
+    except (FileNotFoundError, ProcessLookupError):
+        return True
+
+
+def _wait_gone(pid: int) -> None:
+    waited = time.monotonic()
+    while not _gone(pid) and time.monotonic() - waited < 60:
+        time.sleep(0.1)  # polling a condition (the kill is asynchronous), not timing it
+    assert _gone(pid), f"the grandchild {pid} outlived its group's kill"
+
+
+def test_a_silent_child_is_killed_past_its_deadline_with_its_whole_group(child_module: Path) -> None:
+    with Child(MODULE, {"do": "hang"}, memory=1 << 30) as child:
+        lines = list(child.lines(first=120, each=1))  # it prints one line, then nothing
+        end = child.end()
+    (grandchild,) = [int(line) for line in lines]
+    assert end.hung and end.signal is None  # a deadline missed, not a crash
+    _wait_gone(grandchild)
+
+
+def test_a_failing_child_gives_its_status_and_last_words(child_module: Path) -> None:
+    with Child(MODULE, {"do": "fail"}, memory=1 << 30) as child:
+        assert list(child.lines(first=120)) == []
+        end = child.end()
+    assert (end.status, end.hung, end.last_words) == (5, False, "last words")
+
+
+def test_a_child_that_cannot_start_is_one_error_line(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(sys, "executable", str(tmp_path / "no-python"))
+    with pytest.raises(ChildStartError) as info:
+        Child(MODULE, {}, memory=1 << 30)
+    message = str(info.value)
+    assert "\n" not in message and "could not start: No such file or directory" in message, message
+    assert info.value.reason == "No such file or directory"
+
+
+def test_leaving_the_block_early_kills_the_child(child_module: Path) -> None:
+    with pytest.raises(KeyboardInterrupt), Child(MODULE, {"do": "hang"}, memory=1 << 30) as child:
+        grandchild = int(next(iter(child.lines(first=120))))
+        raise KeyboardInterrupt  # Ctrl-C while the child runs
+    assert child._proc.returncode is not None  # killed and reaped on the way out
+    _wait_gone(grandchild)
+
+
+def test_the_users_limits_here_are_untouched() -> None:
+    """The caps are set on the child alone (prlimit on its pid), never on this process."""
+    before = resource.getrlimit(resource.RLIMIT_AS), resource.getrlimit(resource.RLIMIT_CORE)
+    with Child("json.tool", {}, memory=1 << 28) as child:  # any module that reads stdin and ends
+        list(child.lines(first=120))
+        child.end()
+    assert (resource.getrlimit(resource.RLIMIT_AS), resource.getrlimit(resource.RLIMIT_CORE)) == before

@@ -13,6 +13,7 @@ scenario and the benchmark file:
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
@@ -85,6 +86,13 @@ def test_galaxian_atari2600_runs_as_written(folders, capsys) -> None:
     assert (game / "Level1.state").is_file()
     assert (data / "roms" / "Galaxian-Atari2600" / "rom.a26").is_file()
     assert GALAXIAN.written()[0][0] == "~/.local/share/retrokit/games/Galaxian-Atari2600/game.yaml"
+    # what the text says of the agents' episodes: JERK's ship lost at the right wall after 80 steps, each time
+    episodes = {
+        agent: [json.loads(line) for line in (work / "runs" / agent / "episodes.jsonl").read_text().splitlines()]
+        for agent in ("jerk", "random")
+    }
+    assert {e["steps"] for e in episodes["jerk"]} == {80} and max(e["reward"] for e in episodes["jerk"]) == 30
+    assert [(e["steps"], e["reward"]) for e in episodes["random"]] == [(200, 410), (200, 310)]
 
 
 def test_each_walkthrough_ends_where_the_next_section_starts() -> None:

@@ -93,8 +93,14 @@ def write_recipe(folder: Path, recipe: str) -> None:
         ("  Zone1.Act1: {press: [START], until: {game_mode: 1}, frames: 60}\n", "found both. Keep one"),
         ("  Zone1.Act1: {press: [START], frames: 0}\n", "expected frames to be a number of frames from 1"),
         ("  Zone1.Act1: {set: {zone: 0}, untill: {game_mode: 1}}\n", "Did you mean 'until'"),
+        ("  Zone1.Act1: {script: '_*20 STRAT*2', frames: 60}\n", r"script's step 2 \('STRAT\*2', column 6\).*'START'"),
+        ("  Zone1.Act1: {script: '_*20 START*2', frames: 20}\n", "expected frames .20, counted from power-on. to cover"),
+        ("  Zone1.Act1: {script: [START], frames: 60}\n", "Expected a script of at most"),
     ],
-    ids=["unknown-field", "no-until-nor-frames", "until-and-frames", "zero-frames", "unknown-key"],
+    ids=[
+        "unknown-field", "no-until-nor-frames", "until-and-frames", "zero-frames", "unknown-key", "script-button",
+        "frames-shorter-than-script", "script-not-text",
+    ],
 )
 def test_bad_recipes_say_what_is_wrong(dasher_copy: Path, recipe: str, message: str) -> None:
     write_recipe(dasher_copy, recipe)
@@ -125,6 +131,10 @@ def test_a_frames_recipe_passes_the_schema(dasher_copy: Path) -> None:
     assert check_file(dasher_copy / "game.yaml", "game") == []
     write_recipe(dasher_copy, "  Zone1.Act1: {press: [START], frames: 100, until: {game_mode: 1}}\n")
     assert check_file(dasher_copy / "game.yaml", "game") != []
+    write_recipe(dasher_copy, "  Zone1.Act1: {script: '_*20 START*2', until: {game_mode: 1}}\n")
+    assert check_file(dasher_copy / "game.yaml", "game") == []
+    write_recipe(dasher_copy, "  Zone1.Act1: {script: [START], until: {game_mode: 1}}\n")
+    assert check_file(dasher_copy / "game.yaml", "game") != []
 
 
 
@@ -135,3 +145,30 @@ def test_a_state_name_inside_a_game_folder_is_that_games(dasher_copy: Path, tmp_
     assert main(["integrate", "Level1", "--out", str(tmp_path / "out")]) == 0
     assert capsys.readouterr().out.split()[:2] == ["Level1", "made"]
     assert (tmp_path / "out" / "Level1.state").is_file()
+
+
+def test_a_script_presses_a_console_switch_once(tmp_path: Path) -> None:
+    """The 2600's RESET starts Galaxian; tapped all along by press, as START is, it restarts the game every 4 frames."""
+    import hashlib
+
+    ale_py = pytest.importorskip("ale_py")
+    rom = Path(ale_py.__file__).parent / "roms" / "galaxian.bin"
+    folder = tmp_path / "Galaxian-Atari2600"
+    folder.mkdir()
+    shutil.copy(rom, folder / "rom.a26")
+    (folder / "game.yaml").write_text(
+        f"system: Atari2600\nroms:\n  - sha1: {hashlib.sha1(rom.read_bytes()).hexdigest()}\n"
+        "fields:\n  lives: {address: 0x00B9, type: '|u1'}\n"  # the ships in reserve (docs/integrate.md)
+        "integrate:\n  Wave1: {script: '_*20 RESET*2', frames: 120}\n  Tapped: {press: [RESET], frames: 120}\n"
+    )
+    game = load_game(folder)
+    made = {name: make_state(game, recipe) for name, recipe in recipes(game).items()}
+    assert fields_after(game, made["Wave1"]) == {"lives": 2}  # a ship in play, two in reserve
+    assert fields_after(game, made["Tapped"]) == {"lives": 3}  # held at the game's start
+    with Emulator(game.system, game.require_rom()) as emu:  # the same inputs by hand, as ramsearch run --script
+        reset = emu.system.mask(["RESET"])
+        for masks, frames in (([0, 0], 20), ([reset, 0], 2), ([0, 0], 98)):
+            emu.run(masks, frames)
+        by_hand = emu.ram.copy()
+        emu.set_state(vet_state(made["Wave1"], game.system, game.require_rom()))
+        assert (emu.ram == by_hand).all()

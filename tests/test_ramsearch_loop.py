@@ -22,12 +22,12 @@ import pytest
 
 from retrokit import cli
 from retrokit.data.games import find_game
+from retrokit.data.script import parse_script
 from retrokit.data.statecheck import vet_state
 from retrokit.data.states import read_state_file
 from retrokit.errors import FileConflictError, InvalidArgumentError, MovieError, RamSearchError
 from retrokit.host.emulator import Emulator
 from retrokit.ramsearch import RamSearch
-from retrokit.ramsearch.script import parse_script
 
 REPO = Path(__file__).resolve().parent.parent
 DASHER = REPO / "games" / "Dasher-Genesis"

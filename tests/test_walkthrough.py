@@ -1,24 +1,28 @@
-"""docs/integrate.md's "Your own game, from a ROM", run from the CLI as written, with the output it shows.
+"""docs/integrate.md's walkthroughs, run from the CLI as written, with the output they show.
 
-The whole loop of issue 21 on a header-patched Dasher that no known game
-matches: new game, first state saved from a RAM search, lives and x found by
-RAM search and saved with ranges, a scenario, validate (which catches another
-game's state) and one evaluation of two agents, every command's output
-compared with the text's. Nothing is written by hand but the scenario and
-the benchmark file.
+The whole loop of issue 21, from a ROM no game knows to a benchmark, every
+command's output compared with the text's; nothing is written by hand but the
+scenario and the benchmark file:
+
+- "Your own game, from a ROM": a header-patched Dasher (Genesis). Lives and x
+  found by RAM search and saved with ranges; validate catches another game's state.
+- "An Atari 2600 game, from ale-py's ROMs" (issue 29): ale-py's bare
+  galaxian.bin, no header, 128 bytes of RAM at 0x80, a first state after the
+  console's RESET switch; lives and a six-digit BCD score found by RAM search.
 """
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import pytest
-import walkthrough
+from walkthrough import GALAXIAN, RUNNER, SHOWN_DATA, Step, Walkthrough
 
 
 @pytest.fixture
 def folders(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> tuple[Path, Path]:
-    data, work = tmp_path / "data", tmp_path / "runner"
+    data, work = tmp_path / "data", tmp_path / "work"
     work.mkdir()
     monkeypatch.setenv("RETROKIT_DATA", str(data))
     monkeypatch.delenv("RETROKIT_GAMES", raising=False)
@@ -29,30 +33,71 @@ def folders(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> tuple[Path, Path
     return work, data
 
 
-def test_the_walkthrough_runs_as_written(folders, capsys) -> None:
-    work, data = folders
-    steps = list(walkthrough.run(work, data, capsys))
-    wrong = [f"{walkthrough.DOCUMENT.name}:{s.line}: $ {s.command}\n--- shown\n{s.shown}\n--- printed\n{s.printed}"
-             for s in steps if not s.matches()]
+def run_as_written(text: Walkthrough, work: Path, data: Path, capsys) -> list[Step]:
+    """Run the walkthrough; check every command printed what the text shows, and every file shown is as written."""
+    steps = list(text.run(work, data, capsys))
+    wrong = [
+        f"{text.document.name}:{s.line}: $ {s.command}\n--- shown\n{s.shown}\n--- printed\n{s.printed}"
+        for s in steps
+        if not s.matches()
+    ]
     assert not wrong, "\n\n".join(wrong)
     commands = [s.command.split()[1] for s in steps]
     for command in ("import", "new", "ramsearch", "validate", "evaluate"):
         assert command in commands
     lines = [s.command for s in steps]
     # issue 21: the CLI makes the first state and writes the fields' ranges; one command evaluates both agents
-    assert "retrokit ramsearch savestate Level1 --default" in lines
+    assert any(line.startswith("retrokit ramsearch savestate ") and line.endswith(" --default") for line in lines)
     assert sum("--range" in line for line in lines if line.startswith("retrokit ramsearch save ")) == 2
     assert [c for c in lines if c.startswith("retrokit evaluate") and c.count("--agent") == 2]
-    text = walkthrough.DOCUMENT.read_text(encoding="utf-8")
-    by_hand = [body.partition("\n")[0] for _, language, body in walkthrough.blocks(text)
-               if language == "yaml" and body.startswith(("# file: ", "# append to: "))]
-    assert by_hand == ["# file: ~/.local/share/retrokit/games/Runner-Genesis/scenario.yaml", "# file: runner.yaml"]
+    assert (work / "runs" / "report.md").is_file()
+    shown = text.written()
+    assert len(shown) == 1
+    for path, content in shown:
+        assert Path(path.replace(SHOWN_DATA, str(data))).read_text(encoding="utf-8").strip() == content.strip()
+    return steps
+
+
+def test_runner_genesis_runs_as_written(folders, capsys) -> None:
+    work, data = folders
+    lines = [s.command for s in run_as_written(RUNNER, work, data, capsys)]
+    assert "retrokit ramsearch savestate Level1 --default" in lines
+    assert RUNNER.by_hand() == [
+        "# file: ~/.local/share/retrokit/games/Runner-Genesis/scenario.yaml",
+        "# file: runner.yaml",
+    ]
     game = data / "games" / "Runner-Genesis"
     assert (game / "game.yaml").is_file() and (game / "Level1.state").is_file()
     assert (data / "roms" / "Runner-Genesis" / "rom.md").is_file()
-    assert (work / "runs" / "report.md").is_file()
-    # the game.yaml the text says the commands left
-    written = "# written by the commands above: ~/.local/share/retrokit/games/Runner-Genesis/game.yaml\n"
-    shown = [body for _, language, body in walkthrough.blocks(text) if language == "yaml" and body.startswith(written)]
-    assert len(shown) == 1
-    assert (game / "game.yaml").read_text(encoding="utf-8").strip() == shown[0][len(written):].strip()
+    assert RUNNER.written()[0][0] == "~/.local/share/retrokit/games/Runner-Genesis/game.yaml"
+
+
+def test_galaxian_atari2600_runs_as_written(folders, capsys) -> None:
+    work, data = folders
+    lines = [s.command for s in run_as_written(GALAXIAN, work, data, capsys)]
+    # a new user's path: the bare .bin told by its size, the console's RESET switch pressed before the first state
+    assert "retrokit new galaxian.bin --name Galaxian-Atari2600" in lines
+    assert any(line.startswith("retrokit ramsearch run --script ") and "RESET" in line for line in lines)
+    assert GALAXIAN.by_hand() == [
+        "# file: ~/.local/share/retrokit/games/Galaxian-Atari2600/scenario.yaml",
+        "# file: galaxian.yaml",
+    ]
+    game = data / "games" / "Galaxian-Atari2600"
+    assert (game / "Level1.state").is_file()
+    assert (data / "roms" / "Galaxian-Atari2600" / "rom.a26").is_file()
+    assert GALAXIAN.written()[0][0] == "~/.local/share/retrokit/games/Galaxian-Atari2600/game.yaml"
+    # what the text says of the agents' episodes: JERK's ship lost at the right wall after 80 steps, each time
+    episodes = {
+        agent: [json.loads(line) for line in (work / "runs" / agent / "episodes.jsonl").read_text().splitlines()]
+        for agent in ("jerk", "random")
+    }
+    assert {e["steps"] for e in episodes["jerk"]} == {80} and max(e["reward"] for e in episodes["jerk"]) == 30
+    assert [(e["steps"], e["reward"]) for e in episodes["random"]] == [(200, 410), (200, 310)]
+
+
+def test_each_walkthrough_ends_where_the_next_section_starts() -> None:
+    # the Genesis walkthrough runs up to the Atari one's heading, not into its commands
+    runner, galaxian = ([line for line, _, _ in w.blocks()] for w in (RUNNER, GALAXIAN))
+    assert runner and galaxian
+    assert max(runner) < min(galaxian)
+    assert not any("Galaxian" in text for _, _, text in RUNNER.blocks())

@@ -1,18 +1,22 @@
-"""Running docs/integrate.md's walkthrough, "Your own game, from a ROM", as written.
+"""Running a walkthrough of the docs (a section of commands and their output) as written.
 
-The section's blocks run in order in one working folder, with a fresh data
-folder shown in the text as ``~/.local/share/retrokit``:
+docs/integrate.md has two: "Your own game, from a ROM" (a header-patched
+Dasher on the Genesis) and "An Atari 2600 game, from ale-py's ROMs"
+(Galaxian). A walkthrough's blocks run in order in one working folder, with a
+fresh data folder shown in the text as ``~/.local/share/retrokit``:
 
-- a ``python`` block is executed (it builds the header-patched ROM);
+- a ``python`` block is executed (it makes or copies the ROM);
 - a ``yaml`` block whose first line is ``# file: PATH`` is that file's text,
   written by hand; ``# append to: PATH`` is text added at its end;
-- any other block is shown, not run (the test checks the ``game.yaml`` the
-  commands wrote against its block);
+- a ``yaml`` block whose first line is ``# written by the commands above: PATH``
+  is shown, not run: :meth:`Walkthrough.written` gives it, for a test to compare
+  with the file the commands wrote;
+- any other block is shown, not run;
 - a ``console`` block holds ``$ retrokit ...`` commands, each followed by
   what it prints (standard output, then any ``retrokit: error:`` line).
 
-:func:`run` returns each command with the output the text shows and the one
-it gave, so a test can compare them.
+:meth:`Walkthrough.run` returns each command with the output the text shows
+and the one it gave, so a test can compare them.
 """
 
 from __future__ import annotations
@@ -28,15 +32,15 @@ import pytest
 from retrokit.cli import main
 
 REPO = Path(__file__).resolve().parent.parent
-DOCUMENT = REPO / "docs" / "integrate.md"
-SECTION = "## Your own game, from a ROM"
 SHOWN_DATA = "~/.local/share/retrokit"
+BY_HAND = ("# file: ", "# append to: ")
+WRITTEN = "# written by the commands above: "
 _BLOCK = re.compile(r"^```(\w+)\n(.*?)^```", re.MULTILINE | re.DOTALL)
 
 
 @dataclass(frozen=True)
 class Step:
-    """One command of the walkthrough: what the text shows under it, and what it printed."""
+    """One command of a walkthrough: what the text shows under it, and what it printed."""
 
     line: int
     command: str
@@ -58,18 +62,69 @@ def _squash(text: str) -> str:
     return "".join(text.split())
 
 
-def section(text: str) -> tuple[int, str]:
-    """The walkthrough's text, and the line of the document it starts on."""
-    start = text.index(SECTION)
-    end = text.find("\n## ", start + len(SECTION))
-    return text.count("\n", 0, start), text[start : end if end >= 0 else len(text)]
+@dataclass(frozen=True)
+class Walkthrough:
+    """The section of ``document`` under the heading ``heading`` (``## ...``), up to the next one of its level."""
 
+    document: Path
+    heading: str
 
-def blocks(text: str) -> Iterator[tuple[int, str, str]]:
-    """Each fenced block of the walkthrough: its line in the document, its language and its text."""
-    first, body = section(text)
-    for match in _BLOCK.finditer(body):
-        yield first + body.count("\n", 0, match.start()) + 2, match.group(1), match.group(2)
+    def section(self) -> tuple[int, str]:
+        """The walkthrough's text, and the line of the document it starts on."""
+        text = self.document.read_text(encoding="utf-8")
+        start = text.index(self.heading + "\n")
+        level = self.heading.split(" ", 1)[0]
+        end = text.find(f"\n{level} ", start + len(self.heading))
+        return text.count("\n", 0, start), text[start : end if end >= 0 else len(text)]
+
+    def blocks(self) -> Iterator[tuple[int, str, str]]:
+        """Each fenced block of the walkthrough: its line in the document, its language and its text."""
+        first, body = self.section()
+        for match in _BLOCK.finditer(body):
+            yield first + body.count("\n", 0, match.start()) + 2, match.group(1), match.group(2)
+
+    def by_hand(self) -> list[str]:
+        """The first line of each file written by hand (``# file: PATH``, ``# append to: PATH``)."""
+        return [
+            text.partition("\n")[0]
+            for _, language, text in self.blocks()
+            if language == "yaml" and text.startswith(BY_HAND)
+        ]
+
+    def written(self) -> list[tuple[str, str]]:
+        """Each file the text shows as the commands left it: its path as shown, and its text below that line."""
+        return [
+            (head[len(WRITTEN) :].strip(), content)
+            for _, language, text in self.blocks()
+            if language == "yaml" and text.startswith(WRITTEN)
+            for head, _, content in [text.partition("\n")]
+        ]
+
+    def run(self, workdir: Path, data: Path, capsys: pytest.CaptureFixture[str]) -> Iterator[Step]:
+        """Run it in ``workdir`` (the current folder) with ``data`` as the data folder; yield each command."""
+        name = self.document.name
+
+        def local(text: str) -> str:
+            return text.replace(SHOWN_DATA, str(data))
+
+        for line, language, text in self.blocks():
+            if language == "python":
+                exec(compile(text, f"{name}:{line}", "exec"), {"__name__": "walkthrough"})  # noqa: S102
+            elif language == "yaml" and text.startswith(BY_HAND):
+                head, _, content = text.partition("\n")
+                path = Path(local(head.split(": ", 1)[1].strip()))
+                with open(path, "w" if head.startswith(BY_HAND[0]) else "a", encoding="utf-8") as f:
+                    f.write(content)
+            elif language == "console":
+                for offset, command, shown in commands(text):
+                    argv = shlex.split(local(command))
+                    assert argv[0] == "retrokit", f"{name}:{line + offset}: only retrokit commands run here"
+                    capsys.readouterr()
+                    main(argv[1:])
+                    out, err = capsys.readouterr()
+                    errors = [e for e in err.splitlines() if e.startswith("retrokit:")]
+                    printed = "\n".join([*out.rstrip("\n").splitlines(), *errors]).replace(str(data), SHOWN_DATA)
+                    yield Step(line + offset, command, shown, printed.strip("\n"), str(data))
 
 
 def commands(console: str) -> Iterator[tuple[int, str, str]]:
@@ -81,28 +136,6 @@ def commands(console: str) -> Iterator[tuple[int, str, str]]:
         yield i, lines[i][2:], "\n".join(lines[i + 1 : end]).strip("\n")
 
 
-def run(workdir: Path, data: Path, capsys: pytest.CaptureFixture[str]) -> Iterator[Step]:
-    """Run the walkthrough in ``workdir`` (the current folder) with ``data`` as the data folder; yield each command."""
-
-    def local(text: str) -> str:
-        return text.replace(SHOWN_DATA, str(data))
-
-    for line, language, text in blocks(DOCUMENT.read_text(encoding="utf-8")):
-        if language == "python":
-            exec(compile(text, f"{DOCUMENT.name}:{line}", "exec"), {"__name__": "walkthrough"})  # noqa: S102
-        elif language == "yaml" and text.startswith(("# file: ", "# append to: ")):
-            head, _, content = text.partition("\n")
-            path = Path(local(head.split(": ", 1)[1].strip()))
-            mode = "w" if head.startswith("# file: ") else "a"
-            with open(path, mode, encoding="utf-8") as f:
-                f.write(content)
-        elif language == "console":
-            for offset, command, shown in commands(text):
-                argv = shlex.split(local(command))
-                assert argv[0] == "retrokit", f"{DOCUMENT.name}:{line + offset}: only retrokit commands run here"
-                capsys.readouterr()
-                main(argv[1:])
-                out, err = capsys.readouterr()
-                errors = [e for e in err.splitlines() if e.startswith("retrokit:")]
-                printed = "\n".join([*out.rstrip("\n").splitlines(), *errors]).replace(str(data), SHOWN_DATA)
-                yield Step(line + offset, command, shown, printed.strip("\n"), str(data))
+INTEGRATE = REPO / "docs" / "integrate.md"
+RUNNER = Walkthrough(INTEGRATE, "## Your own game, from a ROM")
+GALAXIAN = Walkthrough(INTEGRATE, "## An Atari 2600 game, from ale-py's ROMs")

@@ -39,8 +39,8 @@ _VALUES_SHOWN = 8  # snapshots whose values `show` prints; older ones are elided
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``ramsearch`` command and its subcommands."""
+    from retrokit.data.script import SYNTAX
     from retrokit.ramsearch.filters import OPS, THAN_FORMS
-    from retrokit.ramsearch.script import SYNTAX
 
     parser = subparsers.add_parser(
         "ramsearch",

@@ -14,6 +14,9 @@ has a recipe for, and checks the ones already there::
       Level1:
         press: [START]                 # a new game has no fields yet: press START
         frames: 300                    # for 300 frames from power-on, then save
+      Start:
+        script: _*20 RESET*2           # played once first (ramsearch's script syntax)
+        frames: 120                    # frames from power-on, the script's included
 
 States can also be made from a movie: the state a ``.bk2`` reaches at a
 frame (:func:`retrokit.movie.playback.state_from_movie`), placed with
@@ -30,7 +33,7 @@ process to the next; a state that is already up to date is not rewritten.
 from __future__ import annotations
 
 import hashlib
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -40,6 +43,7 @@ import numpy as np
 from retrokit import paths
 from retrokit.data.games import Game, cached_rom_sha1, list_games
 from retrokit.data.names import check_state_name
+from retrokit.data.script import parse_script, port_masks
 from retrokit.data.statecheck import check_state, load_state, remember_written
 from retrokit.data.states import StateRecord, write_state
 from retrokit.errors import (
@@ -69,6 +73,8 @@ class Recipe:
     settle: int = 0
     max_frames: int = 3000
     frames: int | None = None  # instead of until: play exactly this many frames
+    # played once before the taps of press: each step's masks (one per port) and frames
+    script: tuple[tuple[tuple[int, ...], int], ...] = ()
 
 
 def recipes(game: Game) -> dict[str, Recipe]:
@@ -85,7 +91,7 @@ def recipes(game: Game) -> dict[str, Recipe]:
     return {str(name): _recipe(game, str(name), spec) for name, spec in raw.items()}
 
 
-_RECIPE_KEYS = ("set", "press", "until", "frames", "settle", "max_frames")
+_RECIPE_KEYS = ("set", "press", "script", "until", "frames", "settle", "max_frames")
 MAX_RECIPE_FRAMES = 1_000_000  # about 4.6 hours of play: a recipe that needs more is a mistake
 
 
@@ -111,10 +117,17 @@ def _recipe(game: Game, name: str, spec: Any) -> Recipe:
             "how many frames to play from power-on, such as 300 (for a game with no fields yet); found neither."
         )
     frames = _count(where, "frames", spec["frames"], 1) if "frames" in spec else None
+    script = _script(game, where, spec.get("script"))
+    if frames is not None and frames < sum(length for _, length in script):
+        raise DataFileError(
+            f"{where}: expected frames ({frames}, counted from power-on) to cover its script's "
+            f"{sum(length for _, length in script)} frames; found fewer. Raise frames, or shorten the script."
+        )
     return Recipe(
         name=name,
         set=_values(game, where, "set", spec.get("set")),
         press=_press(game, where, spec.get("press")),
+        script=script,
         until=_values(game, where, "until", spec.get("until")),
         settle=_count(where, "settle", spec.get("settle", 0), 0),
         max_frames=_count(where, "max_frames", spec.get("max_frames", 3000), 1),
@@ -190,6 +203,18 @@ def _press(game: Game, where: str, raw: Any) -> dict[int, tuple[str, ...]]:
     return press
 
 
+def _script(game: Game, where: str, raw: Any) -> tuple[tuple[tuple[int, ...], int], ...]:
+    """``script``: inputs played once from power-on, as ``ramsearch run --script`` takes them (``_*20 RESET*2``)."""
+    if raw is None:
+        return ()
+    ports = _ports(game)
+    try:
+        steps = parse_script(raw, lambda names: port_masks(game.system, ports, names))
+    except RetrokitError as exc:
+        raise DataFileError(f"{where}: {exc}") from None
+    return tuple((tuple(port_masks(game.system, ports, step.buttons)), step.frames) for step in steps)
+
+
 def _ports(game: Game) -> int:
     """The controller ports a recipe's emulator has: one per player, and at least two, as an env's."""
     return max(2, game.players)
@@ -207,8 +232,8 @@ def make_state(game: Game, recipe: Recipe) -> VettedState:
 
     An ``until`` recipe plays until its fields hold their values (at most
     ``max_frames``); a ``frames`` recipe plays exactly that many frames. Either
-    taps its buttons (held :data:`HOLD_FRAMES`, released as long) meanwhile,
-    then runs ``settle`` idle frames.
+    plays its script first, then taps its buttons (held :data:`HOLD_FRAMES`,
+    released as long), then runs ``settle`` idle frames.
 
     Raises:
         StateError: The recipe did not arrive within its frame budget.
@@ -221,19 +246,34 @@ def make_state(game: Game, recipe: Recipe) -> VettedState:
                 raise InvalidArgumentError(f"Expected ports 1 to {emu.ports} in the recipe of {recipe.name!r}, got {port}.")
             masks[port - 1] = emu.system.mask(buttons)
         values: dict[str, int] = {}
-        for frame in range(recipe.frames if recipe.frames is not None else recipe.max_frames):
+        inputs = _inputs(recipe.script, masks)
+        for _ in range(recipe.frames if recipe.frames is not None else recipe.max_frames):
             for name, value in recipe.set.items():
                 reader.write(name, value)
             values = reader.read()
             if recipe.until and all(values[k] == v for k, v in recipe.until.items()):
                 break
-            pressed = (frame // HOLD_FRAMES) % 2 == 0
-            emu.run(masks if pressed else [0] * emu.ports, 1)
+            emu.run(next(inputs), 1)
         else:
             if recipe.frames is None:
                 _not_arrived(game, recipe, values)
         emu.run([0] * emu.ports, recipe.settle)
         return emu.get_state()
+
+
+def _inputs(script: tuple[tuple[tuple[int, ...], int], ...], taps: list[int]) -> Iterator[list[int]]:
+    """Each frame's buttons, one mask per port: the script's, once; then ``taps`` held and released in turn.
+
+    A script presses a button for as long as it says: the 2600's RESET, tapped
+    all along as press taps START, would restart the game every 4 frames.
+    """
+    for masks, frames in script:
+        for _ in range(frames):
+            yield list(masks)
+    frame = 0
+    while True:
+        yield taps if (frame // HOLD_FRAMES) % 2 == 0 else [0] * len(taps)
+        frame += 1
 
 
 def _not_arrived(game: Game, recipe: Recipe, values: Mapping[str, int]) -> None:

@@ -35,6 +35,7 @@ import numpy as np
 from retrokit.data import statecheck
 from retrokit.data.games import Game, find_game
 from retrokit.data.roms import rom_sha1
+from retrokit.data.script import MAX_FRAMES, parse_script, port_masks
 from retrokit.data.states import StateRecord
 from retrokit.errors import InvalidArgumentError, MovieError, SessionError, StateError
 from retrokit.host.emulator import Emulator
@@ -44,7 +45,6 @@ from retrokit.ramsearch.candidates import Candidate
 from retrokit.ramsearch.engine import Engine, list_candidates
 from retrokit.ramsearch.keeping import Keeping
 from retrokit.ramsearch.ram import RamLayout
-from retrokit.ramsearch.script import MAX_FRAMES, parse_script
 from retrokit.ramsearch.session import SessionData, read_session, write_session
 from retrokit.ramsearch.types import parse_search_types
 
@@ -234,16 +234,7 @@ class RamSearch(Keeping):
         Raises:
             UnknownNameError: A name is not one of the system's buttons.
         """
-        masks = [0] * self.emulator.ports
-        for name in press:
-            port, _, button = name.rpartition(":")
-            index = int(port) - 1 if port.isdigit() else 0
-            if port and not port.isdigit() or not 0 <= index < len(masks):
-                raise InvalidArgumentError(
-                    f"Expected a button, or PORT:BUTTON with a port of 1 to {len(masks)}; got {name!r}."
-                )
-            masks[index] |= self.emulator.system.mask([button])
-        return masks
+        return port_masks(self.emulator.system, self.emulator.ports, press)
 
     def step(self, press: Sequence[str] = (), frames: int = 1) -> None:
         """Hold buttons for some frames, without a snapshot (to script play between snapshots)."""
@@ -268,7 +259,7 @@ class RamSearch(Keeping):
         return self._snap(f"{'state ' + state + ', ' if state else ''}{held} for {frames} frames", snapshot)
 
     def run_script(self, script: str, *, state: str | None = None, snapshot: bool = True) -> int | None:
-        """Play an input script (taps, holds and waits: see :mod:`retrokit.ramsearch.script`), then take a snapshot.
+        """Play an input script (taps, holds and waits: see :mod:`retrokit.data.script`), then take a snapshot.
 
         Raises:
             InvalidArgumentError: The script is malformed or names an unknown button (all of it is checked first).

@@ -1,4 +1,4 @@
-"""Input scripts: taps, holds and waits in one line, as ``ramsearch run --script`` takes them.
+"""Input scripts: taps, holds and waits in one line, as ``ramsearch run --script`` and state recipes take them.
 
 A script is steps separated by spaces; each step holds some buttons for some
 frames, then the next step begins::
@@ -18,8 +18,12 @@ from __future__ import annotations
 import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from retrokit.errors import InvalidArgumentError, RetrokitError, shown
+
+if TYPE_CHECKING:
+    from retrokit.host.systems import System
 
 MAX_FRAMES = 1_000_000  # about 4.6 hours of play, as a state recipe's budget: more is a typo
 MAX_SCRIPT = 100_000  # characters
@@ -78,6 +82,23 @@ def parse_script(text: str, check_buttons: Callable[[Sequence[str]], object] | N
     if not steps:
         raise InvalidArgumentError(f"Expected a script of {SYNTAX}; got an empty one.")
     return steps
+
+
+def port_masks(system: System, ports: int, names: Sequence[str]) -> list[int]:
+    """The button mask of each of ``ports`` ports for names like ``RIGHT`` (port 1) or ``2:START``.
+
+    Raises:
+        InvalidArgumentError: A port is not one of 1 to ``ports``.
+        UnknownNameError: A name is not one of the system's buttons.
+    """
+    masks = [0] * ports
+    for name in names:
+        port, _, button = name.rpartition(":")
+        index = int(port) - 1 if port.isdigit() else 0
+        if port and not port.isdigit() or not 0 <= index < len(masks):
+            raise InvalidArgumentError(f"Expected a button, or PORT:BUTTON with a port of 1 to {len(masks)}; got {name!r}.")
+        masks[index] |= system.mask([button])
+    return masks
 
 
 def _parse_step(word: str, where: str) -> Step:

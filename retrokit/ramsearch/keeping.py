@@ -16,10 +16,10 @@ from typing import TYPE_CHECKING
 
 from retrokit import paths
 from retrokit.data.names import check_state_name
+from retrokit.data.script import MAX_FRAMES
 from retrokit.errors import DataFileError, FileConflictError, MovieError, SessionError
 from retrokit.paths import atomic_write, ensure_folder, locked, wheel_dir
 from retrokit.ramsearch import gamefile
-from retrokit.ramsearch.script import MAX_FRAMES
 from retrokit.ramsearch.types import BitType, search_type
 
 if TYPE_CHECKING:

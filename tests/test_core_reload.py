@@ -141,3 +141,24 @@ def test_a_genesis_game_reloads_too_when_its_descriptor_says_so(
         emulator.set_state(airstriker_state)
         emulator.run(0, 60)
         assert np.array_equal(played[0], emulator.screen()) and played[1] == reader.read()
+
+
+def test_an_env_plays_each_episode_alike(breakout_rom: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import shutil
+
+    import retrokit
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path))
+    (tmp_path / "roms" / "Breakout-Atari2600").mkdir(parents=True)
+    shutil.copy(breakout_rom, tmp_path / "roms" / "Breakout-Atari2600" / "rom.a26")
+    with retrokit.make("Breakout-Atari2600", action_type="all", noop_max=1) as env:
+        actions = np.zeros((40, len(env.buttons)), dtype=np.int8)
+        actions[:30, env.buttons.index("LEFT")] = 1
+        actions[::3, env.buttons.index("BUTTON")] = 1  # serve, then keep pressing
+        episodes = []
+        for _ in range(2):
+            obs, info = env.reset(seed=0)
+            seen = [(obs, info)] + [env.step(a)[::4] for a in actions]
+            episodes.append(seen)
+    first, second = episodes
+    assert all(np.array_equal(a[0], b[0]) and a[1] == b[1] for a, b in zip(first, second, strict=True))

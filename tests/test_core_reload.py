@@ -12,6 +12,7 @@ native host refuses to reload while any other view is alive.
 from __future__ import annotations
 
 import dataclasses
+import pickle
 from pathlib import Path
 
 import numpy as np
@@ -80,6 +81,24 @@ def test_without_the_reload_the_paddle_charge_leaks_into_the_next_load(
         assert not _same(_play(emulator, breakout_state), _play(emulator, breakout_state))
 
 
+def _play_from_power_on(emulator: Emulator) -> list[np.ndarray]:
+    """Hard-reset, start a game, move the paddle left then right: the screens seen."""
+    emulator.reset()
+    start, fire = emulator.system.mask(["RESET"]), emulator.system.mask(["BUTTON"])
+    screens = []
+    for mask in [start] * 3 + [0] * 10 + [LEFT] * 20 + [fire | RIGHT] * 5:
+        emulator.run([mask, 0], 4)
+        screens.append(emulator.screen())
+    return screens
+
+
+@pytest.mark.parametrize("reload", [True, False], ids=["reloaded-alike", "reset-only-unalike"])
+def test_every_hard_reset_plays_alike_only_with_the_reload(breakout_rom: Path, reload: bool) -> None:
+    system = dataclasses.replace(get_system("Atari2600"), reload_before_state=reload)
+    with Emulator(system, breakout_rom) as emulator:
+        assert _same(_play_from_power_on(emulator), _play_from_power_on(emulator)) == reload
+
+
 def test_the_address_space_and_its_readers_follow_the_reload(breakout_rom: Path, breakout_state: VettedState) -> None:
     from retrokit.host.fields import FieldSpec
 
@@ -116,6 +135,11 @@ def test_a_view_alive_across_a_reload_is_refused_in_one_line_and_nothing_changes
             emulator.set_state(breakout_state)
         assert emulator.peek(0x80) == kept[0]
         del kept
+        held = pickle.PickleBuffer(emulator.space.buffers[0])  # a buffer taken from the space's view itself
+        with pytest.raises(CoreError, match="found one onto 0x80-0xff"):
+            emulator.set_state(breakout_state)
+        assert emulator.peek(0x80) == emulator.ram[0]
+        del held
         emulator.set_state(breakout_state)  # with every view gone, the load goes through
         assert emulator.peek(0x80) == emulator.ram[0]
 

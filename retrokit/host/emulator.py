@@ -291,7 +291,13 @@ class Emulator:
         return self._emu.held()
 
     def reset(self) -> None:
-        """Hard-reset the console, as the reset button would."""
+        """Hard-reset the console, as the reset button would.
+
+        On a system that reloads its game before a state (``reload_before_state``) the game is
+        loaded again first, as before a state: what the core keeps outside its states starts afresh.
+        """
+        if self.system.reload_before_state:
+            self._reload_game()
         self._emu.reset()
 
     @property

@@ -78,7 +78,8 @@ class System:
         reload_before_state: The core keeps part of the console outside its
             states, where a reset does not reach it either: the game is unloaded
             and loaded again before each state is loaded (then reset, if
-            ``reset_before_state``), as a fresh core would take it.
+            ``reset_before_state``), as a fresh core would take it, and before
+            each hard reset.
         start: The button that starts a game from its title screen.
         jump: The button JERK jumps with, unless a scenario names another.
         switches: Console switches (not pad buttons), which default action sets, the random

@@ -43,6 +43,7 @@ host = Extension(
         "retrokit/native/host.c",
         "retrokit/native/host_emulator.c",
         "retrokit/native/host_functions.c",
+        "retrokit/native/host_state.c",
         "retrokit/native/host_runner.c",
         "retrokit/native/core.c",
         "retrokit/native/environment.c",

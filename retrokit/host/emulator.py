@@ -7,6 +7,7 @@ core is touched, and maps console addresses for RAM access.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 import zlib
@@ -16,7 +17,7 @@ from typing import Self
 
 import numpy as np
 
-from retrokit.errors import InvalidArgumentError, RetrokitError, StateError, UnknownNameError, did_you_mean
+from retrokit.errors import CoreError, InvalidArgumentError, RetrokitError, StateError, UnknownNameError, did_you_mean
 from retrokit.host import primitives
 from retrokit.host.corecheck import vet_core
 from retrokit.host.cores import find_core
@@ -167,7 +168,7 @@ class Emulator:
                     f"Expected one of {', '.join(map(repr, allowed))} for core option {key!r}, got {options[key]!r}."  # type: ignore[index]
                 )
         need_path = bool(self._emu.system_info()["need_fullpath"])
-        self._emu.load_game(str(rom), None if need_path else rom.read_bytes())
+        self._emu.load_game(str(rom), None if need_path else rom.read_bytes(), self.system.reload_before_state)
         self.rom = rom
         self.space = AddressSpace.for_emulator(self.system, self._emu)
         self._actions = np.zeros(ports, dtype=np.uint16)
@@ -290,7 +291,13 @@ class Emulator:
         return self._emu.held()
 
     def reset(self) -> None:
-        """Hard-reset the console, as the reset button would."""
+        """Hard-reset the console, as the reset button would.
+
+        On a system that reloads its game before a state (``reload_before_state``) the game is
+        loaded again first, as before a state: what the core keeps outside its states starts afresh.
+        """
+        if self.system.reload_before_state:
+            self._reload_game()
         self._emu.reset()
 
     @property
@@ -330,7 +337,11 @@ class Emulator:
 
     @property
     def ram(self) -> np.ndarray:
-        """The system RAM as a writable zero-copy ``uint8`` array, in the core's byte order."""
+        """The system RAM as a writable zero-copy ``uint8`` array, in the core's byte order.
+
+        On a system that reloads its game before a state (``reload_before_state``), the load
+        frees this memory, so :meth:`set_state` refuses while the array lives: copy what you keep.
+        """
         view = self._emu.memory(primitives.MEMORY_SYSTEM_RAM)
         if view is None:
             raise InvalidArgumentError(f"The {self.system.name} core exposes no system RAM.")
@@ -372,9 +383,26 @@ class Emulator:
                 f"Expected a state for this emulator of {self.system.name}; found one checked for {state.system}. "
                 f"Load it into an emulator of {state.system}."
             )
+        if self.system.reload_before_state:
+            self._reload_game()
         if self.system.reset_before_state:
             self._emu.reset()
         self._emu.unserialize(state, self.system.state_length == "exact")
+
+    def _reload_game(self) -> None:
+        """Unload the game and load it again; :attr:`space` (which every field reader holds) then shows the new memory.
+
+        The core frees the memory it showed, so the space lets go of its views first, and the
+        native host refuses while any other view is alive: nothing is left pointing at freed memory.
+        """
+        try:
+            self.space.release()
+            self._emu.reload()
+        except CoreError:
+            with contextlib.suppress(CoreError):  # unless the load itself failed, the game is there: show it again
+                self.space.rebind(AddressSpace.for_emulator(self.system, self._emu))
+            raise
+        self.space.rebind(AddressSpace.for_emulator(self.system, self._emu))
 
     def av_info(self) -> dict[str, float | int]:
         """Return the frame rate, sample rate and geometry."""

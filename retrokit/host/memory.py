@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from retrokit.errors import FieldNotFoundError, InvalidArgumentError, did_you_mean
+from retrokit.errors import CoreError, FieldNotFoundError, InvalidArgumentError, did_you_mean
 from retrokit.host import primitives
 from retrokit.host.fields import FieldSpec
 from retrokit.host.systems import System
@@ -49,6 +49,50 @@ class AddressSpace:
     def __init__(self, regions: Sequence[Region]) -> None:
         self.regions = list(regions)
         self.buffers = [r.buffer for r in self.regions]
+        self._layout = self._describe(self.regions)
+
+    @staticmethod
+    def _describe(regions: Sequence[Region]) -> list[tuple[int, int, int]]:
+        return [(r.start, r.length, r.swap) for r in regions]
+
+    def release(self) -> None:
+        """Let go of every buffer onto the core's memory (before a reload frees it), until :meth:`rebind`.
+
+        An array made from a buffer keeps the core's memory exported even so (a
+        memoryview shares what it looks through): the native host refuses the
+        reload while any such export lives.
+
+        Raises:
+            CoreError: A buffer is still exported directly (then it stays alive).
+        """
+        held = []
+        for region in self.regions:
+            try:
+                region.buffer.release()
+            except BufferError:  # something took a buffer from it directly
+                held.append(f"{region.start:#x}-{region.start + region.length - 1:#x}")
+        self.regions.clear()
+        self.buffers.clear()
+        if held:
+            raise CoreError(
+                f"Expected no array onto the emulator's memory to be alive before its game is reloaded (a reload "
+                f"frees that memory); found one onto {', '.join(held)}. Copy the values to keep (array.copy()) "
+                "and drop the array before loading a state."
+            )
+
+    def rebind(self, fresh: AddressSpace) -> None:
+        """Look at the memory of ``fresh`` from now on, in place: whoever holds this space reads the new memory.
+
+        Raises:
+            CoreError: ``fresh`` lays its regions out otherwise (the core changed its map on a reload).
+        """
+        if self._describe(fresh.regions) != self._layout:
+            raise CoreError(
+                f"Expected the core to map the same memory after reloading its game ({self._layout}); found "
+                f"{self._describe(fresh.regions)}. Report the core: its fields cannot be read across a reload."
+            )
+        self.regions[:] = fresh.regions
+        self.buffers[:] = fresh.buffers
 
     @classmethod
     def for_emulator(cls, system: System, emulator: primitives.NativeEmulator) -> AddressSpace:

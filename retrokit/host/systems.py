@@ -75,6 +75,11 @@ class System:
         reset_before_state: The core restores some state only partly (so a
             load's outcome would depend on what ran before it): the console is
             reset before each state is loaded, so every load starts alike.
+        reload_before_state: The core keeps part of the console outside its
+            states, where a reset does not reach it either: the game is unloaded
+            and loaded again before each state is loaded (then reset, if
+            ``reset_before_state``), as a fresh core would take it, and before
+            each hard reset.
         start: The button that starts a game from its title screen.
         jump: The button JERK jumps with, unless a scenario names another.
         switches: Console switches (not pad buttons), which default action sets, the random
@@ -97,6 +102,7 @@ class System:
     frame_rates: dict[str, float] = field(default_factory=dict)
     state_length: str = "exact"
     reset_before_state: bool = False
+    reload_before_state: bool = False
     detect: tuple[DetectRule, ...] = ()
     rom_format: str = ""
     missing_mappers: frozenset[int] = frozenset()
@@ -199,6 +205,7 @@ def _parse(name: str, entry: object) -> System:
             frame_rates={str(k): float(v) for k, v in (entry.get("frame_rate") or {}).items()},
             state_length=_one_of(entry.get("state_length", "exact"), ("exact", "parsed"), "state_length"),
             reset_before_state=_one_of(entry.get("reset_before_state", False), (False, True), "reset_before_state"),
+            reload_before_state=_one_of(entry.get("reload_before_state", False), (False, True), "reload_before_state"),
             detect=tuple(_detect_rule(rule) for rule in entry.get("detect") or ()),
             rom_format=_one_of(str((entry.get("rom") or {}).get("format", "")), ("", "ines"), "rom.format"),
             missing_mappers=frozenset(int(m) for m in (entry.get("rom") or {}).get("missing_mappers", ())),

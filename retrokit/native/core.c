@@ -142,7 +142,7 @@ int rk_core_open(rk_core *core, const char *path, const char *system_dir, const 
     return 0;
 }
 
-int rk_core_load_game(rk_core *core, const char *path, const void *data, size_t size) {
+static int load_game(rk_core *core, const char *path, const void *data, size_t size) {
     struct rk_retro_game_info info = {path, data, size, NULL};
     rk_enter(core);
     bool ok = core->api.load_game(&info);
@@ -156,6 +156,34 @@ int rk_core_load_game(rk_core *core, const char *path, const void *data, size_t 
         return -1;
     }
     return 0;
+}
+
+int rk_core_load_game(rk_core *core, const char *path, const void *data, size_t size, int keep) {
+    if (keep) {
+        core->game_path = strdup(path);
+        core->game_data = size ? malloc(size) : NULL;
+        if (!core->game_path || (size && !core->game_data)) {
+            rk_set_error(core, "cannot keep a copy of %s (%zu bytes) to reload it", path, size);
+            return -1;
+        }
+        if (size) memcpy(core->game_data, data, size);
+        core->game_size = size;
+    }
+    return load_game(core, path, data, size);
+}
+
+int rk_core_reload_game(rk_core *core) {
+    if (!core->game_path) {
+        rk_set_error(core, "the game was loaded without keeping a copy, so it cannot be reloaded");
+        return -1;
+    }
+    rk_enter(core);
+    core->api.unload_game();
+    rk_leave();
+    core->game_loaded = 0;
+    /* The last frame may have gone with the game: until the next frame, the screen is black. */
+    core->frame_data = NULL;
+    return load_game(core, core->game_path, core->game_data, core->game_size);
 }
 
 void rk_core_close(rk_core *core) {
@@ -185,6 +213,11 @@ void rk_core_close(rk_core *core) {
     free(core->system_dir);
     free(core->save_dir);
     core->system_dir = core->save_dir = NULL;
+    free(core->game_path);
+    free(core->game_data);
+    core->game_path = NULL;
+    core->game_data = NULL;
+    core->game_size = 0;
 }
 
 /* ---- running frames with sticky actions -------------------------------------------------------- */

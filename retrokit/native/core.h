@@ -82,6 +82,10 @@ typedef struct rk_core {
     rk_core_api api;
     int initialized;
     int game_loaded;
+    /* The game as it was loaded, kept (when asked) so that rk_core_reload_game can load it again. */
+    char *game_path;
+    void *game_data;
+    size_t game_size;
 
     char *system_dir;
     char *save_dir;
@@ -141,7 +145,12 @@ typedef struct rk_core {
 /* Loading and unloading. Each returns 0 on success, else fills core->error. */
 int rk_core_open(rk_core *core, const char *path, const char *system_dir, const char *save_dir);
 void rk_core_close(rk_core *core);
-int rk_core_load_game(rk_core *core, const char *path, const void *data, size_t size);
+/* keep: hold a copy of the game, for rk_core_reload_game. */
+int rk_core_load_game(rk_core *core, const char *path, const void *data, size_t size, int keep);
+/* Unload the game and load the kept copy again: the core rebuilds everything it made for the game (its
+ * memory too, so pointers from get_memory_data and the memory maps may change). Fails if nothing is kept;
+ * after a failed load no game is loaded. */
+int rk_core_reload_game(rk_core *core);
 int rk_core_set_option(rk_core *core, const char *key, const char *value);
 
 /* Running: enter/leave set the calling thread's current core for the callbacks. */

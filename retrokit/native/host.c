@@ -2,7 +2,7 @@
  * retrokit.native._host: the CPython face of the libretro host.
  *
  * The Emulator type (and the Memory it hands out) lives in host_emulator.c,
- * the Runner type in host_runner.c, the module's functions in
+ * its state calls in host_state.c, the Runner type in host_runner.c, the module's functions in
  * host_functions.c; this file makes the module, with the helpers all share.
  */
 #include "host.h"

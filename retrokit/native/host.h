@@ -23,6 +23,11 @@ typedef struct {
 
 extern PyTypeObject EmulatorType, MemoryType, RunnerType;
 
+/* Emulator's state calls (host_state.c). */
+PyObject *rk_py_serialize(EmulatorObject *self, PyObject *unused);
+PyObject *rk_py_unserialize(EmulatorObject *self, PyObject *args);
+PyObject *rk_py_reload(EmulatorObject *self, PyObject *unused);
+
 PyObject *rk_py_read_fields(PyObject *module, PyObject *const *args, Py_ssize_t nargs);
 PyObject *rk_py_pack_buttons(PyObject *module, PyObject *const *args, Py_ssize_t nargs);
 

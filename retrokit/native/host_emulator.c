@@ -1,7 +1,8 @@
 /*
  * The Emulator type of retrokit.native._host: loading, information, running,
  * and what it hands out: its screen as RGB, zero-copy views of its memory
- * (Memory objects keep their emulator alive), audio, and states.
+ * (Memory objects keep their emulator alive), and audio; its states are
+ * host_state.c's.
  *
  * Arguments are checked before the core is touched, and every failure
  * raises; the GIL is released while frames run.
@@ -105,13 +106,14 @@ static PyObject *emulator_close(EmulatorObject *self, PyObject *unused) {
 static PyObject *emulator_load_game(EmulatorObject *self, PyObject *args) {
     const char *path;
     Py_buffer data = {0};
-    if (self->core.game_loaded)
+    int keep = 0;
+    if (self->core.game_loaded || self->core.game_path)
         return PyErr_Format(CoreError, "a game is already loaded; make a new Emulator for another game");
-    if (!PyArg_ParseTuple(args, "s|z*", &path, &data)) return NULL;
+    if (!PyArg_ParseTuple(args, "s|z*p", &path, &data, &keep)) return NULL;
     if (rk_py_enter(self, 0)) return rk_py_release(&data, NULL);
     int rc;
     Py_BEGIN_ALLOW_THREADS
-    rc = rk_core_load_game(&self->core, path, data.buf, (size_t)data.len);
+    rc = rk_core_load_game(&self->core, path, data.buf, (size_t)data.len, keep);
     Py_END_ALLOW_THREADS
     PyBuffer_Release(&data);
     rk_py_leave(self);
@@ -345,9 +347,9 @@ static PyObject *memory_view(EmulatorObject *self, void *ptr, size_t size) {
 
 static PyObject *emulator_screen_shape(EmulatorObject *self, PyObject *unused) {
     if (rk_py_enter(self, 1)) return NULL;
-    rk_core *c = &self->core; /* before the first frame, the size the core announced */
-    unsigned w = c->frame_data ? c->frame_width : c->av.geometry.base_width;
-    unsigned h = c->frame_data ? c->frame_height : c->av.geometry.base_height;
+    rk_core *c = &self->core; /* before the first frame, the size the core announced; after a reload, the last */
+    unsigned w = c->frame_width ? c->frame_width : c->av.geometry.base_width;
+    unsigned h = c->frame_width ? c->frame_height : c->av.geometry.base_height;
     rk_py_leave(self);
     return Py_BuildValue("(II)", h, w);
 }
@@ -355,8 +357,8 @@ static PyObject *emulator_screen_shape(EmulatorObject *self, PyObject *unused) {
 static PyObject *emulator_screen(EmulatorObject *self, PyObject *out) {
     if (rk_py_enter(self, 1)) return NULL;
     rk_core *c = &self->core;
-    unsigned w = c->frame_data ? c->frame_width : c->av.geometry.base_width;
-    unsigned h = c->frame_data ? c->frame_height : c->av.geometry.base_height;
+    unsigned w = c->frame_width ? c->frame_width : c->av.geometry.base_width;
+    unsigned h = c->frame_width ? c->frame_height : c->av.geometry.base_height;
     Py_buffer buf;
     if (rk_py_get_screen(out, &buf, h, w)) {
         rk_py_leave(self);
@@ -418,62 +420,10 @@ static PyObject *emulator_take_audio(EmulatorObject *self, PyObject *unused) {
     return out;
 }
 
-static PyObject *emulator_serialize(EmulatorObject *self, PyObject *unused) {
-    if (rk_py_enter(self, 1)) return NULL;
-    rk_enter(&self->core);
-    size_t size = self->core.api.serialize_size();
-    rk_leave();
-    PyObject *out = PyBytes_FromStringAndSize(NULL, (Py_ssize_t)size);
-    char *dst = out ? PyBytes_AS_STRING(out) : NULL;
-    bool ok = false;
-    if (out) {
-        Py_BEGIN_ALLOW_THREADS
-        /* A core may write less than its size (Genesis Plus GX: a quarter): the rest is zeros, not whatever
-         * the allocator left there, so that a state's bytes depend on the game alone. */
-        memset(dst, 0, size);
-        rk_enter(&self->core);
-        ok = self->core.api.serialize(dst, size);
-        rk_leave();
-        Py_END_ALLOW_THREADS
-    }
-    rk_py_leave(self);
-    if (out && !ok) Py_SETREF(out, PyErr_Format(CoreError, "the core refused to serialize its state"));
-    return out;
-}
-
-/* exact: the core reads retro_serialize_size bytes whatever length it is given, so only a state of that length
-   may reach it. Otherwise (a core that parses the state within the length it is given, as stella does) the state
-   goes as it is, and the core refuses what it cannot read. */
-static PyObject *emulator_unserialize(EmulatorObject *self, PyObject *args) {
-    Py_buffer buf;
-    int exact = 1;
-    if (!PyArg_ParseTuple(args, "y*|p", &buf, &exact)) return NULL;
-    if (rk_py_enter(self, 1)) return rk_py_release(&buf, NULL);
-    rk_enter(&self->core);
-    size_t size = self->core.api.serialize_size();
-    rk_leave();
-    bool fits = exact ? (size_t)buf.len == size : buf.len > 0, ok = false;
-    if (fits) {
-        Py_BEGIN_ALLOW_THREADS
-        rk_enter(&self->core);
-        ok = self->core.api.unserialize(buf.buf, (size_t)buf.len);
-        rk_leave();
-        Py_END_ALLOW_THREADS
-        self->core.have_held = 0;
-    }
-    rk_py_leave(self); /* before raising: it may call the log callback */
-    if (!fits)
-        PyErr_Format(StateError, "expected a state of %zu bytes for this core, got %zd bytes: the state is truncated, "
-                     "corrupt, or was made by another core or core version; make it again with this core",
-                     size, buf.len);
-    else if (!ok)
-        PyErr_Format(StateError, "the core refused the state (%zu bytes): it is corrupt or was made by another core; "
-                     "make it again with this core", (size_t)buf.len);
-    return rk_py_release(&buf, ok ? Py_NewRef(Py_None) : NULL);
-}
-
 static PyMethodDef emulator_methods[] = {
-    {"load_game", (PyCFunction)emulator_load_game, METH_VARARGS, "Load a game from a path, with its bytes unless the core needs the path."},
+    {"load_game", (PyCFunction)emulator_load_game, METH_VARARGS,
+     "load_game(path, data=None, keep=False): load a game from a path, with its bytes unless the core needs the "
+     "path; keep: hold a copy, so that reload() can load it again."},
     {"system_info", (PyCFunction)emulator_system_info, METH_NOARGS, "The core's name, version and extensions."},
     {"av_info", (PyCFunction)emulator_av_info, METH_NOARGS, "Frame rate, sample rate and geometry."},
     {"options", (PyCFunction)emulator_options, METH_NOARGS, "Core options: key -> (description, value, allowed)."},
@@ -496,9 +446,11 @@ static PyMethodDef emulator_methods[] = {
     {"memory_maps", (PyCFunction)emulator_memory_maps, METH_NOARGS, "The core's memory descriptors, with views."},
     {"capture_audio", (PyCFunction)emulator_capture_audio, METH_O, "Start or stop keeping audio samples."},
     {"take_audio", (PyCFunction)emulator_take_audio, METH_NOARGS, "Return and clear the captured int16 stereo samples."},
-    {"serialize", (PyCFunction)emulator_serialize, METH_NOARGS, "The core's state as bytes."},
-    {"unserialize", (PyCFunction)emulator_unserialize, METH_VARARGS,
+    {"serialize", (PyCFunction)rk_py_serialize, METH_NOARGS, "The core's state as bytes."},
+    {"unserialize", (PyCFunction)rk_py_unserialize, METH_VARARGS,
      "unserialize(data, exact=True): restore a state; exact: only one of the core's serialize size."},
+    {"reload", (PyCFunction)rk_py_reload, METH_NOARGS,
+     "Unload the game and load its kept copy again; refused while a view of the core's memory is alive."},
     {"close", (PyCFunction)emulator_close, METH_NOARGS, "Unload the game and the core."},
     {NULL, NULL, 0, NULL},
 };

@@ -35,7 +35,7 @@ from retrokit.movie.playback import replay
 # timers that YM2612UpdateTimers keeps in step to reach the RAM. Dasher has no sound (tools/testcart/src/main.c
 # parks the Z80 on "di; halt", silences the PSG and never writes the YM): from its states, skipping has no sound
 # to change and only has to leave the game alone, which a change of frame timing would show within frames. Each
-# plays 2,000 frames on random buttons (both pads, all 12 buttons); test_video_skip plays each 10,000 frames more
+# plays 2,000 frames on random buttons (both pads, all 12 buttons); test_video_skip plays each 4,000 frames more
 # through an env on the same skipping core (whose env clears the audio bit too) against the wheel's.
 FRAMES = {"Airstriker-Level1": 20_000, "Dasher": 2_000}
 RUN = 4  # frames a run, each with new random buttons

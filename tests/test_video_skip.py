@@ -23,8 +23,8 @@ from retrokit.host.emulator import Emulator
 FRAMES = 10_000
 # Frames from each Dasher state. With these random actions, the first episode from every state ends (player 1
 # loses a life) after 250 to 435 steps and the env resets; and the player stays near the start: of the furthest
-# x reached in 2,500 steps, all but 30 pixels are reached in the first 500 on every state. So 1,000 steps draw
-# the screens 2,500 would, resets included; Airstriker, which scrolls by itself, keeps its 10,000 frames.
+# x reached in 2,500 steps, all but 31 pixels at most are reached in the first 500 on every state. So 1,000
+# steps draw nearly the screens 2,500 would, resets included. Airstriker keeps its 10,000 frames.
 DASHER_FRAMES = 4_000
 VECTOR_STEPS = 1_000  # two truncations at max_episode_steps=400 in each env, each followed by its autoreset
 FRAMESKIP = 4

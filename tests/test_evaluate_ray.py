@@ -61,16 +61,19 @@ from ray.cluster_utils import Cluster
 from retrokit.cli import main
 
 out, args = Path(sys.argv[1]), sys.argv[2:]
+marks = Path(os.environ["MARKS"])
 cluster = Cluster(initialize_head=True, head_node_args={"num_cpus": 1, "include_dashboard": False})
 node = cluster.add_node(num_cpus=1)
 cluster.wait_for_nodes()
 ray.init(address=cluster.address, logging_level=logging.WARNING, log_to_driver=False)
+(marks / "doomed.tmp").write_text(node.node_id)
+os.replace(marks / "doomed.tmp", marks / "doomed")  # the agent holds its level on this node (see MARKING_JERK)
 
 def lose_the_node():
     """Once the level playing on the second node has logged an episode, remove that node."""
     while True:
-        marks = [json.loads(p.read_text()) for p in out.parent.glob("*.node")]
-        there = [m["level"] for m in marks if m["node"] == node.node_id]
+        found = [json.loads(p.read_text()) for p in marks.glob("*.node")]
+        there = [m["level"] for m in found if m["node"] == node.node_id]
         log = out / "episodes.jsonl"
         if there and log.exists() and any(json.loads(line)["level"] == there[0] for line in log.read_text().splitlines()):
             cluster.remove_node(node)
@@ -86,16 +89,45 @@ sys.exit(code)
 '''
 
 MARKING_JERK = '''
-import json, os, pathlib
+import json, os, pathlib, time
+import gymnasium
 from retrokit.benchmark.jerk import jerk
+
+
+class HeldAfterItsFirstEpisode(gymnasium.Wrapper):
+    """The env of the level on the node the test removes: it waits there, after its first episode, to be lost.
+
+    So the node is lost while its level plays however fast or slow the machine is, and the level's budget
+    can be small. Removing the node ends this process; if that never comes, the level fails, saying why.
+    """
+
+    def __init__(self, env):
+        super().__init__(env)
+        self.resets = 0
+
+    def reset(self, **kwargs):
+        self.resets += 1
+        if self.resets == 2:
+            deadline = time.monotonic() + 300
+            while time.monotonic() < deadline:
+                time.sleep(0.05)
+            raise RuntimeError("the test did not remove this Ray node within 300 s of its level's first episode")
+        return self.env.reset(**kwargs)
+
 
 def marking_jerk(env, budget, seed):
     """JERK, which first notes the Ray node its level plays on (the first time only) beside the run folder."""
     level = env.unwrapped.state_name
-    mark = pathlib.Path(os.environ.get("MARKS", ".")) / f"{level}.node"
-    if "MARKS" in os.environ and not mark.exists():
+    if "MARKS" in os.environ:
+        marks = pathlib.Path(os.environ["MARKS"])
         import ray
-        mark.write_text(json.dumps({"level": "Dasher-Genesis/" + level, "node": ray.get_runtime_context().get_node_id()}))
+        node = ray.get_runtime_context().get_node_id()
+        mark = marks / f"{level}.node"
+        if not mark.exists():  # written whole, then renamed: the test's driver reads it as it polls
+            (marks / f"{level}.tmp").write_text(json.dumps({"level": "Dasher-Genesis/" + level, "node": node}))
+            os.replace(marks / f"{level}.tmp", mark)
+        if node == (marks / "doomed").read_text():
+            env = HeldAfterItsFirstEpisode(env)
     jerk(env, budget, seed)
 '''
 
@@ -103,7 +135,9 @@ def marking_jerk(env, budget, seed):
 def test_a_level_whose_node_is_lost_plays_again_on_the_node_left(tmp_path) -> None:
     agents = tmp_path / "marking.py"
     agents.write_text(MARKING_JERK)
-    args = ["--benchmark", "dasher", "--levels", "Zone2.Act2,Zone3.Act2", "--timesteps", "3000", "--seed", "3",
+    # The level on the removed node is held there after its first episode (under 100 steps on both levels), so
+    # a small budget still loses the node mid-level: the retry then plays the whole level again.
+    args = ["--benchmark", "dasher", "--levels", "Zone2.Act2,Zone3.Act2", "--timesteps", "400", "--seed", "3",
             "--agent", f"{agents}:marking_jerk"]
     assert main(["evaluate", *args, "--workers", "1", "--no-progress", "--out", str(tmp_path / "local")]) == 0
     env = {**os.environ, "MARKS": str(tmp_path)}

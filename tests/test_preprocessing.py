@@ -183,6 +183,8 @@ def test_max_pool_with_the_sonic_presets_rules_equals_gymnasiums_wrappers_over_f
     for step in range(700):
         diff = np.abs(obs.astype(int) - as_native(expected, False).astype(int))
         assert diff.max() <= 1, f"step {step} differs by {diff.max()} at {np.argwhere(diff > 1)[:4]}"
+        if episodes >= 2 and ends_inside_a_step >= 1:
+            break  # every path compared: full steps, an end inside a step, the resets (by step 381 with these seeds)
         buttons.masks.clear()
         obs, reward, terminated, _truncated, _ = native.step(native.action_space.sample())
         frames = [((mask >> np.arange(width)) & 1).astype(np.int8) for mask in buttons.masks]

@@ -13,7 +13,7 @@ from typing import Self
 
 from retrokit.data.games import cached_rom_sha1, find_game
 from retrokit.data.states import StateRecord
-from retrokit.errors import FileConflictError, FileSystemError, MovieError, RetrokitError
+from retrokit.errors import FileConflictError, MovieError, RetrokitError
 from retrokit.movie.bk2 import encode_bk2, write_bk2
 from retrokit.movie.model import STATE_DIGEST, Movie, layout
 from retrokit.paths import atomic_write, ensure_folder

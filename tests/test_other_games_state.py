@@ -120,9 +120,10 @@ def test_a_dasher_movie_whose_core_bin_is_airstrikers_state_is_refused(tmp_path,
     assert not (tmp_path / "made").exists() or not list((tmp_path / "made").iterdir())
 
 
-def test_the_studio_refuses_airstrikers_state_put_in_dashers_folder(tmp_path, data, airstriker_file):
-    game = shutil.copytree(REPO / "games" / "Dasher-Genesis", tmp_path / "Dasher-Genesis")
-    (game / "Foreign.state").write_bytes(compress_state(read_state_file(airstriker_file).data, None))
+@pytest.mark.parametrize(("host", "owner"), [("Dasher-Genesis", AIRSTRIKER), (AIRSTRIKER, "Dasher-Genesis")])
+def test_the_studio_refuses_another_games_state_put_in_the_games_folder(tmp_path, data, host, owner):
+    game = shutil.copytree(find_game(host).folders[0], tmp_path / host)  # a copy of the game, its ROM found by hash
+    (game / "Foreign.state").write_bytes(compress_state(read_state_file(find_game(owner).state_path()).data, None))
     child = run_child(
         "from retrokit.errors import StateError\nfrom retrokit.studio import play\n"
         "from retrokit.studio.session import Session\n"
@@ -133,9 +134,9 @@ def test_the_studio_refuses_airstrikers_state_put_in_dashers_folder(tmp_path, da
         env=data, timeout=120,
     )
     assert child.returncode == 0, child.describe()
-    assert f"refused: {game / 'Foreign.state'}: expected a state of Dasher-Genesis; found {AIRSTRIKER}'s state" in (
-        child.stdout
-    ), child.describe()
+    assert f"refused: {game / 'Foreign.state'}: expected a state of {host}; found {owner}'s state" in child.stdout, (
+        child.describe()
+    )
 
 
 SAVE_AND_LOAD = """

@@ -28,12 +28,16 @@ class StudioProcess:
         data: The data folder.
         cwd: The folder it runs in.
         env: More environment variables.
+        launcher: A script run instead of ``python -m retrokit`` (it is given the command line's arguments).
     """
 
-    def __init__(self, game: str | Path, data: Path, cwd: Path, env: dict[str, str] | None = None) -> None:
+    def __init__(
+        self, game: str | Path, data: Path, cwd: Path, env: dict[str, str] | None = None, launcher: Path | None = None
+    ) -> None:
         environ = {**os.environ, "RETROKIT_DATA": str(data), **(env or {})}
+        program = [str(launcher)] if launcher is not None else ["-m", "retrokit"]
         self.process = subprocess.Popen(
-            [sys.executable, "-m", "retrokit", "studio", str(game), "--port", "0", "--no-browser"],
+            [sys.executable, *program, "studio", str(game), "--port", "0", "--no-browser"],
             cwd=cwd, env=environ, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
         )  # fmt: skip
         line = self.process.stdout.readline()

@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from retrokit.movie import read_bk2
-from retrokit.movie.recorder import MovieRecorder, claim_movie_path
+from retrokit.movie.recorder import record_numbered
 
 RECORD = """
 import sys, retrokit
@@ -46,16 +46,16 @@ def test_processes_recording_into_one_folder_never_conflict(tmp_path: Path, proc
     assert all(len(read_bk2(m).frames) == 2 * 1 for m in movies)  # each a whole movie (2 steps of 1 frame)
 
 
-def test_a_claimed_name_is_reserved_on_disk(tmp_path: Path) -> None:
-    first = claim_movie_path(tmp_path, "Game-State")
-    assert first.is_file() and first.stat().st_size == 0  # another process now skips it
+def test_a_numbered_name_is_taken_by_a_whole_movie_never_an_empty_file(tmp_path: Path) -> None:
+    first = record_numbered(tmp_path, "Game-State", "Dasher-Genesis", "Genesis")
+    assert read_bk2(first.path).frames == []  # the name is taken by a movie that plays, header and all
     (tmp_path / "Game-State-000001.bk2").write_bytes(b"someone else's")
-    second = claim_movie_path(tmp_path, "Game-State")
-    assert second.name == "Game-State-000002.bk2"
-    recorder = MovieRecorder(first, "Dasher-Genesis", "Genesis")
-    recorder.record([0])
-    assert recorder.close() == first and len(read_bk2(first).frames) == 1
+    second = record_numbered(tmp_path, "Game-State", "Dasher-Genesis", "Genesis")
+    assert second.path.name == "Game-State-000002.bk2"
+    first.record([0])
+    assert first.close() == tmp_path / "Game-State-000000.bk2" and len(read_bk2(first.path).frames) == 1
     assert (tmp_path / "Game-State-000001.bk2").read_bytes() == b"someone else's"
+    second.close()
 
 
 # --- exporting long movies ----------------------------------------------------------------------

@@ -164,3 +164,46 @@ def test_a_recorder_killed_in_its_first_second_leaves_a_movie_that_plays(tmp_pat
     movie = read_bk2(movie_file)
     assert movie.state and sum(1 for _ in play(movie)) == len(movie.frames)
     assert not [p for p in folder.iterdir() if p.suffix != ".bk2"]
+
+
+RECORDING_FROM_RESET = """
+import retrokit
+env = retrokit.make("Dasher-Genesis", record={folder!r})
+print("ready", flush=True)
+env.reset(seed=0)  # the episode's movie begins here
+env.action_space.seed(0)
+print("recording", flush=True)
+while True:
+    env.step(env.action_space.sample())
+"""
+#: When to kill: at spawn (None: not waiting for it to be ready), then from 0 to 300 ms after it is ready to reset(),
+#: then ("recording") from 0 to 300 ms after reset() returned.
+KILL_AFTER = [
+    (None, 0), (None, 0), *(("ready", d) for d in (0, 0.002, 0.005, 0.01, 0.02, 0.03, 0.045, 0.06, 0.08, 0.1, 0.15,
+    0.2, 0.3)), *(("recording", d) for d in (0, 0.01, 0.1, 0.3)),
+]
+
+
+def test_a_recorder_killed_at_any_moment_leaves_no_movie_or_one_that_plays(tmp_path: Path) -> None:
+    """The movie appears only once it is whole: a name was reserved by an empty .bk2 first, and a kill in the
+    milliseconds before the movie replaced it left that empty file, which plays nowhere."""
+    played = 0
+    for attempt, (mark, delay) in enumerate(KILL_AFTER):
+        folder = tmp_path / f"try-{attempt}"
+        child = subprocess.Popen(
+            [sys.executable, "-c", textwrap.dedent(RECORDING_FROM_RESET.format(folder=str(folder)))],
+            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO,
+        )  # fmt: skip
+        try:
+            for line in ("ready", "recording")[: ("ready", "recording").index(mark) + 1] if mark else ():
+                assert child.stdout is not None and child.stdout.readline() == f"{line}\n", child.stderr
+            time.sleep(delay)  # the moment of the kill is what this test varies
+            child.send_signal(signal.SIGKILL)
+        finally:
+            child.kill()
+            child.wait(timeout=30)
+        for movie_file in sorted(folder.glob("*.bk2")):
+            movie = read_bk2(movie_file)  # an empty or half-written file raises here
+            assert movie.state and sum(1 for _ in play(movie)) == len(movie.frames), (delay, movie_file)
+            played += 1
+    assert played >= sum(mark == "recording" for mark, _ in KILL_AFTER)  # every kill after reset() left a movie

@@ -17,7 +17,7 @@ import yaml
 from childproc import MAX_RSS_MB, REPO, run_child, run_cli
 
 from retrokit.data.games import find_game
-from retrokit.data.shipped import STATE_HASHES, state_hashes
+from retrokit.data.shipped import STATE_HASHES, WHEEL_STATE_HASHES, state_hashes, wheel_state_hashes
 from retrokit.data.states import StateRecord, compress_state, read_state, read_state_file
 from retrokit.errors import StateError
 from retrokit.movie import Movie, write_bk2
@@ -269,3 +269,14 @@ def test_find_game_is_the_one_resolver_of_names_and_folders(dasher_copy: Path, m
     by_name = find_game("Dasher-Genesis-v0")
     assert by_name.name == "Dasher-Genesis" and find_game(by_name) is by_name
     assert find_game(".").folders == (Path("."),) and find_game(str(dasher_copy)).name == "Dasher-Genesis"
+
+
+def test_the_wheels_state_hashes_are_current() -> None:
+    """The list that knows the wheel's states by what they hold (Airstriker's, Sonic's) matches the wheel installed."""
+    games = REPO / "games"
+    listed = (games / WHEEL_STATE_HASHES).read_text()
+    assert listed == wheel_state_hashes(games), (
+        "games/WHEEL-STATES.sha256 is out of date: run python -m retrokit.data.shipped"
+    )
+    assert "stable/Airstriker-Genesis-v0/Level1.state" in listed
+    assert "stable/SonicTheHedgehog-Genesis-v0/GreenHillZone.Act1.state" in listed

@@ -7,6 +7,15 @@ SHA-256 of each of its files, and retrokit's own ``games/`` carries
 (written by ``python -m retrokit.data.shipped``, checked current by
 ``tests/test_trust.py``). A file whose bytes are on neither list is not
 shipped, wherever it is.
+
+Which game a shipped state is for is known too (:mod:`retrokit.data.statecheck`
+refuses it for another game): a file of the wheel by the folder ``RECORD``
+lists it in, and the state inside, however it is wrapped again (its record
+stripped, a movie's ``Core.bin``), by :data:`WHEEL_STATE_HASHES`, which
+lists the digest of the state in each of the wheel's ``.state`` files of the
+games retrokit knows (those ``games/`` integrates too, and those whose ROM the
+wheel ships, as Airstriker's). Only its lines whose file the installed wheel
+holds, by its ``RECORD`` digest, are used.
 """
 
 from __future__ import annotations
@@ -22,6 +31,8 @@ from retrokit import paths
 
 STATE_HASHES = "STATES.sha256"
 """The file in ``games/`` listing ``<sha256>  <Game>/<Name>.state``, one shipped state a line."""
+WHEEL_STATE_HASHES = "WHEEL-STATES.sha256"
+"""The file in ``games/`` listing ``<state sha256>  <file sha256>  <kind>/<Folder>/<Name>.state`` for the wheel."""
 
 
 @functools.cache
@@ -35,15 +46,68 @@ def shipped_digests() -> frozenset[str]:
         except (OSError, UnicodeDecodeError):
             text = ""
         digests.update(line.split()[0] for line in text.splitlines() if line.strip())
+    digests.update(wheel_state_files())
+    return frozenset(digests)
+
+
+@functools.cache
+def wheel_state_files() -> dict[str, tuple[str, ...]]:
+    """The SHA-256 (hex) of every ``.state`` file the stable-retro wheel ships, to its paths in the wheel's ``data``
+    folder (``stable/Airstriker-Genesis-v0/Level1.state``; a few files are there twice), from the wheel's ``RECORD``."""
     try:
         files = importlib.metadata.distribution("stable-retro").files or []
     except importlib.metadata.PackageNotFoundError:
         files = []
+    found: dict[str, tuple[str, ...]] = {}
     for file in files:
-        if file.hash is not None and file.hash.mode == "sha256" and str(file).endswith(".state"):
+        parts = file.parts
+        if file.hash is not None and file.hash.mode == "sha256" and parts[-1].endswith(".state") and "data" in parts:
             value = file.hash.value
-            digests.add(base64.urlsafe_b64decode(value + "=" * (-len(value) % 4)).hex())
-    return frozenset(digests)
+            digest = base64.urlsafe_b64decode(value + "=" * (-len(value) % 4)).hex()
+            found[digest] = (*found.get(digest, ()), "/".join(parts[parts.index("data") + 1 :]))
+    return found
+
+
+def wheel_known_games(games: Path) -> list[Path]:
+    """The wheel's game folders whose states :data:`WHEEL_STATE_HASHES` lists: the games ``games`` integrates too,
+    and those whose ROM the wheel ships."""
+    from retrokit.errors import RetrokitError
+    from retrokit.host.systems import system_for_extension
+
+    def ships_rom(folder: Path) -> bool:
+        for file in folder.glob("rom.*"):
+            try:
+                system_for_extension(file.suffix)
+                return True
+            except RetrokitError:  # rom.sha, rom.delta: no ROM
+                continue
+        return False
+
+    ours = {p.name for p in games.iterdir() if p.is_dir()}
+    return [
+        folder
+        for kind in paths.wheel_data_dirs()
+        for folder in sorted(kind.iterdir())
+        if folder.is_dir() and (folder.name.removesuffix("-v0") in ours or ships_rom(folder))
+    ]
+
+
+def wheel_state_hashes(games: Path) -> str:
+    """The text of :data:`WHEEL_STATE_HASHES` for the installed wheel (the states' digests, once inflated)."""
+    from retrokit.data.states import read_state_file
+    from retrokit.errors import RetrokitError
+
+    lines = []
+    for folder in wheel_known_games(games):
+        for path in sorted(folder.glob("*.state")):
+            try:
+                data = read_state_file(path).data
+            except RetrokitError:  # a file no core can load identifies nothing
+                continue
+            blob = path.read_bytes()
+            where = path.relative_to(folder.parent.parent).as_posix()
+            lines.append(f"{hashlib.sha256(data).hexdigest()}  {hashlib.sha256(blob).hexdigest()}  {where}")
+    return "\n".join(lines) + "\n"
 
 
 def is_shipped_blob(blob: bytes) -> bool:
@@ -60,7 +124,8 @@ def state_hashes(games: Path) -> str:
     return "\n".join(lines) + "\n"
 
 
-if __name__ == "__main__":  # python -m retrokit.data.shipped: rewrite games/STATES.sha256 after adding a state
+if __name__ == "__main__":  # python -m retrokit.data.shipped: rewrite games/*STATES.sha256 after adding a state
     root = Path(__file__).resolve().parents[2] / "games"
     paths.atomic_write(root / STATE_HASHES, state_hashes(root).encode(), overwrite=True)
+    paths.atomic_write(root / WHEEL_STATE_HASHES, wheel_state_hashes(root).encode(), overwrite=True)
     sys.exit(0)

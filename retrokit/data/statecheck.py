@@ -8,6 +8,12 @@ and these functions are how one is made from a file or from bytes:
   without a record that sits in another game's folder (where stable-retro keeps
   each game's states) is refused too, unless the two games share a ROM. The
   record only ever refuses: anyone can write one;
+- a state known to be another game's (:func:`state_owners`), whatever file
+  holds it (a ``.state`` file, its record stripped or rewritten, a movie's
+  ``Core.bin``), is refused by its digest: this machine records the game of
+  each state it writes (``<data>/state-owners/``), and the states retrokit
+  and the stable-retro wheel ship are listed with their games
+  (:mod:`retrokit.data.shipped`);
 - whether the state may crash the core is decided by :func:`retrokit.data.probe.vet_state`,
   from what this machine wrote or probed and what the package ships, never
   from the file itself.
@@ -18,17 +24,21 @@ from __future__ import annotations
 import functools
 import hashlib
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 from retrokit import paths
 from retrokit.data.games import Game, cached_rom_sha1, load_game
 from retrokit.data.probe import remember
 from retrokit.data.probe import vet_state as _vet
-from retrokit.data.shipped import STATE_HASHES
-from retrokit.data.states import StateRecord, read_state_file
+from retrokit.data.shipped import STATE_HASHES, WHEEL_STATE_HASHES, wheel_state_files
+from retrokit.data.states import MAX_STATE_FILE_SIZE, StateRecord, read_state_file
 from retrokit.errors import RetrokitError, StateError
 from retrokit.host.emulator import VettedState
 from retrokit.host.systems import System, get_system
+
+OWNERS = "state-owners"
+"""The data folder's records of the states this machine wrote: ``<sha256 of the state>`` holds ``<ROM SHA-1> <game>``."""
 
 
 def check_state(
@@ -58,40 +68,100 @@ def check_state(
             f"recorded on another ROM (SHA-1 {record.rom_sha1}{of}). Load it with the game of that ROM, "
             f"or pick a state of {game.name}."
         )
-    _check_identity(game, data, rom_sha1, source)
+    _check_identity(game, data, rom_sha1, source, shipped)
     return _vet(data, game.system, rom, rom_sha1, source=source, shipped=shipped)
 
 
-def _check_identity(game: Game, data: bytes, rom_sha1: str, source: str) -> None:
-    """Refuse a state retrokit ships for another game (on another ROM), known by its digest.
+@dataclass(frozen=True)
+class Owner:
+    """The game a state is known to be for, and how it is known.
+
+    Attributes:
+        game: The game's name.
+        sha1s: The SHA-1s of the ROMs it runs on.
+        known: How it is known, for the error ("retrokit ships it", "this machine saved it ...").
+    """
+
+    game: str
+    sha1s: frozenset[str]
+    known: str
+
+
+def state_owners(data: bytes, file: Path | None = None) -> list[Owner]:
+    """The games the state ``data`` is known to be for (none, mostly one): by what this machine recorded when it
+    wrote the state, by retrokit's shipped states, or by the stable-retro wheel's (``file``: the file it was read
+    from, known by its digest if it is one of the wheel's).
+
+    Each of these only ever refuses a state for another game; none makes a state trusted.
+    """
+    digest = hashlib.sha256(data).hexdigest()
+    owners = [_recorded_owner(digest), _shipped_owners().get(digest)]
+    owners += [_wheel_owner(where) for where in _wheel_states().get(digest, ())]
+    if file is not None and not any(owners):
+        try:
+            with open(file, "rb") as f:
+                blob = f.read(MAX_STATE_FILE_SIZE + 1)
+        except OSError:
+            blob = b""
+        owners += [_wheel_owner(where) for where in wheel_state_files().get(hashlib.sha256(blob).hexdigest(), ())]
+    return [owner for owner in owners if owner is not None]
+
+
+def _check_identity(game: Game, data: bytes, rom_sha1: str, source: str, file: Path | None = None) -> None:
+    """Refuse a state known to be another game's (see :func:`state_owners`), unless the two games share a ROM.
 
     Whatever file holds it, with its record stripped or a movie's header
-    rewritten around it, a shipped state is known by its digest. (A record
+    rewritten around it, a state is known by its digest. (A record in the file
     that no longer describes its state only loses its say: the state is
     probed, as a state changed since is.)
     """
-    digest = hashlib.sha256(data).hexdigest()
-    owner = _shipped_owners().get(digest)
-    if owner is None or owner == game.name:
-        return
-    try:
-        owner_sha1s = set(load_game(paths.repo_games_dir() / owner).sha1s)  # type: ignore[operator]
-    except RetrokitError:
-        return
-    if owner_sha1s & ({rom_sha1} | set(game.sha1s)):
-        return  # two games on one ROM: the state fits both
+    owners = state_owners(data, file)
+    accepted = {rom_sha1} | set(game.sha1s)
+    if not owners or any(owner.game == game.name or owner.sha1s & accepted for owner in owners):
+        return  # unknown, its own game's, or a game's on the same ROM: the state fits
+    owner = owners[0]
     raise StateError(
-        f"{source}: expected a state of {game.name}; found {owner}'s state (retrokit ships it, SHA-256 "
-        f"{digest[:16]}…), made on another ROM, where it plays garbage. Load it with {owner}, or pick a state "
-        f"of {game.name}."
+        f"{source}: expected a state of {game.name}; found {owner.game}'s state ({owner.known}, SHA-256 "
+        f"{hashlib.sha256(data).hexdigest()[:16]}…), made on another ROM, where it plays garbage. Load it with "
+        f"{owner.game}, or pick a state of {game.name}."
     )
 
 
+def _owner_file(digest: str) -> Path:
+    return paths.data_dir() / OWNERS / digest
+
+
+def _record_owner(game: Game, state: bytes, rom_sha1: str) -> None:
+    """Note in the data folder that this machine wrote ``state`` from a core running ``game``'s ROM."""
+    try:
+        text = f"{rom_sha1} {game.name}\n".encode()
+        paths.atomic_write(_owner_file(hashlib.sha256(state).hexdigest()), text, overwrite=True)
+    except (OSError, RetrokitError):
+        pass  # an unwritable data folder only means this state is not known as its game's
+
+
+def _recorded_owner(digest: str) -> Owner | None:
+    try:
+        with open(_owner_file(digest), "rb") as f:
+            rom_sha1, name = f.read(512).decode("utf-8").split(maxsplit=1)
+    except (OSError, UnicodeDecodeError, ValueError):
+        return None
+    name = name.strip()
+    return Owner(name, frozenset({rom_sha1}), f"this machine saved it for {name}")
+
+
+def _game_sha1s(folder: Path) -> frozenset[str]:
+    try:
+        return frozenset(load_game(folder).sha1s)
+    except RetrokitError:
+        return frozenset()
+
+
 @functools.cache
-def _shipped_owners() -> dict[str, str]:
-    """The digest of the state in every ``.state`` file retrokit's ``games/`` ships, to its game's name."""
+def _shipped_owners() -> dict[str, Owner]:
+    """The digest of the state in every ``.state`` file retrokit's ``games/`` ships, to its game."""
     games = paths.repo_games_dir()
-    owners: dict[str, str] = {}
+    owners: dict[str, Owner] = {}
     if games is None:
         return owners
     try:
@@ -102,11 +172,45 @@ def _shipped_owners() -> dict[str, str]:
         parts = line.split(maxsplit=1)
         if len(parts) != 2 or "/" not in parts[1]:
             continue
+        name = parts[1].split("/")[0]
         try:
-            owners[hashlib.sha256(read_state_file(games / parts[1]).data).hexdigest()] = parts[1].split("/")[0]
+            digest = hashlib.sha256(read_state_file(games / parts[1]).data).hexdigest()
         except RetrokitError:
             continue  # a shipped file missing or damaged here: it identifies nothing
+        owners[digest] = Owner(name, _game_sha1s(games / name), "retrokit ships it")
     return owners
+
+
+@functools.cache
+def _wheel_states() -> dict[str, tuple[str, ...]]:
+    """The digest of the state in the wheel's ``.state`` files :data:`WHEEL_STATE_HASHES` lists, to the files' paths
+    in the wheel's ``data`` folder; only files the installed wheel holds, by its ``RECORD``."""
+    games = paths.repo_games_dir()
+    try:
+        listed = (games / WHEEL_STATE_HASHES).read_text(encoding="utf-8").splitlines() if games else []
+    except (OSError, UnicodeDecodeError):
+        listed = []
+    installed = wheel_state_files()
+    found: dict[str, tuple[str, ...]] = {}
+    for line in listed:
+        parts = line.split()
+        if len(parts) == 3 and parts[2] in installed.get(parts[1], ()):
+            found[parts[0]] = (*found.get(parts[0], ()), parts[2])
+    return found
+
+
+@functools.cache
+def _wheel_owner(where: str | None) -> Owner | None:
+    """The game of the wheel's state file at ``where`` in its ``data`` folder (``stable/<Folder>/<Name>.state``)."""
+    root = paths.wheel_dir()
+    if where is None or root is None or where.count("/") != 2:
+        return None
+    folder = root / "data" / where.rsplit("/", 1)[0]
+    try:
+        name = load_game(folder).name
+    except RetrokitError:
+        name = folder.name.removesuffix("-v0")
+    return Owner(name, _game_sha1s(folder), "the stable-retro wheel ships it")
 
 
 def load_state(game: Game, path: str | os.PathLike[str]) -> VettedState:
@@ -143,8 +247,11 @@ def vet_state(
 
 
 def remember_written(game: Game, state: VettedState, rom: Path | None = None) -> None:
-    """Note that retrokit wrote ``state`` (a core made it), so reading it back from its file needs no probe."""
-    remember(state, cached_rom_sha1(rom if rom is not None else game.require_rom(), game.system))
+    """Note that retrokit wrote ``state`` (a core made it) for ``game``: reading it back from its file needs no probe,
+    and it is refused for a game on another ROM, whatever file holds it."""
+    rom_sha1 = cached_rom_sha1(rom if rom is not None else game.require_rom(), game.system)
+    remember(state, rom_sha1)
+    _record_owner(game, state, rom_sha1)
 
 
 def folder_game(path: Path) -> Game | None:

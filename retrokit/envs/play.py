@@ -25,7 +25,7 @@ from retrokit.data.statecheck import load_state, remember_written
 from retrokit.data.states import write_state
 from retrokit.errors import EnvError, install_extra
 from retrokit.host.emulator import Emulator
-from retrokit.movie.recorder import MovieRecorder, claim_movie_path
+from retrokit.movie.recorder import MovieRecorder, record_numbered
 
 __all__ = ["KEYS", "PlaySession"]
 
@@ -120,9 +120,10 @@ class PlaySession:
         """Start recording a movie from now, or stop and write the one being recorded (returning its path)."""
         if self.recorder is None:
             (self.folder / "movies").mkdir(parents=True, exist_ok=True)
-            path = claim_movie_path(self.folder / "movies", self.name)
-            self.recorder = MovieRecorder(path, self.game.name, self.game.system.name, 1, self.emulator.get_state())
-            print(f"recording {path}")
+            self.recorder = record_numbered(
+                self.folder / "movies", self.name, self.game.name, self.game.system.name, 1, self.emulator.get_state()
+            )
+            print(f"recording {self.recorder.path}")
             return None
         path = self.recorder.close()
         self.recorder = None

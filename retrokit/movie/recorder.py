@@ -13,24 +13,29 @@ from typing import Self
 
 from retrokit.data.games import cached_rom_sha1, find_game
 from retrokit.data.states import StateRecord
-from retrokit.errors import FileConflictError, FileSystemError, MovieError, RetrokitError
-from retrokit.movie.bk2 import write_bk2
+from retrokit.errors import FileConflictError, MovieError, RetrokitError
+from retrokit.movie.bk2 import encode_bk2, write_bk2
 from retrokit.movie.model import STATE_DIGEST, Movie, layout
-from retrokit.paths import ensure_folder
+from retrokit.paths import atomic_write, ensure_folder
 
 _claims: dict[tuple[Path, str], int] = {}
-_reserved: set[Path] = set()
 _claims_lock = threading.Lock()
 
 
-def claim_movie_path(folder: str | os.PathLike[str], stem: str) -> Path:
-    """Reserve the first free ``<stem>-NNNNNN.bk2`` in ``folder`` and return it.
+def record_numbered(
+    folder: str | os.PathLike[str], stem: str, game: str, system: str, players: int = 1,
+    start_state: bytes | None = None,
+) -> MovieRecorder:
+    """Start recording into the first free ``<stem>-NNNNNN.bk2`` in ``folder``; return the recorder.
 
-    The name is reserved on disk at once, as an empty file created with
-    ``O_EXCL``, so envs recording into one folder, in this process or in others
-    running at the same time, each get names of their own, and none writes
-    over another's movie or a file already there. The recorder given the path
-    replaces the empty file with the movie.
+    The name is taken by the movie itself: its header and start state are
+    written to a temporary file that is linked into place only if no file has
+    that name (the atomic writer, :func:`retrokit.paths.atomic_write`), so envs
+    recording into one folder, in this process or in others, each get names of
+    their own, none writes over another's file, and a process killed at any
+    moment leaves either no movie or one that plays (a name reserved by an empty
+    file first left an empty ``.bk2`` to a kill in the few milliseconds before the
+    movie was written).
 
     Raises:
         FileSystemError: The folder cannot be written.
@@ -41,26 +46,14 @@ def claim_movie_path(folder: str | os.PathLike[str], stem: str) -> Path:
         while True:
             path = folder / f"{stem}-{n:06d}.bk2"
             n += 1
-            try:
-                os.close(os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
-            except FileExistsError:
+            if os.path.lexists(path):
                 continue
-            except OSError as exc:
-                raise FileSystemError(
-                    f"Expected a folder to record movies into at {str(folder)!r}; found it cannot be written: "
-                    f"{exc.strerror or exc}. Choose another folder with record=."
-                ) from None
+            try:
+                recorder = MovieRecorder(path, game, system, players, start_state)
+            except FileConflictError:  # another process took the name meanwhile
+                continue
             _claims[folder, stem] = n
-            _reserved.add(path)
-            return path
-
-
-def _is_reservation(path: Path) -> bool:
-    """Whether ``path`` is a name this process reserved and nothing has been written to yet."""
-    try:
-        return path.resolve() in _reserved and path.stat().st_size == 0
-    except OSError:
-        return False
+            return recorder
 
 
 def state_header(game: str, state: bytes) -> dict[str, str]:
@@ -104,11 +97,15 @@ class _MovieFile:
         self.pid = os.getpid()  # a forked child must not write its parent's movie
 
     def write(self) -> None:
-        """Write the movie whole, as it is now, replacing what this recorder wrote before (atomically)."""
-        reserved = _is_reservation(self.path)
-        write_bk2(self.path, self.movie, overwrite=self.overwrite or reserved or self.written is not None)
-        if reserved:
-            _reserved.discard(self.path.resolve())
+        """Write the movie whole, as it is now, replacing what this recorder wrote before (atomically).
+
+        The first write makes a new file or fails (unless asked to overwrite), even where an identical movie is:
+        another process starting the same episode made that one, and it is not this recorder's to write on.
+        """
+        if self.written is None and not self.overwrite:
+            atomic_write(self.path, encode_bk2(self.movie))
+        else:
+            write_bk2(self.path, self.movie, overwrite=True)
         self.written = len(self.movie.frames)
 
     def write_at_exit(self) -> None:
@@ -161,7 +158,7 @@ class MovieRecorder:
         overwrite: bool = False,
     ) -> None:
         path = Path(path)
-        if not overwrite and path.exists() and not _is_reservation(path):  # fail before the episode
+        if not overwrite and path.exists():  # fail before the episode
             raise FileConflictError(
                 f"Expected no file at {path} to record a movie into; found one. "
                 "Delete it, choose another name, or pass overwrite=True to replace it."
@@ -172,7 +169,7 @@ class MovieRecorder:
         self._layout = layout(self.movie.system)
         self._players = self.movie.players
         self._file = _MovieFile(path, self.movie, overwrite)
-        self._file.write()  # now: a recorder killed before its first flush leaves a movie that plays, not 0 bytes
+        self._file.write()  # now, whole and atomically: a recorder killed before its first flush leaves a movie that plays
         self._finalizer = weakref.finalize(self, self._file.write_at_exit)
         self._next_flush = time.monotonic() + FLUSH_SECONDS
         self._closed = False
@@ -181,11 +178,6 @@ class MovieRecorder:
     def path(self) -> Path:
         """The ``.bk2`` file the movie goes to."""
         return self._file.path
-
-    @path.setter
-    def path(self, path: Path) -> None:
-        self._file.path = Path(path)
-        self._file.written = None  # nothing of this recording is at the new path yet
 
     def record(self, masks: Sequence[int]) -> None:
         """Append one frame: one RetroPad bit mask per port.
@@ -254,7 +246,7 @@ class EpisodeMovies:
     """Records each episode of an env into a movie of its own: an observer of the env's stepper.
 
     Every episode gets the first free ``<stem>-NNNNNN.bk2`` in ``folder``
-    (:func:`claim_movie_path`), so a file already there is never replaced.
+    (:func:`record_numbered`), so a file already there is never replaced.
 
     Args:
         folder: Where the movies go (made if missing).
@@ -282,7 +274,7 @@ class EpisodeMovies:
         """Begin an episode's movie, ending the last one if it is still open."""
         self.end()
         ensure_folder(self.folder, "to record movies into")
-        self.recorder = MovieRecorder(claim_movie_path(self.folder, self.stem), *self._movie)
+        self.recorder = record_numbered(self.folder, self.stem, *self._movie)
 
     def frames(self, first: tuple[int, ...], applied: tuple[int, ...], count: int) -> None:
         """Record ``count`` frames: the first held ``first``, the rest ``applied``."""
@@ -298,8 +290,4 @@ class EpisodeMovies:
         recorder, self.recorder = self.recorder, None
         if recorder is None:
             return None
-        try:
-            return recorder.close()
-        except FileConflictError:  # another process wrote a movie of that name meanwhile
-            recorder.path = claim_movie_path(self.folder, self.stem)
-            return recorder.close()
+        return recorder.close()  # its file, written when it began: no one else's is at that name

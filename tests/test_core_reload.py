@@ -36,8 +36,8 @@ def breakout_rom() -> Path:
 @pytest.fixture(scope="module")
 def breakout_state(breakout_rom: Path) -> VettedState:
     """stable-retro's shipped Breakout start, checked for ale-py's ROM (stable-retro's, by its SHA-1)."""
-    from retrokit.data.states import read_state
     from retrokit.data.statecheck import vet_state
+    from retrokit.data.states import read_state
     from retrokit.paths import wheel_dir
 
     path = wheel_dir() / "data" / "stable" / "Breakout-Atari2600-v0" / "Start.state"

@@ -6,6 +6,9 @@ studio, so the browser sends it the studio's token cookie: a form posted as
 Here a second local server serves such pages to the same browser that opened
 the studio, and the studio must refuse them, change nothing, and keep every
 response out of frames.
+
+One studio serves the module's tests, each leaving it as it found it (the speed at 1x); the test of a
+fresh studio's canvas starts its own.
 """
 
 from __future__ import annotations
@@ -18,7 +21,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from chromium import chrome, until  # first: it skips this module where Chromium is missing
+from chromium import until  # first: it skips this module where Chromium is missing
 from selenium import webdriver
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
@@ -30,19 +33,35 @@ DASHER = REPO / "games" / "Dasher-Genesis"
 pytestmark = pytest.mark.timeout(900)
 
 
-@pytest.fixture
-def studio(tmp_path: Path) -> Iterator[StudioProcess]:
-    shutil.copytree(DASHER, tmp_path / "Dasher-Genesis")
-    server = StudioProcess(tmp_path / "Dasher-Genesis", tmp_path / "data", tmp_path)
-    yield server
+def start_studio(root: Path) -> StudioProcess:
+    shutil.copytree(DASHER, root / "Dasher-Genesis")
+    return StudioProcess(root / "Dasher-Genesis", root / "data", root)
+
+
+def stop_studio(server: StudioProcess) -> None:
     err = server.stop()
     assert "Traceback" not in err, err
 
 
+@pytest.fixture(scope="module")
+def studio_root(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Where the module's studio runs and writes (its game's copy, its data folder)."""
+    return tmp_path_factory.mktemp("studio")
+
+
+@pytest.fixture(scope="module")
+def studio(studio_root: Path) -> Iterator[StudioProcess]:
+    server = start_studio(studio_root)
+    yield server
+    stop_studio(server)
+
+
 @pytest.fixture
-def browser() -> Iterator[webdriver.Chrome]:
-    with chrome() as driver:
-        yield driver
+def fresh_studio(tmp_path: Path) -> Iterator[StudioProcess]:
+    """A studio of this test's own, that no page has opened yet."""
+    server = start_studio(tmp_path)
+    yield server
+    stop_studio(server)
 
 
 def open_studio(driver: webdriver.Chrome, studio: StudioProcess) -> None:
@@ -96,7 +115,7 @@ def other_page(tmp_path: Path, studio: StudioProcess) -> Iterator[str]:
         server.server_close()
 
 
-def test_another_local_page_cannot_drive_the_studio(browser, studio, other_page, tmp_path):
+def test_another_local_page_cannot_drive_the_studio(browser, studio, other_page, studio_root):
     open_studio(browser, studio)  # the browser now holds the token cookie, as the user's does
     assert studio.request("GET", "/api/status")[1]["speed"] == 1
     browser.get(f"{other_page}/form.html")
@@ -105,7 +124,7 @@ def test_another_local_page_cannot_drive_the_studio(browser, studio, other_page,
     browser.get(f"{other_page}/fetch.html")
     until("the fetches to settle", lambda: browser.title == "sent")
     assert studio.request("GET", "/api/status")[1]["speed"] == 1  # no speed changed
-    made = [p.name for p in tmp_path.rglob("Planted*")]
+    made = [p.name for p in studio_root.rglob("Planted*")]
     assert not made, made  # no state saved
     # In a frame of another page, the studio's page is not shown at all.
     browser.get(f"{other_page}/frame.html")
@@ -117,6 +136,7 @@ def test_another_local_page_cannot_drive_the_studio(browser, studio, other_page,
     open_studio(browser, studio)
     browser.find_element(By.ID, "speed").send_keys("2")
     until("the speed to change from the page", lambda: studio.request("GET", "/api/status")[1]["speed"] == 2)
+    assert studio.request("POST", "/api/play/speed", {"value": 1})[0] == 200  # as the other tests found it
 
 
 def test_every_response_carries_the_security_headers(studio):
@@ -157,8 +177,9 @@ def canvas_hash(driver: webdriver.Chrome) -> str:
     return hashlib.sha1(driver.execute_script("return document.getElementById('screen').toDataURL()").encode()).hexdigest()
 
 
-def test_a_fresh_studio_draws_what_is_played(browser, studio):
+def test_a_fresh_studio_draws_what_is_played(browser, fresh_studio):
     """Open a fresh studio and play at once, without Reset or Resume: the canvas shows the game moving."""
+    studio = fresh_studio
     open_studio(browser, studio)
     until("a first picture", lambda: int(browser.find_element(By.ID, "screen").get_attribute("data-frame") or 0) > 0)
     first = canvas_hash(browser)

@@ -161,9 +161,16 @@ class Page:
         return self.text("run-state") == "paused"
 
     def pause(self) -> None:
+        """Pause, and wait for the canvas to show the frame the game paused on.
+
+        The status saying "paused" comes before the last screens (the server sends messages first), and a
+        loaded browser draws them later still: a frame number read at once could be some frames old.
+        """
         if not self.paused():
             self.click("pause")
         until("the game to pause", self.paused)
+        until("the screen of the frame it paused on", lambda: self.frame() == self.studio.server.request(
+            "GET", "/api/status")[1]["frame"])  # fmt: skip
 
     def resume(self) -> None:
         if self.paused():

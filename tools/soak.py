@@ -19,6 +19,7 @@ import argparse
 import collections
 import os
 import re
+import signal
 import statistics
 import subprocess
 import sys
@@ -48,8 +49,14 @@ def run_once(selection: list[str], log: Path) -> tuple[int, float, str, list[str
     """Run pytest on ``selection`` once; return its exit status, seconds, result line and failed test ids."""
     started = time.monotonic()
     with log.open("w") as out:
-        code = subprocess.call([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *selection],
+        run = subprocess.Popen([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *selection],
                                cwd=REPO, stdout=out, stderr=subprocess.STDOUT)  # fmt: skip
+        try:
+            code = run.wait()
+        finally:
+            if run.poll() is None:  # the soak was stopped: its run stops with it
+                run.terminate()
+                run.wait()
     seconds = time.monotonic() - started
     lines = log.read_text(errors="replace").splitlines()
     result = next((m.group(1) for line in reversed(lines) if (m := SUMMARY.match(line.strip()))), "no result line")
@@ -71,6 +78,7 @@ def main(argv: list[str] | None = None) -> int:
     times: list[float] = []
     failures: collections.Counter[str] = collections.Counter()
     failed_runs = 0
+    signal.signal(signal.SIGTERM, lambda *_: sys.exit(143))  # kill PID: the hogs and the run end too
     hogs = start_hogs(args.hogs)
     try:
         for run in range(1, args.runs + 1):
@@ -88,6 +96,8 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         stop_hogs(hogs)
 
+    if not times:
+        return 1
     print(f"soak: {failed_runs} of {len(times)} runs failed; time min {min(times):.1f} s, "
           f"median {statistics.median(times):.1f} s, max {max(times):.1f} s")  # fmt: skip
     for test, count in failures.most_common():

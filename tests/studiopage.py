@@ -21,6 +21,7 @@ import time
 from collections.abc import Iterator
 from pathlib import Path
 
+import pytest
 from chromium import WAIT, until  # first: it skips the importing module where Chromium is missing
 from selenium import webdriver
 from selenium.webdriver.common.action_chains import ActionChains
@@ -256,3 +257,19 @@ def click_pixel(page: Page, x: int, y: int) -> None:
     dx = round((x + 0.5) * scale - size["width"] / 2)  # Selenium's offsets are from the element's centre
     dy = round((y + 0.5) * scale - size["height"] / 2)
     ActionChains(page.driver).move_to_element_with_offset(canvas, dx, dy).click().perform()
+
+
+def dasher_studio(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Studio]:
+    """A studio on a copy of Dasher for a test module (the ``studio`` fixture of :func:`fixtures`)."""
+    with running_studio(tmp_path_factory.mktemp("studio")) as server:
+        yield server
+
+
+def studio_page(browser: webdriver.Chrome, studio: Studio) -> Page:
+    """The page of the module's studio in this test's browser (the ``page`` fixture of :func:`fixtures`)."""
+    return Page(browser, studio)
+
+
+def fixtures() -> tuple:
+    """The fixtures ``studio`` (a module's, on Dasher) and ``page``, to assign to names in a test module."""
+    return pytest.fixture(dasher_studio, scope="module", name="studio"), pytest.fixture(studio_page, name="page")

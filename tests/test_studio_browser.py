@@ -13,37 +13,25 @@ shows, game.yaml, the .state file and its record.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+import studiopage
 import yaml
-from selenium import webdriver
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 from selenium.webdriver.support.ui import Select
 from studiopage import (  # first: skips without Chromium
-    Page,
-    Studio,
     canvas_colours,
     canvas_pixels,
-    running_studio,
     until,
 )
 
 pytestmark = pytest.mark.timeout(600)
 
 
-@pytest.fixture(scope="module")
-def studio(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Studio]:
-    with running_studio(tmp_path_factory.mktemp("studio")) as server:
-        yield server
-
-
-@pytest.fixture
-def page(browser: webdriver.Chrome, studio: Studio) -> Page:
-    return Page(browser, studio)
+studio_fixture, page_fixture = studiopage.fixtures()
 
 
 # --- the steps of the "Done when" -----------------------------------------------------------------

@@ -7,20 +7,16 @@ session's headless Chromium driving its page as a user would.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+import studiopage
 import yaml
-from selenium import webdriver
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
 from studiopage import (  # first: it skips this module where Chromium is missing
-    Page,
-    Studio,
     click_pixel,
     editor_text,
-    running_studio,
     type_scenario,
     until,
 )
@@ -28,15 +24,7 @@ from studiopage import (  # first: it skips this module where Chromium is missin
 pytestmark = pytest.mark.timeout(600)
 
 
-@pytest.fixture(scope="module")
-def studio(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Studio]:
-    with running_studio(tmp_path_factory.mktemp("studio")) as server:
-        yield server
-
-
-@pytest.fixture
-def page(browser: webdriver.Chrome, studio: Studio) -> Page:
-    return Page(browser, studio)
+studio_fixture, page_fixture = studiopage.fixtures()
 
 
 def test_write_a_scenario_and_watch_its_reward_live(page, studio):

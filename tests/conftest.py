@@ -113,3 +113,20 @@ def wheel() -> Path:
     path = wheel_core("genesis_plus_gx")
     assert path is not None, "the stable-retro wheel ships genesis_plus_gx"
     return path
+
+
+@pytest.fixture(scope="session")
+def chromium_session():
+    """One headless Chromium for all the browser tests this process runs (skipped where Chromium is missing)."""
+    from chromium import chrome  # importing it skips the test where Chromium is not installed
+
+    with chrome() as driver:
+        yield driver
+
+
+@pytest.fixture
+def browser(chromium_session):
+    """That Chromium, as fresh for this test as a new one: a blank page, no cookies, no alert, no console log."""
+    from chromium import fresh
+
+    return fresh(chromium_session)

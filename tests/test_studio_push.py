@@ -25,10 +25,12 @@ SLOW = 0.1  # seconds a message takes the slow page: six game frames
 pytestmark = pytest.mark.timeout(300)
 
 
-@pytest.fixture
-def studio(tmp_path: Path):
-    shutil.copytree(DASHER, tmp_path / "Dasher-Genesis")
-    server = StudioProcess(tmp_path / "Dasher-Genesis", tmp_path / "data", tmp_path)
+@pytest.fixture(scope="module")
+def studio(tmp_path_factory: pytest.TempPathFactory):
+    """One studio for the module: each test asks for the play it needs (a new one took seconds to start)."""
+    root = tmp_path_factory.mktemp("studio")
+    shutil.copytree(DASHER, root / "Dasher-Genesis")
+    server = StudioProcess(root / "Dasher-Genesis", root / "data", root)
     yield server
     err = server.stop()
     assert "Traceback" not in err, err
@@ -41,6 +43,7 @@ def frame_of(message: bytes) -> int:
 def test_a_slow_page_gets_the_newest_screens_and_its_pause_at_once(studio):
     url = studio.origin.replace("http://", "ws://") + f"/ws?token={studio.token}"
     with websockets.connect(url, max_size=None) as ws:
+        ws.send(json.dumps({"type": "resume"}))  # playing, whatever another test left
         received, lags = 0, []
         while len(lags) < 30:
             message = ws.recv(timeout=60)

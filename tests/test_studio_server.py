@@ -215,7 +215,7 @@ def test_closing_the_last_socket_pauses_and_then_stops_the_emulator(client, stud
     with socket(client) as ws:
         receive_screen(ws)
         assert studio_session.running and not studio_session.paused
-    deadline = time.monotonic() + 10
+    deadline = time.monotonic() + 120  # generous: a loaded machine is slow, never wrong
     while studio_session.running and time.monotonic() < deadline:
         time.sleep(0.05)
     assert studio_session.paused and not studio_session.running  # paused at once, thread gone after the grace period
@@ -296,7 +296,7 @@ def test_record_a_movie_of_what_is_played_and_replay_it(client, studio_session, 
     post(client, "/api/play/reset", {"state": "Zone3.Act1"})  # somewhere else, then replay
     post(client, "/api/play/speed", {"value": 4})
     assert post(client, "/api/movies/play", {"name": "run"})["frames"] == 30
-    deadline = time.monotonic() + 20
+    deadline = time.monotonic() + 120
     while client.get("/api/status").json()["replaying"] and time.monotonic() < deadline:
         time.sleep(0.05)
     post(client, "/api/play/speed", {"value": 1})
@@ -354,7 +354,7 @@ def test_validate_reports_as_json_while_the_game_plays_on(client, studio_session
         start = studio_session.frame
         report = post(client, "/api/validate", {"frames": 10})
         played = studio_session.frame - start
-        reader.join(timeout=30)
+        reader.join(timeout=120)
     post(client, "/api/play/pause")
     assert report["game"] == "Dasher-Genesis" and report["counts"]["pass"] > 10
     failed = [r for r in report["results"] if r["status"] == "fail"]

@@ -1,7 +1,8 @@
 """The studio on every system we have a cartridge for (issue 29 §4): its buttons and keys, its RAM.
 
 Parametrized over tools/cartridges.yaml as tests/test_systems.py is, in a real browser (headless
-Chromium through Selenium, with tests/test_studio_browser.py's server, page and browser):
+Chromium through Selenium, with tests/studiopage.py's server and page). One studio serves them all: it
+opens each cartridge in turn by name, as its page's Open does, rather than a new studio for each:
 
 - the page shows the system's buttons, each with a key, and the keys play the game: holding them
   moves it as the same buttons move our own emulator;
@@ -19,7 +20,7 @@ import pytest
 import yaml
 from selenium.webdriver.common.by import By
 from selenium.webdriver.common.keys import Keys
-from test_studio_browser import Page, Studio, browser, click_pixel, until  # noqa: F401 (browser: a fixture)
+from studiopage import Page, Studio, click_pixel, running_studio, until  # first: it skips this module without Chromium
 
 from retrokit.data.games import find_game
 from retrokit.data.statecheck import load_state
@@ -45,24 +46,24 @@ def selenium_key(code: str) -> str:
     return SELENIUM_KEYS.get(code) or code.removeprefix("Key").removeprefix("Digit").lower()
 
 
+@pytest.fixture(scope="module")
+def studio(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Studio]:
+    games = [REPO / "games" / name for name in CARTRIDGES]
+    with running_studio(tmp_path_factory.mktemp("studio"), games[0], tuple(games[1:])) as server:
+        yield server
+
+
 @pytest.fixture(scope="module", params=CARTRIDGES, ids=CARTRIDGES)
-def studio(request, tmp_path_factory: pytest.TempPathFactory) -> Iterator[Studio]:
-    server = Studio(tmp_path_factory.mktemp("studio"), REPO / "games" / request.param)
-    yield server
-    err = server.stop()
-    assert server.process.returncode == 0, err
-    assert "Traceback" not in err
+def cartridge(request, studio: Studio) -> str:
+    """The cartridge the module's studio plays, opened by name (its tests run one after the other)."""
+    studio.open_game(request.param)
+    return request.param
 
 
 @pytest.fixture
-def page(browser, studio: Studio) -> Page:  # noqa: F811
+def page(browser, studio: Studio, cartridge: str) -> Page:
+    assert studio.game.name == cartridge
     return Page(browser, studio)
-
-
-def this_studios_errors(page: Page) -> list[str]:
-    """The browser console's errors from this studio's page (the module's browser saw the previous studios' stop)."""
-    origin = page.studio.url.split("/", 3)[2]
-    return [error for error in page.errors() if origin in error]
 
 
 def fields_after(name: str, masks: int, frames: int) -> dict[str, int]:
@@ -82,8 +83,7 @@ def test_the_keys_play_the_systems_buttons(page: Page) -> None:
     system = game.system
     page.open("watch")
     assert page.text("game-name") == f"{game.name} ({system.name})"
-    legend = {b.get_attribute("data-button"): b.find_element(By.TAG_NAME, "kbd").text
-              for b in page.driver.find_elements(By.CSS_SELECTOR, "#buttons .pad-button")}  # fmt: skip
+    legend = page.legend()
     assert set(legend) == set(system.button_names), legend
     keys = key_map(system)
     assert set(keys.values()) == set(system.button_names), keys  # every button has a key, each its own
@@ -99,7 +99,7 @@ def test_the_keys_play_the_systems_buttons(page: Page) -> None:
     expected = fields_after(game.name, system.mask(held), FRAMES)
     assert shown == expected, {k: (shown[k], expected[k]) for k in shown if shown[k] != expected[k]}
     assert expected != fields_after(game.name, 0, FRAMES), "the buttons held changed nothing"
-    assert not this_studios_errors(page)
+    assert not page.errors()
 
 
 def pixel_of_a_field(name: str, start: int, size: int) -> tuple[str, int, int, int]:
@@ -152,4 +152,4 @@ def test_ram_view_and_click_to_find_start_on_the_systems_ram(page: Page) -> None
     hits = {int(row.get_attribute("data-address"), 16): row.text
             for row in page.driver.find_elements(By.CSS_SELECTOR, "#cf-rows tr")}  # fmt: skip
     assert address in hits and field in hits[address], (field, hex(address), hits)
-    assert not this_studios_errors(page)
+    assert not page.errors()

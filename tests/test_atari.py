@@ -196,6 +196,7 @@ def _vet(data: bytes, game: str = "Pong"):
     [
         pytest.param("truncated", "core refused the state", id="truncated"),
         pytest.param("another-system", "core can run; found one that it cannot", id="a-genesis-state"),
+        pytest.param("another-game", "found Airstriker-Genesis's state", id="the-wheels-airstriker-state"),
         pytest.param("empty", "expected a serialized core state", id="empty"),
         pytest.param("huge", "at most", id="huge-past-the-largest-state"),
     ],
@@ -205,7 +206,9 @@ def test_a_hostile_state_ends_in_one_clear_error(imported: Path, airstriker_stat
     from retrokit.errors import StateError
 
     pong = read_state(_shipped_state("Pong"))
-    data = {"truncated": pong[:100], "another-system": bytes(airstriker_state), "empty": b"",
+    data = {"truncated": pong[:100], "another-game": bytes(airstriker_state), "empty": b"",
+            # one byte changed: no record knows it, so the core itself must refuse it
+            "another-system": bytes(airstriker_state[:-1]) + bytes([airstriker_state[-1] ^ 1]),
             "huge": pong + bytes(MAX_STATE_SIZE)}[kind]
     with (
         pytest.raises(StateError, match=expected) as error,

@@ -41,3 +41,15 @@ def test_ci_runs_the_readme_commands_exactly_with_the_stock_pip() -> None:
     assert positions[0] < build < positions[1]  # the patched core is built before the tests run
     for text in (ci, (REPO / "README.md").read_text()):
         assert not re.search(r"pip install[^\n]*(-U|--upgrade)[^\n]*\bpip\b", text)  # the stock pip, never upgraded
+
+
+def test_the_readme_gives_the_measured_time_of_its_two_commands() -> None:
+    """Measured times, with the machine and the day, not a guess ("about a minute" was 3 CPU-minutes)."""
+    text = (REPO / "README.md").read_text()
+    demo, tests = text.index("retrokit demo\n```"), text.index("python -m pytest -q\n```")
+    before_demo = " ".join(text[:demo].split())
+    assert re.search(r"\(\d+ s on the developers' 2-core \S+ VM with nothing else running, \d+ CPU-seconds, "
+                     r"\d{4}-\d\d-\d\d", before_demo), "the demo's measured time, machine and day"
+    after_tests = " ".join(text[tests:text.index("## The main job")].split())
+    assert re.search(r"took [\d,]+ s \([\d.]+ minutes, [\d,]+ tests\) on the developers' 2-core \S+ VM with "
+                     r"nothing else running \(\d{4}-\d\d-\d\d\)", after_tests), "the suite's measured time"

@@ -8,6 +8,7 @@ killing the suite.
 
 from __future__ import annotations
 
+import gzip
 import shutil
 import zipfile
 from pathlib import Path
@@ -189,6 +190,33 @@ def test_a_shipped_state_needs_no_probe_and_a_shipped_path_vouches_for_no_other_
     with pytest.raises(StateError, match="crashed"):  # other bytes do not borrow a shipped file's trust
         statecheck.vet_state(corrupt_state, "Genesis", game.require_rom(), shipped=DASHER / "Zone1.Act1.state")
     assert calls == [1]
+
+
+def test_validate_spares_only_states_this_machine_vouches_for_the_run_under_input(
+    tmp_path: Path, corrupt_state: bytes, good_state: bytes, forged, monkeypatch
+) -> None:
+    from retrokit.data import probe
+    from retrokit.data.states import write_state
+    from retrokit.testing import states
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    game = find_game("Dasher-Genesis")
+    files = {"Shipped": DASHER / "Zone1.Act1.state", "Regzipped": tmp_path / "Regzipped.state",
+             "Forged": tmp_path / "Forged.state", "Remembered": tmp_path / "Remembered.state"}
+    # Good bytes in another file than the shipped one: nothing vouches for them, until this machine records a verdict.
+    files["Regzipped"].write_bytes(gzip.compress(read_state(DASHER / "Zone1.Act2.state"), compresslevel=1, mtime=0))
+    files["Remembered"].write_bytes(gzip.compress(good_state, compresslevel=1, mtime=0))
+    probe._remember(probe.probe_key(good_state, "Genesis", game.sha1s[0]), probe.ProbeVerdict(True))
+    write_state(files["Forged"], corrupt_state, record=forged)  # a record vouches for nothing
+    asked = {}
+
+    def run_child(system, rom, todo, **kwargs):
+        asked.update({name: frames for name, _, frames in todo})
+        return {}, None, "stopped"
+
+    monkeypatch.setattr(probe, "run_child", run_child)
+    states.probe_states(game, list(files), game.require_rom(), files=files)
+    assert asked == {"Shipped": 0, "Regzipped": states.INPUT_FRAMES, "Forged": states.INPUT_FRAMES, "Remembered": 0}
 
 
 def test_the_shipped_state_hashes_are_current() -> None:

@@ -99,7 +99,8 @@ class ChildResult:
 
 
 def run_child(
-    system: str, rom: str | os.PathLike[str], states: Sequence[tuple[str, str]], *, frames: int,
+    system: str, rom: str | os.PathLike[str], states: Sequence[tuple[str, str] | tuple[str, str, int]], *,
+    frames: int,
     input_frames: int, fields: Sequence[Mapping[str, Any]] = (), timeout: float = PROBE_TIMEOUT,
 ) -> tuple[dict[str, ChildResult], str | None, str]:
     """Run one child over ``states``; return the results it finished, the state it was on when it stopped, and why.
@@ -111,7 +112,8 @@ def run_child(
     Args:
         system: The system's name.
         rom: The ROM to load the states on.
-        states: ``(name, path)`` of each state file, in order.
+        states: ``(name, path)`` of each state file, in order; or ``(name, path, input_frames)``
+            for one that needs other than ``input_frames``.
         frames: Idle frames to run after the first load of each state.
         input_frames: Frames of random input to run after loading it again.
         fields: RAM fields (``name``, ``address``, ``type``, ``mask``) to read after loading.
@@ -122,7 +124,7 @@ def run_child(
     """
     request = {"system": system, "rom": os.fspath(rom), "frames": frames, "input_frames": input_frames,
                "fields": list(fields),
-               "states": [list(s) for s in states]}
+               "states": [[*s[:2], input_frames if len(s) < 3 else s[2]] for s in states]}
     results: dict[str, ChildResult] = {}
     current = None
     with Child("retrokit.data.probe", request, memory=CHILD_MEMORY) as child:
@@ -277,6 +279,27 @@ def vet_state(
     return _mint(state, system)
 
 
+def known_safe(path: str | os.PathLike[str], system: str, rom_sha1: str) -> bool:
+    """Whether the state file at ``path`` needs no probe on this ROM: shipped, or found safe here before.
+
+    The same trust :func:`vet_state` gives, for a caller that runs the state in
+    a child anyway but may spare it the long run under input (``retrokit
+    validate``). Any doubt (an unreadable file, a layout the core cannot
+    run, no record) is ``False``.
+    """
+    try:
+        blob = paths.read_regular_file(path, "a save state file", MAX_STATE_FILE_SIZE)
+        state = decompress_state(blob)
+    except (RetrokitError, OSError):
+        return False
+    if state_layout_problem(system, state):
+        return False
+    if is_shipped_blob(blob):
+        return True
+    verdict = _cached(probe_key(state, system, rom_sha1))
+    return verdict is not None and verdict.safe
+
+
 def _unrunnable(source: str, system: str, reason: str) -> StateError:
     return StateError(
         f"{source}: expected a save state the {system} core can run; found one that it cannot: "
@@ -312,13 +335,13 @@ def _child_main() -> int:
     from retrokit.host.memory import FieldReader
 
     request = json.load(sys.stdin)  # its limits are set by now (retrokit.host.child)
-    frames, input_frames = int(request["frames"]), int(request["input_frames"])
+    frames = int(request["frames"])
     emu = Emulator(request["system"], request["rom"])
     specs = [FieldSpec(f["name"], f["address"], f["type"], f["mask"]) for f in request["fields"]]
     reader = FieldReader([s for s in specs if emu.space.holds(s.address, s.field_type.width)], emu.space)
     idle = [0] * emu.ports
     rng = random.Random(0)
-    for name, path in request["states"]:
+    for name, path, input_frames in request["states"]:
         print(json.dumps({"begin": name}), flush=True)
         result: dict[str, Any] = {"name": name, "path": path}
         try:
@@ -334,7 +357,7 @@ def _child_main() -> int:
             emu.run(idle, max(frames - 1, 0))
             result["after"] = reader.read()
             emu.set_state(state)  # every reset() loads the state again: some crash only then
-            for _ in range(0, input_frames, 10):  # and some only under input
+            for _ in range(0, int(input_frames), 10):  # and some only under input
                 emu.run([rng.getrandbits(12) for _ in range(emu.ports)], 10)
             # An env's reset(): load, one scratch frame (its first observation), load again. Loading
             # resets the console from the state that ran before, so a load after one frame differs.

@@ -67,17 +67,24 @@ def probe_states(
     The child is the crash probe's (:func:`retrokit.data.probe.run_child`: a
     memory cap, no core file, this retrokit). A child that dies or hangs marks
     the state it was loading as failed, and a new child carries on with the
-    states after it: each state gets its own result, none is cached.
+    states after it: each state gets its own result, none is cached. A state
+    the crash probe's records already vouch for on this ROM
+    (:func:`~retrokit.data.probe.known_safe`: it ran 3,000 frames under input
+    there) is loaded and run idle as every other, but spared the run under input.
     """
-    from retrokit.data.probe import run_child
+    from retrokit.data.games import cached_rom_sha1
+    from retrokit.data.probe import known_safe, run_child
 
     paths = {name: str(files[name] if files is not None else game.state_path(name)) for name in names}
     fields = [{"name": f.name, "address": f.address, "type": f.type, "mask": f.mask} for f in game.fields.values()]
     probes: dict[str, StateProbe] = {}
+    rom_sha1 = cached_rom_sha1(rom, game.system)
+    input_frames = {n: 0 if known_safe(paths[n], game.system.name, rom_sha1) else INPUT_FRAMES for n in names}
     todo = list(names)
     while todo:
         done, current, failure = run_child(
-            game.system.name, rom, [(n, paths[n]) for n in todo], frames=frames, input_frames=INPUT_FRAMES,
+            game.system.name, rom, [(n, paths[n], input_frames[n]) for n in todo], frames=frames,
+            input_frames=INPUT_FRAMES,
             fields=fields, timeout=CHILD_TIMEOUT,
         )
         probes.update({name: StateProbe(**vars(result)) for name, result in done.items()})

@@ -1,7 +1,8 @@
 """Field ranges in game.yaml: read, checked by ``retrokit validate`` on every state, and by ``make(state=...)``.
 
-Another game's state, dropped into a game's folder (re-gzipped, so no byte-for-byte
-copy is found) plays garbage: Dasher's fields read out of their ranges one frame in.
+Another game's state that no record knows (played on, and saved by a tool that records
+nothing), dropped into a game's folder, plays garbage: Dasher's fields read out of their
+ranges one frame in. A state that is known (the wheel's, even re-gzipped) is named first.
 """
 
 from __future__ import annotations
@@ -96,8 +97,17 @@ def test_make_refuses_another_games_state_with_a_state_error(copy, airstriker_di
         env.close()
 
 
-def test_validate_names_the_fields_of_another_games_state_out_of_range(copy, airstriker_dir):
+def test_validate_names_the_game_a_known_state_belongs_to(copy, airstriker_dir):
+    """The wheel's Airstriker state, re-gzipped: validate knows it by its hash, as make(state=...) does."""
     (copy / "Level1.state").write_bytes(airstriker_regzipped(airstriker_dir))
+    report = check_game(GAME, frames=30)
+    status, message = results(report, "state is the game's")["Level1"]
+    assert status == FAIL and "found Airstriker-Genesis's state" in message and "Load it with Airstriker-Genesis" in message
+    assert "Level1" not in results(report, "fields in range") and not report.passed
+
+
+def test_validate_names_the_fields_of_another_games_state_out_of_range(copy, airstriker_dir, airstriker_rom):
+    write_state(copy / "Level1.state", airstriker_played(airstriker_dir, airstriker_rom))
     report = check_game(GAME, frames=30)
     ranges = results(report, "fields in range")
     assert ranges["Zone1.Act1"][0] == PASS
@@ -114,10 +124,11 @@ def test_validate_catches_a_state_saved_on_another_games_rom(copy, airstriker_di
     assert results(report, "fields in range")["Saved"][0] == FAIL
 
 
-def test_validate_covers_the_states_in_the_data_folder_of_a_game_given_by_folder(copy, data, airstriker_dir):
+def test_validate_covers_the_states_in_the_data_folder_of_a_game_given_by_folder(copy, data, airstriker_dir,
+                                                                                 airstriker_rom):
     made = data / "games" / GAME
     made.mkdir(parents=True)
-    (made / "Dropped.state").write_bytes(airstriker_regzipped(airstriker_dir))
+    write_state(made / "Dropped.state", airstriker_played(airstriker_dir, airstriker_rom))
     report = check_game(copy, frames=30)  # validate FOLDER, as docs/integrate.md runs it in the game's folder
     assert results(report, "fields in range")["Dropped"][0] == FAIL
     assert results(report, "state loads")["Dropped"][0] == PASS

@@ -68,7 +68,7 @@ def check_state(
             f"recorded on another ROM (SHA-1 {record.rom_sha1}{of}). Load it with the game of that ROM, "
             f"or pick a state of {game.name}."
         )
-    _check_identity(game, data, rom_sha1, source, shipped)
+    check_identity(game, data, rom_sha1, source, shipped)
     return _vet(data, game.system, rom, rom_sha1, source=source, shipped=shipped)
 
 
@@ -107,7 +107,7 @@ def state_owners(data: bytes, file: Path | None = None) -> list[Owner]:
     return [owner for owner in owners if owner is not None]
 
 
-def _check_identity(game: Game, data: bytes, rom_sha1: str, source: str, file: Path | None = None) -> None:
+def check_identity(game: Game, data: bytes, rom_sha1: str, source: str, file: Path | None = None) -> None:
     """Refuse a state known to be another game's (see :func:`state_owners`), unless the two games share a ROM.
 
     Whatever file holds it, with its record stripped or a movie's header

@@ -266,14 +266,21 @@ def check_movie_states(game: Game, report: GameReport, rom: Path | None) -> None
 
 
 def _recorded_elsewhere(game: Game, path: Path) -> str:
-    """Why a state retrokit wrote is another ROM's (from the record in its file), or ``""``."""
+    """Why a state is another ROM's (by the record in its file, or by the one rule of what states are known), or ``""``."""
+    from retrokit.data.statecheck import check_identity
     from retrokit.data.states import read_state_file
+    from retrokit.errors import StateError
 
     try:
-        record = read_state_file(path).record
+        state = read_state_file(path)
     except RetrokitError:
         return ""  # an unreadable file already failed to load
+    record = state.record
     if record is None or not game.sha1s or record.rom_sha1 in game.sha1s:
+        try:  # the check make(state=...) applies: a state this machine wrote, or the wheel shipped, for another game
+            check_identity(game, state.data, "", str(path), path)
+        except StateError as exc:
+            return str(exc)
         return ""
     of = f" (a state of {record.game})" if record.game != game.name else ""
     return (f"expected a state made with {game.name}'s ROM ({', '.join(game.sha1s)}); found one retrokit recorded "

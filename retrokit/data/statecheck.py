@@ -95,7 +95,7 @@ def state_owners(data: bytes, file: Path | None = None) -> list[Owner]:
     Each of these only ever refuses a state for another game; none makes a state trusted.
     """
     digest = hashlib.sha256(data).hexdigest()
-    owners = [_recorded_owner(digest), _shipped_owners().get(digest)]
+    owners = [_recorded_owner(digest), _shipped_owner(_shipped_states().get(digest))]
     owners += [_wheel_owner(where) for where in _wheel_states().get(digest, ())]
     if file is not None and not any(owners):
         try:
@@ -158,27 +158,36 @@ def _game_sha1s(folder: Path) -> frozenset[str]:
 
 
 @functools.cache
-def _shipped_owners() -> dict[str, Owner]:
-    """The digest of the state in every ``.state`` file retrokit's ``games/`` ships, to its game."""
+def _shipped_states() -> dict[str, Path]:
+    """The digest of the state in every ``.state`` file retrokit's ``games/`` ships, to its game's folder.
+
+    Only the states are read here: a game's ROMs are looked up for the one digest that matches
+    (:func:`_shipped_owner`), so a process that loads one state does not parse every game's files.
+    """
     games = paths.repo_games_dir()
-    owners: dict[str, Owner] = {}
+    found: dict[str, Path] = {}
     if games is None:
-        return owners
+        return found
     try:
         listed = (games / STATE_HASHES).read_text(encoding="utf-8").splitlines()
     except (OSError, UnicodeDecodeError):
-        return owners
+        return found
     for line in listed:
         parts = line.split(maxsplit=1)
         if len(parts) != 2 or "/" not in parts[1]:
             continue
-        name = parts[1].split("/")[0]
         try:
             digest = hashlib.sha256(read_state_file(games / parts[1]).data).hexdigest()
         except RetrokitError:
             continue  # a shipped file missing or damaged here: it identifies nothing
-        owners[digest] = Owner(name, _game_sha1s(games / name), "retrokit ships it")
-    return owners
+        found[digest] = games / parts[1].split("/")[0]
+    return found
+
+
+@functools.cache
+def _shipped_owner(folder: Path | None) -> Owner | None:
+    """The game of retrokit's shipped game folder ``folder``."""
+    return None if folder is None else Owner(folder.name, _game_sha1s(folder), "retrokit ships it")
 
 
 @functools.cache

@@ -10,6 +10,15 @@ A worker dies with this process (a parent-death signal on Linux, and a thread
 that watches the parent everywhere), so a killed evaluation leaves no worker
 playing on. A level's result depends only on its own seed, never on which
 process played it.
+
+Workers are forked by multiprocessing's fork server, which imported what a
+level needs once (:mod:`retrokit.benchmark.preload`): a worker starts in
+milliseconds instead of the second a fresh interpreter takes to import
+numpy, Gymnasium and retrokit. The server is a single-threaded process of
+its own, so forking it copies no half-held lock (forking this process, which
+may hold tqdm's and the host's threads, would). A worker takes this process's
+environment variables as they are when its level starts, not the server's
+(:func:`_work`). Where there is no fork server (Windows), workers are spawned.
 """
 
 from __future__ import annotations
@@ -19,7 +28,6 @@ import os
 import signal
 import sys
 import threading
-import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
@@ -41,8 +49,7 @@ class _Worker:
 
 def run_local(tasks: list[LevelTask], handle: Callable[[Message], None], workers: int, watchdog: Watchdog) -> None:
     """Play each of ``tasks`` in a worker process, ``workers`` at a time, passing each message to ``handle``."""
-    # spawn, not fork: this process may hold threads (tqdm's, the emulator host's) that fork would copy half-way.
-    context = multiprocessing.get_context("spawn")
+    context = _context()
     pending = list(reversed(tasks))
     running: dict[Connection, _Worker] = {}
     try:
@@ -50,9 +57,9 @@ def run_local(tasks: list[LevelTask], handle: Callable[[Message], None], workers
             while pending and len(running) < workers:
                 task = pending.pop()
                 reader, writer = context.Pipe(duplex=False)
-                process = context.Process(target=_work, args=(task, writer, os.getpid()), daemon=True,
+                process = context.Process(target=_work, args=(task, writer, dict(os.environ)), daemon=True,
                                           name=f"retrokit level {task.level.name}")
-                _start(process)
+                _start(process, context)
                 writer.close()  # the worker holds the only writer: its exit ends the pipe
                 watchdog.start(task.level.name)
                 running[reader] = _Worker(task, process, reader)
@@ -81,11 +88,29 @@ def run_local(tasks: list[LevelTask], handle: Callable[[Message], None], workers
             worker.pipe.close()
 
 
-def _start(process: multiprocessing.process.BaseProcess) -> None:
+def _context() -> multiprocessing.context.BaseContext:
+    """The fork server's context, preloading what a level needs; spawn where there is none."""
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        return multiprocessing.get_context("spawn")
+    context = multiprocessing.get_context("forkserver")
+    context.set_forkserver_preload(["retrokit.benchmark.preload"])
+    return context
+
+
+def _start(process: multiprocessing.process.BaseProcess, context: multiprocessing.context.BaseContext) -> None:
     """Start a worker with Ctrl-C blocked: a terminal's SIGINT goes to the whole process group, and it is this
-    process's to handle (it stops the workers); the mask is inherited, so not even the worker's start sees it."""
+    process's to handle (it stops the workers); the mask is inherited, so not even the worker's start sees it.
+
+    The fork server is started here too if it is not running yet, so it and every worker it forks inherit the
+    mask (a server started with Ctrl-C open would fork workers that a Ctrl-C could interrupt before they
+    ignore it).
+    """
     signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
+        if context.get_start_method() == "forkserver":
+            from multiprocessing import forkserver
+
+            forkserver.ensure_running()
         process.start()
     finally:
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # a Ctrl-C meanwhile arrives now
@@ -118,10 +143,17 @@ def _died(worker: _Worker, watchdog: Watchdog) -> LevelFailed:
         "the agent ended its process (os._exit) or crashed in native code."), step)
 
 
-def _work(task: LevelTask, pipe: Connection, parent: int) -> None:
-    """A worker process: play one level, sending every message down ``pipe``."""
-    _die_with_parent(parent)
+def _work(task: LevelTask, pipe: Connection, environment: dict[str, str]) -> None:
+    """A worker process: play one level, sending every message down ``pipe``.
+
+    ``environment`` is the evaluation's environment variables when the level started: a forked worker has the
+    fork server's, which are the evaluation's as they were when the server started (RETROKIT_GAMES,
+    RETROKIT_DATA and the like may have changed since).
+    """
+    _die_with_parent()
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # also if the agent unblocks it: Ctrl-C is the parent's
+    os.environ.clear()
+    os.environ.update(environment)
     run_level(task, pipe.send)
     pipe.close()
     # Exit now: a thread the agent left running must not keep the process (and the evaluation) waiting.
@@ -130,8 +162,14 @@ def _work(task: LevelTask, pipe: Connection, parent: int) -> None:
     os._exit(0)
 
 
-def _die_with_parent(parent: int) -> None:
-    """End this process as soon as the evaluation's process is gone, whatever the agent is doing."""
+def _die_with_parent() -> None:
+    """End this process as soon as the evaluation's process is gone, whatever the agent is doing.
+
+    The parent-death signal fires when this process's parent ends: the evaluation where workers are spawned,
+    the fork server where they are forked (which ends when the evaluation does). The thread watches the
+    evaluation itself: ``parent_process()`` is it for both start methods (multiprocessing hands the worker a
+    pipe end that the evaluation holds open while it lives).
+    """
     if sys.platform.startswith("linux"):
         import ctypes
 
@@ -139,12 +177,12 @@ def _die_with_parent(parent: int) -> None:
             ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
         except (OSError, AttributeError):
             pass  # the watching thread below still ends it
-    if os.getppid() != parent:  # the parent died before the signal was set up
+    evaluation = multiprocessing.parent_process()
+    if evaluation is None or not evaluation.is_alive():  # it died before the signal was set up
         os._exit(1)
 
     def watch() -> None:
-        while os.getppid() == parent:
-            time.sleep(1.0)
+        evaluation.join()
         os._exit(1)
 
     threading.Thread(target=watch, name="retrokit parent watch", daemon=True).start()

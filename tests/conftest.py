@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import gzip
 import json
+import os
+import sys
 from pathlib import Path
 
 import pytest
@@ -15,6 +17,17 @@ import pytest
 from retrokit.paths import wheel_dir
 
 REPO = Path(__file__).resolve().parent.parent
+
+# Compiled bytecode, kept: where PYTHONDONTWRITEBYTECODE is set (it is on the developers' VMs), every test
+# process and every child a test starts (a level worker, the state probe, a CLI) compiled retrokit's modules from
+# source again, and pytest rewrote every test module's asserts again (about 0.15 CPU-s a child, 10 a worker). The
+# files go into the checkout's pytest cache folder (ignored by git), not beside the sources, so the tree is as
+# clean as before; the children find the folder through the environment they inherit.
+_PYCACHE = REPO / ".pytest_cache" / "pycache"
+sys.dont_write_bytecode = False
+sys.pycache_prefix = str(_PYCACHE)
+os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
+os.environ["PYTHONPYCACHEPREFIX"] = str(_PYCACHE)
 
 
 @pytest.fixture(scope="session")

@@ -4,7 +4,8 @@ Each writer reads game.yaml, inserts its line and writes the file back; two
 that read it at once would each write a file missing the other's line, so
 every read-modify-write holds the folder's lock (retrokit.paths.locked).
 The writers are real processes started together: 10 ``retrokit ramsearch
-save`` commands (forked at once from one interpreter, tests/incli.py), and two studios on one game adding 15 fields each.
+save`` commands (forked at once from one interpreter, tests/incli.py), and
+two studios on one game adding 15 fields each.
 """
 
 from __future__ import annotations

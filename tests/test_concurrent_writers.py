@@ -4,20 +4,20 @@ Each writer reads game.yaml, inserts its line and writes the file back; two
 that read it at once would each write a file missing the other's line, so
 every read-modify-write holds the folder's lock (retrokit.paths.locked).
 The writers are real processes started together: 10 ``retrokit ramsearch
-save`` commands, and two studios on one game adding 15 fields each.
+save`` commands (forked at once from one interpreter, tests/incli.py), and
+two studios on one game adding 15 fields each.
 """
 
 from __future__ import annotations
 
 import os
 import shutil
-import subprocess
-import sys
 import threading
 from pathlib import Path
 
 import pytest
 import yaml
+from incli import retrokit_at_once, retrokit_in_process
 from studioproc import StudioProcess
 
 REPO = Path(__file__).resolve().parent.parent
@@ -38,24 +38,17 @@ def fields_of(game: Path) -> dict:
     return yaml.safe_load((game / "game.yaml").read_text())["fields"]
 
 
-def test_ten_ramsearch_saves_at_once_each_keep_their_field(tmp_path, game):
+def test_ten_ramsearch_saves_at_once_each_keep_their_field(tmp_path, game, monkeypatch):
     env = {**os.environ, "RETROKIT_GAMES": str(game.parent), "RETROKIT_DATA": str(tmp_path / "data")}
+    monkeypatch.setenv("RETROKIT_GAMES", env["RETROKIT_GAMES"])  # for the session made in this process
+    monkeypatch.setenv("RETROKIT_DATA", env["RETROKIT_DATA"])
     before = fields_of(game)
-    made = subprocess.run(
-        [sys.executable, "-m", "retrokit", "ramsearch", "new", "Dasher-Genesis", "--state", "Zone1.Act1"],
-        cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120, check=False,
-    )  # fmt: skip
+    # one type: a small session to load; what the saves race on is game.yaml
+    made = retrokit_in_process(tmp_path, "ramsearch", "new", "Dasher-Genesis", "--state", "Zone1.Act1", "--types", "|u1")
     assert made.returncode == 0, made.stderr
-    writers = [
-        subprocess.Popen(
-            [sys.executable, "-m", "retrokit", "ramsearch", "save", f"found_{i}", hex(0xFF0100 + i), "|u1"],
-            cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-        )
-        for i in range(10)
-    ]
-    for writer in writers:
-        out, err = writer.communicate(timeout=300)
-        assert writer.returncode == 0 and out.startswith("Wrote field"), err
+    saves = [["ramsearch", "save", f"found_{i}", hex(0xFF0100 + i), "|u1"] for i in range(10)]
+    for writer in retrokit_at_once(tmp_path, saves, env, warm=("retrokit.ramsearch", "retrokit.commands.ramsearch")):
+        assert writer.returncode == 0 and writer.stdout.startswith("Wrote field"), writer.stderr
     after = fields_of(game)
     assert {name: after[name] for name in before} == before  # nothing of the author's lost
     assert sorted(set(after) - set(before)) == sorted(f"found_{i}" for i in range(10))

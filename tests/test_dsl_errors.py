@@ -375,7 +375,7 @@ CASES = [
     pytest.param(
         'reward: x\n  done: y\n',
         ScenarioError,
-        '{tmp}/s.yaml:2:7: this is not valid YAML: mapping values are not allowed here\n'
+        '{tmp}/s.yaml:2:7: this is not valid YAML: mapping values are not allowed in this context\n'
         '      done: y\n'
         '          ^',
         id='invalid_yaml',

@@ -119,7 +119,7 @@ BAD_FILES = [
     pytest.param(b"tables:\n  t:\n    values: {1: .nan}\nreward: t[x]\n", ScenarioError, (3, 17), "finite", id="nan_table_value"),
     pytest.param(b"tables:\n  t:\n    values: {1: 1e308 * 10}\nreward: t[x]\n", ScenarioError, (3, 17), "finite", id="overflowing_constant"),
     pytest.param(b"tables:\n  t:\n    values: {1: 0x1_0000_0000_0000_0000}\nreward: t[x]\n", ScenarioError, (3, 17), "64 bits", id="65_bit_table_value"),
-    pytest.param(b"reward: " + b"[" * 5000 + b"\n", ScenarioError, (1, 1), "not valid YAML", id="5000_open_brackets"),
+    pytest.param(b"reward: " + b"[" * 5000 + b"\n", ScenarioError, (1, 1008), "not valid YAML: exceeded maximum nesting depth", id="5000_open_brackets"),
 ]
 
 

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import difflib
+import io
 import json
-import os
 import shutil
 import subprocess
 import sys
@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from incli import retrokit_in_process
 
 from retrokit import cli
 from retrokit.errors import SessionError
@@ -24,11 +25,16 @@ DASHER = REPO / "games" / "Dasher-Genesis"
 
 
 def ramsearch(cwd: Path, *argv: str) -> subprocess.CompletedProcess:
-    """One command, in its own process."""
+    """One command in its own process: what another process finds in the session file."""
     return subprocess.run(
         [sys.executable, "-m", "retrokit", "ramsearch", *argv],
         cwd=cwd, capture_output=True, text=True, timeout=120, check=False,
     )  # fmt: skip
+
+
+def in_process(cwd: Path, *argv: str) -> subprocess.CompletedProcess:
+    """One command, as its own process would run it, in this one (it loads the session file and saves it back)."""
+    return retrokit_in_process(cwd, "ramsearch", *argv)
 
 
 def run(capsys, *argv: str) -> tuple[int, str, str]:
@@ -37,13 +43,20 @@ def run(capsys, *argv: str) -> tuple[int, str, str]:
     return status, out, err
 
 
+@pytest.fixture(scope="module")
+def dasher_session(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A Dasher search with one snapshot, saved once for the module (tests get a copy)."""
+    path = tmp_path_factory.mktemp("session") / DEFAULT_SESSION
+    with RamSearch("Dasher-Genesis", "Zone1.Act1") as search:
+        search.save(path)
+    return path
+
+
 @pytest.fixture
-def session(tmp_path: Path, monkeypatch) -> Path:
+def session(dasher_session: Path, tmp_path: Path, monkeypatch) -> Path:
     """A Dasher search with one snapshot, in the default session file of a fresh folder (the cwd)."""
     monkeypatch.chdir(tmp_path)
-    with RamSearch("Dasher-Genesis", "Zone1.Act1") as search:
-        search.save(tmp_path / DEFAULT_SESSION)
-    return tmp_path / DEFAULT_SESSION
+    return Path(shutil.copyfile(dasher_session, tmp_path / DEFAULT_SESSION))
 
 
 def test_a_cli_session_gives_the_api_candidates(tmp_path):
@@ -59,8 +72,8 @@ def test_a_cli_session_gives_the_api_candidates(tmp_path):
         ("show", "--json", "--limit", "0"),
     ]
     outputs = []
-    for step in steps:
-        done = ramsearch(tmp_path, *step)
+    for step in steps:  # each command loads the session file and saves it back; the last one in another process
+        done = (ramsearch if step == steps[-1] else in_process)(tmp_path, *step)
         assert done.returncode == 0, (step, done.stderr)
         outputs.append(done.stdout)
     assert "decreased --than previous: 1," in outputs[3]
@@ -237,15 +250,12 @@ def test_save_refuses_another_games_file_and_a_wheel_game(tmp_path, capsys, monk
     assert (tmp_path / "dasher.yaml").read_bytes() == (DASHER / "game.yaml").read_bytes()
 
 
-def test_the_default_session_name_lives_in_the_current_folder(tmp_path):
-    done = ramsearch(tmp_path, "new", "Airstriker-Genesis", "--types", "|u1,>u2")
+def test_the_default_session_name_lives_in_the_current_folder(tmp_path, monkeypatch):
+    done = in_process(tmp_path, "new", "Airstriker-Genesis", "--types", "|u1,>u2")
     assert done.returncode == 0, done.stderr
     assert "2 types" in done.stdout and (tmp_path / DEFAULT_SESSION).is_file()
-    env = {**os.environ, "RETROKIT_GAMES": ""}
-    done = subprocess.run(
-        [sys.executable, "-m", "retrokit", "ramsearch", "filter", "decreased"],
-        cwd=tmp_path, capture_output=True, text=True, timeout=120, env=env, check=False,
-    )  # fmt: skip
+    monkeypatch.setenv("RETROKIT_GAMES", "")
+    done = in_process(tmp_path, "filter", "decreased")
     assert done.returncode == 2 and done.stderr.count("\n") == 1 and "Traceback" not in done.stderr
 
 
@@ -290,7 +300,7 @@ def test_run_plays_a_movie_up_to_a_frame(session, capsys):
     assert {"address": 0xFF0020, "type": ">i2"} in [{k: c[k] for k in ("address", "type")} for c in json.loads(out)]
 
 
-def test_the_shell_runs_subcommands_line_by_line(tmp_path):
+def test_the_shell_runs_subcommands_line_by_line(tmp_path, monkeypatch):
     lines = [
         "new Dasher-Genesis --state Zone1.Act1",
         "# comments and blank lines are skipped",
@@ -304,11 +314,8 @@ def test_the_shell_runs_subcommands_line_by_line(tmp_path):
         "quit",
         "filter changed",
     ]
-    script = "\n".join(lines)
-    done = subprocess.run(
-        [sys.executable, "-m", "retrokit", "ramsearch", "shell", "--session", "s.session"],
-        cwd=tmp_path, input=script, capture_output=True, text=True, timeout=120, check=False,
-    )  # fmt: skip
+    monkeypatch.setattr(sys, "stdin", io.StringIO("\n".join(lines)))  # read as from a pipe: no prompt
+    done = in_process(tmp_path, "shell", "--session", "s.session")
     assert done.returncode == 0, done.stderr
     assert "decreased --than previous: 1," in done.stdout and "0xFF002B  |u1" in done.stdout
     assert "changed" not in done.stdout  # after quit

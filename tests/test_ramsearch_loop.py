@@ -10,15 +10,14 @@ earlier snapshot; ``save --range`` writes a field's range.
 from __future__ import annotations
 
 import json
-import os
 import re
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from incli import retrokit_in_process
 
 from retrokit import cli
 from retrokit.data.games import find_game
@@ -44,11 +43,8 @@ def data(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 
 
 def ramsearch(cwd: Path, *argv: str) -> subprocess.CompletedProcess:
-    """One command, in its own process (the environment, with its RETROKIT_DATA, is inherited)."""
-    return subprocess.run(
-        [sys.executable, "-m", "retrokit", "ramsearch", *argv],
-        cwd=cwd, capture_output=True, text=True, timeout=180, check=False, env=dict(os.environ),
-    )  # fmt: skip
+    """One command, as a child would run it (with this process's RETROKIT_DATA), but in this process."""
+    return retrokit_in_process(cwd, "ramsearch", *argv)
 
 
 def ok(done: subprocess.CompletedProcess) -> str:
@@ -100,11 +96,7 @@ def test_savestate_default_and_movie_from_the_command_line(tmp_path, data):
     # The movie of the inputs played, from Zone1.Act1: integrate --movie reproduces the session's RAM.
     out = ok(ramsearch(tmp_path, "movie", "runner.bk2"))
     assert out == "Wrote 67 frames played since the start state to runner.bk2.\n"
-    done = subprocess.run(
-        [sys.executable, "-m", "retrokit", "integrate", "Dasher-Genesis", "FromMovie", "--movie", "runner.bk2"],
-        cwd=tmp_path, capture_output=True, text=True, timeout=180, check=False, env=dict(os.environ),
-    )  # fmt: skip
-    assert done.returncode == 0, done.stderr
+    ok(retrokit_in_process(tmp_path, "integrate", "Dasher-Genesis", "FromMovie", "--movie", "runner.bk2"))
     replayed = read_state_file(data / "games" / "Dasher-Genesis" / "FromMovie.state").data
     assert ram_after(replayed) == ram
 

@@ -166,17 +166,35 @@ def test_a_recorder_killed_in_its_first_second_leaves_a_movie_that_plays(tmp_pat
     assert not [p for p in folder.iterdir() if p.suffix != ".bk2"]
 
 
-RECORDING_FROM_RESET = """
+#: Forks one recorder per line read (the folder it records into), each told apart by its pid. The launcher made and
+#: closed an env first, so each recorder's make() finds the game, its checks and the emulator host warm: what a
+#: kill interrupts is make(), reset() and the recording, not a fresh interpreter's second of imports.
+LAUNCHER = """
+import os, sys, tempfile, traceback
 import retrokit
-env = retrokit.make("Dasher-Genesis", record={folder!r})
-print("ready", flush=True)
-env.reset(seed=0)  # the episode's movie begins here
-env.action_space.seed(0)
-print("recording", flush=True)
-while True:
-    env.step(env.action_space.sample())
+with tempfile.TemporaryDirectory() as warm:
+    retrokit.make("Dasher-Genesis", record=warm).close()
+def say(*words):
+    os.write(1, (" ".join(map(str, words)) + "\\n").encode())
+for folder in sys.stdin:
+    pid = os.fork()
+    if pid == 0:
+        try:
+            env = retrokit.make("Dasher-Genesis", record=folder.strip())
+            say(os.getpid(), "ready")
+            env.reset(seed=0)  # the episode's movie begins here
+            env.action_space.seed(0)
+            say(os.getpid(), "recording")
+            while True:
+                env.step(env.action_space.sample())
+        except BaseException:
+            traceback.print_exc()
+        os._exit(1)
+    say(pid, "forked")
+    _, status = os.waitpid(pid, 0)
+    say(pid, "ended", status)
 """
-#: When to kill: at spawn (None: not waiting for it to be ready), then from 0 to 300 ms after it is ready to reset(),
+#: When to kill: at fork (None: not waiting for it to be ready), then from 0 to 300 ms after it is ready to reset(),
 #: then ("recording") from 0 to 300 ms after reset() returned.
 KILL_AFTER = [
     (None, 0), (None, 0), *(("ready", d) for d in (0, 0.002, 0.005, 0.01, 0.02, 0.03, 0.045, 0.06, 0.08, 0.1, 0.15,
@@ -187,23 +205,36 @@ KILL_AFTER = [
 def test_a_recorder_killed_at_any_moment_leaves_no_movie_or_one_that_plays(tmp_path: Path) -> None:
     """The movie appears only once it is whole: a name was reserved by an empty .bk2 first, and a kill in the
     milliseconds before the movie replaced it left that empty file, which plays nowhere."""
+    launcher = subprocess.Popen(
+        [sys.executable, "-c", textwrap.dedent(LAUNCHER)],
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO,
+    )  # fmt: skip
+    assert launcher.stdin is not None and launcher.stdout is not None
     played = 0
-    for attempt, (mark, delay) in enumerate(KILL_AFTER):
-        folder = tmp_path / f"try-{attempt}"
-        child = subprocess.Popen(
-            [sys.executable, "-c", textwrap.dedent(RECORDING_FROM_RESET.format(folder=str(folder)))],
-            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO,
-        )  # fmt: skip
-        try:
-            for line in ("ready", "recording")[: ("ready", "recording").index(mark) + 1] if mark else ():
-                assert child.stdout is not None and child.stdout.readline() == f"{line}\n", child.stderr
+    try:
+        for attempt, (mark, delay) in enumerate(KILL_AFTER):
+            folder = tmp_path / f"try-{attempt}"
+            launcher.stdin.write(f"{folder}\n")
+            launcher.stdin.flush()
+            said = ""
+            while said != (mark or "forked"):  # the child may speak before its launcher says it forked it
+                pid, said, *_ = launcher.stdout.readline().split() or ("", "gone")
+                if said not in ("forked", "ready", "recording"):  # ended or gone before the kill: show why
+                    launcher.kill()
+                    raise AssertionError(f"{pid} {said}: {launcher.communicate()[1]}")
             time.sleep(delay)  # the moment of the kill is what this test varies
-            child.send_signal(signal.SIGKILL)
-        finally:
-            child.kill()
-            child.wait(timeout=30)
-        for movie_file in sorted(folder.glob("*.bk2")):
-            movie = read_bk2(movie_file)  # an empty or half-written file raises here
-            assert movie.state and sum(1 for _ in play(movie)) == len(movie.frames), (delay, movie_file)
-            played += 1
+            os.kill(int(pid), signal.SIGKILL)
+            for line in launcher.stdout:  # "ready" or "recording" may come before the kill lands
+                if line.startswith(f"{pid} ended"):
+                    assert os.waitstatus_to_exitcode(int(line.split()[2])) == -signal.SIGKILL, line
+                    break
+            else:
+                raise AssertionError(f"the launcher ended: {launcher.stderr.read() if launcher.stderr else ''}")
+            for movie_file in sorted(folder.glob("*.bk2")):
+                movie = read_bk2(movie_file)  # an empty or half-written file raises here
+                assert movie.state and sum(1 for _ in play(movie)) == len(movie.frames), (delay, movie_file)
+                played += 1
+    finally:
+        launcher.kill()
+        launcher.wait(timeout=30)
     assert played >= sum(mark == "recording" for mark, _ in KILL_AFTER)  # every kill after reset() left a movie

@@ -6,6 +6,7 @@ CancelledError traceback.
 
 from __future__ import annotations
 
+import queue
 import re
 import shutil
 import threading
@@ -28,18 +29,16 @@ def test_ctrl_c_during_a_validation_stops_the_studio_at_once(tmp_path):
     scenario.write_text(re.sub(r"^done: .*$", "done: frame < 0", scenario.read_text(), flags=re.MULTILINE))
     studio = StudioProcess(game, tmp_path / "data", tmp_path)
     try:
-        long_one = None
-        deadline = time.monotonic() + 400  # a short validation of ours may run first: a loaded machine takes minutes
-        while True:  # under way once a second one is refused as running
-            if long_one is None or not long_one.is_alive():  # (again, if our short one took the lock first)
-                long_one = threading.Thread(
-                    target=studio.request, args=("POST", "/api/validate", {"frames": 100_000}), daemon=True
-                )
-                long_one.start()
-            status, body, _ = studio.request("POST", "/api/validate", {"frames": 1})
-            if status >= 400 and "one is running" in str(body):
-                break
-            assert time.monotonic() < deadline, (status, body)
+        # Two long validations asked at once: whichever takes the lock runs for minutes, the other is refused at
+        # once as running. (A short one asked to see whether the long one had started could take the lock first,
+        # and then ran Dasher's whole check before the next try.)
+        answers: queue.Queue = queue.Queue()
+        for _ in range(2):
+            threading.Thread(
+                target=lambda: answers.put(studio.request("POST", "/api/validate", {"frames": 100_000})), daemon=True
+            ).start()
+        status, body, _ = answers.get(timeout=400)  # generous: a loaded machine starts slowly
+        assert status >= 400 and "one is running" in str(body), (status, body)
         asked = time.monotonic()
         err = studio.stop(timeout=60)
         took = time.monotonic() - asked

@@ -20,14 +20,13 @@ holds, by its ``RECORD`` digest, are used.
 
 from __future__ import annotations
 
-import base64
 import functools
 import hashlib
-import importlib.metadata
 import sys
 from pathlib import Path
 
 from retrokit import paths
+from retrokit.wheel import wheel_files
 
 STATE_HASHES = "STATES.sha256"
 """The file in ``games/`` listing ``<sha256>  <Game>/<Name>.state``, one shipped state a line."""
@@ -54,17 +53,10 @@ def shipped_digests() -> frozenset[str]:
 def wheel_state_files() -> dict[str, tuple[str, ...]]:
     """The SHA-256 (hex) of every ``.state`` file the stable-retro wheel ships, to its paths in the wheel's ``data``
     folder (``stable/Airstriker-Genesis-v0/Level1.state``; a few files are there twice), from the wheel's ``RECORD``."""
-    try:
-        files = importlib.metadata.distribution("stable-retro").files or []
-    except importlib.metadata.PackageNotFoundError:
-        files = []
     found: dict[str, tuple[str, ...]] = {}
-    for file in files:
-        parts = file.parts
-        if file.hash is not None and file.hash.mode == "sha256" and parts[-1].endswith(".state") and "data" in parts:
-            value = file.hash.value
-            digest = base64.urlsafe_b64decode(value + "=" * (-len(value) % 4)).hex()
-            found[digest] = (*found.get(digest, ()), "/".join(parts[parts.index("data") + 1 :]))
+    for path, _, digest in wheel_files(lambda path: path.endswith(".state") and "/data/" in f"/{path}"):
+        parts = path.split("/")
+        found[digest] = (*found.get(digest, ()), "/".join(parts[parts.index("data") + 1 :]))
     return found
 
 

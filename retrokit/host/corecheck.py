@@ -26,10 +26,8 @@ The probe's child is :mod:`retrokit.host.coreprobe`, run as every risky child is
 
 from __future__ import annotations
 
-import base64
 import functools
 import hashlib
-import importlib.metadata
 import json
 import os
 from dataclasses import dataclass
@@ -40,6 +38,7 @@ from retrokit.host.child import Child
 from retrokit.host.cores import built_cores_dir, core_filename
 from retrokit.host.elf import check_core_file
 from retrokit.paths import atomic_write, data_dir
+from retrokit.wheel import wheel_files, wheel_version
 
 PROBE_FRAMES = 60
 """Frames the probe runs after loading: a damaged ``.text`` shows within the first."""
@@ -91,18 +90,13 @@ def file_sha256(path: Path) -> str:
 @functools.lru_cache(maxsize=1)
 def wheel_vouchers() -> dict[Path, Voucher]:
     """Return the stable-retro wheel's cores by path, with the SHA-256 its ``RECORD`` lists for each."""
-    try:
-        dist = importlib.metadata.distribution("stable-retro")
-    except importlib.metadata.PackageNotFoundError:
-        return {}
-    source = f"stable-retro {dist.version}'s RECORD"
+    version = wheel_version()
+    source = f"stable-retro {version}'s RECORD"
     fix = "Reinstall it: pip install --force-reinstall --no-deps stable-retro"
-    found = {}
-    for file in dist.files or []:
-        if "_libretro." in file.name and file.hash is not None and file.hash.mode == "sha256":
-            raw = base64.urlsafe_b64decode(file.hash.value + "=" * (-len(file.hash.value) % 4))
-            found[Path(str(file.locate())).resolve()] = Voucher(raw.hex(), source, fix)
-    return found
+    return {
+        where.resolve(): Voucher(digest, source, fix)
+        for _, where, digest in wheel_files(lambda path: "_libretro." in path.rpartition("/")[2])
+    }
 
 
 def built_vouchers(data: Path | None = None) -> dict[Path, Voucher]:

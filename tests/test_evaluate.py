@@ -23,7 +23,7 @@ def summary(out: Path) -> bytes:
 
 @pytest.fixture(scope="module")
 def reference(tmp_path_factory) -> Path:
-    """JERK on two levels, 600 timesteps each, seed 0, one worker."""
+    """JERK on two levels, 300 timesteps each, seed 0, one worker."""
     out = tmp_path_factory.mktemp("reference") / "run"
     assert evaluate(out, "--agent", "jerk", "--workers", "1") == 0
     return out
@@ -31,12 +31,16 @@ def reference(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="module")
 def jerk_and_random(tmp_path_factory) -> dict[str, Path]:
-    """Both agents on the same two levels with 1500 timesteps, on two workers; JERK saves GIFs."""
+    """Both agents on the same two levels with 600 timesteps, on two workers; JERK saves GIFs.
+
+    600 timesteps are enough for JERK to score almost three times random's aggregate (836 to 303), and for
+    JERK's long runs on Zone2.Act2 to end 3 episodes.
+    """
     outs = {}
     for agent in ("jerk", "random"):
         outs[agent] = tmp_path_factory.mktemp(agent) / "run"
         extra = ["--gif"] if agent == "jerk" else []
-        assert main(["evaluate", "--levels", TWO_LEVELS, "--timesteps", "1500", "--agent", agent, "--workers", "2",
+        assert main(["evaluate", "--levels", TWO_LEVELS, "--timesteps", "600", "--agent", agent, "--workers", "2",
                      "--no-progress", "--out", str(outs[agent]), *extra]) == 0
     return outs
 
@@ -49,9 +53,9 @@ def test_dasher_writes_every_file(jerk_and_random) -> None:
     data = json.loads((out / "summary.json").read_text())
     for level, entry in data["levels"].items():
         mine = [e for e in episodes if e["level"] == level]
-        assert entry["episodes"] == len(mine) > 3
+        assert entry["episodes"] == len(mine) >= 3
         assert entry["mean_score"] == pytest.approx(sum(e["reward"] for e in mine) / len(mine))
-        assert entry["timesteps"] == 1500 and max(e["timesteps"] for e in mine) <= 1500
+        assert entry["timesteps"] == 600 and max(e["timesteps"] for e in mine) <= 600
     assert data["aggregate"] == pytest.approx(sum(e["mean_score"] for e in data["levels"].values()) / 2)
     rows = (out / "summary.csv").read_text().splitlines()
     assert rows[0].startswith("level,mean_score") and len(rows) == 4 and rows[-1].startswith("aggregate,")
@@ -224,7 +228,7 @@ def agents_file(tmp_path) -> Path:
 
 def test_an_agent_that_raises_names_level_and_step_and_keeps_the_rest(agents_file, tmp_path, capsys) -> None:
     out = tmp_path / "run"
-    assert evaluate(out, "--agent", f"{agents_file}:fails_on_zone2", "--workers", "2") == 2
+    assert evaluate(out, "--agent", f"{agents_file}:fails_on_zone2", "--workers", "2", "--timesteps", "150") == 2
     err = capsys.readouterr().err
     assert "raised ValueError: the agent's own bug (level Dasher-Genesis/Zone2.Act2, step 51" in err
     assert "--resume" in err and "Traceback" not in err

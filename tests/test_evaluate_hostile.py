@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 import pytest
-from childproc import MAX_RSS_MB, run_cli
+from childproc import MAX_RSS_MB, Child, run_child, run_cli
 from evaluating import session_processes, wait_for, write_agents
 
 from retrokit.cli import main
@@ -134,13 +134,15 @@ def test_an_agent_that_ends_its_process_fails_its_level_and_the_others_are_kept(
 
 def test_a_stalled_level_is_stopped_and_the_run_resumes_to_the_uninterrupted_result(agents, tmp_path,
                                                                                    monkeypatch) -> None:
+    # All five levels play at once, so the four stalls run out their timeout together (the spinning ones burn a
+    # core each while they wait). The timeout only has to outlast a gap between the normal level's reports,
+    # which come twice a second; the resumed and fresh runs, where nothing stalls, keep the default.
     out, flag = tmp_path / "run", tmp_path / "fixed"
-    args = [*FAST, "--levels", f"{THREE},Zone1.Act1,Zone2.Act1", "--agent", f"{agents}:stalls", "--workers", "2",
-            "--stall-timeout", "4"]
+    args = [*FAST, "--levels", f"{THREE},Zone1.Act1,Zone2.Act1", "--agent", f"{agents}:stalls", "--workers", "5"]
     env = {"RETROKIT_TEST_FLAG": str(flag)}
     began = time.monotonic()
-    child = run_cli([*args, "--out", str(out)], timeout=240, env=env)
-    assert child.returncode == 2 and "stalled and was stopped after 4 s" in child.stderr, child.describe()
+    child = run_cli([*args, "--stall-timeout", "2", "--out", str(out)], timeout=240, env=env)
+    assert child.returncode == 2 and "stalled and was stopped after 2 s" in child.stderr, child.describe()
     assert time.monotonic() - began < 200
     text = report(out)
     assert "Zone1.Act2: Level Dasher-Genesis/Zone1.Act2 stalled" in text and "no timestep after step 10 of 200" in text
@@ -287,15 +289,41 @@ DAMAGES = {
 }
 
 
+@pytest.fixture(scope="module")
+def resumed_damages(finished, tmp_path_factory) -> tuple[dict[str, tuple[int, str]], Child]:
+    """Each damaged copy of the finished run, resumed in turn in one child: what each said, and the child.
+
+    One interpreter for all of them spares its start per damage; its peak memory is the largest any of them
+    needed (and more), so it holds each to the limit.
+    """
+    folders = {}
+    for damage, (make, _) in DAMAGES.items():
+        folders[damage] = str(tmp_path_factory.mktemp(damage) / "run")
+        shutil.copytree(finished, folders[damage])
+        make(Path(folders[damage]))
+    child = run_child(f"""
+        import contextlib, io, json
+        from retrokit.cli import main
+
+        outcomes = {{}}
+        for damage, out in {folders!r}.items():
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err):
+                code = main({[*FAST, "--levels", LEVEL, "--agent", "jerk"]!r} + ["--out", out, "--resume"])
+            outcomes[damage] = [code, err.getvalue()]
+        print(json.dumps(outcomes))
+        """, timeout=120)
+    assert child.returncode == 0, child.describe()
+    return json.loads(child.stdout.splitlines()[-1]), child
+
+
 @pytest.mark.parametrize("damage", list(DAMAGES))
-def test_a_damaged_run_folder_is_refused_in_one_line(finished, tmp_path, damage) -> None:
-    out = tmp_path / "run"
-    shutil.copytree(finished, out)
-    make, expected = DAMAGES[damage]
-    make(out)
-    child = run_cli([*FAST, "--levels", LEVEL, "--agent", "jerk", "--out", str(out), "--resume"], timeout=60)
-    assert child.returncode == 2 and expected in child.stderr, child.describe()
-    assert child.stderr.count("\n") == 1 and "Traceback" not in child.stderr, child.describe()
+def test_a_damaged_run_folder_is_refused_in_one_line(resumed_damages, damage) -> None:
+    outcomes, child = resumed_damages
+    code, stderr = outcomes[damage]
+    expected = DAMAGES[damage][1]
+    assert code == 2 and expected in stderr, (code, stderr)
+    assert stderr.count("\n") == 1 and "Traceback" not in stderr, stderr
     assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
 
 

@@ -9,7 +9,8 @@ import sys
 
 from retrokit.cli import main
 
-ARGS = ["evaluate", "--benchmark", "dasher", "--levels", "Zone2.Act2,Zone3.Act2", "--timesteps", "400",
+# 200 timesteps: JERK (seed 3) ends 10 episodes, its first on each level under 100 steps.
+ARGS = ["evaluate", "--benchmark", "dasher", "--levels", "Zone2.Act2,Zone3.Act2", "--timesteps", "200",
         "--agent", "jerk", "--seed", "3", "--no-progress"]
 
 
@@ -137,7 +138,7 @@ def test_a_level_whose_node_is_lost_plays_again_on_the_node_left(tmp_path) -> No
     agents.write_text(MARKING_JERK)
     # The level on the removed node is held there after its first episode (under 100 steps on both levels), so
     # a small budget still loses the node mid-level: the retry then plays the whole level again.
-    args = ["--benchmark", "dasher", "--levels", "Zone2.Act2,Zone3.Act2", "--timesteps", "400", "--seed", "3",
+    args = ["--benchmark", "dasher", "--levels", "Zone2.Act2,Zone3.Act2", "--timesteps", "200", "--seed", "3",
             "--agent", f"{agents}:marking_jerk"]
     assert main(["evaluate", *args, "--workers", "1", "--no-progress", "--out", str(tmp_path / "local")]) == 0
     env = {**os.environ, "MARKS": str(tmp_path)}

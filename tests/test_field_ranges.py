@@ -10,9 +10,11 @@ from __future__ import annotations
 import dataclasses
 import gzip
 import shutil
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from probestore import shared_verdicts
 
 import retrokit
 from retrokit.data.gamefiles import read_game_yaml
@@ -28,10 +30,17 @@ DASHER = repo_games_dir() / "Dasher-Genesis"
 GAME = "Dashcopy-Genesis"
 
 
+@pytest.fixture(scope="module")
+def verdicts(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """State-probe verdicts shared by this module's tests: probing is not what they test."""
+    return tmp_path_factory.mktemp("state-probes")
+
+
 @pytest.fixture
-def data(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+def data(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, verdicts: Path) -> Iterator[Path]:
     monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
-    return tmp_path / "data"
+    with shared_verdicts(verdicts, tmp_path / "data") as folder:
+        yield folder
 
 
 @pytest.fixture

@@ -98,9 +98,9 @@ def unreadable_files(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str
     root = tmp_path_factory.mktemp("unreadable")
     folders = []
     for file in FILES:
-        for special in SPECIAL:
+        for special, make in SPECIAL.items():
             folders.append(dasher_copy(root / "games", f"{file}-{special}"))
-            SPECIAL[special](folders[-1] / file)
+            make(folders[-1] / file)
     return _validate_all(root, folders)
 
 

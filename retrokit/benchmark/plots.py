@@ -13,7 +13,6 @@ import math
 
 from retrokit.benchmark.monitor import Episode
 
-
 #: Inches a character of a tick label takes at font size 8 (DejaVu Sans averages about 0.53 em; a little more).
 _CHAR_INCHES = 8 * 0.56 / 72
 

@@ -250,7 +250,7 @@ def all_systems() -> dict[str, System]:
     with open(_FILE, encoding="utf-8") as f:
         # libyaml's loader where PyYAML has it: every process that makes an env reads this file, and the
         # pure-Python one takes a fifth of a second over it.
-        data = yaml.load(f, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))  # noqa: S506 - a safe loader
+        data = yaml.load(f, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
     return {name: _parse(name, entry) for name, entry in data.items()}
 
 

@@ -311,12 +311,17 @@ def another_games_state(cart: Cartridge) -> Path:
 
 
 def test_validate_passes_the_game_and_catches_a_state_from_another_game(cart: Cartridge, tmp_path: Path) -> None:
-    # One run (validate plays every state, scenario and movie): the copy with a foreign state fails on
-    # that state alone, so everything of the game's own passes.
+    # One run (validate plays every state and scenario): the copy with a foreign state fails on that state alone,
+    # so everything of the game's own passes. Dasher's solution movies are left out of the copy: their replays
+    # (5,700 frames) are no system's, and tests/test_validate.py validates every folder of games/ with its movies.
     folder = tmp_path / cart.name
-    shutil.copytree(cart.game.folders[0], folder)
+    shutil.copytree(cart.game.folders[0], folder, ignore=shutil.ignore_patterns("movies"))
+    game_yaml = folder / "game.yaml"
+    text = game_yaml.read_text()
+    if "\nmovies:" in text:  # the movies section comes last (Dasher's game.yaml)
+        game_yaml.write_text(text[: text.index("\nmovies:")] + "\n")
     shutil.copy(another_games_state(cart), folder / "Foreign.state")
-    assert main(["validate", str(folder), "--quiet", "--frames", "200", "--json", str(tmp_path / "report.json")]) == 1
+    assert main(["validate", str(folder), "--quiet", "--frames", "120", "--json", str(tmp_path / "report.json")]) == 1
     (report,) = json.loads((tmp_path / "report.json").read_text())["games"]
     failed = [r for r in report["results"] if r["status"] == "fail"]
     assert failed and all(r["state"] == "Foreign" for r in failed), failed
@@ -369,12 +374,13 @@ def test_native_preprocessing_equals_gymnasiums_wrappers_on_its_screen(cart: Car
 def test_jerk_beats_random_on_its_benchmark(cart: Cartridge, tmp_path: Path, capsys) -> None:
     from retrokit.benchmark.definition import load_benchmark
 
+    # One run compares both agents (each into OUT/<agent>/). 300 timesteps a level: with seed 0 JERK scores 1.8
+    # (Skipper-Snes) to 29 (Hopper-GameGear) times random's on every cartridge, as it did with 600.
     levels = ",".join(level.name for level in load_benchmark(cart.benchmark).test[:2])
-    scores = {}
-    for agent in ("jerk", "random"):
-        out = tmp_path / agent
-        args = ["evaluate", "--benchmark", cart.benchmark, "--levels", levels,
-                "--timesteps", "600", "--no-progress", "--agent", agent, "--out", str(out)]  # fmt: skip
-        assert main(args) == 0, capsys.readouterr().err
-        scores[agent] = json.loads((out / "summary.json").read_text())["aggregate"]
+    args = ["evaluate", "--benchmark", cart.benchmark, "--levels", levels, "--timesteps", "300", "--no-progress",
+            "--agent", "jerk", "--agent", "random", "--out", str(tmp_path)]  # fmt: skip
+    assert main(args) == 0, capsys.readouterr().err
+    scores = {
+        agent: json.loads((tmp_path / agent / "summary.json").read_text())["aggregate"] for agent in ("jerk", "random")
+    }
     assert scores["jerk"] > 1.5 * scores["random"], scores

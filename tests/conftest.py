@@ -9,6 +9,7 @@ from __future__ import annotations
 import gzip
 import json
 import os
+import signal
 import sys
 from pathlib import Path
 
@@ -28,6 +29,13 @@ sys.dont_write_bytecode = False
 sys.pycache_prefix = str(_PYCACHE)
 os.environ.pop("PYTHONDONTWRITEBYTECODE", None)
 os.environ["PYTHONPYCACHEPREFIX"] = str(_PYCACHE)
+
+# Ctrl-C as a user presses it: a shell without job control (a script's `cmd &`, some CI runners) starts background
+# jobs with SIGINT ignored, and an ignored signal stays ignored across exec, so every child a test starts (an
+# evaluation, a studio) would shrug off the SIGINT the Ctrl-C tests send. Python leaves an ignored SIGINT alone at
+# startup, so it is put back here; children then start with the default, as under a terminal.
+if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture(scope="session")

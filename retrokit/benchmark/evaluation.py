@@ -90,6 +90,9 @@ class Evaluation:
             InvalidArgumentError: A number is out of range, or an option does not fit the backend.
             RetrokitError: A level, ROM or agent cannot be found (see :meth:`Benchmark.check_levels`).
         """
+        from retrokit.benchmark.local import refuse_inside_a_worker
+
+        refuse_inside_a_worker()
         if self.backend not in BACKENDS:
             raise InvalidArgumentError(f"Expected --backend local or ray, got {self.backend!r}.")
         if self.workers < 1:

@@ -37,6 +37,13 @@ from retrokit.benchmark.watchdog import Watchdog
 
 POLL_SECONDS = 0.5
 _PR_SET_PDEATHSIG = 1  # from <linux/prctl.h>
+WORKER_NAME = "retrokit level "
+"""How a worker process's name starts (then the level's name)."""
+_GUARD = (
+    "put the code that starts the evaluation under `if __name__ == \"__main__\":` (as multiprocessing asks): "
+    "every level's worker imports the script that started the evaluation again, and this one starts an evaluation "
+    "when imported."
+)
 
 
 @dataclass
@@ -44,6 +51,7 @@ class _Worker:
     task: LevelTask
     process: multiprocessing.process.BaseProcess
     pipe: Connection
+    heard: bool = False  # the worker sent a message: it got as far as the level
     ended: bool = False  # the level sent LevelDone or LevelFailed
 
 
@@ -58,7 +66,7 @@ def run_local(tasks: list[LevelTask], handle: Callable[[Message], None], workers
                 task = pending.pop()
                 reader, writer = context.Pipe(duplex=False)
                 process = context.Process(target=_work, args=(task, writer, dict(os.environ)), daemon=True,
-                                          name=f"retrokit level {task.level.name}")
+                                          name=f"{WORKER_NAME}{task.level.name}")
                 _start(process, context)
                 writer.close()  # the worker holds the only writer: its exit ends the pipe
                 watchdog.start(task.level.name)
@@ -121,6 +129,7 @@ def _read(worker: _Worker, handle: Callable[[Message], None], watchdog: Watchdog
     try:
         while worker.pipe.poll():
             message = worker.pipe.recv()
+            worker.heard = True
             watchdog.see(message)
             if isinstance(message, LevelDone | LevelFailed):
                 worker.ended = True
@@ -137,10 +146,28 @@ def _died(worker: _Worker, watchdog: Watchdog) -> LevelFailed:
     """The failure of a level whose worker ended without finishing it."""
     level, code = worker.task.level.name, worker.process.exitcode or 0
     how = f"was killed by signal {signal.Signals(-code).name}" if code < 0 else f"exited with status {code}"
+    if not worker.heard:
+        return LevelFailed(level, (
+            f"The worker for level {level} {how} before it started the level (its error, if it printed one, is "
+            f"above). If a script of yours started the evaluation, {_GUARD}"), 0)
     step = watchdog.timesteps(level)
     return LevelFailed(level, (
         f"The worker playing level {level} {how} (its last report: step {step:,}) before the level was finished: "
         "the agent ended its process (os._exit) or crashed in native code."), step)
+
+
+def refuse_inside_a_worker() -> None:
+    """End this process, saying why, if it is an evaluation's worker about to start an evaluation of its own.
+
+    multiprocessing imports the script that started the evaluation again in each worker (as ``__mp_main__``)
+    before the worker plays its level. A script that starts an evaluation at its top level would start one more
+    in every worker, and run whatever comes after it there. The worker ends instead (status 2, one line on
+    stderr), and the evaluation reports the level as failed with the same advice.
+    """
+    if multiprocessing.current_process().name.startswith(WORKER_NAME):
+        sys.stderr.write(f"retrokit: error: Expected no evaluation to start inside an evaluation's worker: {_GUARD}\n")
+        sys.stderr.flush()
+        os._exit(2)  # not an exception: the script's own handlers (or retrokit.cli.main's) would carry on
 
 
 def _work(task: LevelTask, pipe: Connection, environment: dict[str, str]) -> None:

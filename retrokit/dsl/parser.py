@@ -39,6 +39,14 @@ MAX_BRACKETS = 10 * MAX_DEPTH
 #: The largest integer literal: the console's values are at most 64 bits wide.
 MAX_INT = 2**64 - 1
 
+#: Trees of expressions parsed before, by their text. Games share expressions (stable-retro's ~1,000
+#: scenarios use ~350 different ones: `retrokit games` parsed "lives == 0" 428 times), and a tree is
+#: immutable and holds no trace of its source, so one tree serves every snippet with the same text. Only
+#: successful parses are kept (an error must point into its own snippet); bounded in count and text length.
+_PARSED: dict[str, n.Node] = {}
+_PARSED_MAX = 4096
+_PARSED_TEXT_MAX = 1000
+
 #: How lark's terminal names read in a message.
 _TERMINALS = {
     "LPAR": "'('", "RPAR": "')'", "LSQB": "'['", "RSQB": "']'", "COMMA": "','",
@@ -171,6 +179,9 @@ def parse(snippet: Snippet) -> n.Node:
     Raises:
         ScenarioSyntaxError: The text is not an expression.
     """
+    cached = _PARSED.get(snippet.text)
+    if cached is not None:
+        return cached
     if not snippet.text.strip():
         raise snippet.error(ScenarioSyntaxError, 0, len(snippet.text), "the expression is empty")
     _check_brackets(snippet)
@@ -180,11 +191,14 @@ def parse(snippet: Snippet) -> n.Node:
         raise _syntax_error(snippet, exc) from None
     _check_depth(snippet, tree)
     try:
-        return ToAst(snippet).transform(tree)
+        root = ToAst(snippet).transform(tree)
     except VisitError as exc:
         if isinstance(exc.orig_exc, ScenarioError):
             raise exc.orig_exc from None
         raise
+    if len(snippet.text) <= _PARSED_TEXT_MAX and len(_PARSED) < _PARSED_MAX:
+        _PARSED[snippet.text] = root
+    return root
 
 
 def _check_brackets(snippet: Snippet) -> None:

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from dashercopy import dasher_copy
 from starlette.testclient import TestClient
 
 from retrokit.host.systems import all_systems, get_system
@@ -30,6 +31,17 @@ TOKEN = "test-token"
 PORT = 8722
 BASE = f"http://127.0.0.1:{PORT}"
 RIGHT = 1 << 7  # the RetroPad bit of RIGHT
+
+
+@pytest.fixture(scope="module")
+def studio_game(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The session's copy of Dasher: the states the tests play, and the one solution movie they replay.
+
+    The validation below then checks 5 states and 1 movie, not Dasher's 9 states and 6 movies (5,700 frames of
+    replay); tests/test_validate.py validates Dasher as shipped.
+    """
+    states = ("Zone1.Act1", "Zone1.Act1.2P", "Zone1.Act2", "Zone2.Act1", "Zone3.Act1")
+    return dasher_copy(tmp_path_factory.mktemp("studio"), states, movies=("Zone1.Act1",))
 
 
 @pytest.fixture(scope="module")

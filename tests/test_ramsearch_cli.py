@@ -283,6 +283,31 @@ def test_sessions_that_do_not_fit_are_refused_in_one_line(session, capsys, chang
     assert status == 2 and message in err and err.count("\n") == 1, err
 
 
+def test_a_session_file_listing_the_scales_in_another_order_has_them_mapped(session, capsys):
+    """A file of a version that lists the scales in another order: each candidate's scale bits are mapped to ours."""
+    from retrokit.ramsearch.session import read_session
+
+    run(capsys, "filter", "equal", "3")  # a value search pins each candidate's scales: masks that differ
+    with np.load(session) as archive:
+        arrays = dict(archive)
+    meta = json.loads(bytes(arrays["meta"]))
+    count = len(meta["scales"])
+    meta["scales"] = meta["scales"][::-1]
+    arrays["meta"] = np.frombuffer(json.dumps(meta).encode(), dtype=np.uint8)
+    for name in [name for name in arrays if name.endswith("_scale")]:
+        stored, one = arrays[name], arrays[name].dtype.type(1)
+        arrays[name] = sum((((stored >> stored.dtype.type(bit)) & one) << stored.dtype.type(count - 1 - bit)
+                            for bit in range(count)), np.zeros_like(stored))  # fmt: skip
+    reordered = session.with_name("reordered.session")
+    with reordered.open("wb") as f:
+        np.savez_compressed(f, **arrays)
+    ours, theirs = read_session(session), read_session(reordered)
+    assert len(set(ours.candidates.pack().scales.tolist())) > 1
+    assert (theirs.candidates.pack().scales == ours.candidates.pack().scales).all()
+    assert [(theirs_packed.scales == ours_packed.scales).all() for (_, theirs_packed), (_, ours_packed)
+            in zip(theirs.history, ours.history, strict=True)] == [True] * len(ours.history)  # fmt: skip
+
+
 def test_run_plays_a_movie_up_to_a_frame(session, capsys):
     from retrokit.data.states import read_state
     from retrokit.host.systems import get_system

@@ -127,6 +127,37 @@ def test_savestate_and_movie_refusals_are_one_line(tmp_path, data):
     ok(ramsearch(tmp_path, "movie", "poked.bk2"))
 
 
+def test_a_movie_from_a_start_the_core_made_here_replays_without_a_probe(tmp_path, data, monkeypatch):
+    """The start state of a movie the session recorded was written by this process's core: no child probes it at
+    replay (2 CPU-s). The same bytes read from a session file are probed, as any state from a file is."""
+    from retrokit.data import probe
+    from retrokit.movie import read_bk2
+    from retrokit.movie.playback import replay
+
+    probed: list[bytes] = []
+    monkeypatch.setattr(probe, "probe_state", lambda state, *_: probed.append(state) or probe.ProbeVerdict(True))
+
+    def replayed(search: RamSearch, movie: Path) -> None:
+        for _ in replay(read_bk2(movie), search.emulator, source=movie.name):
+            pass
+
+    with RamSearch("Dasher-Genesis", "Zone1.Act1") as search:
+        search.step(["RIGHT"], 5)
+        search.restart_inputs()  # a start state the core made here
+        search.step(["RIGHT"], 10)
+        search.save(tmp_path / "s.session")
+        with RamSearch.load(tmp_path / "s.session") as loaded:  # the same start, read from the file
+            loaded.write_movie(tmp_path / "from-file.bk2")
+            replayed(loaded, tmp_path / "from-file.bk2")
+        assert len(probed) == 1
+        search.step([], 3)
+        search.restart_inputs()
+        search.step(["LEFT"], 5)
+        search.write_movie(tmp_path / "made.bk2")
+        replayed(search, tmp_path / "made.bk2")
+    assert len(probed) == 1  # the movie's start was remembered as this machine's when the movie was written
+
+
 # --- the same, through the API -----------------------------------------------------------------------
 
 

@@ -166,7 +166,10 @@ def test_ram_view_highlights_what_changes(page):
     # Dasher's frame counter (0xFF0004-7) changes every frame: its low byte is highlighted.
     until("a changed byte", lambda: "changed" in (page.driver.find_element(
         By.CSS_SELECTOR, '#ram-grid td[title="0xFF0007"]').get_attribute("class") or ""))  # fmt: skip
-    cells = [td.text for td in page.driver.find_elements(By.CSS_SELECTOR, "#ram-grid td")[:16]]
+    # Read in one script: the grid is redrawn as the game runs, and cells found in one call may be gone in the next.
+    cells = page.driver.execute_script(
+        "return Array.from(document.querySelectorAll('#ram-grid td'), (td) => td.innerText).slice(0, 16);"
+    )
     assert all(len(c) == 2 and int(c, 16) >= 0 for c in cells)
     page.shot("ramview")
     page.pause()

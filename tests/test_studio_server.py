@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from dashercopy import dasher_copy
 from starlette.testclient import TestClient
 
 from retrokit.host.systems import all_systems, get_system
@@ -30,6 +31,17 @@ TOKEN = "test-token"
 PORT = 8722
 BASE = f"http://127.0.0.1:{PORT}"
 RIGHT = 1 << 7  # the RetroPad bit of RIGHT
+
+
+@pytest.fixture(scope="module")
+def studio_game(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The session's copy of Dasher: the states the tests play, and the one solution movie they replay.
+
+    The validation below then checks 5 states and 1 movie, not Dasher's 9 states and 6 movies (5,700 frames of
+    replay); tests/test_validate.py validates Dasher as shipped.
+    """
+    states = ("Zone1.Act1", "Zone1.Act1.2P", "Zone1.Act2", "Zone2.Act1", "Zone3.Act1")
+    return dasher_copy(tmp_path_factory.mktemp("studio"), states, movies=("Zone1.Act1",))
 
 
 @pytest.fixture(scope="module")
@@ -119,17 +131,17 @@ def test_the_socket_sends_screens_with_the_documented_header(client, studio_sess
 
 def test_the_frame_loop_keeps_to_the_speed_asked(client, studio_session):
     """Never faster than asked (whatever the load); at 8x, faster than at 1x."""
-    counts = {}
+    counts, allowed = {}, {}
     for speed in (0.25, 1, 8):
         post(client, "/api/play/speed", {"value": speed})
         post(client, "/api/play/resume")
-        start = studio_session.frame
-        time.sleep(1.0)
-        counts[speed] = studio_session.frame - start
+        start, began = studio_session.frame, time.monotonic()
+        time.sleep(0.5)  # the time measured: a loaded machine's longer sleep allows the frames it played
+        counts[speed], allowed[speed] = studio_session.frame - start, speed * 60 * (time.monotonic() - began) + 4
     post(client, "/api/play/pause")
     post(client, "/api/play/speed", {"value": 1})
-    assert 0 < counts[0.25] <= 0.25 * 60 + 4
-    assert 0 < counts[1] <= 60 + 4
+    assert 0 < counts[0.25] <= allowed[0.25], (counts, allowed)
+    assert 0 < counts[1] <= allowed[1], (counts, allowed)
     assert counts[8] > counts[1]
 
 

@@ -35,10 +35,12 @@ class Keeping:
 
     # Set by RamSearch when it opens the game.
     game: Game
+    rom: Path
     rom_sha1: str
     emulator: Emulator
     layout: RamLayout
     start_state: bytes  # the state the inputs played begin at (b"": power-on)
+    start_made_here: bool  # whether this process's core serialized start_state
     inputs: list[tuple[int, tuple[int, ...]]]  # runs: (frames, a mask per port)
     unreplayable: str | None  # why those inputs no longer lead to the state now
 
@@ -76,9 +78,13 @@ class Keeping:
             MovieError: A poke changed RAM since the start state.
             FileConflictError: A different file is at ``path`` and ``overwrite`` is false.
         """
+        from retrokit.data.statecheck import remember_written
         from retrokit.movie import write_bk2
 
-        write_bk2(path, self.movie(), overwrite=overwrite)
+        movie = self.movie()
+        write_bk2(path, movie, overwrite=overwrite)
+        if self.start_made_here and movie.state:  # the core wrote it here: replaying the movie needs no probe
+            remember_written(self.game, movie.state, self.rom)  # (which took 2 CPU-s, 12 s on a loaded machine)
         return Path(path)
 
     def save_state(self, name: str, *, default: bool = False, force: bool = False) -> Outcome:

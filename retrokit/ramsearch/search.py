@@ -87,12 +87,13 @@ class RamSearch(Keeping):
         self.engine = Engine(self.layout, parse_search_types(types))
         self.labels: list[str] = []
         self.start_state = b""  # the state the inputs played begin at (b"": power-on)
+        self.start_made_here = False  # whether this process's core serialized start_state (not read from a file)
         self.inputs: list[tuple[int, tuple[int, ...]]] = []  # runs: (frames, a mask per port)
         self.unreplayable: str | None = None  # why those inputs no longer lead to the state now
 
     def _restart(self) -> None:
         """Begin the inputs played afresh from the emulator's state now (a state was loaded)."""
-        self.start_state = self.emulator.get_state()
+        self.start_state, self.start_made_here = self.emulator.get_state(), True
         self.inputs, self.unreplayable = [], None
 
     def _played(self, masks: Sequence[int], frames: int) -> None:
@@ -151,6 +152,7 @@ class RamSearch(Keeping):
         if data.inputs.shape[1] != ports + 1:
             raise SessionError(f"{path}: expected inputs of {ports} ports; found {data.inputs.shape[1] - 1}.")
         self.start_state, self.unreplayable = data.start_state, data.unreplayable
+        self.start_made_here = False  # the file's bytes: a movie from them is probed when replayed
         self.inputs = [(int(row[0]), tuple(int(m) for m in row[1:])) for row in data.inputs]
         try:
             # The record may refuse it (another ROM), never vouch for it: unless this machine
@@ -326,6 +328,7 @@ class RamSearch(Keeping):
         yield next(frames)
         # The inputs played now begin at the movie's start (b"": power-on), whatever replayed it.
         self.start_state, self.inputs, self.unreplayable = recorded.state or b"", [], None
+        self.start_made_here = False  # checked by replay(): known safe already, or refused
         for number in frames:
             self._played(recorded.frames[number - 1], 1)
             yield number

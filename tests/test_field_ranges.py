@@ -32,8 +32,21 @@ GAME = "Dashcopy-Genesis"
 
 @pytest.fixture(scope="module")
 def verdicts(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    """State-probe verdicts shared by this module's tests: probing is not what they test."""
-    return tmp_path_factory.mktemp("state-probes")
+    """State-probe verdicts shared by this module's tests: probing is not what they test.
+
+    Seeded as on a machine that once loaded Dasher's shipped Zone1.Act1 (which needs no probe and is then
+    known): the copy's re-gzipped Zone1.Act1 is the same state on the same ROM.
+    """
+    from retrokit.data.statecheck import vet_state
+
+    seed = tmp_path_factory.mktemp("seed")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("RETROKIT_DATA", str(seed))
+        shipped = DASHER / "Zone1.Act1.state"
+        vet_state(read_state(shipped), "Genesis", DASHER / "rom.md", shipped=shipped)
+    store = tmp_path_factory.mktemp("state-probes")
+    shutil.copytree(seed / "state-probes", store, dirs_exist_ok=True)
+    return store
 
 
 @pytest.fixture

@@ -14,7 +14,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-from probestore import shared_verdicts
+from probestore import seed_shipped, shared_verdicts
 
 import retrokit
 from retrokit.data.gamefiles import read_game_yaml
@@ -37,16 +37,8 @@ def verdicts(tmp_path_factory: pytest.TempPathFactory) -> Path:
     Seeded as on a machine that once loaded Dasher's shipped Zone1.Act1 (which needs no probe and is then
     known): the copy's re-gzipped Zone1.Act1 is the same state on the same ROM.
     """
-    from retrokit.data.statecheck import vet_state
-
-    seed = tmp_path_factory.mktemp("seed")
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setenv("RETROKIT_DATA", str(seed))
-        shipped = DASHER / "Zone1.Act1.state"
-        vet_state(read_state(shipped), "Genesis", DASHER / "rom.md", shipped=shipped)
-    store = tmp_path_factory.mktemp("state-probes")
-    shutil.copytree(seed / "state-probes", store, dirs_exist_ok=True)
-    return store
+    shipped = DASHER / "Zone1.Act1.state"
+    return seed_shipped(tmp_path_factory.mktemp("state-probes"), shipped, DASHER / "rom.md")
 
 
 @pytest.fixture

@@ -32,3 +32,24 @@ def shared_verdicts(store: Path, data: Path) -> Iterator[Path]:
         # finished verdicts only, never a writer's leftover temp file (".<name>.*.tmp")
         if verdict.is_file() and not verdict.name.startswith(".") and not (store / verdict.name).exists():
             shutil.copy(verdict, store / verdict.name)
+
+
+def seed_shipped(store: Path, state_file: Path, rom: Path) -> Path:
+    """Seed ``store`` as a machine that once loaded the shipped ``state_file`` on ``rom`` knows it, and return it.
+
+    A shipped state needs no probe and is then known by its bytes, so the same state in another file (re-gzipped,
+    or a movie's Core.bin) is not probed again.
+    """
+    import pytest
+
+    from retrokit.data.statecheck import vet_state
+    from retrokit.data.states import read_state
+
+    seed = store / ".seed"
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("RETROKIT_DATA", str(seed))
+        vet_state(read_state(state_file), "Genesis", rom, shipped=state_file)
+    for verdict in (seed / "state-probes").glob("*"):
+        shutil.copy(verdict, store / verdict.name)
+    shutil.rmtree(seed)
+    return store

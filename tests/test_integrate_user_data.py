@@ -8,10 +8,12 @@ from __future__ import annotations
 
 import os
 import shutil
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 import pytest
+from probestore import seed_shipped, shared_verdicts
 
 import retrokit
 from retrokit.cli import main
@@ -28,12 +30,20 @@ PACKAGE = Path(retrokit.__file__).resolve().parent
 SOLUTION = DASHER / "movies" / "Zone1.Act1.bk2"
 
 
+@pytest.fixture(scope="module")
+def verdicts(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """Probe verdicts as a machine that once loaded Dasher's shipped Zone1.Act1 knows them: probing is not the claim
+    here, and the solution movie starts from that state."""
+    return seed_shipped(tmp_path_factory.mktemp("state-probes"), DASHER / "Zone1.Act1.state", DASHER / "rom.md")
+
+
 @pytest.fixture
-def data(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    """An empty per-user data folder."""
+def data(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, verdicts: Path) -> Iterator[Path]:
+    """A per-user data folder with nothing but those verdicts (and the ones this module's tests earn)."""
     folder = tmp_path / "data"
     monkeypatch.setenv("RETROKIT_DATA", str(folder))
-    return folder
+    with shared_verdicts(verdicts, folder):
+        yield folder
 
 
 def snapshot(*folders: Path) -> dict[str, tuple[int, int]]:

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import subprocess
-import sys
 import zipfile
 
 import numpy as np
@@ -39,9 +38,10 @@ def test_weights_near_a_floats_limit_still_make_probabilities():
     (["0x" + "f" * 5000], "number to fit in 64 bits"),
 ], ids=["5000-digit-snapshot", "20000-bit-address", "20000-bit-value"])
 def test_a_number_of_thousands_of_digits_is_a_clear_error(tmp_path, args, message):
-    def ramsearch(*argv: str) -> subprocess.CompletedProcess:
-        return subprocess.run([sys.executable, "-m", "retrokit", "ramsearch", *argv], cwd=tmp_path,
-                              capture_output=True, text=True, timeout=120, check=False)  # fmt: skip
+    from incli import retrokit_in_process
+
+    def ramsearch(*argv: str) -> subprocess.CompletedProcess:  # a message, not a process: in this one
+        return retrokit_in_process(tmp_path, "ramsearch", *argv)
 
     assert ramsearch("new", "Dasher-Genesis", "--state", "Zone1.Act1").returncode == 0
     done = ramsearch("filter", "equal", *args)

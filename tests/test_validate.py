@@ -22,6 +22,7 @@ from retrokit.testing import check_game
 from retrokit.testing.report import FAIL, PASS, SKIP, GameReport, render
 
 DASHER = repo_games_dir() / "Dasher-Genesis"
+TREKKER = repo_games_dir() / "Trekker-GameBoy"  # the cheapest own game with a ROM: for the command's own claims
 FRAMES = 120  # smoke-run frames in these tests: enough to reach a division or a lookup, cheap on CPU
 
 
@@ -48,15 +49,44 @@ def dasher(dasher_with_movies: Path) -> Path:
     return dasher_with_movies
 
 
+@pytest.fixture
+def trekker(tmp_path: Path) -> Path:
+    """A copy of Trekker-GameBoy's folder: the command's claims on a game folder, without Dasher's 9 states' runs."""
+    folder = tmp_path / "Trekker-GameBoy"
+    shutil.copytree(TREKKER, folder)
+    return folder
+
+
 # --- Every game of the project passes ------------------------------------------------------------------
 
 
 SONICS = ("SonicTheHedgehog-Genesis", "SonicTheHedgehog2-Genesis", "SonicAndKnuckles3-Genesis")
 
 
+@pytest.fixture(scope="module")
+def shipped_dasher() -> tuple[GameReport, dict]:
+    """The shipped Dasher's check_game report, and each solution movie's replay outcome from it (by file name).
+
+    Replaying Dasher's six movies is most of its check: the tests that read the outcomes share one run.
+    """
+    from retrokit.testing import movies
+
+    outcomes = {}
+    real = movies.replay
+
+    def replay(game, movie_path, *args, **kwargs):
+        outcomes[Path(movie_path).stem] = outcome = real(game, movie_path, *args, **kwargs)
+        return outcome
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(movies, "replay", replay)
+        report = check_game("Dasher-Genesis", frames=FRAMES)
+    return report, outcomes
+
+
 @pytest.mark.parametrize("name", sorted(p.name for p in repo_games_dir().iterdir() if p.is_dir()))
-def test_every_game_in_games_passes_check_game(name: str) -> None:
-    report = check_game(name, frames=FRAMES)
+def test_every_game_in_games_passes_check_game(name: str, request: pytest.FixtureRequest) -> None:
+    report = request.getfixturevalue("shipped_dasher")[0] if name == "Dasher-Genesis" else check_game(name, frames=FRAMES)
     assert report.passed, render(report)
     checks = {r.check for r in report.results if r.status == PASS}
     assert {"data file", "scenario compiles"} <= checks
@@ -70,18 +100,21 @@ def test_every_game_in_games_passes_check_game(name: str) -> None:
         assert "retrokit import" in skipped["ROM"]
 
 
-def test_dasher_movies_prove_the_completion_reward_and_done() -> None:
+def test_dasher_movies_prove_the_completion_reward_and_done(shipped_dasher: tuple[GameReport, dict]) -> None:
     """Each act's solution movie is done when the act is cleared, paid its progress plus each player's bonus."""
     from retrokit.data.games import find_game
-    from retrokit.testing.movies import movie_files, replay
+    from retrokit.testing.movies import movie_files
 
     game = find_game("Dasher-Genesis")
     movies = movie_files(game)
     assert sorted(movies) == ["Zone1.Act1", "Zone1.Act2", "Zone2.Act1", "Zone2.Act2", "Zone3.Act1", "Zone3.Act2"]
+    assert game.default_scenario == "scenario"  # so validate's replays, under each movie's scenario, are replay(game, path)
+    outcomes = shipped_dasher[1]  # validate's replays of the shipped movies
+    assert sorted(outcomes) == sorted(movies)
     ends = {0: (1600, 2000), 1: (2400, 2640), 2: (2960, 3200)}
-    for name, path in movies.items():
+    for name in movies:
         zone, act = int(name[4]) - 1, int(name[-1]) - 1
-        outcome = replay(game, path)
+        outcome = outcomes[name]
         assert outcome.done_at == outcome.frames, f"{name}: done must come with the clear, the movie's last frame"
         progress = outcome.reward - 2 * 1000  # both players' rewards carry the clear bonus
         assert 0 <= progress - (ends[zone][act] - 48) <= 3, f"{name}: paid {outcome.reward}"
@@ -243,33 +276,33 @@ def test_a_field_outside_ram_fails_and_overlaps_warn(dasher: Path) -> None:
 # --- The command -------------------------------------------------------------------------------------------
 
 
-def test_validate_command_passes_on_the_free_games(capsys, tmp_path: Path, dasher: Path) -> None:
-    # Dasher by folder, without its six solution movies: the command's tables, status and JSON are the claim
-    # here; the shipped Dasher passing with its movies is test_every_game_in_games_passes_check_game's
+def test_validate_command_passes_on_the_free_games(capsys, tmp_path: Path, trekker: Path) -> None:
+    # an own game by folder and a wheel game by name: the command's tables, status and JSON are the claim
+    # here; every shipped game passing check_game is test_every_game_in_games_passes_check_game's
     out_json = tmp_path / "results.json"
-    status = main(["validate", str(dasher), "Airstriker-Genesis", "--frames", str(FRAMES),
+    status = main(["validate", str(trekker), "Airstriker-Genesis", "--frames", str(FRAMES),
                    "--json", str(out_json)])
     out = capsys.readouterr().out
     assert status == 0, out
     assert "check" in out and "result" in out and "smoke run" in out  # the tables
     assert "2 of 2 games passed" in out
     doc = json.loads(out_json.read_text())
-    assert doc["passed"] and [g["game"] for g in doc["games"]] == ["Dasher-Genesis", "Airstriker-Genesis"]
+    assert doc["passed"] and [g["game"] for g in doc["games"]] == ["Trekker-GameBoy", "Airstriker-Genesis"]
 
 
-def test_validate_command_exits_1_on_a_failure(capsys, dasher: Path) -> None:
-    (dasher / "Zone1.Act1.state").write_bytes(b"not a state")
-    status = main(["validate", str(dasher), "--frames", str(FRAMES), "-q"])
+def test_validate_command_exits_1_on_a_failure(capsys, trekker: Path) -> None:
+    (trekker / "Level2.state").write_bytes(b"not a state")
+    status = main(["validate", str(trekker), "--frames", str(FRAMES), "-q"])
     out = capsys.readouterr().out
     assert status == 1
-    assert "state loads" in out and "Zone1.Act1" in out and "FAIL" in out and "0 of 1 game passed" in out
+    assert "state loads" in out and "Level2" in out and "FAIL" in out and "0 of 1 game passed" in out
 
 
-def test_validate_without_names_checks_the_game_yaml_here(capsys, dasher: Path, monkeypatch) -> None:
-    monkeypatch.chdir(dasher)
+def test_validate_without_names_checks_the_game_yaml_here(capsys, trekker: Path, monkeypatch) -> None:
+    monkeypatch.chdir(trekker)
     assert main(["validate", "--frames", str(FRAMES), "-q"]) == 0
-    assert "Dasher-Genesis: all" in capsys.readouterr().out
-    monkeypatch.chdir(dasher.parent)
+    assert "Trekker-GameBoy: all" in capsys.readouterr().out
+    monkeypatch.chdir(trekker.parent)
     assert main(["validate"]) == 2
     assert "Expected game names, --all, or a game.yaml" in capsys.readouterr().err
 

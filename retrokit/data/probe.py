@@ -40,7 +40,7 @@ import json
 import os
 import sys
 import tempfile
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -260,17 +260,10 @@ def vet_state(
     if isinstance(state, VettedState) and state.system == system:
         return state
     state = bytes(state)
-    # Before any record or probe: a state the core would map outside its memory crashes or not by the
-    # process's layout, so a probe's verdict on it (or an old record of one) proves nothing.
-    problem = state_layout_problem(system, state)
-    if problem:
-        raise _unrunnable(source, system, problem)
     key = probe_key(state, system, rom_sha1)
-    if shipped is not None and _ships(Path(shipped), state):
-        if _cached(key) is None:  # a movie that starts from it (Core.bin) is then known too
-            _remember(key, ProbeVerdict(True))
-        return _mint(state, system)
-    verdict = _cached(key)
+    verdict, ships = _known(state, system, key, lambda: shipped is not None and _ships(Path(shipped), state))
+    if ships and _cached(key) is None:  # a movie that starts from it (Core.bin) is then known too
+        _remember(key, ProbeVerdict(True))
     if verdict is None:
         verdict = probe_state(state, system, rom)
         _remember(key, verdict)
@@ -292,12 +285,30 @@ def known_safe(path: str | os.PathLike[str], system: str, rom_sha1: str) -> bool
         state = decompress_state(blob)
     except (RetrokitError, OSError):
         return False
-    if state_layout_problem(system, state):
-        return False
-    if is_shipped_blob(blob):
-        return True
-    verdict = _cached(probe_key(state, system, rom_sha1))
+    verdict, _ = _known(state, system, probe_key(state, system, rom_sha1), lambda: is_shipped_blob(blob))
     return verdict is not None and verdict.safe
+
+
+def _known(state: bytes, system: str, key: str, ships: Callable[[], bool]) -> tuple[ProbeVerdict | None, bool]:
+    """What this machine knows of a state without probing it, in the one order of trust; writes nothing.
+
+    Args:
+        state: The serialized state.
+        system: The system's name.
+        key: The state's :func:`probe_key` on the ROM it is for.
+        ships: Whether the state's file is one retrokit or the stable-retro wheel ships (asked only if needed).
+
+    Returns:
+        The verdict (``None``: only a probe can tell) and whether it comes from the state being shipped.
+    """
+    # Before any record or probe: a state the core would map outside its memory crashes or not by the
+    # process's layout, so a probe's verdict on it (or an old record of one) proves nothing.
+    problem = state_layout_problem(system, state)
+    if problem:
+        return ProbeVerdict(False, problem), False
+    if ships():
+        return ProbeVerdict(True), True
+    return _cached(key), False
 
 
 def _unrunnable(source: str, system: str, reason: str) -> StateError:

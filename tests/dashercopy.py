@@ -1,4 +1,4 @@
-"""A smaller copy of Dasher's folder, for tests that validate it but are not about every state and movie.
+"""A smaller copy of Dasher's (or another game's) folder, for tests that validate it but are not about every state and movie.
 
 A validation of Dasher as shipped plays every state's smoke runs and replays
 its six solution movies (5,700 frames): about 9 CPU-seconds. A test whose
@@ -27,16 +27,27 @@ def dasher_copy(parent: Path, states: Iterable[str], movies: Iterable[str] = ())
     Returns:
         The copy's folder.
     """
-    states, movies = set(states), set(movies)
+    return game_copy(DASHER, parent, states, movies)
+
+
+def game_copy(source: Path, parent: Path, states: Iterable[str] | None = None, movies: Iterable[str] = ()) -> Path:
+    """Copy a game's folder to ``parent/<its name>`` with only these states (``None``: all) and solution movies.
+
+    Returns:
+        The copy's folder.
+    """
+    kept_states, movies = (None if states is None else set(states)), set(movies)
 
     def left_out(folder: str, names: list[str]) -> list[str]:
-        return [n for n in names if (n.endswith(".state") and n.removesuffix(".state") not in states)
+        return [n for n in names if (n.endswith(".state") and kept_states is not None
+                                     and n.removesuffix(".state") not in kept_states)
                 or (n.endswith(".bk2") and n.removesuffix(".bk2") not in movies)]  # fmt: skip
 
-    folder = parent / DASHER.name
-    shutil.copytree(DASHER, folder, ignore=left_out)
+    folder = parent / source.name
+    shutil.copytree(source, folder, ignore=left_out)
     game_yaml = folder / "game.yaml"
-    head, _, section = game_yaml.read_text().partition("\nmovies:\n")  # the movies section comes last
-    kept = [line for line in section.splitlines() if line.split(":", 1)[0].strip() in movies]
-    game_yaml.write_text(head + ("\nmovies:\n" + "\n".join(kept) if kept else "") + "\n")
+    head, found, section = game_yaml.read_text().partition("\nmovies:\n")  # the movies section comes last
+    if found:
+        kept = [line for line in section.splitlines() if line.split(":", 1)[0].strip() in movies]
+        game_yaml.write_text(head + ("\nmovies:\n" + "\n".join(kept) if kept else "") + "\n")
     return folder

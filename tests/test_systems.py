@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from dashercopy import game_copy
 from stable_retro_game import Integration, pressed, wandering, write_integration
 
 import retrokit
@@ -314,12 +315,7 @@ def test_validate_passes_the_game_and_catches_a_state_from_another_game(cart: Ca
     # One run (validate plays every state and scenario): the copy with a foreign state fails on that state alone,
     # so everything of the game's own passes. Dasher's solution movies are left out of the copy: their replays
     # (5,700 frames) are no system's, and tests/test_validate.py validates every folder of games/ with its movies.
-    folder = tmp_path / cart.name
-    shutil.copytree(cart.game.folders[0], folder, ignore=shutil.ignore_patterns("movies"))
-    game_yaml = folder / "game.yaml"
-    text = game_yaml.read_text()
-    if "\nmovies:" in text:  # the movies section comes last (Dasher's game.yaml)
-        game_yaml.write_text(text[: text.index("\nmovies:")] + "\n")
+    folder = game_copy(cart.game.folders[0], tmp_path)  # every state, no solution movie
     shutil.copy(another_games_state(cart), folder / "Foreign.state")
     assert main(["validate", str(folder), "--quiet", "--frames", "120", "--json", str(tmp_path / "report.json")]) == 1
     (report,) = json.loads((tmp_path / "report.json").read_text())["games"]

@@ -38,7 +38,6 @@ if signal.getsignal(signal.SIGINT) is signal.SIG_IGN:
     signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
-
 def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     """`-n auto`: one worker more than the cores this process may use.
 
@@ -47,8 +46,9 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     with 3 workers against 665 s with 2). Every wait is on a condition with a generous limit, so a busier core only
     makes a test slower, never wrong.
     """
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    return cores + 1
+    from retrokit.envs.vector import available_cpus
+
+    return available_cpus() + 1
 
 @pytest.fixture(scope="session")
 def airstriker_dir() -> Path:

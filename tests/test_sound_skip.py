@@ -9,7 +9,8 @@ core, which makes both, on the same random buttons: the 68000's RAM, the
 Z80's RAM (where a sound driver keeps what it read from the chips) and what
 the chips hold that the CPUs can read or that times it (the YM2612's status,
 mode and timers, the PSG, the FM clock: compared directly in the state, so a
-drift shows at the first comparison) must stay equal; a state saved by the
+drift shows at the first comparison) must stay equal, in Airstriker's music
+and under a Z80 program that runs the YM2612's timers; a state saved by the
 skipping core must play on in the wheel's core and in stable-retro exactly as
 the wheel's own; movies recorded with skipping must play back without it, and
 the reverse. They skip when the patched core is not built.
@@ -74,8 +75,8 @@ def chip_state(state: bytes) -> dict[str, int | bytes]:
 # core and into stable-retro, which play on beside the wheel's own from there. Airstriker is the only game here with a
 # sound driver: its Z80 plays music through the YM2612 and the PSG. Measured over 20,000 frames of this play, it
 # never starts the YM2612's timers (mode 0, both counters 0 throughout: a started counter never returns to 0), so
-# no length of play lets a timer drift reach the RAM, and what a game that starts them would show is not played
-# here. The chips' state above is compared directly instead, with the Z80's RAM, every Z80_EVERY runs, where any
+# no length of play lets a timer drift reach the RAM: a Z80 program planted in a Dasher state runs them instead
+# (TIMER_PROGRAM below). The chips' state above is compared directly instead, with the Z80's RAM, every Z80_EVERY runs, where any
 # difference in what the CPUs can read, in the PSG or in the FM clock shows at once (a core built to move the FM
 # clock, or the PSG's tone edges, one step off while skipping fails at frame 4; the RAM alone let both through
 # 20,000 frames). The 6,000 frames (100 s
@@ -251,6 +252,53 @@ def test_ram_and_z80_ram_equal_the_wheel_cores(played, start) -> None:
     run = played(start)
     assert run.differs["skipping"] is None, run.differs["skipping"]
     assert run.asked == run.frames and run.drawn == 0  # every frame asked, none drawn
+
+
+# A Z80 program that runs the YM2612's timers, as a sound driver timing its music would: timer A every 300 samples
+# (TA 724) in CSM mode (which keys channel 3 on and off at each overflow), timer B every 160 (TB 246); it polls the
+# status and, at each flag, stores the flags and its 16-bit loop count in a ring at 0x0100, then clears the flags.
+# A timer one sample off moves a flag to another iteration of the loop, so the Z80's RAM differs at once: cores built
+# to run timer A or timer B one sample short per update, or to leave the CSM key unshifted, while skipping fail at
+# frame 4.
+TIMER_PROGRAM = bytes.fromhex(
+    "F3 310020 210040"  # di; ld sp,0x2000; ld hl,0x4000 (the YM2612's address port; data at 0x4001)
+    "3624 23 36B5 2B 3625 23 3600 2B"  # timer A = 0xB5 << 2 | 0 = 724
+    "3626 23 36F6 2B"  # timer B = 246
+    "3627 23 36BF 2B"  # mode: CSM, flags enabled and cleared, both timers started
+    "110001 010000"  # ld de,0x0100; ld bc,0
+    "03 7E E603 28FA"  # loop: inc bc; ld a,(hl); and 3; jr z,loop
+    "12 13 79 12 13 78 12 13"  # store the flags, c, b at (de)
+    "7A FE1F 3802 1601"  # wrap de from 0x1F00 to 0x0100
+    "3627 23 36BF 2B 18E3"  # clear the flags (keeping the rest of the mode); jr loop
+)
+Z80_REGS = GENESIS_BANK_MAP - 88  # Genesis Plus GX's Z80_Regs: pc (4 bytes) first, halt at 56
+
+
+def timer_state(dasher) -> bytes:
+    """Dasher's Zone1.Act1 with the Z80 (which the game parks on "di; halt" and never touches again) running
+    TIMER_PROGRAM from 0, checked as any state is."""
+    state = bytearray(gzip.decompress(dasher.state_path("Zone1.Act1").read_bytes()))
+    z80 = Z80_RAM.start
+    state[z80 : z80 + 0x2000] = TIMER_PROGRAM.ljust(0x2000, b"\0")
+    assert state[GENESIS_Z80_BANK - 1] == 1 and state[Z80_REGS + 56] == 1, "expected the Z80 running and halted"
+    struct.pack_into("<I", state, Z80_REGS, 0)
+    state[Z80_REGS + 56] = 0
+    return vet_state(bytes(state), "Genesis", dasher.rom_path())
+
+
+def test_the_ym2612_timers_and_csm_run_the_same_skipping(patched, wheel) -> None:
+    dasher = find_game(DASHER)
+    skipping, making = pair(patched, wheel, dasher.rom_path(), timer_state(dasher))
+    try:
+        differs = play(making, {"skipping": skipping}, 1_000, seed=5)
+        final = bytes(making.get_state())
+    finally:
+        skipping.close()
+        making.close()
+    assert differs["skipping"] is None, differs["skipping"]
+    records = final[Z80_RAM][0x100:0x1F00]
+    flags = {records[i] for i in range(0, len(records) - 2, 3) if any(records[i : i + 3])}
+    assert chip_state(final)["YM mode"] == 0xBF and flags >= {1, 2}, f"the timers did not run: flags {flags}"
 
 
 def test_the_skipping_core_makes_no_sound_and_the_same_sound_when_asked(patched, wheel, airstriker_dir) -> None:

@@ -117,7 +117,9 @@ def test_video_frames_must_be_a_known_mode(airstriker) -> None:
 # drawn at all, which is what that run adds, through the env, for one episode and its reset; test_sound_skip.py
 # plays Airstriker 6,000 frames more on the emulator drawing no frame (and making no sound) against the wheel's core.
 @pytest.mark.parametrize(("obs_type", "episodes"), [("rgb", 3), ("ram", 1)], ids=["rgb", "ram"])
-def test_airstriker_plays_the_same_skipping_as_drawing(monkeypatch, patched, wheel, obs_type: str, episodes: int) -> None:
+def test_airstriker_plays_the_same_skipping_as_drawing(
+    monkeypatch, patched, wheel, obs_type: str, episodes: int
+) -> None:
     skipping = make_env(monkeypatch, patched, "Airstriker-Genesis", obs_type=obs_type)
     drawing = make_env(monkeypatch, wheel, "Airstriker-Genesis", obs_type=obs_type)
     play_both(skipping, drawing, AIRSTRIKER_STEPS, seed=1, episodes=episodes)

@@ -38,7 +38,6 @@ from retrokit.host.statelayout import GENESIS_BANK_MAP, GENESIS_FIFO_INDEX, GENE
 from retrokit.movie.bk2 import read_bk2
 from retrokit.movie.playback import replay
 
-
 # Where Genesis Plus GX 1.7.5 keeps, in a Mega Drive state, what its sound chips hold that the CPUs can read or that
 # decides when they change (its state_save, sound_context_save, YM2612SaveContext, psg_context_save): after the VDP's
 # context (which ends 26 bytes after its FIFO index) comes the YM2612's whole C struct (3,576 bytes as the x86-64 C

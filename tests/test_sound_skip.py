@@ -60,7 +60,7 @@ SLOT_PHASES = [YM + channel * 400 + slot * 80 + 36 for channel in range(6) for s
 def chip_state(state: bytes) -> dict[str, int | bytes]:
     """What the CPUs can read of the sound chips (the YM2612's status, timers and mode; the PSG is write-only but
     its counters decide its future), and the FM clock that times them, by name; checked to be where it is read."""
-    address, status, mode, fn_h, ta, tal, tac, tb, tbl, tbc = struct.unpack_from("<HBxIB3xiiiiii", state, YM_TIMERS)
+    _address, status, mode, _fn_h, ta, tal, tac, tb, tbl, tbc = struct.unpack_from("<HBxIB3xiiiiii", state, YM_TIMERS)
     detune = struct.unpack_from("<256i", state, YM_TIMERS + 36)
     assert state[:16] == GENESIS_SIGNATURE and tal == 1024 - ta and tbl == (256 - tb) << 4, "not an FM_ST here"
     assert detune[32:64] == tuple(-d for d in detune[160:192]) and any(detune[32:64]), "not the detune table here"

@@ -2,14 +2,13 @@
 
 from __future__ import annotations
 
-import json
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 from bombs import zip_bytes
-from childproc import MAX_RSS_MB, Child, run_child, run_cli
+from childproc import MAX_RSS_MB, Child, run_cli, run_cli_cases
 
 from retrokit.movie import read_bk2
 from retrokit.movie.recorder import record_numbered
@@ -125,38 +124,27 @@ BOMBS = {"input-log-bomb": "Input Log.txt", "header-bomb": "Header.txt"}
 
 
 @pytest.fixture(scope="module")
-def bomb_playbacks(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, tuple[int, str]], Child]:
-    """Each bomb played back in one child under the memory cap: each bomb's status and stderr, and the child."""
+def bomb_playbacks(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Child]:
+    """Each bomb played back by its own command, all in one child under the memory cap (its peak bounds each)."""
     folder = tmp_path_factory.mktemp("bombs")
     small = {
-        "Input Log.txt": b"[Input]\nP1 B|\n|..|.|\n[/Input]", "Header.txt": b"Platform GEN\nGameName Dasher-Genesis-v0\n"
+        "Input Log.txt": b"[Input]\nP1 B|\n|..|.|\n[/Input]",
+        "Header.txt": b"Platform GEN\nGameName Dasher-Genesis-v0\n",
     }
-    paths = {}
+    commands = {}
     for case, member in BOMBS.items():
         members = [(name, [1024] if name == member else [data], True) for name, data in small.items()]
-        paths[case] = str(folder / f"{case}.bk2")
-        Path(paths[case]).write_bytes(zip_bytes(members))
-    # one interpreter for both (each refused by its own command run), its peak memory a bound on each
-    child = run_child(f"""
-        import contextlib, io, json
-        from retrokit.cli import main
-        answers = {{}}
-        for case, path in {paths!r}.items():
-            with contextlib.redirect_stderr(io.StringIO()) as err:
-                status = main(["playback", path, path + ".out"])
-            answers[case] = [status, err.getvalue()]
-        print(json.dumps(answers))
-        """, timeout=120)
-    assert child.returncode == 0, child.describe()
-    return {case: tuple(answer) for case, answer in json.loads(child.stdout).items()}, child
+        path = folder / f"{case}.bk2"
+        path.write_bytes(zip_bytes(members))
+        commands[case] = ["playback", str(path), str(folder / f"{case}.out")]
+    return run_cli_cases(commands)
 
 
 @pytest.mark.parametrize("case", list(BOMBS))
-def test_a_movie_member_that_inflates_to_a_gigabyte_is_refused(bomb_playbacks, case: str) -> None:
-    answers, child = bomb_playbacks
-    status, stderr = answers[case]
-    assert status == 2, (stderr, child.describe())
-    assert f"expected {BOMBS[case]!r} to hold at most" in stderr, stderr
+def test_a_movie_member_that_inflates_to_a_gigabyte_is_refused(bomb_playbacks: dict[str, Child], case: str) -> None:
+    child = bomb_playbacks[case]
+    assert child.returncode == 2, child.describe()
+    assert f"expected {BOMBS[case]!r} to hold at most" in child.stderr, child.describe()
     assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
 
 

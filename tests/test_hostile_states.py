@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pytest
 from bombs import gzip_of_zeros, zip_bytes
-from childproc import MAX_RSS_MB, REPO, Child, run_child, run_cli
+from childproc import MAX_RSS_MB, REPO, Child, run_child, run_cli_cases
 from probestore import seed_shipped, shared_verdicts
 
 from retrokit.data.games import cached_rom_sha1, find_game
@@ -257,9 +257,9 @@ HOSTILE_CORE_BINS = {"corrupt-core-bin": "SIGSEGV", "gzip-bomb-core-bin": "at mo
 @pytest.fixture(scope="module")
 def playbacks(
     tmp_path_factory: pytest.TempPathFactory, corrupt_state: bytes, good_state: bytes, verdicts: Path
-) -> tuple[dict, Child]:
-    """``retrokit playback`` of each hostile movie, in one child under the memory cap: each command's status,
-    stderr, movie and output path, and the child (whose peak memory bounds each command's)."""
+) -> dict[str, tuple[Child, str, str]]:
+    """``retrokit playback`` of each hostile movie, each its own command, all in one child under the memory cap:
+    each command's answer (the child's peak memory bounds each), movie and output path."""
     folder = tmp_path_factory.mktemp("hostile-movies")
     for case in ("corrupt", "bomb", "other"):
         (folder / case).mkdir()
@@ -275,28 +275,20 @@ def playbacks(
         ),
     }
     with shared_verdicts(verdicts, folder / "data"):
-        child = run_child(f"""
-            import contextlib, io, json
-            from retrokit.cli import main
-            answers = {{}}
-            for case, (movie, out) in {cases!r}.items():
-                with contextlib.redirect_stderr(io.StringIO()) as err:
-                    status = main(["playback", movie, out])
-                answers[case] = [status, err.getvalue(), movie, out]
-            print(json.dumps(answers))
-            """, env={"RETROKIT_DATA": str(folder / "data")})
-    assert child.returncode == 0, child.describe()
-    return json.loads(child.stdout), child
+        answers = run_cli_cases(
+            {case: ["playback", movie, out] for case, (movie, out) in cases.items()},
+            env={"RETROKIT_DATA": str(folder / "data")},
+        )
+    return {case: (answers[case], movie, out) for case, (movie, out) in cases.items()}
 
 
 @pytest.mark.parametrize("kind", list(HOSTILE_CORE_BINS))
-def test_playback_refuses_a_hostile_core_bin(playbacks: tuple[dict, Child], kind: str) -> None:
-    answers, child = playbacks
-    status, stderr, movie, out = answers[kind]
-    assert status == 2, (stderr, child.describe())
-    last = stderr.strip().splitlines()[-1]
-    assert last.startswith(f"retrokit: error: {movie}") and "Traceback" not in stderr, stderr
-    assert HOSTILE_CORE_BINS[kind] in last, stderr
+def test_playback_refuses_a_hostile_core_bin(playbacks: dict[str, tuple[Child, str, str]], kind: str) -> None:
+    child, movie, out = playbacks[kind]
+    assert child.returncode == 2, child.describe()
+    last = child.stderr.strip().splitlines()[-1]
+    assert last.startswith(f"retrokit: error: {movie}") and "Traceback" not in child.stderr, child.describe()
+    assert HOSTILE_CORE_BINS[kind] in last, child.describe()
     assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
     assert not Path(out).exists()
 
@@ -378,10 +370,10 @@ def test_make_refuses_another_games_recorded_state() -> None:
         retrokit.make("Airstriker-Genesis", str(DASHER / "Zone1.Act1.state"))
 
 
-def test_playback_refuses_a_movie_recorded_with_another_games_state(playbacks: tuple[dict, Child]) -> None:
-    status, stderr, _, _ = playbacks[0]["another-games-state"]  # the playbacks fixture's Dasher movie as Airstriker's
-    assert status == 2, stderr
-    assert f"recorded on another ROM (SHA-1 {find_game('Dasher-Genesis').sha1s[0]})" in stderr, stderr
+def test_playback_refuses_a_movie_recorded_with_another_games_state(playbacks) -> None:
+    child, _, _ = playbacks["another-games-state"]  # the playbacks fixture's Dasher movie under Airstriker's name
+    assert child.returncode == 2, child.describe()
+    assert f"recorded on another ROM (SHA-1 {find_game('Dasher-Genesis').sha1s[0]})" in child.stderr, child.describe()
 
 
 def test_a_recorded_movie_names_its_rom_and_state(tmp_path: Path) -> None:

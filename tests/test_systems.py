@@ -319,9 +319,11 @@ def test_validate_passes_the_game_and_catches_a_state_from_another_game(cart: Ca
     # One run (validate plays every state and scenario): the copy with a foreign state fails on that state alone,
     # so everything of the game's own passes. Dasher's solution movies are left out of the copy: their replays
     # (5,700 frames) are no system's, and tests/test_validate.py validates every folder of games/ with its movies.
+    # Its smoke runs are short here (24 frames: 6 steps, one held action) for the same reason: test_validate's
+    # every-game test plays 120 frames of each state and scenario of each cartridge.
     folder = game_copy(cart.game.folders[0], tmp_path)  # every state, no solution movie
     shutil.copy(another_games_state(cart), folder / "Foreign.state")
-    assert main(["validate", str(folder), "--quiet", "--frames", "60", "--json", str(tmp_path / "report.json")]) == 1
+    assert main(["validate", str(folder), "--quiet", "--frames", "24", "--json", str(tmp_path / "report.json")]) == 1
     (report,) = json.loads((tmp_path / "report.json").read_text())["games"]
     failed = [r for r in report["results"] if r["status"] == "fail"]
     assert failed and all(r["state"] == "Foreign" for r in failed), failed

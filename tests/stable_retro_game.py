@@ -24,7 +24,7 @@ import numpy as np
 
 from retrokit.data.games import Game
 from retrokit.data.roms import rom_sha1
-from retrokit.data.statecheck import load_state
+from retrokit.data.statecheck import load_state, remember_written
 from retrokit.data.states import read_state
 from retrokit.dsl.scenario import load_scenario
 from retrokit.host.emulator import Emulator
@@ -88,7 +88,12 @@ def write_integration(game: Game, root: Path) -> Integration:
         start = FieldReader(list(game.fields.values()), emu.space).read()
         emu.run([0, 0], 1)
         after = root / f"{game.name}.after-reset.state"
-        after.write_bytes(gzip.compress(bytes(emu.get_state()), mtime=0))
+        snapshot = emu.get_state()
+        after.write_bytes(gzip.compress(bytes(snapshot), mtime=0))
+        # Noted as written by retrokit from a core, as retrokit notes each state it saves: loading it back needs no
+        # probe in a child (about 1-3 CPU-s; a probe's verdict is kept, but Genesis Plus GX's states hold bytes that
+        # differ run to run, and a fresh data folder has none).
+        remember_written(game, snapshot, rom)
     finally:
         emu.close()
     _json(folder / "scenario.json", _scenario(game, start))

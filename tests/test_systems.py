@@ -51,8 +51,12 @@ stable_retro = pytest.importorskip("stable_retro")
 
 REPO = Path(__file__).resolve().parent.parent
 CARTRIDGES = yaml.safe_load((REPO / "tools" / "cartridges.yaml").read_text())
-STEPS = 600  # the differential's steps (frames: frame skip 1)
-PLAY = 240  # frames of the shorter plays (states, movies, ramsearch)
+# The differential's steps (frames: frame skip 1). In 300 the episode ends and restarts at least once on every
+# cartridge whose episode ends within 600 (Hopper-Sms at 245, Hopper-GameGear 149, the Trekkers 192, Skipper-Snes
+# 275: the dones and resets are compared too), and the fewest screens any cartridge shows is 143 (Hopper-Sms).
+STEPS = 300
+PLAY = 240  # frames of the ramsearch's play
+STATE_PLAY = 120  # frames played before a state is saved, after it is loaded, and in a movie
 
 
 @dataclass
@@ -172,7 +176,7 @@ def test_a_state_retrokit_saved_loads_in_stable_retro(cart: Cartridge, tmp_path:
     emu = Emulator(cart.system, cart.game.require_rom())
     try:
         emu.set_state(load_state(cart.game, cart.game.state_path()))
-        run_ours(emu, cart, inputs(cart, 1, PLAY))
+        run_ours(emu, cart, inputs(cart, 1, STATE_PLAY))
         data = emu.get_state()
         path = write_state(tmp_path / "Middle.state", data, record=StateRecord.of(cart.name, cart.game.sha1s[0], data))
         env = cart.stable_env()
@@ -180,7 +184,7 @@ def test_a_state_retrokit_saved_loads_in_stable_retro(cart: Cartridge, tmp_path:
             env.load_state(str(path))
             env.reset(seed=0)  # loads it, then runs a frame with no buttons
             emu.run([0, 0], 1)
-            later = inputs(cart, 2, PLAY)
+            later = inputs(cart, 2, STATE_PLAY)
             assert first_difference(run_ours(emu, cart, later), run_theirs(env, later)) is None
             assert cart.system.ram_base in shared_ram_agrees(emu, env)  # the system RAM at least
         finally:
@@ -193,13 +197,13 @@ def test_a_state_stable_retro_saved_loads_in_retrokit(cart: Cartridge, tmp_path:
     env = cart.stable_env()
     try:
         env.reset(seed=0)
-        run_theirs(env, inputs(cart, 3, PLAY))
+        run_theirs(env, inputs(cart, 3, STATE_PLAY))
         path = tmp_path / "Theirs.state"
         path.write_bytes(gzip.compress(env.unwrapped.em.get_state()))  # stable-retro's .state: plain gzip
         ours = retrokit.make(cart.name, state=path, action_type="all")
         try:
             ours.reset(seed=0)
-            later = inputs(cart, 4, PLAY)
+            later = inputs(cart, 4, STATE_PLAY)
             mine = [ours.step(pressed(ours.buttons, n))[0].copy() for n in later]
             assert first_difference(mine, run_theirs(env, later)) is None
         finally:
@@ -210,7 +214,7 @@ def test_a_state_stable_retro_saved_loads_in_retrokit(cart: Cartridge, tmp_path:
 
 def test_a_retrokit_movie_plays_in_stable_retro(cart: Cartridge, tmp_path: Path) -> None:
     ours = retrokit.make(cart.name, record=tmp_path, action_type="all")
-    names = inputs(cart, 5, PLAY, recordable=True)
+    names = inputs(cart, 5, STATE_PLAY, recordable=True)
     try:
         ours.reset(seed=0)
         mine = [ours.step(pressed(ours.buttons, n))[0].copy() for n in names]
@@ -240,7 +244,7 @@ def test_a_stable_retro_movie_plays_in_retrokit(cart: Cartridge, tmp_path: Path)
     try:
         env.reset(seed=0)
         screens = [env.unwrapped.em.get_screen().copy()]
-        screens += run_theirs(env, inputs(cart, 6, PLAY, recordable=True))
+        screens += run_theirs(env, inputs(cart, 6, STATE_PLAY, recordable=True))
         env.unwrapped.stop_record()
     finally:
         env.close()
@@ -315,9 +319,11 @@ def test_validate_passes_the_game_and_catches_a_state_from_another_game(cart: Ca
     # One run (validate plays every state and scenario): the copy with a foreign state fails on that state alone,
     # so everything of the game's own passes. Dasher's solution movies are left out of the copy: their replays
     # (5,700 frames) are no system's, and tests/test_validate.py validates every folder of games/ with its movies.
+    # Its smoke runs are short here (24 frames: 6 steps, one held action) for the same reason: test_validate's
+    # every-game test plays 120 frames of each state and scenario of each cartridge.
     folder = game_copy(cart.game.folders[0], tmp_path)  # every state, no solution movie
     shutil.copy(another_games_state(cart), folder / "Foreign.state")
-    assert main(["validate", str(folder), "--quiet", "--frames", "120", "--json", str(tmp_path / "report.json")]) == 1
+    assert main(["validate", str(folder), "--quiet", "--frames", "24", "--json", str(tmp_path / "report.json")]) == 1
     (report,) = json.loads((tmp_path / "report.json").read_text())["games"]
     failed = [r for r in report["results"] if r["status"] == "fail"]
     assert failed and all(r["state"] == "Foreign" for r in failed), failed

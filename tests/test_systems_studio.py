@@ -2,7 +2,8 @@
 
 Parametrized over tools/cartridges.yaml as tests/test_systems.py is, in a real browser (headless
 Chromium through Selenium, with tests/studiopage.py's server and page). One studio serves them all: it
-opens each cartridge in turn by name, as its page's Open does, rather than a new studio for each:
+opens each cartridge in turn by name, as its page's Open does, rather than a new studio for each, and the page is
+loaded once for each cartridge:
 
 - the page shows the system's buttons, each with a key, and the keys play the game: holding them
   moves it as the same buttons move our own emulator;
@@ -32,7 +33,9 @@ from retrokit.studio.play import key_map
 
 REPO = Path(__file__).resolve().parent.parent
 CARTRIDGES = list(yaml.safe_load((REPO / "tools" / "cartridges.yaml").read_text()))
-FRAMES = 40
+# Frames the keys are held: in 20 every cartridge's pad field shows both buttons held and its player has moved
+# (x and vx differ from no buttons' on all eight), and each frame is a screen the browser draws.
+FRAMES = 20
 VIEW = 256  # bytes the RAM view and click-to-find show by default
 
 pytestmark = pytest.mark.timeout(600)
@@ -60,10 +63,18 @@ def cartridge(request, studio: Studio) -> str:
     return request.param
 
 
-@pytest.fixture
-def page(browser, studio: Studio, cartridge: str) -> Page:
+@pytest.fixture(scope="module")
+def page(chromium_session, studio: Studio, cartridge: str) -> Iterator[Page]:
+    """The studio's page on the cartridge, loaded once for its tests: each goes to its panels by their tabs, as a
+    user does. A load costs about a second (the panels start one after the other, each asking the server), and
+    loading the page for each panel took three a cartridge."""
+    from chromium import fresh
+
     assert studio.game.name == cartridge
-    return Page(browser, studio)
+    page = Page(fresh(chromium_session), studio).open("watch")
+    page.pause()  # each test steps the game itself; a running game is 60 screens a second for Chromium to draw
+    yield page
+    page.driver.get("about:blank")  # off the page before the studio opens the next cartridge
 
 
 def fields_after(name: str, masks: int, frames: int) -> dict[str, int]:
@@ -81,7 +92,8 @@ def fields_after(name: str, masks: int, frames: int) -> dict[str, int]:
 def test_the_keys_play_the_systems_buttons(page: Page) -> None:
     game = find_game(page.studio.game.name)
     system = game.system
-    page.open("watch")
+    if not page.el("watch").is_displayed():  # where the page opened, unless a test before went elsewhere
+        page.tab("watch")
     assert page.text("game-name") == f"{game.name} ({system.name})"
     legend = page.legend()
     assert set(legend) == set(system.button_names), legend
@@ -129,7 +141,7 @@ def test_ram_view_and_click_to_find_start_on_the_systems_ram(page: Page) -> None
     emu.close()
     start, size = next(region for region in layout.regions if region[0] == game.system.ram_base)
     length = min(VIEW, size)
-    page.open("ramview")
+    page.tab("ramview")
     assert int(page.el("ram-start").get_attribute("value"), 16) == start
     assert int(page.el("ram-length").get_attribute("value")) == length
     until("the grid", lambda: len(page.driver.find_elements(By.CSS_SELECTOR, "#ram-grid td")) == length)
@@ -138,7 +150,7 @@ def test_ram_view_and_click_to_find_start_on_the_systems_ram(page: Page) -> None
     # Click-to-find over VIEW bytes of the system RAM (where a field that draws a pixel is: Hopper-Nes keeps its
     # fields from 0x300) names that field under the pixel.
     field, address, x, y = pixel_of_a_field(game.name, start, size)
-    page.open("clickfind")
+    page.tab("clickfind")
     page.pause()
     page.reset(game.default_state)
     assert int(page.el("cf-start").get_attribute("value"), 16) == start

@@ -156,15 +156,23 @@ class _Decoder:
         # whose bytes run past the end are masked out by the caller.
         padded = np.zeros(self.n + MAX_WIDTH, dtype=np.uint8)
         padded[: self.n] = data
-        self.digits = {UNSIGNED: padded, **{k: table[padded] for k, table in _DIGITS.items()}}
+        # A BCD kind's digit values are made when a type of that kind is first read: most searches read none, and
+        # each table lookup costs a pass over the whole RAM on every snapshot.
+        self.digits = {UNSIGNED: padded}
         self.parts: dict[tuple[int, tuple[int, ...]], np.ndarray] = {}
+
+    def digit_values(self, kind: int) -> np.ndarray:
+        """Each byte's digit value as ``kind`` reads it (the byte itself for binary kinds), padded as the data is."""
+        if kind not in self.digits:
+            self.digits[kind] = _DIGITS[kind][self.digits[UNSIGNED]]
+        return self.digits[kind]
 
     def part(self, digits: int, offsets: tuple[int, ...]) -> np.ndarray:
         """The value of the bytes at ``offsets`` from each position (least significant first)."""
         key = (digits, offsets)
         if key not in self.parts:
             if len(offsets) == 1:
-                value = self.digits[digits][offsets[0] : offsets[0] + self.n]
+                value = self.digit_values(digits)[offsets[0] : offsets[0] + self.n]
             elif digits == UNSIGNED and len(offsets) in (2, 4) and _run(offsets):
                 value = self.integers(min(offsets), len(offsets), ">" if offsets[0] > offsets[1] else "<")
             else:

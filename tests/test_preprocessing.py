@@ -164,7 +164,7 @@ class PooledFrames(gymnasium.Wrapper):
 
 
 # Ends the episode on the frame player 1 gets 8 pixels right of the start, which is most often not a step's last;
-# short episodes reach every path below (two resets, ends inside a step) in ~140 steps rather than ~380.
+# short episodes reach every path below (two resets, two ends inside a step) in ~60 steps rather than ~380.
 REACH = {"reward": "p1_x", "done": "p1_x > initial(p1_x) + 8"}
 
 
@@ -185,15 +185,15 @@ def test_max_pool_with_the_sonic_presets_rules_equals_gymnasiums_wrappers_over_f
     base = native.unwrapped
     base.stepper.observers.append(buttons)
     width = base.actions.num_buttons
-    obs, _ = native.reset(seed=1)
-    expected, _ = ref.reset(seed=1)
-    native.action_space.seed(1)
+    obs, _ = native.reset(seed=2)
+    expected, _ = ref.reset(seed=2)
+    native.action_space.seed(2)
     ends_inside_a_step = episodes = 0
     for step in range(700):
         diff = np.abs(obs.astype(int) - as_native(expected, False).astype(int))
         assert diff.max() <= 1, f"step {step} differs by {diff.max()} at {np.argwhere(diff > 1)[:4]}"
         if episodes >= 2 and ends_inside_a_step >= 1:
-            break  # every path compared: full steps, an end inside a step, the resets (by step 137 with these seeds)
+            break  # every path compared: full steps, an end inside a step, the resets (by step 56 with these seeds)
         buttons.masks.clear()
         obs, reward, terminated, _truncated, _ = native.step(native.action_space.sample())
         frames = [((mask >> np.arange(width)) & 1).astype(np.int8) for mask in buttons.masks]

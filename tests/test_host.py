@@ -98,52 +98,74 @@ def test_audio_is_captured_only_when_asked(airstriker: Emulator) -> None:
 
 # --- determinism, states ------------------------------------------------------------------------
 
+# Steps (of 4 frames) of the reference run: seconds of play, the ship moving, firing and stuck by sticky draws.
+RUN_STEPS = 100
 
-def test_same_inputs_give_identical_ram_and_screen(airstriker_rom: Path, airstriker_state: bytes) -> None:
-    digests = []
-    for _ in range(2):
-        with Emulator("Genesis", airstriker_rom) as emu:
-            emu.set_state(airstriker_state)
-            emu.set_sticky(0.25, 7)
-            play(emu, script(300, 1))
-            digests.append(digest(emu))
-    assert digests[0] == digests[1]
+
+@pytest.fixture(scope="module")
+def reference_run(airstriker_rom: Path, airstriker_state: bytes) -> tuple[str, str]:
+    """One in-process run every determinism test compares against, computed once.
+
+    Returns:
+        The digest after script(RUN_STEPS, 1) with sticky 0.25 (seed 7), and the digest after it went on
+        without sticky for script(RUN_STEPS // 2, 2).
+    """
+    with Emulator("Genesis", airstriker_rom) as emu:
+        emu.set_state(airstriker_state)
+        emu.set_sticky(0.25, 7)
+        play(emu, script(RUN_STEPS, 1))
+        played = digest(emu)
+        emu.set_sticky(0.0, 0)
+        play(emu, script(RUN_STEPS // 2, 2))
+        return played, digest(emu)
+
+
+def test_same_inputs_give_identical_ram_and_screen(
+    airstriker_rom: Path, airstriker_state: bytes, reference_run: tuple[str, str]
+) -> None:
+    with Emulator("Genesis", airstriker_rom) as emu:
+        emu.set_state(airstriker_state)
+        emu.set_sticky(0.25, 7)
+        play(emu, script(RUN_STEPS, 1))
+        assert digest(emu) == reference_run[0]
 
 
 CHILD = """
 import gzip, hashlib, sys
+from pathlib import Path
 import numpy as np
+from retrokit.data.games import cached_rom_sha1
+from retrokit.data.probe import remember
 from retrokit.data.statecheck import vet_state
 from retrokit.host.emulator import Emulator
-from tests.test_host import play, script
+from tests.test_host import RUN_STEPS, play, script
 emu = Emulator("Genesis", sys.argv[1])
 emu.set_state(vet_state(gzip.decompress(open(sys.argv[2], "rb").read()), "Genesis", sys.argv[1], shipped=sys.argv[2]))
 emu.set_sticky(0.25, 7)
-play(emu, script(300, 1))
+play(emu, script(RUN_STEPS, 1))
 print(hashlib.sha1(emu.ram.tobytes() + emu.screen().tobytes()).hexdigest())
-open(sys.argv[3], "wb").write(emu.get_state())
+state = emu.get_state()
+open(sys.argv[3], "wb").write(state)
+# This machine wrote it from a core, as retrokit's own writers note: the other process loads it without a probe.
+remember(state, cached_rom_sha1(Path(sys.argv[1]), "Genesis"))
 """
 
 
-def test_runs_are_identical_across_processes(airstriker_rom: Path, airstriker_dir: Path, airstriker_state: bytes, tmp_path: Path) -> None:
+def test_runs_are_identical_across_processes(
+    airstriker_rom: Path, airstriker_dir: Path, reference_run: tuple[str, str], tmp_path: Path
+) -> None:
     repo = Path(__file__).resolve().parent.parent
     out = subprocess.run(
         [sys.executable, "-c", CHILD, str(airstriker_rom), str(airstriker_dir / "Level1.state"), str(tmp_path / "s")],
         capture_output=True, text=True, cwd=repo, check=True,
     ).stdout.strip()
-    with Emulator("Genesis", airstriker_rom) as emu:
-        emu.set_state(airstriker_state)
-        emu.set_sticky(0.25, 7)
-        play(emu, script(300, 1))
-        assert digest(emu) == out
-        # A state saved in the other process continues here exactly as here.
-        emu.set_sticky(0.0, 0)
-        play(emu, script(100, 2))
-        expected = digest(emu)
+    played, went_on = reference_run
+    assert out == played
+    # A state saved in the other process continues here exactly as the reference run went on.
     with Emulator("Genesis", airstriker_rom) as other:
-        other.set_state(vet_state((tmp_path / "s").read_bytes(), "Genesis", airstriker_rom))  # probed: not ours
-        play(other, script(100, 2))
-        assert digest(other) == expected
+        other.set_state(vet_state((tmp_path / "s").read_bytes(), "Genesis", airstriker_rom))  # remembered by the child
+        play(other, script(RUN_STEPS // 2, 2))
+        assert digest(other) == went_on
 
 
 def test_serialize_round_trip_continues_identically(airstriker: Emulator) -> None:
@@ -197,7 +219,7 @@ def test_emulator_reports_whether_a_run_stuck(airstriker: Emulator, prob: float,
 
 
 def test_sticky_draws_follow_the_seed(airstriker_rom: Path, airstriker_state: bytes) -> None:
-    inputs = script(150, 6)
+    inputs = script(60, 6)
 
     def run(seed: int) -> str:
         with Emulator("Genesis", airstriker_rom) as emu:
@@ -206,8 +228,9 @@ def test_sticky_draws_follow_the_seed(airstriker_rom: Path, airstriker_state: by
             play(emu, inputs)
             return digest(emu)
 
-    assert run(11) == run(11)
-    assert len({run(11), run(12), run(13)}) > 1
+    seeded = run(11)
+    assert seeded == run(11)
+    assert len({seeded, run(12), run(13)}) > 1
 
 
 def test_forget_action_applies_the_next_action_at_once(airstriker_rom: Path, airstriker_state: bytes) -> None:
@@ -224,20 +247,38 @@ def test_forget_action_applies_the_next_action_at_once(airstriker_rom: Path, air
 
 # --- several emulators, threads, the GIL ------------------------------------------------------
 
+SOLO_STEPS, SOLO_RUNS = 60, 5
 
-def test_two_emulators_in_two_threads_match_single_runs(airstriker_rom: Path, airstriker_state: bytes) -> None:
-    scripts = [script(400, 21), script(400, 22)]
 
-    def solo(inputs: list[int]) -> bytes:
+def solo_script(i: int) -> list[int]:
+    return script(SOLO_STEPS, 31 + i)
+
+
+def sticky_like_solo(emu: Emulator, state: bytes) -> Emulator:
+    emu.set_state(state)
+    emu.set_sticky(0.25, 5)
+    return emu
+
+
+@pytest.fixture(scope="module")
+def solo_runs(airstriker_rom: Path, airstriker_state: bytes) -> list[tuple[bytes, np.ndarray]]:
+    """RAM and screen after solo_script(i), each alone in its own emulator on this thread, computed once for
+    every test that runs the same scripts in threads or in the native runner."""
+    runs = []
+    for i in range(SOLO_RUNS):
         with Emulator("Genesis", airstriker_rom) as emu:
-            emu.set_state(airstriker_state)
-            play(emu, inputs)
-            return emu.ram.tobytes()
+            play(sticky_like_solo(emu, airstriker_state), solo_script(i))
+            runs.append((emu.ram.tobytes(), emu.screen().copy()))
+    assert len({ram for ram, _ in runs}) == SOLO_RUNS, "the scripts should play different games"
+    return runs
 
-    expected = [solo(s) for s in scripts]
-    emus = [Emulator("Genesis", airstriker_rom) for _ in scripts]
-    for emu in emus:
-        emu.set_state(airstriker_state)
+
+def test_two_emulators_in_two_threads_match_single_runs(
+    airstriker_rom: Path, airstriker_state: bytes, solo_runs: list[tuple[bytes, np.ndarray]]
+) -> None:
+    scripts = [solo_script(0), solo_script(1)]
+    expected = [ram for ram, _ in solo_runs[:2]]
+    emus = [sticky_like_solo(Emulator("Genesis", airstriker_rom), airstriker_state) for _ in scripts]
     threads = [threading.Thread(target=play, args=(emu, s)) for emu, s in zip(emus, scripts)]
     for t in threads:
         t.start()
@@ -294,27 +335,21 @@ def test_an_emulator_used_from_two_threads_at_once_raises(airstriker: Emulator) 
 
 @pytest.mark.parametrize("count, workers", [(2, 1), (5, 1), (3, 0), (2, 3)], ids=["2-on-2", "5-on-2", "3-on-1", "2-on-4"])
 def test_runner_steps_match_single_runs_and_screens_land_in_the_batch(
-    airstriker_rom: Path, airstriker_state: bytes, count: int, workers: int
+    airstriker_rom: Path, airstriker_state: bytes, solo_runs: list[tuple[bytes, np.ndarray]], count: int, workers: int
 ) -> None:
-    scripts = [script(60, 31 + i) for i in range(count)]
-    emus = [Emulator("Genesis", airstriker_rom) for _ in scripts]
-    solo = [Emulator("Genesis", airstriker_rom) for _ in scripts]
-    for emu in emus + solo:
-        emu.set_state(airstriker_state)
-        emu.set_sticky(0.25, 5)
+    scripts = [solo_script(i) for i in range(count)]
+    emus = [sticky_like_solo(Emulator("Genesis", airstriker_rom), airstriker_state) for _ in scripts]
     runner = _host.Runner(workers)  # with the calling thread, workers + 1 threads share the emulators
     batch = np.zeros((count, 224, 320, 3), dtype=np.uint8)
-    for step in range(60):
+    for step in range(SOLO_STEPS):
         actions = np.array([[s[step], 0] for s in scripts], dtype=np.uint16)
         converted = runner.run([e.handle for e in emus], actions, 4, list(batch))
-        for emu, row in zip(solo, actions):
-            emu.run(row, 4)
         assert converted == (True,) * count
-    for i in range(count):
-        assert emus[i].ram.tobytes() == solo[i].ram.tobytes()
-        assert (batch[i] == solo[i].screen()).all()
+    for i, (ram, screen) in enumerate(solo_runs[:count]):
+        assert emus[i].ram.tobytes() == ram, f"emulator {i} of {count} left the single run's RAM"
+        assert (batch[i] == screen).all(), f"emulator {i} of {count}: the batch is not the single run's screen"
     assert emus[0].ram.tobytes() != emus[1].ram.tobytes()
-    for emu in emus + solo:
+    for emu in emus:
         emu.close()
 
 
@@ -330,7 +365,7 @@ def test_runner_calls_of_changing_subsets_run_each_task_once(airstriker_rom: Pat
     for step in range(150):
         which = sorted(rng.choice(count, size=int(rng.integers(1, count + 1)), replace=False))
         actions = rng.integers(0, 256, (len(which), 2)).astype(np.uint16)
-        frames = int(rng.integers(1, 5))
+        frames = int(rng.integers(1, 3))  # few frames a call: many calls, the races this is about
         runner.run([emus[i].handle for i in which], actions, frames)
         for i, row in zip(which, actions):
             solo[i].run(row, frames)

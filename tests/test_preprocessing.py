@@ -99,6 +99,10 @@ CONFIGS = {
 }
 
 
+# Steps compared per configuration: enough for the stack to fill and the game to move for seconds.
+STEPS = 48
+
+
 @pytest.mark.parametrize("config", CONFIGS, ids=list(CONFIGS))
 def test_native_preprocessing_equals_gymnasiums_wrappers(config: str) -> None:
     game, options = CONFIGS[config]
@@ -114,8 +118,10 @@ def test_native_preprocessing_equals_gymnasiums_wrappers(config: str) -> None:
     expected, _ = ref.reset(seed=3)
     space = native.action_space
     space.seed(3)
-    for step in range(120):
+    start, moved = obs.copy(), 0
+    for step in range(STEPS):
         assert native.observation_space.contains(obs)
+        moved += not np.array_equal(obs, start)
         diff = np.abs(obs.astype(int) - as_native(expected, first).astype(int))
         assert diff.max() <= 1, f"{config}: step {step} differs by {diff.max()} at {np.argwhere(diff > 1)[:4]}"
         action = space.sample()
@@ -125,6 +131,8 @@ def test_native_preprocessing_equals_gymnasiums_wrappers(config: str) -> None:
         expected, _, ref_terminated, ref_truncated, _ = ref.step(action)
         if terminated or truncated or ref_terminated or ref_truncated:
             break
+    # Compared over frames that changed, not a still screen (the scenario may end an episode early).
+    assert moved >= STEPS // 2, f"{config}: the observation changed on only {moved} of {step + 1} steps"
     native.close()
     ref.close()
 
@@ -155,8 +163,9 @@ class PooledFrames(gymnasium.Wrapper):
         return obs, total, terminated, truncated, {**info, "frames": len(seen)}
 
 
-# Ends the episode on the frame player 1 gets 24 pixels right of the start, which is most often not a step's last.
-REACH = {"reward": "p1_x", "done": "p1_x > initial(p1_x) + 24"}
+# Ends the episode on the frame player 1 gets 8 pixels right of the start, which is most often not a step's last;
+# short episodes reach every path below (two resets, two ends inside a step) in ~60 steps rather than ~380.
+REACH = {"reward": "p1_x", "done": "p1_x > initial(p1_x) + 8"}
 
 
 def test_max_pool_with_the_sonic_presets_rules_equals_gymnasiums_wrappers_over_frames_run_one_by_one() -> None:
@@ -176,15 +185,15 @@ def test_max_pool_with_the_sonic_presets_rules_equals_gymnasiums_wrappers_over_f
     base = native.unwrapped
     base.stepper.observers.append(buttons)
     width = base.actions.num_buttons
-    obs, _ = native.reset(seed=1)
-    expected, _ = ref.reset(seed=1)
-    native.action_space.seed(1)
+    obs, _ = native.reset(seed=2)
+    expected, _ = ref.reset(seed=2)
+    native.action_space.seed(2)
     ends_inside_a_step = episodes = 0
     for step in range(700):
         diff = np.abs(obs.astype(int) - as_native(expected, False).astype(int))
         assert diff.max() <= 1, f"step {step} differs by {diff.max()} at {np.argwhere(diff > 1)[:4]}"
         if episodes >= 2 and ends_inside_a_step >= 1:
-            break  # every path compared: full steps, an end inside a step, the resets (by step 381 with these seeds)
+            break  # every path compared: full steps, an end inside a step, the resets (by step 56 with these seeds)
         buttons.masks.clear()
         obs, reward, terminated, _truncated, _ = native.step(native.action_space.sample())
         frames = [((mask >> np.arange(width)) & 1).astype(np.int8) for mask in buttons.masks]
@@ -358,7 +367,7 @@ def test_reward_clip_gives_the_sign_or_a_bound() -> None:
         env.reset(seed=0)
         env.action_space.seed(0)
     seen = set()
-    for _ in range(150):
+    for _ in range(50):  # enough random play to earn rewards; each step checks all three clips
         action = envs[False].action_space.sample()
         raw, sign, bound = (env.step(action)[1] for env in envs.values())
         assert sign == float(np.sign(raw)) and bound == min(max(raw, -0.5), 0.5)

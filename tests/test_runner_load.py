@@ -29,7 +29,11 @@ CHILD = textwrap.dedent(
 
     caller_cpu, busy_cpu, n, one_cpu = (int(a) for a in sys.argv[1:])
     options = {"frameskip": 4, "sticky_prob": 0.25, "action_type": "discrete"}
-    steps, seed = 300, 3
+    # The burner runs as long as the child: stop 40 steps after the first move (moves come within some 30
+    # steps even on a loaded machine), or after 300 steps with none. Confined to one CPU, where a move is a bug,
+    # 120 steps give a move four times the chance it needs under the burner.
+    steps, seed, after_move = (120 if one_cpu else 300), 3, 40
+    first_move = None
     if one_cpu:  # the whole process on the caller's CPU, before the runner starts: there is nowhere to move to
         os.sched_setaffinity(0, {caller_cpu})
     vec = retrokit.make_vec("Airstriker-Genesis", n, threads=2, **options)
@@ -48,7 +52,11 @@ CHILD = textwrap.dedent(
             for i, env in enumerate(singles):
                 o, r, term, trunc, _ = env.step(actions[i])
                 same = same and (obs[i] == o).all() and rewards[i] == r and terms[i] == term and truncs[i] == trunc
-        print(json.dumps({"moved": vec._runner.moved, "same": bool(same)}))
+            if first_move is None and vec._runner.moved:
+                first_move = step
+            if first_move is not None and step - first_move >= after_move:
+                break  # the runner moved a worker and went on stepping, compared, after the move
+        print(json.dumps({"moved": vec._runner.moved, "same": bool(same), "steps": step + 1}))
     finally:
         burner.kill()
         burner.wait()
@@ -74,11 +82,11 @@ needs_two_cpus = pytest.mark.skipif(len(CPUS) < 2, reason="needs two CPUs: the c
 def test_a_worker_stalled_behind_a_busy_process_is_moved_onto_the_waiting_callers_cpu(n: int) -> None:
     got = run_child(n, one_cpu=False)
     assert got["same"], "the vector's observations or rewards differ from single envs' under load"
-    assert got["moved"] > 0, "no stalled worker was moved, though a burner shared its CPU for 300 steps"
+    assert got["moved"] > 0, f"no stalled worker was moved, though a burner shared its CPU for {got['steps']} steps"
 
 
 @needs_two_cpus
 def test_a_process_confined_to_one_cpu_moves_nothing_and_steps_the_same() -> None:
     got = run_child(2, one_cpu=True)
     assert got["same"], "the vector's observations or rewards differ from single envs' on one CPU"
-    assert got["moved"] == 0, "the runner moved a worker, though the process may use one CPU only"
+    assert got["moved"] == 0, f"the runner moved a worker, though the process may use one CPU only ({got['steps']} steps)"

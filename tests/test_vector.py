@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import hashlib
+from collections.abc import Callable
+
 import gymnasium
 import numpy as np
 import pytest
@@ -22,38 +25,74 @@ def actions_for(step: int, n: int) -> np.ndarray:
 MID_STEP = {"reward": "delta(score)", "done": "frame >= 37 or gameover == 1"}
 
 
+# Steps compared: the 25-step limit ends every episode once (the next step autoresets) and ten steps follow.
+STEPS, MOST_ENVS = 35, 5
+
+
+def pixels(obs: np.ndarray) -> str:
+    """An observation's digest: equal digests, equal pixels."""
+    return hashlib.sha1(obs.tobytes()).hexdigest()
+
+
+def trace(obs: np.ndarray, reward: float, terminated: bool, truncated: bool, info: dict) -> tuple:
+    """One env's step as compared."""
+    return pixels(obs), reward, terminated, truncated, info["score"], info["lives"]
+
+
+@pytest.fixture(scope="module")
+def single_runs() -> Callable[[bool], list[list[tuple]]]:
+    """Single envs 0..MOST_ENVS-1 stepped as the vector steps them, through their autoresets; made once per
+    scenario mode for every vector size (env i's run does not depend on how many envs the vector has)."""
+    runs: dict[bool, list[list[tuple]]] = {}
+
+    def get(every_frame: bool) -> list[list[tuple]]:
+        if every_frame not in runs:
+            runs[every_frame] = []
+            for i in range(MOST_ENVS):
+                env = retrokit.make("Airstriker-Genesis", **vector_options(every_frame))
+                steps, done = [(pixels(env.reset(seed=SEED + i)[0]),)], False
+                for step in range(STEPS):
+                    if done:  # next-step autoreset: this step resets, reward 0
+                        obs, info = env.reset()
+                        steps.append(trace(obs, 0.0, False, False, info))
+                    else:
+                        steps.append(trace(*env.step(actions_for(step, MOST_ENVS)[i])))
+                    done = steps[-1][2] or steps[-1][3]
+                runs[every_frame].append(steps)
+                env.close()
+        return runs[every_frame]
+
+    return get
+
+
+SEED = 10
+
+
+def vector_options(every_frame: bool) -> dict:
+    return {**OPTIONS, "scenario_every_frame": every_frame, "scenario": MID_STEP if every_frame else None}
+
+
 @pytest.mark.parametrize("every_frame", [False, True], ids=["per-step", "per-frame"])
 @pytest.mark.parametrize("n, threads", [(2, None), (5, 2), (3, 1)], ids=["2-envs", "5-envs-2-threads", "3-envs-1-thread"])
-def test_vector_equals_single_envs_through_autoreset(n: int, threads: int | None, every_frame: bool) -> None:
-    seed, steps = 10, 60
-    options = {**OPTIONS, "scenario_every_frame": every_frame, "scenario": MID_STEP if every_frame else None}
-    vec = retrokit.make_vec("Airstriker-Genesis", n, threads=threads, **options)
+def test_vector_equals_single_envs_through_autoreset(
+    single_runs: Callable[[bool], list[list[tuple]]], n: int, threads: int | None, every_frame: bool
+) -> None:
+    vec = retrokit.make_vec("Airstriker-Genesis", n, threads=threads, **vector_options(every_frame))
     assert vec.threads == min(n, threads or available_cpus())
     assert vec.native  # both kinds run on the native runner
-    singles = [retrokit.make("Airstriker-Genesis", **options) for _ in range(n)]
-    obs, infos = vec.reset(seed=seed)
-    single_obs = [env.reset(seed=seed + i)[0] for i, env in enumerate(singles)]
-    assert all((obs[i] == single_obs[i]).all() for i in range(n))
-    done = [False] * n
+    singles = single_runs(every_frame)[:n]
+    obs, infos = vec.reset(seed=SEED)
+    assert all((pixels(obs[i]),) == singles[i][0] for i in range(n))
     resets = 0
-    for step in range(steps):
-        acts = actions_for(step, n)
+    for step in range(STEPS):
+        acts = actions_for(step, MOST_ENVS)[:n]
         obs, rewards, terms, truncs, infos = vec.step(acts)
-        for i, env in enumerate(singles):
-            if done[i]:  # next-step autoreset: this step resets, reward 0
-                expected_obs, info = env.reset()
-                expected = (expected_obs, 0.0, False, False, info)
-                resets += 1
-            else:
-                expected = env.step(acts[i])
-            assert (obs[i] == expected[0]).all(), (step, i)
-            assert rewards[i] == expected[1] and terms[i] == expected[2] and truncs[i] == expected[3]
-            assert infos["score"][i] == expected[4]["score"] and infos["lives"][i] == expected[4]["lives"]
-            done[i] = expected[2] or expected[3]
+        for i, single in enumerate(singles):
+            got = trace(obs[i], rewards[i], terms[i], truncs[i], {key: infos[key][i] for key in ("score", "lives")})
+            assert got == single[step + 1], f"env {i} of {n}, step {step}: vector {got}, single env {single[step + 1]}"
+            resets += step > 0 and bool(single[step][2] or single[step][3])  # this step autoreset
     assert resets >= n  # the 25-step limit forced autoresets along the way
     vec.close()
-    for env in singles:
-        env.close()
 
 
 def test_vector_spaces_are_batched() -> None:

@@ -92,20 +92,52 @@ def _ends_cleanly(shared: tuple[dict[str, list[dict]], object], names: list[str]
     assert sorted(reports) == sorted(names), child.describe()
 
 
+def _unreadable_movie(folder: Path, special: str) -> None:
+    (folder / "movies").mkdir()
+    (folder / "game.yaml").write_text(GAME_YAML + "movies:\n  Zone1.Act1: {done_at: 621, reward: 3552}\n")
+    SPECIAL[special](folder / "movies" / "Zone1.Act1.bk2")
+
+
+def _alias_bombed(folder: Path) -> None:
+    (folder / "game.yaml").write_text(GAME_YAML + _alias_bomb())
+
+
+#: Every case validated by the one shared child, by its folder's (and so its game's) name: how to make it hostile.
+UNREADABLE: dict[str, Callable[[Path], None]] = {
+    **{f"{file}-{special}": (lambda f, file=file, make=make: make(f / file))
+       for file in FILES for special, make in SPECIAL.items()},
+    **{f"movie-{special}": (lambda f, special=special: _unreadable_movie(f, special)) for special in SPECIAL},
+    **{f"game.yaml-{special}": (lambda f, make=make: make(f / "game.yaml")) for special, make in SPECIAL.items()},
+    "alias-bomb": _alias_bombed,
+}
+
+
+def _unreadable_results(shared, case: str, tmp_path: Path) -> tuple[list[dict], object]:
+    """The case's results from the shared child; if it died before the case, from a child of the case's own."""
+    reports, child = shared
+    if case in reports:
+        return reports[case], child
+    folder = dasher_copy(tmp_path / "games")  # so the failure names its case
+    UNREADABLE[case](folder)
+    return _validate(folder, tmp_path)
+
+
 @pytest.fixture(scope="module")
 def unreadable_files(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, list[dict]], object]:
-    """The (file, special) cases, each a game folder named ``<file>-<special>``, validated by one child."""
+    """The cases of :data:`UNREADABLE`, each a game folder named after it, validated by one child.
+
+    One child for all: a validate child's interpreter start and imports (~1 CPU-s) were most of each case's cost.
+    """
     root = tmp_path_factory.mktemp("unreadable")
     folders = []
-    for file in FILES:
-        for special, make in SPECIAL.items():
-            folders.append(dasher_copy(root / "games", f"{file}-{special}"))
-            make(folders[-1] / file)
+    for case, make in UNREADABLE.items():
+        folders.append(dasher_copy(root / "games", case))
+        make(folders[-1])
     return _validate_all(root, folders)
 
 
 def test_one_validate_of_every_unreadable_folder_ends_cleanly(unreadable_files) -> None:
-    _ends_cleanly(unreadable_files, [f"{file}-{special}" for file in FILES for special in SPECIAL])
+    _ends_cleanly(unreadable_files, list(UNREADABLE))
 
 
 @pytest.mark.parametrize("special", list(SPECIAL), ids=list(SPECIAL))
@@ -113,33 +145,22 @@ def test_one_validate_of_every_unreadable_folder_ends_cleanly(unreadable_files) 
 def test_an_unreadable_file_in_a_game_folder_is_a_failed_check(
     tmp_path: Path, file: str, special: str, unreadable_files
 ) -> None:
-    reports, child = unreadable_files
-    results = reports.get(f"{file}-{special}")
-    if results is None:  # the shared child died before this case: try it alone, so the failure names its case
-        folder = dasher_copy(tmp_path / "games")
-        SPECIAL[special](folder / file)
-        results, child = _validate(folder, tmp_path)
+    results, child = _unreadable_results(unreadable_files, f"{file}-{special}", tmp_path)
     failed = [r for r in results if r["status"] == "fail"]
     assert any(FOUND[special] in r["message"] and file in r["message"] for r in failed), child.describe()
 
 
 @pytest.mark.parametrize("special", list(SPECIAL), ids=list(SPECIAL))
-def test_an_unreadable_solution_movie_is_a_failed_check(tmp_path: Path, special: str) -> None:
-    folder = dasher_copy(tmp_path / "games")
-    (folder / "movies").mkdir()
-    (folder / "game.yaml").write_text(GAME_YAML + "movies:\n  Zone1.Act1: {done_at: 621, reward: 3552}\n")
-    SPECIAL[special](folder / "movies" / "Zone1.Act1.bk2")
-    results, child = _validate(folder, tmp_path)
+def test_an_unreadable_solution_movie_is_a_failed_check(tmp_path: Path, special: str, unreadable_files) -> None:
+    results, child = _unreadable_results(unreadable_files, f"movie-{special}", tmp_path)
     movie = [r for r in results if r["check"] == "movie"]
     assert [r["status"] for r in movie] == ["fail"], child.describe()
     assert FOUND[special] in movie[0]["message"] and "Zone1.Act1.bk2" in movie[0]["message"], child.describe()
 
 
 @pytest.mark.parametrize("special", list(SPECIAL), ids=list(SPECIAL))
-def test_an_unreadable_game_yaml_fails_the_data_check(tmp_path: Path, special: str) -> None:
-    folder = dasher_copy(tmp_path / "games")
-    SPECIAL[special](folder / "game.yaml")
-    results, child = _validate(folder, tmp_path)
+def test_an_unreadable_game_yaml_fails_the_data_check(tmp_path: Path, special: str, unreadable_files) -> None:
+    results, child = _unreadable_results(unreadable_files, f"game.yaml-{special}", tmp_path)
     data = [r for r in results if r["check"] == "data file"]
     assert data and data[0]["status"] == "fail" and FOUND[special] in data[0]["message"], child.describe()
 
@@ -175,11 +196,11 @@ def test_a_game_folder_linking_to_itself_breaks_no_command(tmp_path: Path) -> No
     assert child.returncode == 0 and "Dasher-Genesis" in child.stdout, child.describe()
 
 
-def test_an_alias_bomb_in_game_yaml_is_refused_quickly(tmp_path: Path) -> None:
+def test_an_alias_bomb_in_game_yaml_is_refused_quickly(tmp_path: Path, unreadable_files) -> None:
     folder = dasher_copy(tmp_path / "games")
-    (folder / "game.yaml").write_text(GAME_YAML + _alias_bomb())
+    _alias_bombed(folder)
     assert (folder / "game.yaml").stat().st_size - len(GAME_YAML) < 1024
-    results, child = _validate(folder, tmp_path)
+    results, child = _unreadable_results(unreadable_files, "alias-bomb", tmp_path)  # validate (in the shared child)
     failed = [r for r in results if r["status"] == "fail"]
     assert any("aliases (*name) to add at most" in r["message"] for r in failed), child.describe()
     child = run_child(f"import retrokit\nretrokit.make({str(folder)!r})", timeout=60)
@@ -226,6 +247,10 @@ MOVIE_ENTRIES = {
 }
 
 
+#: The control of the malformed entries (a finite tolerance and a wrong reward), validated in their child too.
+CONTROL = ("control-wrong-reward", "{done_at: 621, reward: 1}")
+
+
 def _with_movie_entry(root: Path, name: str, entry: str) -> Path:
     folder = dasher_copy(root, name)
     (folder / "movies").mkdir()
@@ -236,34 +261,35 @@ def _with_movie_entry(root: Path, name: str, entry: str) -> Path:
 
 @pytest.fixture(scope="module")
 def movie_entries(tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, list[dict]], object]:
-    """The malformed movies entries, each a game folder named after its case, validated by one child."""
+    """The malformed movies entries and their control, each a game folder named after its case, validated by one child."""
     root = tmp_path_factory.mktemp("entries")
-    folders = [_with_movie_entry(root / "games", case, entry) for case, (entry, _) in MOVIE_ENTRIES.items()]
-    return _validate_all(root, folders)
+    entries = {case: entry for case, (entry, _) in MOVIE_ENTRIES.items()} | dict([CONTROL])
+    return _validate_all(root, [_with_movie_entry(root / "games", case, entry) for case, entry in entries.items()])
+
+
+def _movie_entry_results(shared, case: str, entry: str, tmp_path: Path) -> tuple[list[dict], object]:
+    """The case's results from the shared child; if it died before the case, from a child of the case's own."""
+    reports, child = shared
+    if case in reports:
+        return reports[case], child
+    return _validate(_with_movie_entry(tmp_path / "games", "Dasher-Genesis", entry), tmp_path)  # names its case
 
 
 def test_one_validate_of_every_malformed_movies_entry_ends_cleanly(movie_entries) -> None:
-    _ends_cleanly(movie_entries, list(MOVIE_ENTRIES))
+    _ends_cleanly(movie_entries, [*MOVIE_ENTRIES, CONTROL[0]])
 
 
 @pytest.mark.parametrize("case", list(MOVIE_ENTRIES), ids=list(MOVIE_ENTRIES))
 def test_a_malformed_movies_entry_is_a_failed_check(tmp_path: Path, case: str, movie_entries) -> None:
     entry, message = MOVIE_ENTRIES[case]
-    reports, child = movie_entries
-    results = reports.get(case)
-    if results is None:  # the shared child died before this case: try it alone, so the failure names its case
-        results, child = _validate(_with_movie_entry(tmp_path / "games", "Dasher-Genesis", entry), tmp_path)
+    results, child = _movie_entry_results(movie_entries, case, entry, tmp_path)
     movie = [r for r in results if r["check"] == "movie"]
     assert [r["status"] for r in movie] == ["fail"] and message in movie[0]["message"], child.describe()
 
 
-def test_a_nan_tolerance_no_longer_passes_a_wrong_reward(tmp_path: Path) -> None:
+def test_a_nan_tolerance_no_longer_passes_a_wrong_reward(tmp_path: Path, movie_entries) -> None:
     """The control: a finite tolerance and a wrong reward fail, as NaN's must too (above)."""
-    folder = dasher_copy(tmp_path / "games")
-    (folder / "movies").mkdir()
-    shutil.copy(DASHER / "movies" / "Zone1.Act1.bk2", folder / "movies" / "Zone1.Act1.bk2")
-    (folder / "game.yaml").write_text(GAME_YAML + "movies:\n  Zone1.Act1: {done_at: 621, reward: 1}\n")
-    results, child = _validate(folder, tmp_path)
+    results, child = _movie_entry_results(movie_entries, *CONTROL, tmp_path)
     movie = [r for r in results if r["check"] == "movie"]
     assert [r["status"] for r in movie] == ["fail"] and "a total reward of 1" in movie[0]["message"], child.describe()
 

@@ -10,10 +10,12 @@ import gzip
 import json
 import random
 import shutil
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 from corrupt import random_body
+from dashercopy import dasher_copy
 
 from retrokit.cli import main
 from retrokit.data.games import list_games
@@ -31,22 +33,19 @@ def failed(report: GameReport) -> set[tuple[str, str]]:
     return {(r.check, r.state) for r in report.failures}
 
 
-@pytest.fixture
-def dasher_with_movies(tmp_path: Path) -> Path:
-    """A full copy of Dasher's folder (states, scenario, movies), as a game folder of its own."""
-    folder = tmp_path / "Dasher-Genesis"
-    shutil.copytree(DASHER, folder)
-    return folder
+#: game.yaml's default states (for 1 and 2 players): every copy keeps them.
+DEFAULTS = ("Zone1.Act1", "Zone1.Act1.2P")
 
 
 @pytest.fixture
-def dasher(dasher_with_movies: Path) -> Path:
-    """The copy without its solution movies, whose replays the other faults need not pay for."""
-    shutil.rmtree(dasher_with_movies / "movies")
-    game_yaml = dasher_with_movies / "game.yaml"
-    text = game_yaml.read_text()
-    game_yaml.write_text(text[: text.index("\nmovies:")] + "\n")
-    return dasher_with_movies
+def dasher(tmp_path: Path) -> Callable[..., Path]:
+    """Makes a copy of Dasher's folder, as a game folder of its own, with its default states and the states and
+    solution movies named (``dasher("Zone2.Act1", movies=["Zone1.Act1"])``).
+
+    A planted fault needs its own state and one next to it, not all nine states' smoke runs and six movies' replays
+    (a third of the CPU each); every shipped state and movie passing is test_every_game_in_games_passes_check_game's.
+    """
+    return lambda *states, movies=(): dasher_copy(tmp_path, (*DEFAULTS, *states), movies)
 
 
 @pytest.fixture
@@ -141,9 +140,10 @@ def test_the_ram_read_from_a_state_file_is_the_ram_the_core_loads(game: str, sta
 # --- Planted faults ----------------------------------------------------------------------------------------
 
 
-def test_division_by_zero_on_one_state_fails_that_state_only(dasher: Path) -> None:
-    (dasher / "broken.yaml").write_text("reward: 100 / (zone * 2 + act - 3)\ndone: level_done == 1\n")
-    report = check_game(dasher, frames=FRAMES)
+def test_division_by_zero_on_one_state_fails_that_state_only(dasher: Callable[..., Path]) -> None:
+    game = dasher("Zone2.Act1", "Zone2.Act2", "Zone3.Act2")
+    (game / "broken.yaml").write_text("reward: 100 / (zone * 2 + act - 3)\ndone: level_done == 1\n")
+    report = check_game(game, frames=FRAMES)
     bad = [r for r in report.failures if r.scenario == "broken"]
     assert [(r.check, r.state) for r in bad] == [("smoke run", "Zone2.Act2")], render(report)
     assert "division by zero" in bad[0].message
@@ -151,27 +151,29 @@ def test_division_by_zero_on_one_state_fails_that_state_only(dasher: Path) -> No
     assert {r.state for r in others if r.scenario == "broken"} >= {"Zone1.Act1", "Zone2.Act1", "Zone3.Act2"}
 
 
-def test_a_table_missing_one_act_fails_coverage_for_that_state(dasher: Path) -> None:
+def test_a_table_missing_one_act_fails_coverage_for_that_state(dasher: Callable[..., Path]) -> None:
+    game = dasher("Zone3.Act1", "Zone3.Act2")
     values = "\n".join(f"      {z}, {a}: {1000 + z}" for z in range(3) for a in range(2) if (z, a) != (2, 1))
-    (dasher / "goal.yaml").write_text(
+    (game / "goal.yaml").write_text(
         f"tables:\n  goal:\n    by: [zone, act]\n    values:\n{values}\n"
         "reward: delta(p1_x) if p1_x < goal[zone, act] else 0\ndone: level_done == 1\n"
     )
-    report = check_game(dasher, frames=FRAMES)
+    report = check_game(game, frames=FRAMES)
     assert failed(report) == {("table coverage", "Zone3.Act2"), ("smoke run", "Zone3.Act2")}, render(report)
     coverage = report.find("table coverage", state="Zone3.Act2")[0]
     assert "zone=2, act=1" in coverage.message and "goal.yaml" in coverage.message
 
 
 @pytest.mark.parametrize("kind", ["truncated", "garbage"])
-def test_a_corrupt_state_fails_without_stopping_the_run(dasher: Path, kind: str) -> None:
-    path = dasher / "Zone2.Act1.state"
+def test_a_corrupt_state_fails_without_stopping_the_run(dasher: Callable[..., Path], kind: str) -> None:
+    game = dasher("Zone2.Act1", "Zone3.Act2")
+    path = game / "Zone2.Act1.state"
     data = gzip.decompress(path.read_bytes())
     if kind == "truncated":
         path.write_bytes(path.read_bytes()[:300])
     else:  # right size and signature, random inside (seed 7: the core dies of SIGSEGV on it within the 60 frames of the child)
         path.write_bytes(gzip.compress(random_body(data, random.Random(7), keep_pointers=True)))
-    report = check_game(dasher, frames=FRAMES)
+    report = check_game(game, frames=FRAMES)
     assert failed(report) == {("state loads", "Zone2.Act1")}, render(report)
     message = report.failures[0].message
     assert ("truncated" in message) if kind == "truncated" else ("the emulator crashed (SIG" in message)
@@ -180,12 +182,14 @@ def test_a_corrupt_state_fails_without_stopping_the_run(dasher: Path, kind: str)
     assert report.find("smoke run", state="Zone3.Act2", status=PASS)
 
 
-def test_a_gzip_bomb_state_fails_without_stopping_the_run(dasher: Path) -> None:
+def test_a_gzip_bomb_state_fails_without_stopping_the_run(dasher: Callable[..., Path]) -> None:
+    game = dasher("Zone1.Act2", "Zone3.Act2")
     member = gzip.compress(bytes(16 << 20), compresslevel=9, mtime=0)
-    (dasher / "Zone1.Act2.state").write_bytes(member * 48)  # 768 MiB once inflated (gzip members concatenate)
-    report = check_game(dasher, frames=FRAMES)
+    (game / "Zone1.Act2.state").write_bytes(member * 48)  # 768 MiB once inflated (gzip members concatenate)
+    report = check_game(game, frames=FRAMES)
     assert failed(report) == {("state loads", "Zone1.Act2")}, render(report)
     assert "inflates past" in report.failures[0].message  # read_state's cap, in the child
+    assert report.find("state loads", state="Zone3.Act2", status=PASS)  # the state after it was still loaded
 
 
 def test_a_state_that_hangs_the_core_fails_and_the_next_child_goes_on(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -198,74 +202,79 @@ def test_a_state_that_hangs_the_core_fails_and_the_next_child_goes_on(monkeypatc
     assert ["hangs the core" in p.error for p in probes.values()] == [True, True]
 
 
-def test_another_games_state_is_flagged(dasher: Path, airstriker_dir: Path) -> None:
-    shutil.copy(airstriker_dir / "Level1.state", dasher / "Zone2.Act2.state")
-    report = check_game(dasher, frames=FRAMES)
+def test_another_games_state_is_flagged(dasher: Callable[..., Path], airstriker_dir: Path) -> None:
+    game = dasher("Zone2.Act2")
+    shutil.copy(airstriker_dir / "Level1.state", game / "Zone2.Act2.state")
+    report = check_game(game, frames=FRAMES)
     assert failed(report) == {("state is the game's", "Zone2.Act2")}, render(report)
     assert "Airstriker-Genesis" in report.failures[0].message
 
 
-def test_a_state_recorded_on_another_rom_is_flagged(dasher: Path, airstriker_dir: Path) -> None:
+def test_a_state_recorded_on_another_rom_is_flagged(dasher: Callable[..., Path], airstriker_dir: Path) -> None:
     from retrokit.data.states import StateRecord, read_state, write_state
 
+    game = dasher("Zone1.Act2")
     data = read_state(airstriker_dir / "Level1.state")
     record = StateRecord.of("Airstriker-Genesis", "0" * 40, data)  # as retrokit writes a state, on another ROM
-    (dasher / "Zone1.Act2.state").unlink()
-    write_state(dasher / "Zone1.Act2.state", data, record=record)
-    report = check_game(dasher, frames=FRAMES)
+    (game / "Zone1.Act2.state").unlink()
+    write_state(game / "Zone1.Act2.state", data, record=record)
+    report = check_game(game, frames=FRAMES)
     assert failed(report) == {("state is the game's", "Zone1.Act2")}, render(report)
     assert "recorded on the ROM with SHA-1 0000" in report.failures[0].message
 
 
-def test_a_state_made_for_another_level_is_flagged_by_its_recipe(dasher: Path) -> None:
-    shutil.copy(dasher / "Zone1.Act1.state", dasher / "Zone3.Act1.state")
-    report = check_game(dasher, frames=FRAMES)
+def test_a_state_made_for_another_level_is_flagged_by_its_recipe(dasher: Callable[..., Path]) -> None:
+    game = dasher("Zone3.Act1")
+    shutil.copy(game / "Zone1.Act1.state", game / "Zone3.Act1.state")
+    report = check_game(game, frames=FRAMES)
     assert failed(report) == {("state is the game's", "Zone3.Act1")}, render(report)
     assert "zone=2" in report.failures[0].message and "found zone=0" in report.failures[0].message
 
 
-def test_a_movie_with_the_wrong_expected_reward_fails(dasher_with_movies: Path) -> None:
+def test_a_movie_with_the_wrong_expected_reward_fails(dasher: Callable[..., Path]) -> None:
     # Zone1's two movies only: the wrong one fails next to a right one, without replaying all six (the
     # shipped game passing with every movie is test_every_game_in_games_passes_check_game's claim)
-    text = (dasher_with_movies / "game.yaml").read_text()
-    for name in ("Zone2.Act1", "Zone2.Act2", "Zone3.Act1", "Zone3.Act2"):
-        (dasher_with_movies / "movies" / f"{name}.bk2").unlink()
-        text = "".join(line for line in text.splitlines(keepends=True) if not line.startswith(f"  {name}: {{scenario"))
-    (dasher_with_movies / "game.yaml").write_text(text.replace("reward: 3952", "reward: 3900"))
-    report = check_game(dasher_with_movies, frames=FRAMES)
+    game = dasher(movies=["Zone1.Act1", "Zone1.Act2"])
+    text = (game / "game.yaml").read_text()
+    assert "\n  Zone1.Act2: {scenario: scenario, done_at: 804, reward: 3952," in text
+    (game / "game.yaml").write_text(text.replace("reward: 3952", "reward: 3900"))
+    report = check_game(game, frames=FRAMES)
     assert failed(report) == {("movie", "Zone1.Act2")}, render(report)
     assert "a total reward of 3900" in report.failures[0].message and "found 3952" in report.failures[0].message
 
 
-def test_movies_without_an_outcome_warn_and_missing_or_broken_ones_fail(dasher: Path) -> None:
-    (dasher / "movies").mkdir()
-    shutil.copy(DASHER / "movies" / "Zone1.Act1.bk2", dasher / "movies" / "Loose.bk2")
-    (dasher / "movies" / "Broken.bk2").write_bytes(b"PK\x03\x04 not really a zip")
-    with (dasher / "game.yaml").open("a") as f:
+def test_movies_without_an_outcome_warn_and_missing_or_broken_ones_fail(dasher: Callable[..., Path]) -> None:
+    game = dasher()
+    (game / "movies").mkdir(exist_ok=True)  # the copy keeps the folder, empty
+    shutil.copy(DASHER / "movies" / "Zone1.Act1.bk2", game / "movies" / "Loose.bk2")
+    (game / "movies" / "Broken.bk2").write_bytes(b"PK\x03\x04 not really a zip")
+    with (game / "game.yaml").open("a") as f:
         f.write("movies:\n  Gone: {reward: 1}\n  Broken: {reward: 1}\n")
-    report = check_game(dasher, frames=FRAMES)
+    report = check_game(game, frames=FRAMES)
     assert failed(report) == {("movie", "Gone"), ("movie", "Broken")}, render(report)
     assert report.find("movie", state="Loose")[0].status == "warn"
     assert "could not be replayed" in report.find("movie", state="Broken")[0].message
 
 
-def test_a_misspelled_key_in_game_yaml_fails_with_its_line(dasher: Path) -> None:
-    text = (dasher / "game.yaml").read_text()
-    (dasher / "game.yaml").write_text(text.replace("\nintegrate:", "\nintgrate:"))
+def test_a_misspelled_key_in_game_yaml_fails_with_its_line(dasher: Callable[..., Path]) -> None:
+    game = dasher()
+    text = (game / "game.yaml").read_text()
+    (game / "game.yaml").write_text(text.replace("\nintegrate:", "\nintgrate:"))
     line = text[: text.index("\nintegrate:")].count("\n") + 2
-    report = check_game(dasher, frames=FRAMES)
+    report = check_game(game, frames=FRAMES)
     assert {check for check, _ in failed(report)} == {"schema", "data file"}, render(report)
     schema = report.find("schema", status=FAIL)[0].message
     assert f"game.yaml:{line}:1:" in schema and "Did you mean 'integrate'?" in schema
     assert "Did you mean 'integrate'?" in report.find("data file")[0].message  # loading the game refuses it too
 
 
-def test_a_field_outside_ram_fails_and_overlaps_warn(dasher: Path) -> None:
-    text = (dasher / "game.yaml").read_text()
+def test_a_field_outside_ram_fails_and_overlaps_warn(dasher: Callable[..., Path]) -> None:
+    game = dasher()
+    text = (game / "game.yaml").read_text()
     text = text.replace('end_x:       {address: 0xFF000A', 'end_x:       {address: 0xFE0000')
     text = text.replace('start_x:     {address: 0xFF000C', 'start_x:     {address: 0xFF000D')
-    (dasher / "game.yaml").write_text(text)
-    report = check_game(dasher, frames=FRAMES)
+    (game / "game.yaml").write_text(text)
+    report = check_game(game, frames=FRAMES)
     outside = report.find("fields in RAM", status=FAIL)
     assert len(outside) == 1 and "'end_x'" in outside[0].message
     overlap = report.find("field overlap")

@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 import yaml
 from childproc import MAX_RSS_MB, REPO, run_child, run_cli
+from probestore import seed_shipped
 
 from retrokit.data.games import find_game
 from retrokit.data.shipped import STATE_HASHES, WHEEL_STATE_HASHES, state_hashes, wheel_state_hashes
@@ -128,7 +129,8 @@ def test_validate_reports_a_solution_movie_from_a_corrupt_state(tmp_path: Path, 
     doc.setdefault("movies", {})["Zone1.Act1"] = {"done_at": None, "reward": 0}
     doc.pop("integrate", None)
     (dasher_copy / "game.yaml").write_text(yaml.safe_dump(doc))
-    child = run_cli(["validate", str(dasher_copy)], timeout=300,
+    # 60 frames per smoke run, not 600: the claim is the movie's replay, which plays the movie whatever --frames says
+    child = run_cli(["validate", str(dasher_copy), "--frames", "60"], timeout=300,
                     env={"RETROKIT_GAMES": str(dasher_copy.parent), "RETROKIT_DATA": str(tmp_path / "data")})
     assert child.signal is None, child.describe()
     words = " ".join(child.stdout.split())  # the table wraps its cells by the width of the (tmp) paths in them
@@ -166,6 +168,9 @@ def test_a_state_retrokit_wrote_needs_no_probe(tmp_path: Path, monkeypatch) -> N
     from retrokit.data import probe, statecheck
 
     monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    # The movie starts from the shipped Zone1.Act1: known by its bytes, as on a machine that loaded it once, so
+    # its Core.bin costs no probe child (3,300 frames); the state integrate writes at frame 100 is other bytes.
+    seed_shipped(tmp_path / "data" / "state-probes", DASHER / "Zone1.Act1.state", DASHER / "rom.md")
     movie = DASHER / "movies" / "Zone1.Act1.bk2"
     assert main(["integrate", "Dasher-Genesis", "Midway", "--movie", str(movie), "--frame", "100"]) == 0
     monkeypatch.setattr(probe, "probe_state", lambda *a, **k: pytest.fail("a state this machine wrote was probed"))

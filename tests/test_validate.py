@@ -21,7 +21,7 @@ from retrokit.cli import main
 from retrokit.data.games import list_games
 from retrokit.paths import repo_games_dir
 from retrokit.testing import check_game
-from retrokit.testing.report import FAIL, PASS, SKIP, GameReport, render
+from retrokit.testing.report import FAIL, PASS, SKIP, GameReport, Result, render
 
 DASHER = repo_games_dir() / "Dasher-Genesis"
 TREKKER = repo_games_dir() / "Trekker-GameBoy"  # the cheapest own game with a ROM: for the command's own claims
@@ -164,32 +164,77 @@ def test_a_table_missing_one_act_fails_coverage_for_that_state(dasher: Callable[
     assert "zone=2, act=1" in coverage.message and "goal.yaml" in coverage.message
 
 
+#: The faults planted in ONE copy of Dasher (:func:`planted`), by state: what each plants, and the failures it must cause.
+#: Each is caught by its own state's checks, which read only that state's file, so none can mask another.
+PLANTED = {
+    "Zone1.Act2": ("a gzip bomb", {("state loads", "Zone1.Act2")}),
+    "Zone2.Act1": ("a truncated state", {("state loads", "Zone2.Act1")}),
+    "Zone2.Act2": ("Airstriker's state", {("state is the game's", "Zone2.Act2")}),
+    "Zone2.Act1.2P": ("a state recorded on another ROM", {("state is the game's", "Zone2.Act1.2P")}),
+    "Zone3.Act1": ("Zone1.Act1's state", {("state is the game's", "Zone3.Act1")}),
+}
+
+
+@pytest.fixture(scope="module")
+def planted(tmp_path_factory: pytest.TempPathFactory, airstriker_dir: Path) -> GameReport:
+    """The report of one check of a Dasher copy with the faults of :data:`PLANTED`, Zone3.Act2 (last) left good.
+
+    One check instead of one per fault: each was a probe child and the default states' smoke runs.
+    """
+    from retrokit.data.states import StateRecord, read_state, write_state
+
+    game = dasher_copy(tmp_path_factory.mktemp("planted"), (*DEFAULTS, *PLANTED, "Zone3.Act2"))
+    member = gzip.compress(bytes(16 << 20), compresslevel=9, mtime=0)
+    (game / "Zone1.Act2.state").write_bytes(member * 48)  # 768 MiB once inflated (gzip members concatenate)
+    (game / "Zone2.Act1.state").write_bytes((game / "Zone2.Act1.state").read_bytes()[:300])
+    shutil.copy(airstriker_dir / "Level1.state", game / "Zone2.Act2.state")
+    data = read_state(airstriker_dir / "Level1.state")
+    record = StateRecord.of("Airstriker-Genesis", "0" * 40, data)  # as retrokit writes a state, on another ROM
+    (game / "Zone2.Act1.2P.state").unlink()
+    write_state(game / "Zone2.Act1.2P.state", data, record=record)
+    shutil.copy(game / "Zone1.Act1.state", game / "Zone3.Act1.state")
+    return check_game(game, frames=FRAMES)
+
+
+def planted_failures(report: GameReport, state: str) -> list[Result]:
+    """The failures on ``state``, after checking they are the ones its planted fault must cause."""
+    what, expected = PLANTED[state]
+    assert {(c, s) for c, s in failed(report) if s == state} == expected, f"{what} planted in {state}:\n{render(report)}"
+    return [r for r in report.failures if r.state == state]
+
+
+def test_planted_faults_fail_their_own_states_only(planted: GameReport) -> None:
+    everything = set().union(*(expected for _, expected in PLANTED.values()))
+    assert failed(planted) == everything, render(planted)
+    # the states after them were still checked
+    assert planted.find("state loads", state="Zone3.Act2", status=PASS), render(planted)
+    assert planted.find("smoke run", state="Zone3.Act2", status=PASS), render(planted)
+
+
 @pytest.mark.parametrize("kind", ["truncated", "garbage"])
-def test_a_corrupt_state_fails_without_stopping_the_run(dasher: Callable[..., Path], kind: str) -> None:
-    game = dasher("Zone2.Act1", "Zone3.Act2")
-    path = game / "Zone2.Act1.state"
-    data = gzip.decompress(path.read_bytes())
+def test_a_corrupt_state_fails_without_stopping_the_run(
+    dasher: Callable[..., Path], kind: str, request: pytest.FixtureRequest
+) -> None:
     if kind == "truncated":
-        path.write_bytes(path.read_bytes()[:300])
-    else:  # right size and signature, random inside (seed 7: the core dies of SIGSEGV on it within the 60 frames of the child)
+        report = request.getfixturevalue("planted")
+        assert "truncated" in planted_failures(report, "Zone2.Act1")[0].message, render(report)
+    else:  # a copy of its own: whether the core crashes may hang on what the child loaded before
+        game = dasher("Zone2.Act1", "Zone3.Act2")
+        path = game / "Zone2.Act1.state"
+        data = gzip.decompress(path.read_bytes())
+        # right size and signature, random inside (seed 7: the core dies of SIGSEGV on it within the 60 frames of the child)
         path.write_bytes(gzip.compress(random_body(data, random.Random(7), keep_pointers=True)))
-    report = check_game(game, frames=FRAMES)
-    assert failed(report) == {("state loads", "Zone2.Act1")}, render(report)
-    message = report.failures[0].message
-    assert ("truncated" in message) if kind == "truncated" else ("the emulator crashed (SIG" in message)
+        report = check_game(game, frames=FRAMES)
+        assert failed(report) == {("state loads", "Zone2.Act1")}, render(report)
+        assert "the emulator crashed (SIG" in report.failures[0].message
     # the states after it were still checked
     assert report.find("state loads", state="Zone3.Act2", status=PASS)
     assert report.find("smoke run", state="Zone3.Act2", status=PASS)
 
 
-def test_a_gzip_bomb_state_fails_without_stopping_the_run(dasher: Callable[..., Path]) -> None:
-    game = dasher("Zone1.Act2", "Zone3.Act2")
-    member = gzip.compress(bytes(16 << 20), compresslevel=9, mtime=0)
-    (game / "Zone1.Act2.state").write_bytes(member * 48)  # 768 MiB once inflated (gzip members concatenate)
-    report = check_game(game, frames=FRAMES)
-    assert failed(report) == {("state loads", "Zone1.Act2")}, render(report)
-    assert "inflates past" in report.failures[0].message  # read_state's cap, in the child
-    assert report.find("state loads", state="Zone3.Act2", status=PASS)  # the state after it was still loaded
+def test_a_gzip_bomb_state_fails_without_stopping_the_run(planted: GameReport) -> None:
+    assert "inflates past" in planted_failures(planted, "Zone1.Act2")[0].message  # read_state's cap, in the child
+    assert planted.find("state loads", state="Zone3.Act2", status=PASS)  # the state after it was still loaded
 
 
 def test_a_state_that_hangs_the_core_fails_and_the_next_child_goes_on(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -202,56 +247,52 @@ def test_a_state_that_hangs_the_core_fails_and_the_next_child_goes_on(monkeypatc
     assert ["hangs the core" in p.error for p in probes.values()] == [True, True]
 
 
-def test_another_games_state_is_flagged(dasher: Callable[..., Path], airstriker_dir: Path) -> None:
-    game = dasher("Zone2.Act2")
-    shutil.copy(airstriker_dir / "Level1.state", game / "Zone2.Act2.state")
-    report = check_game(game, frames=FRAMES)
-    assert failed(report) == {("state is the game's", "Zone2.Act2")}, render(report)
-    assert "Airstriker-Genesis" in report.failures[0].message
+def test_another_games_state_is_flagged(planted: GameReport) -> None:
+    assert "Airstriker-Genesis" in planted_failures(planted, "Zone2.Act2")[0].message
 
 
-def test_a_state_recorded_on_another_rom_is_flagged(dasher: Callable[..., Path], airstriker_dir: Path) -> None:
-    from retrokit.data.states import StateRecord, read_state, write_state
-
-    game = dasher("Zone1.Act2")
-    data = read_state(airstriker_dir / "Level1.state")
-    record = StateRecord.of("Airstriker-Genesis", "0" * 40, data)  # as retrokit writes a state, on another ROM
-    (game / "Zone1.Act2.state").unlink()
-    write_state(game / "Zone1.Act2.state", data, record=record)
-    report = check_game(game, frames=FRAMES)
-    assert failed(report) == {("state is the game's", "Zone1.Act2")}, render(report)
-    assert "recorded on the ROM with SHA-1 0000" in report.failures[0].message
+def test_a_state_recorded_on_another_rom_is_flagged(planted: GameReport) -> None:
+    assert "recorded on the ROM with SHA-1 0000" in planted_failures(planted, "Zone2.Act1.2P")[0].message
 
 
-def test_a_state_made_for_another_level_is_flagged_by_its_recipe(dasher: Callable[..., Path]) -> None:
-    game = dasher("Zone3.Act1")
-    shutil.copy(game / "Zone1.Act1.state", game / "Zone3.Act1.state")
-    report = check_game(game, frames=FRAMES)
-    assert failed(report) == {("state is the game's", "Zone3.Act1")}, render(report)
-    assert "zone=2" in report.failures[0].message and "found zone=0" in report.failures[0].message
+def test_a_state_made_for_another_level_is_flagged_by_its_recipe(planted: GameReport) -> None:
+    message = planted_failures(planted, "Zone3.Act1")[0].message
+    assert "zone=2" in message and "found zone=0" in message
 
 
-def test_a_movie_with_the_wrong_expected_reward_fails(dasher: Callable[..., Path]) -> None:
+@pytest.fixture(scope="module")
+def planted_movies(tmp_path_factory: pytest.TempPathFactory) -> GameReport:
+    """One check of a Dasher copy with Zone1's two movies, Zone1.Act2's expected reward wrong, plus a movie without an
+    outcome (Loose), a broken one (Broken) and an outcome without a movie (Gone): each movie is checked on its own."""
     # Zone1's two movies only: the wrong one fails next to a right one, without replaying all six (the
     # shipped game passing with every movie is test_every_game_in_games_passes_check_game's claim)
-    game = dasher(movies=["Zone1.Act1", "Zone1.Act2"])
+    game = dasher_copy(tmp_path_factory.mktemp("movies"), DEFAULTS, ["Zone1.Act1", "Zone1.Act2"])
     text = (game / "game.yaml").read_text()
-    assert "\n  Zone1.Act2: {scenario: scenario, done_at: 804, reward: 3952," in text
-    (game / "game.yaml").write_text(text.replace("reward: 3952", "reward: 3900"))
-    report = check_game(game, frames=FRAMES)
-    assert failed(report) == {("movie", "Zone1.Act2")}, render(report)
-    assert "a total reward of 3900" in report.failures[0].message and "found 3952" in report.failures[0].message
-
-
-def test_movies_without_an_outcome_warn_and_missing_or_broken_ones_fail(dasher: Callable[..., Path]) -> None:
-    game = dasher()
-    (game / "movies").mkdir(exist_ok=True)  # the copy keeps the folder, empty
+    assert "\n  Zone1.Act2: {scenario: scenario, done_at: 804, reward: 3952," in text and text.endswith("}\n")
+    text = text.replace("reward: 3952", "reward: 3900") + "  Gone: {reward: 1}\n  Broken: {reward: 1}\n"
+    (game / "game.yaml").write_text(text)  # the movies section comes last
     shutil.copy(DASHER / "movies" / "Zone1.Act1.bk2", game / "movies" / "Loose.bk2")
     (game / "movies" / "Broken.bk2").write_bytes(b"PK\x03\x04 not really a zip")
-    with (game / "game.yaml").open("a") as f:
-        f.write("movies:\n  Gone: {reward: 1}\n  Broken: {reward: 1}\n")
-    report = check_game(game, frames=FRAMES)
-    assert failed(report) == {("movie", "Gone"), ("movie", "Broken")}, render(report)
+    return check_game(game, frames=FRAMES)
+
+
+def test_planted_movie_faults_fail_their_own_movies_only(planted_movies: GameReport) -> None:
+    assert failed(planted_movies) == {("movie", "Zone1.Act2"), ("movie", "Gone"), ("movie", "Broken")}, (
+        render(planted_movies)
+    )
+    assert planted_movies.find("movie", state="Zone1.Act1", status=PASS), render(planted_movies)
+
+
+def test_a_movie_with_the_wrong_expected_reward_fails(planted_movies: GameReport) -> None:
+    wrong = planted_movies.find("movie", state="Zone1.Act2")
+    assert [r.status for r in wrong] == [FAIL], render(planted_movies)
+    assert "a total reward of 3900" in wrong[0].message and "found 3952" in wrong[0].message
+
+
+def test_movies_without_an_outcome_warn_and_missing_or_broken_ones_fail(planted_movies: GameReport) -> None:
+    report = planted_movies
+    assert [r.status for r in report.find("movie", state="Gone")] == [FAIL], render(report)
+    assert [r.status for r in report.find("movie", state="Broken")] == [FAIL], render(report)
     assert report.find("movie", state="Loose")[0].status == "warn"
     assert "could not be replayed" in report.find("movie", state="Broken")[0].message
 

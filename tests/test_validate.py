@@ -91,6 +91,7 @@ def test_every_game_in_games_passes_check_game(name: str, request: pytest.Fixtur
     assert {"data file", "scenario compiles"} <= checks
     if name == "Dasher-Genesis":  # the ROM is here: everything ran
         assert {"schema", "fields in RAM", "state loads", "smoke run", "deterministic", "movie"} <= checks
+        assert len(report.find("movie start state", status=PASS)) == 6, render(report)  # loaded with the states
         assert not report.find("smoke run", status=SKIP)
     elif name in SONICS:  # without its ROM: what was checked, and what was skipped and why
         assert {"schema", "fields in RAM", "state parses", "fields decode", "table coverage"} <= checks

@@ -169,13 +169,30 @@ def test_an_overlay_game_yaml_that_cannot_be_read_is_said_not_skipped(
     overlay_folder.mkdir(parents=True)
     OVERLAYS[overlay](overlay_folder / "game.yaml")
     monkeypatch.setenv("RETROKIT_GAMES", str(tmp_path / "first"))
-    results, child = _validate(Path("Dasher-Genesis"), tmp_path)
-    data = [r for r in results if r["check"] == "data file"]
+    out = tmp_path / "report.json"
+    # validate, then make, in one child (a child each was two starts): make's error is printed, not raised, so a
+    # traceback on stderr is validate's
+    child = run_child(
+        f"""
+        import retrokit
+        from retrokit.cli import main
+        from retrokit.errors import RetrokitError
+
+        main(["validate", "Dasher-Genesis", "--frames", "5", "-q", "--json", {str(out)!r}])
+        try:
+            retrokit.make("Dasher-Genesis")
+        except RetrokitError as exc:
+            print("make refused:", " ".join(str(exc).split()))
+        """,
+        timeout=120, cwd=tmp_path,
+    )
+    assert child.signal is None and child.peak_rss_mb < MAX_RSS_MB, child.describe()
+    assert out.is_file() and "Traceback" not in child.stderr, child.describe()
+    data = [r for r in json.loads(out.read_text())["games"][0]["results"] if r["check"] == "data file"]
     assert data and data[0]["status"] == "fail", child.describe()
     assert str(overlay_folder / "game.yaml") in data[0]["message"], child.describe()
-    child = run_child("import retrokit\nretrokit.make('Dasher-Genesis')", timeout=60)
-    last = child.stderr.strip().splitlines()[-1]
-    assert child.returncode != 0 and str(overlay_folder / "game.yaml") in last, child.describe()
+    refused = [line for line in child.stdout.splitlines() if line.startswith("make refused:")]
+    assert len(refused) == 1 and str(overlay_folder / "game.yaml") in refused[0], child.describe()
 
 
 def test_a_game_folder_linking_to_itself_breaks_no_command(tmp_path: Path) -> None:

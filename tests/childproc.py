@@ -7,6 +7,7 @@ line, so a test can hold it to the 500 MB every input must stay under.
 
 from __future__ import annotations
 
+import json
 import os
 import resource
 import signal
@@ -83,3 +84,51 @@ def run_child(code: str, *, timeout: float = 60, env: dict[str, str] | None = No
 def run_cli(args: list[str], *, timeout: float = 60, env: dict[str, str] | None = None, cwd: Path | None = None) -> Child:
     """Run ``retrokit ARGS...`` in a child process."""
     return run_child(f"from retrokit.cli import main\nexit_status = main({args!r})", timeout=timeout, env=env, cwd=cwd)
+
+
+#: Runs each case's command in turn, its environment updated by the case's, and prints each answer as it ends.
+_CASES = """
+import contextlib, io, json, os, traceback
+from retrokit.cli import main
+for name, argv, env in CASES:
+    os.environ.update(env)
+    with contextlib.redirect_stdout(io.StringIO()) as out, contextlib.redirect_stderr(io.StringIO()) as err:
+        try:
+            status = main(argv)
+        except BaseException:  # what an uncaught error does to a command run alone: a traceback and status 1
+            traceback.print_exc()
+            status = 1
+    print(ANSWER, json.dumps([name, status, out.getvalue(), err.getvalue()]), flush=True)
+"""
+_ANSWER = "childproc-case-answer:"
+
+
+def run_cli_cases(
+    cases: dict[str, list[str]], *, timeout: float = 120, env: dict[str, str] | None = None,
+    case_env: dict[str, dict[str, str]] | None = None,
+) -> dict[str, Child]:
+    """Run ``retrokit ARGS...`` for each case in turn in ONE child, under the same limits as :func:`run_child`.
+
+    For several hostile inputs whose outcomes are checked one by one: a child's start and imports cost more
+    than most refusals. Each case's answer is a :class:`Child` of its own status, stdout and stderr, with the
+    child's peak memory (which bounds each command's). A case the child never answered (it crashed or hung
+    on an earlier one, or on this one) gets the child's own ending and output, so its test fails with them.
+
+    Args:
+        cases: Each case's name and command-line arguments.
+        timeout: Seconds for all the cases together.
+        env: Environment variables for the child.
+        case_env: Environment variables set before a case's command (e.g. its own RETROKIT_DATA).
+    """
+    runs = [(name, argv, (case_env or {}).get(name, {})) for name, argv in cases.items()]
+    child = run_child(f"CASES = {runs!r}\nANSWER = {_ANSWER!r}\n" + _CASES, timeout=timeout, env=env)
+    answers: dict[str, Child] = {}
+    rest = []
+    for line in child.stdout.splitlines():
+        if line.startswith(_ANSWER):
+            name, status, out, err = json.loads(line[len(_ANSWER):])
+            answers[name] = Child(status, out, err, child.peak_rss_mb)
+        else:
+            rest.append(line)
+    ended = Child(child.returncode or 1, "\n".join(rest), child.stderr, child.peak_rss_mb)
+    return {name: answers.get(name, ended) for name in cases}

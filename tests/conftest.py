@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 
 import pytest
+import suiteorder
 
 from retrokit.paths import wheel_dir
 
@@ -49,6 +50,15 @@ def pytest_xdist_auto_num_workers(config: pytest.Config) -> int:
     from retrokit.envs.vector import available_cpus
 
     return available_cpus() + 1
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    suiteorder.configure(config)
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """The longest files first (tests/suiteorder.py says why)."""
+    items[:] = suiteorder.longest_first(items)
 
 @pytest.fixture(scope="session")
 def airstriker_dir() -> Path:

@@ -37,9 +37,15 @@ def retrokit_in_process(cwd: Path, *argv: str) -> subprocess.CompletedProcess:
 _FORKING = """
 import importlib, json, os, sys
 from retrokit import cli
-argvs, folder, warm = json.loads(sys.argv[1]), sys.argv[2], json.loads(sys.argv[3])
+argvs, folder, warm, prime = json.loads(sys.argv[1]), sys.argv[2], json.loads(sys.argv[3]), json.loads(sys.argv[4])
 for module in warm:
     importlib.import_module(module)
+if prime:  # a read-only command fills the caches every command would fill (wheel listing, game folders) once
+    with open(os.devnull, "w") as nowhere:
+        sys.stdout, sys.stderr = nowhere, nowhere
+        primed = cli.main(prime)
+        sys.stdout, sys.stderr = sys.__stdout__, sys.__stderr__
+    assert primed == 0, f"the priming command {prime} failed ({primed})"
 pids = []
 for n, argv in enumerate(argvs):
     pid = os.fork()
@@ -57,17 +63,18 @@ print(json.dumps([os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]) for pid in pi
 
 
 def retrokit_at_once(
-    cwd: Path, argvs: list[list[str]], env: dict[str, str], warm: tuple[str, ...] = ()
+    cwd: Path, argvs: list[list[str]], env: dict[str, str], warm: tuple[str, ...] = (), prime: list[str] | None = None
 ) -> list[subprocess.CompletedProcess]:
     """Run ``retrokit ARGV...`` for each argv in its own process, all at once; return each as a finished child.
 
     For tests about processes racing on files: the children are forked, all before any is waited for, from one
-    interpreter that imported ``warm`` (modules) first, so what races is the commands' work, not imports.
+    interpreter that imported ``warm`` (modules) first and ran the read-only command ``prime``, if given, so what
+    races is the commands' work, not imports and first-use caches.
     """
     folder = cwd / ".at-once"
     folder.mkdir()
     done = subprocess.run(
-        [sys.executable, "-c", _FORKING, json.dumps(argvs), str(folder), json.dumps(list(warm))],
+        [sys.executable, "-c", _FORKING, json.dumps(argvs), str(folder), json.dumps(list(warm)), json.dumps(prime or [])],
         cwd=cwd, env=env, capture_output=True, text=True, timeout=600, check=False,
     )  # fmt: skip
     assert done.returncode == 0, done.stderr

@@ -42,13 +42,15 @@ def seed_shipped(store: Path, state_file: Path, rom: Path) -> Path:
     """
     import pytest
 
+    from retrokit.data.games import find_game
     from retrokit.data.statecheck import vet_state
     from retrokit.data.states import read_state
 
     seed = store / ".seed"
+    system = find_game(state_file.parent).system.name  # the game folder the state ships in
     with pytest.MonkeyPatch.context() as patch:
         patch.setenv("RETROKIT_DATA", str(seed))
-        vet_state(read_state(state_file), "Genesis", rom, shipped=state_file)
+        vet_state(read_state(state_file), system, rom, shipped=state_file)
     for verdict in (seed / "state-probes").glob("*"):
         shutil.copy(verdict, store / verdict.name)
     shutil.rmtree(seed)

@@ -1,7 +1,8 @@
 """Hostile inputs to ``retrokit import``: devices, FIFOs and zip bombs neither hang it nor blow up its memory.
 
-Each case runs in a child process with a timeout and an address-space limit
-(tests/childproc.py), so a regression fails here instead of hanging the suite.
+The cases run in a child process with a timeout and an address-space limit
+(tests/childproc.py), so a regression fails here instead of hanging the suite:
+one child for all of them, each case's command and answer its own.
 """
 
 from __future__ import annotations
@@ -13,7 +14,7 @@ from pathlib import Path
 
 import pytest
 from bombs import zip_bytes, zip_parts
-from childproc import MAX_RSS_MB, run_cli
+from childproc import MAX_RSS_MB, Child, run_cli_cases
 
 from retrokit import paths
 
@@ -59,24 +60,41 @@ CASES = {
 }
 
 
+@pytest.fixture(scope="module")
+def imports(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Child, Path]]:
+    """``retrokit import`` of each case's folder (and of a FIFO named on the command line), one child for all.
+
+    Each case has its folder and data folder; its answer is its own command's, the child's peak memory bounds each.
+    """
+    root = tmp_path_factory.mktemp("imports")
+    commands, data = {}, {}
+    for case, (make, _) in CASES.items():
+        folder = root / case / "roms"
+        folder.mkdir(parents=True)
+        make(folder)
+        (folder / "Airstriker.bin").write_bytes(AIRSTRIKER_ROM.read_bytes())  # the good ROM beside it still imports
+        data[case] = root / case / "data"
+        commands[case] = ["import", "-v", str(folder), "--data-dir", str(data[case])]
+    os.mkfifo(root / "pipe.zip")
+    data["fifo-named"] = root / "fifo-named-data"
+    commands["fifo-named"] = ["import", str(root / "pipe.zip"), "--data-dir", str(data["fifo-named"])]
+    answers = run_cli_cases(commands, timeout=120)
+    return {case: (answers[case], data[case]) for case in commands}
+
+
 @pytest.mark.parametrize("case", list(CASES), ids=list(CASES))
-def test_import_skips_hostile_files_quickly_and_in_little_memory(tmp_path: Path, case: str) -> None:
-    make, expected = CASES[case]
-    folder = tmp_path / "roms"
-    folder.mkdir()
-    make(folder)
-    (folder / "Airstriker.bin").write_bytes(AIRSTRIKER_ROM.read_bytes())  # the good ROM beside it still imports
-    child = run_cli(["import", "-v", str(folder), "--data-dir", str(tmp_path / "data")], timeout=60)
+def test_import_skips_hostile_files_quickly_and_in_little_memory(imports, case: str) -> None:
+    _, expected = CASES[case]
+    child, data = imports[case]
     assert child.returncode == 0, child.describe()
     assert "Airstriker-Genesis <- " in child.stdout, child.describe()
     assert expected in child.stdout, child.describe()
     assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
-    assert (tmp_path / "data" / "roms" / "Airstriker-Genesis" / "rom.md").is_file()
+    assert (data / "roms" / "Airstriker-Genesis" / "rom.md").is_file()
 
 
-def test_a_fifo_named_on_the_command_line_is_skipped(tmp_path: Path) -> None:
-    os.mkfifo(tmp_path / "pipe.zip")
-    child = run_cli(["import", str(tmp_path / "pipe.zip"), "--data-dir", str(tmp_path / "data")], timeout=30)
+def test_a_fifo_named_on_the_command_line_is_skipped(imports) -> None:
+    child, _ = imports["fifo-named"]
     assert child.returncode == 0, child.describe()
     assert "not a regular file" in child.stdout, child.describe()
 

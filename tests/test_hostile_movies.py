@@ -7,40 +7,51 @@ import sys
 from pathlib import Path
 
 import pytest
+from bombs import zip_bytes
+from childproc import MAX_RSS_MB, Child, run_cli, run_cli_cases
 
 from retrokit.movie import read_bk2
 from retrokit.movie.recorder import record_numbered
 
+# One interpreter imports what make() needs, then forks the recorders, all before waiting for any: what races
+# is the recording into one folder (each makes its own env and emulator), not 4 interpreters' imports.
 RECORD = """
-import sys, retrokit
-env = retrokit.make("Dasher-Genesis", record=sys.argv[1], max_episode_steps=2)
-for episode in range(int(sys.argv[2])):
-    env.reset(seed=episode)
-    done = False
-    while not done:
-        _, _, terminated, truncated, _ = env.step(env.action_space.sample())
-        done = terminated or truncated
-env.close()
+import os, sys, traceback
+import retrokit, retrokit.envs.env, retrokit.movie.recorder, retrokit.data.statecheck, retrokit.dsl.scenario
+folder, episodes, processes = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+pids = []
+for _ in range(processes):
+    pid = os.fork()
+    if pid == 0:
+        status = 1
+        try:
+            env = retrokit.make("Dasher-Genesis", record=folder, max_episode_steps=2)
+            for episode in range(episodes):
+                env.reset(seed=episode)
+                done = False
+                while not done:
+                    _, _, terminated, truncated, _ = env.step(env.action_space.sample())
+                    done = terminated or truncated
+            env.close()
+            status = 0
+        except BaseException:
+            traceback.print_exc()
+        finally:
+            sys.stderr.flush()
+            os._exit(status)
+    pids.append(pid)
+print([os.waitstatus_to_exitcode(os.waitpid(pid, 0)[1]) for pid in pids])
 """
 
 
 def test_processes_recording_into_one_folder_never_conflict(tmp_path: Path) -> None:
     # 4 writers race for the numbered names: every pair of them races as 2 alone would (2 was a case of its own)
     processes, episodes = 4, 6
-    children = [
-        subprocess.Popen([sys.executable, "-c", RECORD, str(tmp_path), str(episodes)], stderr=subprocess.PIPE, text=True)
-        for _ in range(processes)
-    ]
-    errors = []
-    for child in children:
-        try:
-            _, err = child.communicate(timeout=120)
-        except subprocess.TimeoutExpired:
-            child.kill()
-            raise
-        if child.returncode:
-            errors.append(err)
-    assert errors == []
+    done = subprocess.run(
+        [sys.executable, "-c", RECORD, str(tmp_path), str(episodes), str(processes)],
+        capture_output=True, text=True, timeout=120, check=False,
+    )  # fmt: skip
+    assert done.returncode == 0 and done.stdout.strip() == str([0] * processes), done.stdout + done.stderr
     movies = sorted(tmp_path.glob("*.bk2"))
     assert len(movies) == processes * episodes
     assert all(len(read_bk2(m).frames) == 2 * 1 for m in movies)  # each a whole movie (2 steps of 1 frame)
@@ -81,7 +92,6 @@ def long_movie(tmp_path_factory: pytest.TempPathFactory) -> Path:
 
 
 def test_a_long_gif_export_streams_its_frames_at_30_fps(long_movie: Path, tmp_path: Path) -> None:
-    from childproc import MAX_RSS_MB, run_cli
     from PIL import Image, ImageSequence
 
     out = tmp_path / "long.gif"
@@ -110,16 +120,55 @@ def test_gif_frame_delays_add_up_to_the_true_time(fps: float, step: int, delays:
     assert sum(writer.delay_ms(i) for i in range(300)) == round(300 * 1000 * step / fps, -1)
 
 
-@pytest.mark.parametrize("member", ["Input Log.txt", "Header.txt"], ids=["input-log-bomb", "header-bomb"])
-def test_a_movie_member_that_inflates_to_a_gigabyte_is_refused(tmp_path: Path, member: str) -> None:
-    from bombs import zip_bytes
-    from childproc import MAX_RSS_MB, run_cli
+BOMBS = {"input-log-bomb": "Input Log.txt", "header-bomb": "Header.txt"}
 
-    small = {"Input Log.txt": b"[Input]\nP1 B|\n|..|.|\n[/Input]", "Header.txt": b"Platform GEN\nGameName Dasher-Genesis-v0\n"}
-    members = [(name, [1024] if name == member else [data], True) for name, data in small.items()]
-    path = tmp_path / "bomb.bk2"
-    path.write_bytes(zip_bytes(members))
-    child = run_cli(["playback", str(path), str(tmp_path / "out")], timeout=60)
+
+@pytest.fixture(scope="module")
+def bomb_playbacks(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Child]:
+    """Each bomb played back by its own command, all in one child under the memory cap (its peak bounds each)."""
+    folder = tmp_path_factory.mktemp("bombs")
+    small = {
+        "Input Log.txt": b"[Input]\nP1 B|\n|..|.|\n[/Input]",
+        "Header.txt": b"Platform GEN\nGameName Dasher-Genesis-v0\n",
+    }
+    commands = {}
+    for case, member in BOMBS.items():
+        members = [(name, [1024] if name == member else [data], True) for name, data in small.items()]
+        path = folder / f"{case}.bk2"
+        path.write_bytes(zip_bytes(members))
+        commands[case] = ["playback", str(path), str(folder / f"{case}.out")]
+    return run_cli_cases(commands)
+
+
+@pytest.mark.parametrize("case", list(BOMBS))
+def test_a_movie_member_that_inflates_to_a_gigabyte_is_refused(bomb_playbacks: dict[str, Child], case: str) -> None:
+    child = bomb_playbacks[case]
     assert child.returncode == 2, child.describe()
-    assert f"expected {member!r} to hold at most" in child.stderr, child.describe()
+    assert f"expected {BOMBS[case]!r} to hold at most" in child.stderr, child.describe()
     assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
+
+
+@pytest.mark.parametrize("count", [200, 4096], ids=["200-close-colours-kept-exactly", "4096-colours-reduced"])
+def test_a_gif_frame_keeps_its_colours_exactly_when_a_palette_can_hold_them(count: int) -> None:
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    from retrokit.movie.gif import GifWriter
+
+    rng = np.random.default_rng(count)
+    colours = rng.integers(0, 256, (count, 3)).astype(np.uint8)
+    colours[:50] = [[100 + i // 10, 100 + i % 10, 100] for i in range(50)]  # neighbours differing in the low bits
+    colours = np.unique(colours, axis=0)
+    frame = colours[np.arange(224 * 320) % len(colours)].reshape(224, 320, 3)
+    stream = io.BytesIO()
+    writer = GifWriter(stream, 30)
+    writer.add(frame)
+    writer.close()
+    with Image.open(io.BytesIO(stream.getvalue())) as gif:
+        shown = np.asarray(gif.convert("RGB"))
+    if len(colours) <= 256:
+        assert np.array_equal(shown, frame)
+    else:  # more than a GIF frame holds: an adaptive palette of 256, every pixel near its colour
+        assert len(np.unique(shown.reshape(-1, 3), axis=0)) <= 256 and np.abs(shown.astype(int) - frame).mean() < 16

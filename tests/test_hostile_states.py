@@ -8,13 +8,16 @@ killing the suite.
 from __future__ import annotations
 
 import gzip
+import hashlib
+import json
 import shutil
 import zipfile
 from pathlib import Path
 
 import pytest
 from bombs import gzip_of_zeros, zip_bytes
-from childproc import MAX_RSS_MB, REPO, run_child, run_cli
+from childproc import MAX_RSS_MB, REPO, Child, run_child, run_cli_cases
+from probestore import seed_shipped, shared_verdicts
 
 from retrokit.data.games import cached_rom_sha1, find_game
 from retrokit.data.probe import probe_key, probe_state
@@ -29,6 +32,25 @@ DASHER = REPO / "games" / "Dasher-Genesis"
 def bomb() -> bytes:
     """About 1 MiB of gzip that inflates to 1 GiB."""
     return gzip_of_zeros(1024)
+
+
+@pytest.fixture(scope="module")
+def verdicts(tmp_path_factory: pytest.TempPathFactory, corrupt_state: bytes) -> Path:
+    """The corrupt state vetted once in a bare data folder (a real probe, SIGSEGV): that folder's verdicts.
+
+    test_a_probe_verdict_is_cached_by_sha256 checks this first vetting; the tests that refuse the state through a
+    command start their data folders from its verdict, as on a machine that probed the state before: the state is
+    still vetted (a command that skipped vetting would load it and crash), by its verdict.
+    """
+    from retrokit.data import probe
+
+    data = tmp_path_factory.mktemp("probing")
+    rom = DASHER / "rom.md"
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("RETROKIT_DATA", str(data))
+        with pytest.raises(StateError, match="SIGSEGV"):
+            probe.vet_state(corrupt_state, "Genesis", rom, cached_rom_sha1(rom, "Genesis"), source="x")
+    return data / "state-probes"
 
 
 def test_the_corrupt_state_really_crashes_the_core(corrupt_state: bytes) -> None:
@@ -53,34 +75,57 @@ def _bomb_movie(tmp_path: Path) -> Path:
     return path
 
 
-MAKE = "import retrokit\nenv = retrokit.make('Dasher-Genesis', {state!r})\nenv.reset()\nprint('played')"
+HOSTILE_STATES = {"corrupt-body": "SIGSEGV", "gzip-bomb": "inflates past"}  # each case, and what refuses it
 
 
-@pytest.mark.parametrize("kind", ["corrupt", "gzip-bomb"], ids=["corrupt-body", "gzip-bomb"])
-def test_make_refuses_a_hostile_state_file(tmp_path: Path, kind: str, corrupt_state: bytes, bomb: bytes) -> None:
-    path = tmp_path / "hostile.state"
-    path.write_bytes(compress_state(corrupt_state) if kind == "corrupt" else bomb)
-    child = run_child(
-        "from retrokit.errors import StateError\ntry:\n" + "\n".join("    " + line for line in MAKE.format(state=str(path)).splitlines())
-        + "\nexcept StateError as exc:\n    print('refused:', exc)",
-        env={"RETROKIT_DATA": str(tmp_path / "data")},
-    )
+@pytest.fixture(scope="module")
+def makes(
+    tmp_path_factory: pytest.TempPathFactory, corrupt_state: bytes, bomb: bytes, verdicts: Path
+) -> tuple[dict, Child]:
+    """make() on each hostile state file, in one child under the memory cap: what each answered, and the child.
+
+    Each case is its own make(); the child's peak memory bounds each one's.
+    """
+    folder = tmp_path_factory.mktemp("hostile-states")
+    paths = {"corrupt-body": str(folder / "corrupt.state"), "gzip-bomb": str(folder / "bomb.state")}
+    Path(paths["corrupt-body"]).write_bytes(compress_state(corrupt_state))
+    Path(paths["gzip-bomb"]).write_bytes(bomb)
+    with shared_verdicts(verdicts, folder / "data"):
+        child = run_child(f"""
+            import json
+            import retrokit
+            from retrokit.errors import StateError
+            answers = {{}}
+            for case, path in {paths!r}.items():
+                try:
+                    env = retrokit.make('Dasher-Genesis', path)
+                    env.reset()
+                    answers[case] = 'played'
+                except StateError as exc:
+                    answers[case] = f'refused: {{exc}}'
+            print(json.dumps(answers))
+            """, env={"RETROKIT_DATA": str(folder / "data")})
     assert child.returncode == 0, child.describe()
-    assert "refused:" in child.stdout and "played" not in child.stdout, child.describe()
-    assert ("SIGSEGV" if kind == "corrupt" else "inflates past") in child.stdout, child.describe()
+    return json.loads(child.stdout), child
+
+
+@pytest.mark.parametrize("kind", list(HOSTILE_STATES))
+def test_make_refuses_a_hostile_state_file(makes: tuple[dict, Child], kind: str) -> None:
+    answers, child = makes
+    assert answers[kind].startswith("refused:"), (answers[kind], child.describe())
+    assert HOSTILE_STATES[kind] in answers[kind], answers[kind]
     assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
 
 
-def test_a_probe_verdict_is_cached_by_sha256(tmp_path: Path, corrupt_state: bytes, monkeypatch) -> None:
+def test_a_probe_verdict_is_cached_by_sha256(corrupt_state: bytes, verdicts: Path, monkeypatch) -> None:
     from retrokit.data import probe
 
-    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
     rom = DASHER / "rom.md"
     sha1 = cached_rom_sha1(rom, "Genesis")
-    with pytest.raises(StateError, match="SIGSEGV"):
-        probe.vet_state(corrupt_state, "Genesis", rom, sha1, source="x")
-    cache = tmp_path / "data" / "state-probes" / probe_key(corrupt_state, "Genesis", sha1)
+    # the first vetting, in a bare data folder, probed and was refused: the verdicts fixture
+    cache = verdicts / probe_key(corrupt_state, "Genesis", sha1)
     assert cache.is_file()
+    monkeypatch.setenv("RETROKIT_DATA", str(verdicts.parent))
     monkeypatch.setattr(probe, "probe_state", lambda *a, **k: pytest.fail("probed again"))
     with pytest.raises(StateError, match="SIGSEGV"):
         probe.vet_state(corrupt_state, "Genesis", rom, sha1, source="x")
@@ -192,7 +237,9 @@ def test_shipped_and_recorded_states_need_no_probe(tmp_path: Path, good_state: b
     assert statecheck.load_state(game, mine) == good_state  # written by retrokit, unchanged
 
 
-def test_a_state_changed_since_retrokit_wrote_it_is_probed(tmp_path: Path, corrupt_state: bytes, monkeypatch) -> None:
+def test_a_state_changed_since_retrokit_wrote_it_is_probed(
+    tmp_path: Path, corrupt_state: bytes, verdicts: Path, monkeypatch
+) -> None:
     monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
     from retrokit.data import statecheck
 
@@ -200,45 +247,95 @@ def test_a_state_changed_since_retrokit_wrote_it_is_probed(tmp_path: Path, corru
     record = StateRecord.of(game.name, game.sha1s[0], b"some other state")  # the record no longer describes the body
     path = tmp_path / "edited.state"
     path.write_bytes(compress_state(corrupt_state, record))
-    with pytest.raises(StateError, match="SIGSEGV"):
-        statecheck.load_state(game, path)
+    with shared_verdicts(verdicts, tmp_path / "data"), pytest.raises(StateError, match="SIGSEGV"):
+        statecheck.load_state(game, path)  # vetted (here by the verdict of the module's probe), not trusted
 
 
-@pytest.mark.parametrize("kind", ["corrupt", "gzip-bomb"], ids=["corrupt-core-bin", "gzip-bomb-core-bin"])
-def test_playback_refuses_a_hostile_core_bin(tmp_path: Path, kind: str, corrupt_state: bytes) -> None:
-    movie = _movie(tmp_path, corrupt_state) if kind == "corrupt" else _bomb_movie(tmp_path)
-    child = run_cli(["playback", str(movie), str(tmp_path / "out.gif")], env={"RETROKIT_DATA": str(tmp_path / "data")})
+HOSTILE_CORE_BINS = {"corrupt-core-bin": "SIGSEGV", "gzip-bomb-core-bin": "at most"}  # each case, and its message
+
+
+@pytest.fixture(scope="module")
+def playbacks(
+    tmp_path_factory: pytest.TempPathFactory, corrupt_state: bytes, good_state: bytes, verdicts: Path
+) -> dict[str, tuple[Child, str, str]]:
+    """``retrokit playback`` of each hostile movie, each its own command, all in one child under the memory cap:
+    each command's answer (the child's peak memory bounds each), movie and output path."""
+    folder = tmp_path_factory.mktemp("hostile-movies")
+    for case in ("corrupt", "bomb", "other"):
+        (folder / case).mkdir()
+    # A Dasher movie's Core.bin and header, under Airstriker's name.
+    dasher = find_game("Dasher-Genesis")
+    header = {"SHA1": dasher.sha1s[0], "StateSHA256": StateRecord.of(dasher.name, dasher.sha1s[0], good_state).sha256}
+    cases = {
+        "corrupt-core-bin": (str(_movie(folder / "corrupt", corrupt_state)), str(folder / "corrupt" / "out.gif")),
+        "gzip-bomb-core-bin": (str(_bomb_movie(folder / "bomb")), str(folder / "bomb" / "out.gif")),
+        "another-games-state": (
+            str(_movie(folder / "other", good_state, game="Airstriker-Genesis", header=header)),
+            str(folder / "other" / "out"),
+        ),
+    }
+    with shared_verdicts(verdicts, folder / "data"):
+        answers = run_cli_cases(
+            {case: ["playback", movie, out] for case, (movie, out) in cases.items()},
+            env={"RETROKIT_DATA": str(folder / "data")},
+        )
+    return {case: (answers[case], movie, out) for case, (movie, out) in cases.items()}
+
+
+@pytest.mark.parametrize("kind", list(HOSTILE_CORE_BINS))
+def test_playback_refuses_a_hostile_core_bin(playbacks: dict[str, tuple[Child, str, str]], kind: str) -> None:
+    child, movie, out = playbacks[kind]
     assert child.returncode == 2, child.describe()
     last = child.stderr.strip().splitlines()[-1]
     assert last.startswith(f"retrokit: error: {movie}") and "Traceback" not in child.stderr, child.describe()
-    assert ("SIGSEGV" if kind == "corrupt" else "at most") in last, child.describe()
+    assert HOSTILE_CORE_BINS[kind] in last, child.describe()
     assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
-    assert not (tmp_path / "out.gif").exists()
+    assert not Path(out).exists()
 
 
-@pytest.fixture
-def dasher_copy(tmp_path: Path) -> Path:
-    folder = tmp_path / "games" / "Dasher-Genesis"
+@pytest.fixture(scope="module")
+def integrations(tmp_path_factory: pytest.TempPathFactory, corrupt_state: bytes, verdicts: Path) -> dict:
+    """``retrokit integrate`` over a damaged Zone1.Act1.state of a Dasher copy, without then with --force, in one child.
+
+    Each command's status and stdout, and the SHA-256 of the state file after it.
+    """
+    tmp = tmp_path_factory.mktemp("integrate")
+    folder = tmp / "games" / "Dasher-Genesis"
     folder.mkdir(parents=True)
     for name in ("game.yaml", "rom.md", "scenario.yaml"):
         shutil.copy(DASHER / name, folder / name)
-    return folder
+    damaged = folder / "Zone1.Act1.state"
+    damaged.write_bytes(compress_state(corrupt_state))
+    args = ["integrate", "Dasher-Genesis", "--state", "Zone1.Act1", "--out", str(folder)]  # over the damaged one
+    runs = {"check": args, "force": [*args, "--force"]}  # check first: it must leave the damaged state as it was
+    env = {"RETROKIT_GAMES": str(folder.parent), "RETROKIT_DATA": str(tmp / "data")}
+    with shared_verdicts(verdicts, tmp / "data"):
+        child = run_child(f"""
+            import contextlib, hashlib, io, json
+            from retrokit.cli import main
+            answers = {{}}
+            for case, args in {runs!r}.items():
+                with contextlib.redirect_stdout(io.StringIO()) as out:
+                    status = main(args)
+                state = open({str(damaged)!r}, 'rb').read()
+                answers[case] = [status, out.getvalue(), hashlib.sha256(state).hexdigest()]
+            print(json.dumps(answers))
+            """, env=env)
+    assert child.returncode == 0, child.describe()
+    return {"answers": json.loads(child.stdout), "state": damaged, "child": child}
 
 
 @pytest.mark.parametrize("force", [False, True], ids=["check", "force"])
-def test_integrate_over_a_damaged_state(tmp_path: Path, dasher_copy: Path, corrupt_state: bytes, force: bool) -> None:
-    damaged = dasher_copy / "Zone1.Act1.state"
-    damaged.write_bytes(compress_state(corrupt_state))
-    args = ["integrate", "Dasher-Genesis", "--state", "Zone1.Act1", "--out", str(dasher_copy)]  # over the damaged one
-    args += ["--force"] if force else []
-    env = {"RETROKIT_GAMES": str(dasher_copy.parent), "RETROKIT_DATA": str(tmp_path / "data")}
-    child = run_cli(args, env=env)
-    assert child.returncode == (0 if force else 1), child.describe()
-    assert ("replaced" if force else "damaged") in child.stdout, child.describe()
+def test_integrate_over_a_damaged_state(integrations: dict, corrupt_state: bytes, force: bool) -> None:
+    status, stdout, state_sha256 = integrations["answers"]["force" if force else "check"]
+    assert status == (0 if force else 1), (stdout, integrations["child"].describe())
+    assert ("replaced" if force else "damaged") in stdout, stdout
     if force:
+        damaged = integrations["state"]
         assert read_state_file(damaged).record.describes(read_state(damaged))
+        assert state_sha256 == hashlib.sha256(damaged.read_bytes()).hexdigest()
     else:
-        assert damaged.read_bytes() == compress_state(corrupt_state)  # kept as it was
+        assert state_sha256 == hashlib.sha256(compress_state(corrupt_state)).hexdigest()  # kept as it was
 
 
 # --- another game's state ---------------------------------------------------------------------
@@ -273,14 +370,10 @@ def test_make_refuses_another_games_recorded_state() -> None:
         retrokit.make("Airstriker-Genesis", str(DASHER / "Zone1.Act1.state"))
 
 
-def test_playback_refuses_a_movie_recorded_with_another_games_state(tmp_path: Path, good_state: bytes) -> None:
-    # A Dasher movie's Core.bin and header, under Airstriker's name.
-    dasher = find_game("Dasher-Genesis")
-    header = {"SHA1": dasher.sha1s[0], "StateSHA256": StateRecord.of(dasher.name, dasher.sha1s[0], good_state).sha256}
-    movie = _movie(tmp_path, good_state, game="Airstriker-Genesis", header=header)
-    child = run_cli(["playback", str(movie), str(tmp_path / "out")])
+def test_playback_refuses_a_movie_recorded_with_another_games_state(playbacks) -> None:
+    child, _, _ = playbacks["another-games-state"]  # the playbacks fixture's Dasher movie under Airstriker's name
     assert child.returncode == 2, child.describe()
-    assert f"recorded on another ROM (SHA-1 {dasher.sha1s[0]})" in child.stderr, child.describe()
+    assert f"recorded on another ROM (SHA-1 {find_game('Dasher-Genesis').sha1s[0]})" in child.stderr, child.describe()
 
 
 def test_a_recorded_movie_names_its_rom_and_state(tmp_path: Path) -> None:
@@ -311,7 +404,11 @@ def test_make_refuses_a_state_from_another_games_folder(airstriker_dir: Path) ->
 def test_games_sharing_a_rom_may_share_states(tmp_path: Path, good_state: bytes, monkeypatch) -> None:
     from retrokit.data.statecheck import load_state
 
-    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    # as on a machine that loaded Dasher's shipped Zone1.Act1 before: known by its bytes, not probed again (what
+    # is tested is that the twin's folder, another integration of the same ROM, does not refuse it)
+    (tmp_path / "data" / "state-probes").mkdir(parents=True)
+    data = seed_shipped(tmp_path / "data" / "state-probes", DASHER / "Zone1.Act1.state", DASHER / "rom.md").parent
+    monkeypatch.setenv("RETROKIT_DATA", str(data))
     twin = tmp_path / "DasherTwin-Genesis"  # another integration of Dasher's ROM, with a state of its own
     twin.mkdir()
     shutil.copy(DASHER / "game.yaml", twin / "game.yaml")

@@ -3,17 +3,21 @@
 Dasher's shipped states are known by their digest, whatever file holds them,
 whether or not their record was stripped, and whatever a movie's header
 around them says.
-Each runs in a child process: another game's state may crash the core.
+Another game's state may crash the core, so every case runs in a child process: all of them in one (an
+interpreter and retrokit's imports are most of a case's cost), each with a data folder of its own and its
+answer printed as it ends, so a crash names its case and every test checks its own case's answer.
 """
 
 from __future__ import annotations
 
 import hashlib
+import json
 import shutil
 from pathlib import Path
+from typing import Any
 
 import pytest
-from childproc import run_child, run_cli
+from childproc import run_child
 
 from retrokit.data.games import find_game
 from retrokit.data.states import compress_state, read_state_file
@@ -24,15 +28,32 @@ REPO = Path(__file__).resolve().parent.parent
 DASHER_STATE = REPO / "games" / "Dasher-Genesis" / "Zone1.Act1.state"
 AIRSTRIKER = "Airstriker-Genesis"
 
+#: Runs each case (a command line or a snippet) with RETROKIT_DATA of its own, printing one JSON line per case.
+RUN_CASES = """
+import contextlib, io, json, os, traceback
+from retrokit.cli import main
+for name, data, kind, what in CASES:
+    os.environ["RETROKIT_DATA"] = data
+    out, err = io.StringIO(), io.StringIO()
+    answer = {"case": name}
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            if kind == "cli":
+                answer["status"] = main(what)
+            else:
+                exec(what, {})
+    except Exception:
+        answer["error"] = traceback.format_exc()
+    answer.update(stdout=out.getvalue(), stderr=err.getvalue())
+    print(json.dumps(answer), flush=True)
+"""
 
-@pytest.fixture
-def data(tmp_path: Path) -> dict[str, str]:
-    return {"RETROKIT_DATA": str(tmp_path / "data")}
-
-
-@pytest.fixture
 def dasher_data() -> bytes:
     return read_state_file(DASHER_STATE).data
+
+
+def airstriker_file() -> Path:
+    return find_game(AIRSTRIKER).state_path()  # the wheel's Level1.state
 
 
 def movie_for_airstriker(path: Path, state: bytes, header: dict[str, str]) -> Path:
@@ -42,102 +63,54 @@ def movie_for_airstriker(path: Path, state: bytes, header: dict[str, str]) -> Pa
     return path
 
 
-def refused(child) -> str:
-    assert child.signal is None and child.returncode == 2, child.describe()
-    last = child.stderr.strip().splitlines()[-1]
-    assert last.startswith("retrokit: error:") and "Traceback" not in child.stderr, child.describe()
+def refused(answer: dict) -> str:
+    """The error line of a command the case expected to refuse its input."""
+    assert "error" not in answer and answer.get("status") == 2, answer
+    last = answer["stderr"].strip().splitlines()[-1]
+    assert last.startswith("retrokit: error:") and "Traceback" not in answer["stderr"], answer
     return last
 
 
-def test_make_refuses_dashers_state_without_its_record_for_airstriker(tmp_path, data, dasher_data):
-    stripped = tmp_path / "Level1.state"
-    stripped.write_bytes(compress_state(dasher_data, None))  # no record: only its digest tells whose it is
-    child = run_child(
-        "import retrokit\nfrom retrokit.errors import StateError\n"
-        f"try:\n    retrokit.make({AIRSTRIKER!r}, state={str(stripped)!r}).reset()\n    print('played')\n"
-        "except StateError as exc:\n    print('refused:', exc)\n"
-        f"retrokit.make('Dasher-Genesis', state={str(stripped)!r}).reset()\nprint('its own game plays it')\n",
-        env=data, timeout=120,
-    )
-    assert child.returncode == 0, child.describe()
-    assert "refused:" in child.stdout and "Dasher-Genesis's state" in child.stdout, child.describe()
-    assert "its own game plays it" in child.stdout
+def printed(answer: dict) -> str:
+    """What a snippet case printed, once it ran to its end."""
+    assert "error" not in answer, answer["error"]
+    return answer["stdout"]
 
 
-@pytest.mark.parametrize("command", ["playback", "integrate"])
-def test_a_movie_whose_core_bin_is_another_games_state_is_refused(tmp_path, data, dasher_data, command):
-    movie = movie_for_airstriker(tmp_path / "m.bk2", dasher_data, {})  # a stable-retro header: no SHA1
-    args = (["playback", str(movie), str(tmp_path / "out")] if command == "playback"
-            else ["integrate", AIRSTRIKER, "Made", "--movie", str(movie)])  # fmt: skip
-    assert "Dasher-Genesis's state" in refused(run_cli(args, env=data, timeout=120))
+MAKE_STRIPPED_DASHER = f"""
+import retrokit
+from retrokit.errors import StateError
+try:
+    retrokit.make({AIRSTRIKER!r}, state=STATE).reset()
+    print('played')
+except StateError as exc:
+    print('refused:', exc)
+retrokit.make('Dasher-Genesis', state=STATE).reset()
+print('its own game plays it')
+"""
 
+MAKE_FOREIGN = """
+import retrokit
+from retrokit.errors import StateError
+try:
+    retrokit.make('Dasher-Genesis', state=STATE).reset()
+    print('played')
+except StateError as exc:
+    print('refused:', exc)
+"""
 
-def test_a_movie_whose_core_bin_was_swapped_is_refused_by_its_header(tmp_path, data, dasher_data):
-    game = find_game(AIRSTRIKER)
-    sha1, own = game.sha1s[0], read_state_file(game.state_path()).data
-    header = {"SHA1": sha1, STATE_DIGEST: hashlib.sha256(own).hexdigest()}  # the header of Airstriker's own start
-    movie = movie_for_airstriker(tmp_path / "m.bk2", dasher_data, header)
-    assert "Dasher-Genesis's state" in refused(
-        run_cli(["playback", str(movie), str(tmp_path / "out")], env=data, timeout=120)
-    )
-
-
-# --- the stable-retro wheel's states, and those this machine saved (each known by its game) --------------------
-
-
-@pytest.fixture
-def airstriker_file() -> Path:
-    return find_game(AIRSTRIKER).state_path()  # the wheel's Level1.state
-
-
-@pytest.mark.parametrize("wrapping", ["the-wheels-file-copied", "recompressed-without-record"])
-def test_make_refuses_airstrikers_wheel_state_for_dasher(tmp_path, data, airstriker_file, wrapping):
-    foreign = tmp_path / "Zone1.Act1.state"  # outside any game's folder: only the state's identity tells
-    if wrapping == "the-wheels-file-copied":
-        foreign.write_bytes(airstriker_file.read_bytes())  # known by the file's digest in the wheel's RECORD
-    else:
-        foreign.write_bytes(compress_state(read_state_file(airstriker_file).data, None))  # by the state's digest
-    child = run_child(
-        "import retrokit\nfrom retrokit.errors import StateError\n"
-        f"try:\n    retrokit.make('Dasher-Genesis', state={str(foreign)!r}).reset()\n    print('played')\n"
-        "except StateError as exc:\n    print('refused:', exc)\n",
-        env=data, timeout=120,
-    )
-    assert child.returncode == 0, child.describe()
-    assert f"refused: {foreign}: expected a state of Dasher-Genesis; found {AIRSTRIKER}'s state" in child.stdout, (
-        child.describe()
-    )
-    assert "the stable-retro wheel ships it" in child.stdout and f"Load it with {AIRSTRIKER}" in child.stdout
-
-
-@pytest.mark.parametrize("command", ["playback", "integrate"])
-def test_a_dasher_movie_whose_core_bin_is_airstrikers_state_is_refused(tmp_path, data, airstriker_file, command):
-    movie = Movie("Dasher-Genesis", "Genesis", 1, read_state_file(airstriker_file).data, [(0,)] * 30)
-    write_bk2(tmp_path / "m.bk2", movie)
-    args = (["playback", str(tmp_path / "m.bk2"), str(tmp_path / "out")] if command == "playback"
-            else ["integrate", "Dasher-Genesis", "Made", "--out", str(tmp_path / "made"), "--movie", str(tmp_path / "m.bk2")])  # fmt: skip
-    assert f"{AIRSTRIKER}'s state" in refused(run_cli(args, env=data, timeout=120))
-    assert not (tmp_path / "made").exists() or not list((tmp_path / "made").iterdir())
-
-
-@pytest.mark.parametrize(("host", "owner"), [("Dasher-Genesis", AIRSTRIKER), (AIRSTRIKER, "Dasher-Genesis")])
-def test_the_studio_refuses_another_games_state_put_in_the_games_folder(tmp_path, data, host, owner):
-    game = shutil.copytree(find_game(host).folders[0], tmp_path / host)  # a copy of the game, its ROM found by hash
-    (game / "Foreign.state").write_bytes(compress_state(read_state_file(find_game(owner).state_path()).data, None))
-    child = run_child(
-        "from retrokit.errors import StateError\nfrom retrokit.studio import play\n"
-        "from retrokit.studio.session import Session\n"
-        f"session = Session({str(game)!r})\n"
-        "try:\n    session.call_blocking(play.reset, 'Foreign')\n    print('loaded')\n"
-        "except StateError as exc:\n    print('refused:', exc)\n"
-        "session.close()\n",
-        env=data, timeout=120,
-    )
-    assert child.returncode == 0, child.describe()
-    assert f"refused: {game / 'Foreign.state'}: expected a state of {host}; found {owner}'s state" in child.stdout, (
-        child.describe()
-    )
-
+STUDIO_RESET = """
+from retrokit.errors import StateError
+from retrokit.studio import play
+from retrokit.studio.session import Session
+session = Session(GAME)
+try:
+    session.call_blocking(play.reset, 'Foreign')
+    print('loaded')
+except StateError as exc:
+    print('refused:', exc)
+session.close()
+"""
 
 SAVE_AND_LOAD = """
 from pathlib import Path
@@ -166,12 +139,130 @@ retrokit.make({saver!r}, state=stripped).reset()
 print("its own game plays it")
 """
 
+PAIRS = [(AIRSTRIKER, "Dasher-Genesis"), ("Dasher-Genesis", AIRSTRIKER)]
+COMMANDS = ["playback", "integrate"]
+WRAPPINGS = ["the-wheels-file-copied", "recompressed-without-record"]
 
-@pytest.mark.parametrize(("saver", "loader"), [(AIRSTRIKER, "Dasher-Genesis"), ("Dasher-Genesis", AIRSTRIKER)])
-def test_a_state_this_machine_saved_for_one_game_is_refused_for_another(tmp_path, data, saver, loader):
-    folder = tmp_path / "saved"
-    folder.mkdir()
-    child = run_child(SAVE_AND_LOAD.format(saver=saver, loader=loader, folder=str(folder)), env=data, timeout=180)
-    assert child.returncode == 0, child.describe()
-    assert f"found {saver}'s state (this machine saved it for {saver}" in child.stdout, child.describe()
-    assert "its own game plays it" in child.stdout, child.describe()
+
+@pytest.fixture(scope="module")
+def cases(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
+    """Every case's inputs, made here, and its answer from the one child: ``{name: {"answer", "folder", ...}}``."""
+    root = tmp_path_factory.mktemp("cases")
+    built: dict[str, dict[str, Any]] = {}
+    runs: list[tuple[str, str, str, Any]] = []
+
+    def case(name: str, kind: str, what: Any, folder: Path, **facts: Any) -> None:
+        built[name] = {"folder": folder, **facts}
+        runs.append((name, str(folder / "data"), kind, what))
+
+    def folder_of(name: str) -> Path:
+        folder = root / name
+        folder.mkdir()
+        return folder
+
+    dasher, airstriker = dasher_data(), read_state_file(airstriker_file()).data
+
+    tmp = folder_of("make-stripped-dasher")
+    stripped = tmp / "Level1.state"
+    stripped.write_bytes(compress_state(dasher, None))  # no record: only its digest tells whose it is
+    case("make-stripped-dasher", "code", f"STATE = {str(stripped)!r}\n" + MAKE_STRIPPED_DASHER, tmp)
+
+    for command in COMMANDS:
+        tmp = folder_of(f"dasher-core-bin-{command}")
+        movie = movie_for_airstriker(tmp / "m.bk2", dasher, {})  # a stable-retro header: no SHA1
+        args = (["playback", str(movie), str(tmp / "out")] if command == "playback"
+                else ["integrate", AIRSTRIKER, "Made", "--movie", str(movie)])  # fmt: skip
+        case(f"dasher-core-bin-{command}", "cli", args, tmp)
+
+    tmp = folder_of("swapped-core-bin")
+    game = find_game(AIRSTRIKER)
+    header = {"SHA1": game.sha1s[0], STATE_DIGEST: hashlib.sha256(airstriker).hexdigest()}  # Airstriker's own start
+    movie = movie_for_airstriker(tmp / "m.bk2", dasher, header)
+    case("swapped-core-bin", "cli", ["playback", str(movie), str(tmp / "out")], tmp)
+
+    for wrapping in WRAPPINGS:
+        tmp = folder_of(f"wheel-state-{wrapping}")
+        foreign = tmp / "Zone1.Act1.state"  # outside any game's folder: only the state's identity tells
+        if wrapping == "the-wheels-file-copied":
+            foreign.write_bytes(airstriker_file().read_bytes())  # known by the file's digest in the wheel's RECORD
+        else:
+            foreign.write_bytes(compress_state(airstriker, None))  # by the state's digest
+        case(f"wheel-state-{wrapping}", "code", f"STATE = {str(foreign)!r}\n" + MAKE_FOREIGN, tmp, state=foreign)
+
+    for command in COMMANDS:
+        tmp = folder_of(f"airstriker-core-bin-{command}")
+        write_bk2(tmp / "m.bk2", Movie("Dasher-Genesis", "Genesis", 1, airstriker, [(0,)] * 30))
+        movie = str(tmp / "m.bk2")
+        args = (["playback", movie, str(tmp / "out")] if command == "playback"
+                else ["integrate", "Dasher-Genesis", "Made", "--out", str(tmp / "made"), "--movie", movie])  # fmt: skip
+        case(f"airstriker-core-bin-{command}", "cli", args, tmp)
+
+    for host, owner in PAIRS:
+        tmp = folder_of(f"studio-{host}")
+        game_copy = shutil.copytree(find_game(host).folders[0], tmp / host)  # a copy of the game, its ROM found by hash
+        owners = read_state_file(find_game(owner).state_path()).data
+        (game_copy / "Foreign.state").write_bytes(compress_state(owners, None))
+        case(f"studio-{host}", "code", f"GAME = {str(game_copy)!r}\n" + STUDIO_RESET, tmp, game=game_copy)
+
+    for saver, loader in PAIRS:
+        tmp = folder_of(f"saved-by-{saver}")
+        (tmp / "saved").mkdir()
+        code = SAVE_AND_LOAD.format(saver=saver, loader=loader, folder=str(tmp / "saved"))
+        case(f"saved-by-{saver}", "code", code, tmp)
+
+    child = run_child(f"CASES = {runs!r}\n" + RUN_CASES, timeout=600)
+    answers = {answer["case"]: answer for answer in map(json.loads, child.stdout.splitlines()) if answer}
+    for name, facts in built.items():
+        ended = f"the child ended before this case's answer: {child.describe()}"
+        facts["answer"] = answers.get(name) or {"error": ended}
+    return built
+
+
+def test_make_refuses_dashers_state_without_its_record_for_airstriker(cases):
+    stdout = printed(cases["make-stripped-dasher"]["answer"])
+    assert "refused:" in stdout and "Dasher-Genesis's state" in stdout, stdout
+    assert "its own game plays it" in stdout
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_a_movie_whose_core_bin_is_another_games_state_is_refused(cases, command):
+    assert "Dasher-Genesis's state" in refused(cases[f"dasher-core-bin-{command}"]["answer"])
+
+
+def test_a_movie_whose_core_bin_was_swapped_is_refused_by_its_header(cases):
+    assert "Dasher-Genesis's state" in refused(cases["swapped-core-bin"]["answer"])
+
+
+# --- the stable-retro wheel's states, and those this machine saved (each known by its game) --------------------
+
+
+@pytest.mark.parametrize("wrapping", WRAPPINGS)
+def test_make_refuses_airstrikers_wheel_state_for_dasher(cases, wrapping):
+    case = cases[f"wheel-state-{wrapping}"]
+    stdout, foreign = printed(case["answer"]), case["state"]
+    assert f"refused: {foreign}: expected a state of Dasher-Genesis; found {AIRSTRIKER}'s state" in stdout, stdout
+    assert "the stable-retro wheel ships it" in stdout and f"Load it with {AIRSTRIKER}" in stdout
+
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_a_dasher_movie_whose_core_bin_is_airstrikers_state_is_refused(cases, command):
+    case = cases[f"airstriker-core-bin-{command}"]
+    assert f"{AIRSTRIKER}'s state" in refused(case["answer"])
+    made = case["folder"] / "made"
+    assert not made.exists() or not list(made.iterdir())
+
+
+@pytest.mark.parametrize(("host", "owner"), PAIRS[::-1])
+def test_the_studio_refuses_another_games_state_put_in_the_games_folder(cases, host, owner):
+    case = cases[f"studio-{host}"]
+    stdout = printed(case["answer"])
+    assert f"refused: {case['game'] / 'Foreign.state'}: expected a state of {host}; found {owner}'s state" in stdout, (
+        stdout
+    )
+
+
+@pytest.mark.parametrize(("saver", "loader"), PAIRS)
+def test_a_state_this_machine_saved_for_one_game_is_refused_for_another(cases, saver, loader):
+    stdout = printed(cases[f"saved-by-{saver}"]["answer"])
+    assert f"found {saver}'s state (this machine saved it for {saver}" in stdout, stdout
+    assert "its own game plays it" in stdout, stdout

@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from childproc import MAX_RSS_MB, run_cli
+from childproc import MAX_RSS_MB, Child, run_cli, run_cli_cases
 
 from retrokit import cli
 from retrokit.ramsearch import RamSearch
@@ -74,28 +74,40 @@ def check_one_line(child, *expected: str) -> None:
     assert child.peak_rss_mb < MAX_RSS_MB, child.describe()
 
 
-@pytest.mark.parametrize(
-    ("build", "expected"),
-    [
-        (lambda path, good: os.mkfifo(path), "found a FIFO"),
-        (lambda path, good: path.symlink_to("/dev/zero"), "found a device"),
-        (lambda path, good: path.write_bytes(with_member(good, "snapshots.npy", huge_header())), "declares shape"),
-        (lambda path, good: path.write_bytes(with_member(good, "meta.npy", deep_json())), "RecursionError"),
-        (
-            lambda path, good: path.write_bytes(
-                with_member(good, "snapshots.npy", npy(np.zeros((0, 65536), np.uint8)))
-            ),
-            "expected at least one snapshot",
-        ),
-    ],
-    ids=["fifo", "symlink-to-dev-zero", "npy-header-of-a-huge-shape", "json-nested-100000-deep", "no-snapshot"],
-)
-@pytest.mark.parametrize("command", ["show", "undo"])
-def test_a_hostile_session_file_is_one_line_under_500_mb(tmp_path, good_session, build, expected, command):
-    path = tmp_path / "bad.session"
-    build(path, good_session)
-    child = run_cli(["ramsearch", command, "--session", str(path)], timeout=60)
-    check_one_line(child, expected, "retrokit ramsearch new GAME")
+HOSTILE_SESSIONS = {
+    "fifo": (lambda path, good: os.mkfifo(path), "found a FIFO"),
+    "symlink-to-dev-zero": (lambda path, good: path.symlink_to("/dev/zero"), "found a device"),
+    "npy-header-of-a-huge-shape": (
+        lambda path, good: path.write_bytes(with_member(good, "snapshots.npy", huge_header())), "declares shape"
+    ),
+    "json-nested-100000-deep": (
+        lambda path, good: path.write_bytes(with_member(good, "meta.npy", deep_json())), "RecursionError"
+    ),
+    "no-snapshot": (
+        lambda path, good: path.write_bytes(with_member(good, "snapshots.npy", npy(np.zeros((0, 65536), np.uint8)))),
+        "expected at least one snapshot",
+    ),
+}
+COMMANDS = ["show", "undo"]
+
+
+@pytest.fixture(scope="module")
+def hostile_sessions(tmp_path_factory, good_session) -> dict[str, Child]:
+    """``retrokit ramsearch COMMAND --session BAD`` for each hostile session and command, all in one child (under
+    the memory cap, its peak a bound on each); each its own command and answer, by ``"COMMAND-CASE"``."""
+    commands = {}
+    for case, (build, _) in HOSTILE_SESSIONS.items():
+        for command in COMMANDS:
+            path = tmp_path_factory.mktemp(case) / "bad.session"  # each command its own file: undo may write
+            build(path, good_session)
+            commands[f"{command}-{case}"] = ["ramsearch", command, "--session", str(path)]
+    return run_cli_cases(commands, timeout=120)
+
+
+@pytest.mark.parametrize("case", list(HOSTILE_SESSIONS))
+@pytest.mark.parametrize("command", COMMANDS)
+def test_a_hostile_session_file_is_one_line_under_500_mb(hostile_sessions, case, command):
+    check_one_line(hostile_sessions[f"{command}-{case}"], HOSTILE_SESSIONS[case][1], "retrokit ramsearch new GAME")
 
 
 def test_a_session_of_zero_snapshots_is_refused_by_the_api_too(tmp_path, good_session):

@@ -23,12 +23,13 @@ environment variables as they are when its level starts, not the server's
 
 from __future__ import annotations
 
+import contextlib
 import multiprocessing
 import os
 import signal
 import sys
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from multiprocessing.connection import Connection, wait
 
@@ -119,9 +120,32 @@ def _start(process: multiprocessing.process.BaseProcess, context: multiprocessin
             from multiprocessing import forkserver
 
             forkserver.ensure_running()
-        process.start()
+        with _main_file_only_if_it_exists():
+            process.start()
     finally:
         signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # a Ctrl-C meanwhile arrives now
+
+
+@contextlib.contextmanager
+def _main_file_only_if_it_exists() -> Iterator[None]:
+    """Hide ``__main__.__file__`` while a worker starts when it names no file (``<stdin>``: ``python - < script``).
+
+    multiprocessing asks each worker to run the file ``__main__`` came from again; for a script read from stdin
+    that is ``<stdin>``, no file, and every worker died of FileNotFoundError before its level. Without a
+    ``__file__`` the worker skips that step, as it does for ``python -c`` and a notebook (whose code it cannot
+    run again either).
+    """
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    by_name = getattr(getattr(main, "__spec__", None), "name", None)  # python -m: the worker imports the module
+    if main is None or path is None or by_name is not None or os.path.isfile(path):
+        yield
+        return
+    del main.__file__
+    try:
+        yield
+    finally:
+        main.__file__ = path
 
 
 def _read(worker: _Worker, handle: Callable[[Message], None], watchdog: Watchdog) -> bool:

@@ -15,7 +15,7 @@ plays at exactly 30 fps on average instead of the 100 ms that a stored
 from __future__ import annotations
 
 import math
-from typing import BinaryIO
+from typing import Any, BinaryIO
 
 import numpy as np
 
@@ -26,6 +26,27 @@ MAX_GIF_FPS = 30.0
 def gif_step(fps: float) -> int:
     """How many frames of a ``fps`` stream make one GIF frame, so the GIF runs at :data:`MAX_GIF_FPS` at most."""
     return max(1, math.ceil(fps / MAX_GIF_FPS - 1e-9))
+
+
+def _paletted(frame: np.ndarray) -> Any:
+    """``frame`` (H, W, 3) as a paletted Pillow image: exactly its colours when it has at most 256, as a console's has.
+
+    Pillow's adaptive palette (median cut, ~5 ms a frame) is kept for frames of more colours; a frame of few
+    colours gets a table of exactly its own (~1 ms), each pixel its colour's index, found by a binary search of
+    the packed RGB values (Pillow's own palette mapping merges colours that differ in the low bits).
+    """
+    from PIL import Image
+
+    image = Image.fromarray(frame)
+    colors = image.getcolors(256)
+    if colors is None:
+        return image.convert("P", palette=Image.Palette.ADAPTIVE)
+    table = np.sort(np.array([(r << 16) | (g << 8) | b for _, (r, g, b) in colors], dtype=np.uint32))
+    rgb = frame.astype(np.uint32)
+    indices = np.searchsorted(table, (rgb[..., 0] << 16) | (rgb[..., 1] << 8) | rgb[..., 2]).astype(np.uint8)
+    out = Image.fromarray(indices, "P")
+    out.putpalette(np.stack([table >> 16, (table >> 8) & 0xFF, table & 0xFF], axis=1).astype(np.uint8).tobytes())
+    return out
 
 
 class GifWriter:
@@ -48,9 +69,9 @@ class GifWriter:
 
     def add(self, frame: np.ndarray) -> None:
         """Encode one RGB frame (H, W, 3) and write it."""
-        from PIL import GifImagePlugin, Image
+        from PIL import GifImagePlugin
 
-        image = Image.fromarray(frame).convert("P", palette=Image.Palette.ADAPTIVE)
+        image = _paletted(frame)
         if self.count == 0:
             header, _ = GifImagePlugin.getheader(image, info={"loop": self.loop, "duration": self.delay_ms(0)})
             self.stream.write(b"".join(header))

@@ -160,8 +160,9 @@ def _add_field(
             "Choose another name, or pass --force (force=True) to replace it."
         )
     entry = _Entry(name, address, type_code, value_range, mask)
+    before = _plain(doc)  # the data as read, taken before _insert may edit the document (parsing again costs ~0.1 s)
     new_text = _insert(text, doc, fields, entry)
-    _check(path, text, new_text, entry)
+    _check(path, before, new_text, entry)
     atomic_write(path, new_text.encode("utf-8"), overwrite=True)
     return replaced
 
@@ -279,7 +280,7 @@ def _set_default_state(path: str | os.PathLike[str], name: str) -> None:
             line, column = states.lc.key(next(iter(states)))
             lines.insert(line, f"{' ' * column}default: {value}{nl}")
     new_text = "".join(lines)
-    expected = _plain(_load(text, path)) or {}
+    expected = _plain(doc) or {}  # the data as read: nothing above edits the document
     expected["states"] = wanted
     _verify(path, new_text, expected, f"states: default: {value}")
     atomic_write(path, new_text.encode("utf-8"), overwrite=True)
@@ -390,9 +391,9 @@ def _dump_round_trip(doc: Any, fields: Any, new: _Entry) -> str:
     return out.getvalue()
 
 
-def _check(path: Path, old_text: str, new_text: str, new: _Entry) -> None:
-    """Parse the edited text and check it holds the old data plus (or with) the new field, nothing else."""
-    expected = _plain(_load(old_text, path)) or {}
+def _check(path: Path, before: Any, new_text: str, new: _Entry) -> None:
+    """Parse the edited text; check it holds the data ``before`` the edit plus (or with) the new field, nothing else."""
+    expected = before or {}
     expected.setdefault("fields", {})
     if expected["fields"] is None:
         expected["fields"] = {}

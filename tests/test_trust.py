@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 import yaml
-from childproc import MAX_RSS_MB, REPO, run_child, run_cli
+from childproc import MAX_RSS_MB, REPO, run_child, run_cli, run_cli_cases
 from probestore import seed_shipped
 
 from retrokit.data.games import find_game
@@ -71,29 +71,48 @@ def test_make_probes_a_state_whose_record_is_forged(tmp_path: Path, corrupt_stat
     assert child.returncode == 0 and "refused:" in child.stdout and "SIGSEGV" in child.stdout, child.describe()
 
 
-def test_playback_probes_a_movie_whose_header_is_forged(tmp_path: Path, corrupt_state: bytes, forged, data) -> None:
-    movie = forged_movie(tmp_path / "forged.bk2", corrupt_state, forged)
-    assert_refused(run_cli(["playback", str(movie), str(tmp_path / "out.gif")], env=data))
-    assert not (tmp_path / "out.gif").exists()
+@pytest.fixture(scope="module")
+def forged_commands(tmp_path_factory: pytest.TempPathFactory, corrupt_state: bytes, forged) -> tuple[Path, dict]:
+    """The commands handed a forged state or movie, run in ONE child (tests/childproc.py's run_cli_cases), each
+    with a fresh data folder of its own (no verdict cached): a child each was mostly its start and imports.
+
+    Returns:
+        The folder of the files, and each case's answer by name.
+    """
+    root = tmp_path_factory.mktemp("forged")
+    state = root / "forged.state"
+    state.write_bytes(compress_state(corrupt_state, forged))
+    movie = forged_movie(root / "forged.bk2", corrupt_state, forged)
+    session = str(root / "s.session")
+    cases = {
+        "playback": ["playback", str(movie), str(root / "out.gif")],
+        "integrate-movie": ["integrate", "Dasher-Genesis", "Made", "--movie", str(movie)],
+        "ramsearch-start-state": ["ramsearch", "new", "Dasher-Genesis", "--state", str(state), "--session",
+                                  str(root / "start.session")],
+        "ramsearch-new": ["ramsearch", "new", "Dasher-Genesis", "--session", session],  # then run the movie in it
+        "ramsearch-run-movie": ["ramsearch", "run", "--movie", str(movie), "--session", session],
+    }
+    data = {name: {"RETROKIT_DATA": str(root / "data" / name)} for name in cases}
+    data["ramsearch-run-movie"] = data["ramsearch-new"]
+    return root, run_cli_cases(cases, case_env=data, timeout=240)
 
 
-def test_integrate_movie_probes_a_movie_whose_header_is_forged(tmp_path: Path, corrupt_state: bytes, forged, data) -> None:
-    movie = forged_movie(tmp_path / "forged.bk2", corrupt_state, forged)
-    assert_refused(run_cli(["integrate", "Dasher-Genesis", "Made", "--movie", str(movie)], env=data))
+def test_playback_probes_a_movie_whose_header_is_forged(forged_commands) -> None:
+    root, answers = forged_commands
+    assert_refused(answers["playback"])
+    assert not (root / "out.gif").exists()
+
+
+def test_integrate_movie_probes_a_movie_whose_header_is_forged(forged_commands) -> None:
+    assert_refused(forged_commands[1]["integrate-movie"])
 
 
 @pytest.mark.parametrize("how", ["start-state", "run-movie"])
-def test_ramsearch_probes_a_forged_state_or_movie(tmp_path: Path, corrupt_state: bytes, forged, data, how: str) -> None:
-    state = tmp_path / "forged.state"
-    state.write_bytes(compress_state(corrupt_state, forged))
-    movie = forged_movie(tmp_path / "forged.bk2", corrupt_state, forged)
-    session = str(tmp_path / "s.session")
-    if how == "start-state":
-        assert_refused(run_cli(["ramsearch", "new", "Dasher-Genesis", "--state", str(state), "--session", session], env=data))
-        return
-    started = run_cli(["ramsearch", "new", "Dasher-Genesis", "--session", session], env=data)
-    assert started.returncode == 0, started.describe()
-    assert_refused(run_cli(["ramsearch", "run", "--movie", str(movie), "--session", session], env=data))
+def test_ramsearch_probes_a_forged_state_or_movie(forged_commands, how: str) -> None:
+    answers = forged_commands[1]
+    if how == "run-movie":
+        assert answers["ramsearch-new"].returncode == 0, answers["ramsearch-new"].describe()
+    assert_refused(answers[f"ramsearch-{how}"])
 
 
 @pytest.fixture

@@ -94,6 +94,15 @@ def forged_commands(tmp_path_factory: pytest.TempPathFactory, corrupt_state: byt
     }
     data = {name: {"RETROKIT_DATA": str(root / "data" / name)} for name in cases}
     data["ramsearch-run-movie"] = data["ramsearch-new"]
+    for how in ("check", "force"):  # last: each sets RETROKIT_GAMES to its own copy of Dasher, with a forged state
+        folder = root / how / "games" / "Dasher-Genesis"
+        folder.mkdir(parents=True)
+        for name in ("game.yaml", "rom.md", "scenario.yaml"):
+            shutil.copy(DASHER / name, folder / name)
+        (folder / "Zone1.Act1.state").write_bytes(compress_state(corrupt_state, forged))
+        cases[f"integrate-{how}"] = ["integrate", "Dasher-Genesis", "--state", "Zone1.Act1", "--out", str(folder)] + (
+            ["--force"] if how == "force" else [])
+        data[f"integrate-{how}"] = {"RETROKIT_GAMES": str(folder.parent), "RETROKIT_DATA": str(root / "data" / how)}
     return root, run_cli_cases(cases, case_env=data, timeout=240)
 
 
@@ -125,12 +134,10 @@ def dasher_copy(tmp_path: Path) -> Path:
 
 
 @pytest.mark.parametrize("force", [False, True], ids=["check", "force"])
-def test_integrate_over_a_state_with_a_forged_record(tmp_path: Path, dasher_copy: Path, corrupt_state: bytes, forged,
-                                                    force: bool) -> None:
-    damaged = dasher_copy / "Zone1.Act1.state"
-    damaged.write_bytes(compress_state(corrupt_state, forged))
-    args = ["integrate", "Dasher-Genesis", "--state", "Zone1.Act1", "--out", str(dasher_copy)] + (["--force"] if force else [])
-    child = run_cli(args, env={"RETROKIT_GAMES": str(dasher_copy.parent), "RETROKIT_DATA": str(tmp_path / "data")})
+def test_integrate_over_a_state_with_a_forged_record(forged_commands, corrupt_state: bytes, forged, force: bool) -> None:
+    root, answers = forged_commands
+    how = "force" if force else "check"
+    child, damaged = answers[f"integrate-{how}"], root / how / "games" / "Dasher-Genesis" / "Zone1.Act1.state"
     assert child.signal is None and child.returncode == (0 if force else 1), child.describe()
     assert ("replaced" if force else "damaged") in child.stdout, child.describe()
     assert (read_state(damaged) != corrupt_state) if force else damaged.read_bytes() == compress_state(corrupt_state, forged)

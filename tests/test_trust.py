@@ -15,7 +15,8 @@ from pathlib import Path
 
 import pytest
 import yaml
-from childproc import MAX_RSS_MB, REPO, run_child, run_cli
+from childproc import MAX_RSS_MB, REPO, run_child, run_cli, run_cli_cases
+from probestore import seed_shipped
 
 from retrokit.data.games import find_game
 from retrokit.data.shipped import STATE_HASHES, WHEEL_STATE_HASHES, state_hashes, wheel_state_hashes
@@ -70,29 +71,57 @@ def test_make_probes_a_state_whose_record_is_forged(tmp_path: Path, corrupt_stat
     assert child.returncode == 0 and "refused:" in child.stdout and "SIGSEGV" in child.stdout, child.describe()
 
 
-def test_playback_probes_a_movie_whose_header_is_forged(tmp_path: Path, corrupt_state: bytes, forged, data) -> None:
-    movie = forged_movie(tmp_path / "forged.bk2", corrupt_state, forged)
-    assert_refused(run_cli(["playback", str(movie), str(tmp_path / "out.gif")], env=data))
-    assert not (tmp_path / "out.gif").exists()
+@pytest.fixture(scope="module")
+def forged_commands(tmp_path_factory: pytest.TempPathFactory, corrupt_state: bytes, forged) -> tuple[Path, dict]:
+    """The commands handed a forged state or movie, run in ONE child (tests/childproc.py's run_cli_cases), each
+    with a fresh data folder of its own (no verdict cached): a child each was mostly its start and imports.
+
+    Returns:
+        The folder of the files, and each case's answer by name.
+    """
+    root = tmp_path_factory.mktemp("forged")
+    state = root / "forged.state"
+    state.write_bytes(compress_state(corrupt_state, forged))
+    movie = forged_movie(root / "forged.bk2", corrupt_state, forged)
+    session = str(root / "s.session")
+    cases = {
+        "playback": ["playback", str(movie), str(root / "out.gif")],
+        "integrate-movie": ["integrate", "Dasher-Genesis", "Made", "--movie", str(movie)],
+        "ramsearch-start-state": ["ramsearch", "new", "Dasher-Genesis", "--state", str(state), "--session",
+                                  str(root / "start.session")],
+        "ramsearch-new": ["ramsearch", "new", "Dasher-Genesis", "--session", session],  # then run the movie in it
+        "ramsearch-run-movie": ["ramsearch", "run", "--movie", str(movie), "--session", session],
+    }
+    data = {name: {"RETROKIT_DATA": str(root / "data" / name)} for name in cases}
+    data["ramsearch-run-movie"] = data["ramsearch-new"]
+    for how in ("check", "force"):  # last: each sets RETROKIT_GAMES to its own copy of Dasher, with a forged state
+        folder = root / how / "games" / "Dasher-Genesis"
+        folder.mkdir(parents=True)
+        for name in ("game.yaml", "rom.md", "scenario.yaml"):
+            shutil.copy(DASHER / name, folder / name)
+        (folder / "Zone1.Act1.state").write_bytes(compress_state(corrupt_state, forged))
+        cases[f"integrate-{how}"] = ["integrate", "Dasher-Genesis", "--state", "Zone1.Act1", "--out", str(folder)] + (
+            ["--force"] if how == "force" else [])
+        data[f"integrate-{how}"] = {"RETROKIT_GAMES": str(folder.parent), "RETROKIT_DATA": str(root / "data" / how)}
+    return root, run_cli_cases(cases, case_env=data, timeout=240)
 
 
-def test_integrate_movie_probes_a_movie_whose_header_is_forged(tmp_path: Path, corrupt_state: bytes, forged, data) -> None:
-    movie = forged_movie(tmp_path / "forged.bk2", corrupt_state, forged)
-    assert_refused(run_cli(["integrate", "Dasher-Genesis", "Made", "--movie", str(movie)], env=data))
+def test_playback_probes_a_movie_whose_header_is_forged(forged_commands) -> None:
+    root, answers = forged_commands
+    assert_refused(answers["playback"])
+    assert not (root / "out.gif").exists()
+
+
+def test_integrate_movie_probes_a_movie_whose_header_is_forged(forged_commands) -> None:
+    assert_refused(forged_commands[1]["integrate-movie"])
 
 
 @pytest.mark.parametrize("how", ["start-state", "run-movie"])
-def test_ramsearch_probes_a_forged_state_or_movie(tmp_path: Path, corrupt_state: bytes, forged, data, how: str) -> None:
-    state = tmp_path / "forged.state"
-    state.write_bytes(compress_state(corrupt_state, forged))
-    movie = forged_movie(tmp_path / "forged.bk2", corrupt_state, forged)
-    session = str(tmp_path / "s.session")
-    if how == "start-state":
-        assert_refused(run_cli(["ramsearch", "new", "Dasher-Genesis", "--state", str(state), "--session", session], env=data))
-        return
-    started = run_cli(["ramsearch", "new", "Dasher-Genesis", "--session", session], env=data)
-    assert started.returncode == 0, started.describe()
-    assert_refused(run_cli(["ramsearch", "run", "--movie", str(movie), "--session", session], env=data))
+def test_ramsearch_probes_a_forged_state_or_movie(forged_commands, how: str) -> None:
+    answers = forged_commands[1]
+    if how == "run-movie":
+        assert answers["ramsearch-new"].returncode == 0, answers["ramsearch-new"].describe()
+    assert_refused(answers[f"ramsearch-{how}"])
 
 
 @pytest.fixture
@@ -105,12 +134,10 @@ def dasher_copy(tmp_path: Path) -> Path:
 
 
 @pytest.mark.parametrize("force", [False, True], ids=["check", "force"])
-def test_integrate_over_a_state_with_a_forged_record(tmp_path: Path, dasher_copy: Path, corrupt_state: bytes, forged,
-                                                    force: bool) -> None:
-    damaged = dasher_copy / "Zone1.Act1.state"
-    damaged.write_bytes(compress_state(corrupt_state, forged))
-    args = ["integrate", "Dasher-Genesis", "--state", "Zone1.Act1", "--out", str(dasher_copy)] + (["--force"] if force else [])
-    child = run_cli(args, env={"RETROKIT_GAMES": str(dasher_copy.parent), "RETROKIT_DATA": str(tmp_path / "data")})
+def test_integrate_over_a_state_with_a_forged_record(forged_commands, corrupt_state: bytes, forged, force: bool) -> None:
+    root, answers = forged_commands
+    how = "force" if force else "check"
+    child, damaged = answers[f"integrate-{how}"], root / how / "games" / "Dasher-Genesis" / "Zone1.Act1.state"
     assert child.signal is None and child.returncode == (0 if force else 1), child.describe()
     assert ("replaced" if force else "damaged") in child.stdout, child.describe()
     assert (read_state(damaged) != corrupt_state) if force else damaged.read_bytes() == compress_state(corrupt_state, forged)
@@ -128,7 +155,8 @@ def test_validate_reports_a_solution_movie_from_a_corrupt_state(tmp_path: Path, 
     doc.setdefault("movies", {})["Zone1.Act1"] = {"done_at": None, "reward": 0}
     doc.pop("integrate", None)
     (dasher_copy / "game.yaml").write_text(yaml.safe_dump(doc))
-    child = run_cli(["validate", str(dasher_copy)], timeout=300,
+    # 60 frames per smoke run, not 600: the claim is the movie's replay, which plays the movie whatever --frames says
+    child = run_cli(["validate", str(dasher_copy), "--frames", "60"], timeout=300,
                     env={"RETROKIT_GAMES": str(dasher_copy.parent), "RETROKIT_DATA": str(tmp_path / "data")})
     assert child.signal is None, child.describe()
     words = " ".join(child.stdout.split())  # the table wraps its cells by the width of the (tmp) paths in them
@@ -166,6 +194,9 @@ def test_a_state_retrokit_wrote_needs_no_probe(tmp_path: Path, monkeypatch) -> N
     from retrokit.data import probe, statecheck
 
     monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    # The movie starts from the shipped Zone1.Act1: known by its bytes, as on a machine that loaded it once, so
+    # its Core.bin costs no probe child (3,300 frames); the state integrate writes at frame 100 is other bytes.
+    seed_shipped(tmp_path / "data" / "state-probes", DASHER / "Zone1.Act1.state", DASHER / "rom.md")
     movie = DASHER / "movies" / "Zone1.Act1.bk2"
     assert main(["integrate", "Dasher-Genesis", "Midway", "--movie", str(movie), "--frame", "100"]) == 0
     monkeypatch.setattr(probe, "probe_state", lambda *a, **k: pytest.fail("a state this machine wrote was probed"))

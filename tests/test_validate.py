@@ -10,20 +10,23 @@ import gzip
 import json
 import random
 import shutil
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 from corrupt import random_body
+from dashercopy import dasher_copy
 
 from retrokit.cli import main
 from retrokit.data.games import list_games
 from retrokit.paths import repo_games_dir
 from retrokit.testing import check_game
-from retrokit.testing.report import FAIL, PASS, SKIP, GameReport, render
+from retrokit.testing.report import FAIL, PASS, SKIP, GameReport, Result, render
 
 DASHER = repo_games_dir() / "Dasher-Genesis"
 TREKKER = repo_games_dir() / "Trekker-GameBoy"  # the cheapest own game with a ROM: for the command's own claims
 FRAMES = 120  # smoke-run frames in these tests: enough to reach a division or a lookup, cheap on CPU
+COMMAND_FRAMES = 8  # for the command's own claims (tables, status, JSON, which games): what the checks find is the above's
 
 
 def failed(report: GameReport) -> set[tuple[str, str]]:
@@ -31,22 +34,19 @@ def failed(report: GameReport) -> set[tuple[str, str]]:
     return {(r.check, r.state) for r in report.failures}
 
 
-@pytest.fixture
-def dasher_with_movies(tmp_path: Path) -> Path:
-    """A full copy of Dasher's folder (states, scenario, movies), as a game folder of its own."""
-    folder = tmp_path / "Dasher-Genesis"
-    shutil.copytree(DASHER, folder)
-    return folder
+#: game.yaml's default states (for 1 and 2 players): every copy keeps them.
+DEFAULTS = ("Zone1.Act1", "Zone1.Act1.2P")
 
 
 @pytest.fixture
-def dasher(dasher_with_movies: Path) -> Path:
-    """The copy without its solution movies, whose replays the other faults need not pay for."""
-    shutil.rmtree(dasher_with_movies / "movies")
-    game_yaml = dasher_with_movies / "game.yaml"
-    text = game_yaml.read_text()
-    game_yaml.write_text(text[: text.index("\nmovies:")] + "\n")
-    return dasher_with_movies
+def dasher(tmp_path: Path) -> Callable[..., Path]:
+    """Makes a copy of Dasher's folder, as a game folder of its own, with its default states and the states and
+    solution movies named (``dasher("Zone2.Act1", movies=["Zone1.Act1"])``).
+
+    A planted fault needs its own state and one next to it, not all nine states' smoke runs and six movies' replays
+    (a third of the CPU each); every shipped state and movie passing is test_every_game_in_games_passes_check_game's.
+    """
+    return lambda *states, movies=(): dasher_copy(tmp_path, (*DEFAULTS, *states), movies)
 
 
 @pytest.fixture
@@ -92,6 +92,7 @@ def test_every_game_in_games_passes_check_game(name: str, request: pytest.Fixtur
     assert {"data file", "scenario compiles"} <= checks
     if name == "Dasher-Genesis":  # the ROM is here: everything ran
         assert {"schema", "fields in RAM", "state loads", "smoke run", "deterministic", "movie"} <= checks
+        assert len(report.find("movie start state", status=PASS)) == 6, render(report)  # loaded with the states
         assert not report.find("smoke run", status=SKIP)
     elif name in SONICS:  # without its ROM: what was checked, and what was skipped and why
         assert {"schema", "fields in RAM", "state parses", "fields decode", "table coverage"} <= checks
@@ -141,9 +142,10 @@ def test_the_ram_read_from_a_state_file_is_the_ram_the_core_loads(game: str, sta
 # --- Planted faults ----------------------------------------------------------------------------------------
 
 
-def test_division_by_zero_on_one_state_fails_that_state_only(dasher: Path) -> None:
-    (dasher / "broken.yaml").write_text("reward: 100 / (zone * 2 + act - 3)\ndone: level_done == 1\n")
-    report = check_game(dasher, frames=FRAMES)
+def test_division_by_zero_on_one_state_fails_that_state_only(dasher: Callable[..., Path]) -> None:
+    game = dasher("Zone2.Act1", "Zone2.Act2", "Zone3.Act2")
+    (game / "broken.yaml").write_text("reward: 100 / (zone * 2 + act - 3)\ndone: level_done == 1\n")
+    report = check_game(game, frames=FRAMES)
     bad = [r for r in report.failures if r.scenario == "broken"]
     assert [(r.check, r.state) for r in bad] == [("smoke run", "Zone2.Act2")], render(report)
     assert "division by zero" in bad[0].message
@@ -151,41 +153,90 @@ def test_division_by_zero_on_one_state_fails_that_state_only(dasher: Path) -> No
     assert {r.state for r in others if r.scenario == "broken"} >= {"Zone1.Act1", "Zone2.Act1", "Zone3.Act2"}
 
 
-def test_a_table_missing_one_act_fails_coverage_for_that_state(dasher: Path) -> None:
+def test_a_table_missing_one_act_fails_coverage_for_that_state(dasher: Callable[..., Path]) -> None:
+    game = dasher("Zone3.Act1", "Zone3.Act2")
     values = "\n".join(f"      {z}, {a}: {1000 + z}" for z in range(3) for a in range(2) if (z, a) != (2, 1))
-    (dasher / "goal.yaml").write_text(
+    (game / "goal.yaml").write_text(
         f"tables:\n  goal:\n    by: [zone, act]\n    values:\n{values}\n"
         "reward: delta(p1_x) if p1_x < goal[zone, act] else 0\ndone: level_done == 1\n"
     )
-    report = check_game(dasher, frames=FRAMES)
+    report = check_game(game, frames=FRAMES)
     assert failed(report) == {("table coverage", "Zone3.Act2"), ("smoke run", "Zone3.Act2")}, render(report)
     coverage = report.find("table coverage", state="Zone3.Act2")[0]
     assert "zone=2, act=1" in coverage.message and "goal.yaml" in coverage.message
 
 
+#: The faults planted in ONE copy of Dasher (:func:`planted`), by state: what each plants, and the failures it must cause.
+#: Each is caught by its own state's checks, which read only that state's file, so none can mask another.
+PLANTED = {
+    "Zone1.Act2": ("a gzip bomb", {("state loads", "Zone1.Act2")}),
+    "Zone2.Act1": ("a truncated state", {("state loads", "Zone2.Act1")}),
+    "Zone2.Act2": ("Airstriker's state", {("state is the game's", "Zone2.Act2")}),
+    "Zone2.Act1.2P": ("a state recorded on another ROM", {("state is the game's", "Zone2.Act1.2P")}),
+    "Zone3.Act1": ("Zone1.Act1's state", {("state is the game's", "Zone3.Act1")}),
+}
+
+
+@pytest.fixture(scope="module")
+def planted(tmp_path_factory: pytest.TempPathFactory, airstriker_dir: Path) -> GameReport:
+    """The report of one check of a Dasher copy with the faults of :data:`PLANTED`, Zone3.Act2 (last) left good.
+
+    One check instead of one per fault: each was a probe child and the default states' smoke runs.
+    """
+    from retrokit.data.states import StateRecord, read_state, write_state
+
+    game = dasher_copy(tmp_path_factory.mktemp("planted"), (*DEFAULTS, *PLANTED, "Zone3.Act2"))
+    member = gzip.compress(bytes(16 << 20), compresslevel=9, mtime=0)
+    (game / "Zone1.Act2.state").write_bytes(member * 48)  # 768 MiB once inflated (gzip members concatenate)
+    (game / "Zone2.Act1.state").write_bytes((game / "Zone2.Act1.state").read_bytes()[:300])
+    shutil.copy(airstriker_dir / "Level1.state", game / "Zone2.Act2.state")
+    data = read_state(airstriker_dir / "Level1.state")
+    record = StateRecord.of("Airstriker-Genesis", "0" * 40, data)  # as retrokit writes a state, on another ROM
+    (game / "Zone2.Act1.2P.state").unlink()
+    write_state(game / "Zone2.Act1.2P.state", data, record=record)
+    shutil.copy(game / "Zone1.Act1.state", game / "Zone3.Act1.state")
+    return check_game(game, frames=FRAMES)
+
+
+def planted_failures(report: GameReport, state: str) -> list[Result]:
+    """The failures on ``state``, after checking they are the ones its planted fault must cause."""
+    what, expected = PLANTED[state]
+    assert {(c, s) for c, s in failed(report) if s == state} == expected, f"{what} planted in {state}:\n{render(report)}"
+    return [r for r in report.failures if r.state == state]
+
+
+def test_planted_faults_fail_their_own_states_only(planted: GameReport) -> None:
+    everything = set().union(*(expected for _, expected in PLANTED.values()))
+    assert failed(planted) == everything, render(planted)
+    # the states after them were still checked
+    assert planted.find("state loads", state="Zone3.Act2", status=PASS), render(planted)
+    assert planted.find("smoke run", state="Zone3.Act2", status=PASS), render(planted)
+
+
 @pytest.mark.parametrize("kind", ["truncated", "garbage"])
-def test_a_corrupt_state_fails_without_stopping_the_run(dasher: Path, kind: str) -> None:
-    path = dasher / "Zone2.Act1.state"
-    data = gzip.decompress(path.read_bytes())
+def test_a_corrupt_state_fails_without_stopping_the_run(
+    dasher: Callable[..., Path], kind: str, request: pytest.FixtureRequest
+) -> None:
     if kind == "truncated":
-        path.write_bytes(path.read_bytes()[:300])
-    else:  # right size and signature, random inside (seed 7: the core dies of SIGSEGV on it within the 60 frames of the child)
+        report = request.getfixturevalue("planted")
+        assert "truncated" in planted_failures(report, "Zone2.Act1")[0].message, render(report)
+    else:  # a copy of its own: whether the core crashes may hang on what the child loaded before
+        game = dasher("Zone2.Act1", "Zone3.Act2")
+        path = game / "Zone2.Act1.state"
+        data = gzip.decompress(path.read_bytes())
+        # right size and signature, random inside (seed 7: the core dies of SIGSEGV on it within the 60 frames of the child)
         path.write_bytes(gzip.compress(random_body(data, random.Random(7), keep_pointers=True)))
-    report = check_game(dasher, frames=FRAMES)
-    assert failed(report) == {("state loads", "Zone2.Act1")}, render(report)
-    message = report.failures[0].message
-    assert ("truncated" in message) if kind == "truncated" else ("the emulator crashed (SIG" in message)
+        report = check_game(game, frames=FRAMES)
+        assert failed(report) == {("state loads", "Zone2.Act1")}, render(report)
+        assert "the emulator crashed (SIG" in report.failures[0].message
     # the states after it were still checked
     assert report.find("state loads", state="Zone3.Act2", status=PASS)
     assert report.find("smoke run", state="Zone3.Act2", status=PASS)
 
 
-def test_a_gzip_bomb_state_fails_without_stopping_the_run(dasher: Path) -> None:
-    member = gzip.compress(bytes(16 << 20), compresslevel=9, mtime=0)
-    (dasher / "Zone1.Act2.state").write_bytes(member * 48)  # 768 MiB once inflated (gzip members concatenate)
-    report = check_game(dasher, frames=FRAMES)
-    assert failed(report) == {("state loads", "Zone1.Act2")}, render(report)
-    assert "inflates past" in report.failures[0].message  # read_state's cap, in the child
+def test_a_gzip_bomb_state_fails_without_stopping_the_run(planted: GameReport) -> None:
+    assert "inflates past" in planted_failures(planted, "Zone1.Act2")[0].message  # read_state's cap, in the child
+    assert planted.find("state loads", state="Zone3.Act2", status=PASS)  # the state after it was still loaded
 
 
 def test_a_state_that_hangs_the_core_fails_and_the_next_child_goes_on(monkeypatch: pytest.MonkeyPatch) -> None:
@@ -198,74 +249,75 @@ def test_a_state_that_hangs_the_core_fails_and_the_next_child_goes_on(monkeypatc
     assert ["hangs the core" in p.error for p in probes.values()] == [True, True]
 
 
-def test_another_games_state_is_flagged(dasher: Path, airstriker_dir: Path) -> None:
-    shutil.copy(airstriker_dir / "Level1.state", dasher / "Zone2.Act2.state")
-    report = check_game(dasher, frames=FRAMES)
-    assert failed(report) == {("state is the game's", "Zone2.Act2")}, render(report)
-    assert "Airstriker-Genesis" in report.failures[0].message
+def test_another_games_state_is_flagged(planted: GameReport) -> None:
+    assert "Airstriker-Genesis" in planted_failures(planted, "Zone2.Act2")[0].message
 
 
-def test_a_state_recorded_on_another_rom_is_flagged(dasher: Path, airstriker_dir: Path) -> None:
-    from retrokit.data.states import StateRecord, read_state, write_state
-
-    data = read_state(airstriker_dir / "Level1.state")
-    record = StateRecord.of("Airstriker-Genesis", "0" * 40, data)  # as retrokit writes a state, on another ROM
-    (dasher / "Zone1.Act2.state").unlink()
-    write_state(dasher / "Zone1.Act2.state", data, record=record)
-    report = check_game(dasher, frames=FRAMES)
-    assert failed(report) == {("state is the game's", "Zone1.Act2")}, render(report)
-    assert "recorded on the ROM with SHA-1 0000" in report.failures[0].message
+def test_a_state_recorded_on_another_rom_is_flagged(planted: GameReport) -> None:
+    assert "recorded on the ROM with SHA-1 0000" in planted_failures(planted, "Zone2.Act1.2P")[0].message
 
 
-def test_a_state_made_for_another_level_is_flagged_by_its_recipe(dasher: Path) -> None:
-    shutil.copy(dasher / "Zone1.Act1.state", dasher / "Zone3.Act1.state")
-    report = check_game(dasher, frames=FRAMES)
-    assert failed(report) == {("state is the game's", "Zone3.Act1")}, render(report)
-    assert "zone=2" in report.failures[0].message and "found zone=0" in report.failures[0].message
+def test_a_state_made_for_another_level_is_flagged_by_its_recipe(planted: GameReport) -> None:
+    message = planted_failures(planted, "Zone3.Act1")[0].message
+    assert "zone=2" in message and "found zone=0" in message
 
 
-def test_a_movie_with_the_wrong_expected_reward_fails(dasher_with_movies: Path) -> None:
+@pytest.fixture(scope="module")
+def planted_movies(tmp_path_factory: pytest.TempPathFactory) -> GameReport:
+    """One check of a Dasher copy with Zone1's two movies, Zone1.Act2's expected reward wrong, plus a movie without an
+    outcome (Loose), a broken one (Broken) and an outcome without a movie (Gone): each movie is checked on its own."""
     # Zone1's two movies only: the wrong one fails next to a right one, without replaying all six (the
     # shipped game passing with every movie is test_every_game_in_games_passes_check_game's claim)
-    text = (dasher_with_movies / "game.yaml").read_text()
-    for name in ("Zone2.Act1", "Zone2.Act2", "Zone3.Act1", "Zone3.Act2"):
-        (dasher_with_movies / "movies" / f"{name}.bk2").unlink()
-        text = "".join(line for line in text.splitlines(keepends=True) if not line.startswith(f"  {name}: {{scenario"))
-    (dasher_with_movies / "game.yaml").write_text(text.replace("reward: 3952", "reward: 3900"))
-    report = check_game(dasher_with_movies, frames=FRAMES)
-    assert failed(report) == {("movie", "Zone1.Act2")}, render(report)
-    assert "a total reward of 3900" in report.failures[0].message and "found 3952" in report.failures[0].message
+    game = dasher_copy(tmp_path_factory.mktemp("movies"), DEFAULTS, ["Zone1.Act1", "Zone1.Act2"])
+    text = (game / "game.yaml").read_text()
+    assert "\n  Zone1.Act2: {scenario: scenario, done_at: 804, reward: 3952," in text and text.endswith("}\n")
+    text = text.replace("reward: 3952", "reward: 3900") + "  Gone: {reward: 1}\n  Broken: {reward: 1}\n"
+    (game / "game.yaml").write_text(text)  # the movies section comes last
+    shutil.copy(DASHER / "movies" / "Zone1.Act1.bk2", game / "movies" / "Loose.bk2")
+    (game / "movies" / "Broken.bk2").write_bytes(b"PK\x03\x04 not really a zip")
+    return check_game(game, frames=FRAMES)
 
 
-def test_movies_without_an_outcome_warn_and_missing_or_broken_ones_fail(dasher: Path) -> None:
-    (dasher / "movies").mkdir()
-    shutil.copy(DASHER / "movies" / "Zone1.Act1.bk2", dasher / "movies" / "Loose.bk2")
-    (dasher / "movies" / "Broken.bk2").write_bytes(b"PK\x03\x04 not really a zip")
-    with (dasher / "game.yaml").open("a") as f:
-        f.write("movies:\n  Gone: {reward: 1}\n  Broken: {reward: 1}\n")
-    report = check_game(dasher, frames=FRAMES)
-    assert failed(report) == {("movie", "Gone"), ("movie", "Broken")}, render(report)
+def test_planted_movie_faults_fail_their_own_movies_only(planted_movies: GameReport) -> None:
+    assert failed(planted_movies) == {("movie", "Zone1.Act2"), ("movie", "Gone"), ("movie", "Broken")}, (
+        render(planted_movies)
+    )
+    assert planted_movies.find("movie", state="Zone1.Act1", status=PASS), render(planted_movies)
+
+
+def test_a_movie_with_the_wrong_expected_reward_fails(planted_movies: GameReport) -> None:
+    wrong = planted_movies.find("movie", state="Zone1.Act2")
+    assert [r.status for r in wrong] == [FAIL], render(planted_movies)
+    assert "a total reward of 3900" in wrong[0].message and "found 3952" in wrong[0].message
+
+
+def test_movies_without_an_outcome_warn_and_missing_or_broken_ones_fail(planted_movies: GameReport) -> None:
+    report = planted_movies
+    assert [r.status for r in report.find("movie", state="Gone")] == [FAIL], render(report)
+    assert [r.status for r in report.find("movie", state="Broken")] == [FAIL], render(report)
     assert report.find("movie", state="Loose")[0].status == "warn"
     assert "could not be replayed" in report.find("movie", state="Broken")[0].message
 
 
-def test_a_misspelled_key_in_game_yaml_fails_with_its_line(dasher: Path) -> None:
-    text = (dasher / "game.yaml").read_text()
-    (dasher / "game.yaml").write_text(text.replace("\nintegrate:", "\nintgrate:"))
+def test_a_misspelled_key_in_game_yaml_fails_with_its_line(dasher: Callable[..., Path]) -> None:
+    game = dasher()
+    text = (game / "game.yaml").read_text()
+    (game / "game.yaml").write_text(text.replace("\nintegrate:", "\nintgrate:"))
     line = text[: text.index("\nintegrate:")].count("\n") + 2
-    report = check_game(dasher, frames=FRAMES)
+    report = check_game(game, frames=FRAMES)
     assert {check for check, _ in failed(report)} == {"schema", "data file"}, render(report)
     schema = report.find("schema", status=FAIL)[0].message
     assert f"game.yaml:{line}:1:" in schema and "Did you mean 'integrate'?" in schema
     assert "Did you mean 'integrate'?" in report.find("data file")[0].message  # loading the game refuses it too
 
 
-def test_a_field_outside_ram_fails_and_overlaps_warn(dasher: Path) -> None:
-    text = (dasher / "game.yaml").read_text()
+def test_a_field_outside_ram_fails_and_overlaps_warn(dasher: Callable[..., Path]) -> None:
+    game = dasher()
+    text = (game / "game.yaml").read_text()
     text = text.replace('end_x:       {address: 0xFF000A', 'end_x:       {address: 0xFE0000')
     text = text.replace('start_x:     {address: 0xFF000C', 'start_x:     {address: 0xFF000D')
-    (dasher / "game.yaml").write_text(text)
-    report = check_game(dasher, frames=FRAMES)
+    (game / "game.yaml").write_text(text)
+    report = check_game(game, frames=FRAMES)
     outside = report.find("fields in RAM", status=FAIL)
     assert len(outside) == 1 and "'end_x'" in outside[0].message
     overlap = report.find("field overlap")
@@ -280,7 +332,7 @@ def test_validate_command_passes_on_the_free_games(capsys, tmp_path: Path, trekk
     # an own game by folder and a wheel game by name: the command's tables, status and JSON are the claim
     # here; every shipped game passing check_game is test_every_game_in_games_passes_check_game's
     out_json = tmp_path / "results.json"
-    status = main(["validate", str(trekker), "Airstriker-Genesis", "--frames", str(FRAMES),
+    status = main(["validate", str(trekker), "Airstriker-Genesis", "--frames", str(COMMAND_FRAMES),
                    "--json", str(out_json)])
     out = capsys.readouterr().out
     assert status == 0, out
@@ -292,7 +344,7 @@ def test_validate_command_passes_on_the_free_games(capsys, tmp_path: Path, trekk
 
 def test_validate_command_exits_1_on_a_failure(capsys, trekker: Path) -> None:
     (trekker / "Level2.state").write_bytes(b"not a state")
-    status = main(["validate", str(trekker), "--frames", str(FRAMES), "-q"])
+    status = main(["validate", str(trekker), "--frames", str(COMMAND_FRAMES), "-q"])
     out = capsys.readouterr().out
     assert status == 1
     assert "state loads" in out and "Level2" in out and "FAIL" in out and "0 of 1 game passed" in out
@@ -300,7 +352,7 @@ def test_validate_command_exits_1_on_a_failure(capsys, trekker: Path) -> None:
 
 def test_validate_without_names_checks_the_game_yaml_here(capsys, trekker: Path, monkeypatch) -> None:
     monkeypatch.chdir(trekker)
-    assert main(["validate", "--frames", str(FRAMES), "-q"]) == 0
+    assert main(["validate", "--frames", str(COMMAND_FRAMES), "-q"]) == 0
     assert "Trekker-GameBoy: all" in capsys.readouterr().out
     monkeypatch.chdir(trekker.parent)
     assert main(["validate"]) == 2
@@ -331,11 +383,11 @@ def test_validate_all_says_which_games_it_means(capsys, monkeypatch) -> None:
     own = validate.own_games()
     wheel = [g.name for g in list_games() if g.name not in own]
     assert "Airstriker-Genesis" in wheel and "Dasher-Genesis" in own
-    # one small own game (not Dasher's 17 s of states and movies): the line, not the hour
-    assert "Hopper-Sms" in own
-    monkeypatch.setattr(validate, "own_games", lambda: ["Hopper-Sms"])
-    assert main(["validate", "--all", "--frames", str(FRAMES), "-q"]) == 0
+    # the smallest own game (not Dasher's 17 s of states and movies): the line, not the hour
+    assert "Trekker-GameBoy" in own
+    monkeypatch.setattr(validate, "own_games", lambda: ["Trekker-GameBoy"])
+    assert main(["validate", "--all", "--frames", str(COMMAND_FRAMES), "-q"]) == 0
     first, *rest = capsys.readouterr().out.splitlines()
     assert first == (f"--all: 1 of the {len(list_games())} games retrokit games lists, those not from the "
-                     "stable-retro wheel (name one of the others to check it): Hopper-Sms")
-    assert any(line.startswith("Hopper-Sms: all") for line in rest)
+                     "stable-retro wheel (name one of the others to check it): Trekker-GameBoy")
+    assert any(line.startswith("Trekker-GameBoy: all") for line in rest)

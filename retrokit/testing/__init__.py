@@ -59,7 +59,7 @@ def check_game(
     from retrokit.testing.movies import check_movies
     from retrokit.testing.scenarios import SMOKE_FRAMES, check_scenarios
     from retrokit.testing.schema import check_schemas
-    from retrokit.testing.states import check_movie_states, check_states
+    from retrokit.testing.states import check_states
 
     def step(stage: str, detail: str = "") -> None:
         if progress is not None:
@@ -103,8 +103,7 @@ def check_game(
     step("fields")
     _check_fields(game, report, rom)
     step("states")
-    probes = check_states(game, report, rom)
-    check_movie_states(game, report, rom)
+    probes = check_states(game, report, rom)  # and the solution movies' start states
     step("scenarios")
     starts = {name: probe.start for name, probe in probes.items() if probe.start}
     check_scenarios(game, report, starts, rom=rom is not None, frames=frames or SMOKE_FRAMES,

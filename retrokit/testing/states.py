@@ -135,8 +135,17 @@ def parse_states(game: Game, names: Sequence[str]) -> dict[str, StateProbe]:
 # --- Results -----------------------------------------------------------------------------------------
 
 
+_MOVIE = "movies/"  # before a movie's start state's label among the states probed: no state file's name holds a "/"
+
+
 def check_states(game: Game, report: GameReport, rom: Path | None) -> dict[str, StateProbe]:
-    """Check every state of the game; add the results to ``report``; return the probes of those that loaded."""
+    """Check every state of the game, and each solution movie's start state as one of its states (it loads, and its
+    fields are in range); add the results to ``report``; return the probes of the game's states that loaded.
+
+    With the ROM, one child loads them all (a child of their own cost the movies' start states a second start).
+    """
+    import tempfile
+
     _check_default(game, report)
     names = []
     for name in game.states:
@@ -145,10 +154,22 @@ def check_states(game: Game, report: GameReport, rom: Path | None) -> dict[str, 
             names.append(name)
         except RetrokitError as exc:
             report.add("state file", FAIL, str(exc), state=name)
+    with tempfile.TemporaryDirectory(prefix="retrokit-movie-states-") as scratch:
+        movies = _movie_state_files(game, Path(scratch)) if rom is not None else {}
+        files = {name: game.state_path(name) for name in names} | {_MOVIE + label: path for label, path in movies.items()}
+        probes = probe_states(game, list(files), rom, files=files) if rom is not None else parse_states(game, names)
+    good = _check_loaded(game, report, rom, names, {name: probes[name] for name in names})
+    _check_movie_states(game, report, {label: probes[_MOVIE + label] for label in movies})
+    return good
+
+
+def _check_loaded(
+    game: Game, report: GameReport, rom: Path | None, names: list[str], probes: dict[str, StateProbe],
+) -> dict[str, StateProbe]:
+    """Report what loading (or parsing) each state showed; return the probes of those that loaded."""
     if not names:
         report.add("states", WARN if game.state_recipes else SKIP, "the game has no state files")
         return {}
-    probes = probe_states(game, names, rom) if rom is not None else parse_states(game, names)
     if rom is None:
         report.add("state loads", SKIP, f"{len(names)} state{'s' * (len(names) != 1)} parsed, not loaded: "
                    "no ROM to load them with (import it: retrokit import /path/to/roms)")
@@ -234,35 +255,33 @@ def check_ranges(game: Game, report: GameReport, probe: StateProbe, label: str) 
     return True
 
 
-def check_movie_states(game: Game, report: GameReport, rom: Path | None) -> None:
-    """Check the start state of each solution movie as a state of the game: it loads, and its fields are in range."""
-    import tempfile
-
+def _movie_state_files(game: Game, scratch: Path) -> dict[str, Path]:
+    """Write the start state of each solution movie that has one into ``scratch``; return the files by label."""
     from retrokit.data.states import write_state
     from retrokit.movie import read_bk2
     from retrokit.testing.movies import movie_files
 
-    if rom is None:
-        return
-    with tempfile.TemporaryDirectory(prefix="retrokit-movie-states-") as scratch:
-        files = {}
-        for name, path in movie_files(game).items():
-            label = f"{path.name} start"
-            try:
-                state = read_bk2(path).state
-            except RetrokitError:  # the movies stage says why it cannot be read
-                continue
-            if state is None:  # a movie from power-on: nothing to check
-                continue
-            files[label] = Path(scratch) / f"{name}.state"
-            write_state(files[label], state)
-        for label, probe in probe_states(game, list(files), rom, files=files).items():
-            if probe.error:
-                report.add("movie start state", FAIL, probe.error, state=label)
-            else:
-                report.add("movie start state", PASS, f"loaded and ran {IDLE_FRAMES} frames in a child process",
-                           state=label)
-                check_ranges(game, report, probe, label)
+    files = {}
+    for name, path in movie_files(game).items():
+        try:
+            state = read_bk2(path).state
+        except RetrokitError:  # the movies stage says why it cannot be read
+            continue
+        if state is None:  # a movie from power-on: nothing to check
+            continue
+        files[f"{path.name} start"] = scratch / f"{name}.state"
+        write_state(files[f"{path.name} start"], state)
+    return files
+
+
+def _check_movie_states(game: Game, report: GameReport, probes: Mapping[str, StateProbe]) -> None:
+    """Report what loading each solution movie's start state showed."""
+    for label, probe in probes.items():
+        if probe.error:
+            report.add("movie start state", FAIL, probe.error, state=label)
+        else:
+            report.add("movie start state", PASS, f"loaded and ran {IDLE_FRAMES} frames in a child process", state=label)
+            check_ranges(game, report, probe, label)
 
 
 def _recorded_elsewhere(game: Game, path: Path) -> str:

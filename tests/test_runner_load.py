@@ -30,9 +30,10 @@ CHILD = textwrap.dedent(
     caller_cpu, busy_cpu, n, one_cpu = (int(a) for a in sys.argv[1:])
     options = {"frameskip": 4, "sticky_prob": 0.25, "action_type": "discrete"}
     # The burner runs as long as the child: stop 40 steps after the first move (moves come within some 30
-    # steps even on a loaded machine), or after 300 steps with none. Confined to one CPU, where a move is a bug,
-    # 120 steps give a move four times the chance it needs under the burner.
-    steps, seed, after_move = (120 if one_cpu else 300), 3, 40
+    # steps on a quiet machine), or after 3,000 steps with none. With every CPU busy besides (a CPU hog on each
+    # core), the caller is descheduled too and may miss a stall: no move came in 300 steps in 1 of 3 such runs.
+    # Confined to one CPU, where a move is a bug, 120 steps give a move four times the chance it needs.
+    steps, seed, after_move = (120 if one_cpu else 3000), 3, 40
     first_move = None
     if one_cpu:  # the whole process on the caller's CPU, before the runner starts: there is nowhere to move to
         os.sched_setaffinity(0, {caller_cpu})

@@ -30,8 +30,9 @@ CHILD = textwrap.dedent(
     caller_cpu, busy_cpu, n, one_cpu = (int(a) for a in sys.argv[1:])
     options = {"frameskip": 4, "sticky_prob": 0.25, "action_type": "discrete"}
     # The burner runs as long as the child: stop 40 steps after the first move (moves come within some 30
-    # steps on a quiet machine), or after 3,000 steps with none. With every CPU busy besides (a CPU hog on each
-    # core), the caller is descheduled too and may miss a stall: no move came in 300 steps in 1 of 3 such runs.
+    # steps on a quiet machine), or at the first episode's end, or after 3,000 steps with none. With every CPU
+    # busy besides (a CPU hog on each core), the caller is descheduled too and may miss a stall: no move came
+    # in 300 steps in 1 of 3 such runs.
     # Confined to one CPU, where a move is a bug, 120 steps give a move four times the chance it needs.
     steps, seed, after_move = (120 if one_cpu else 3000), 3, 40
     first_move = None
@@ -57,6 +58,8 @@ CHILD = textwrap.dedent(
                 first_move = step
             if first_move is not None and step - first_move >= after_move:
                 break  # the runner moved a worker and went on stepping, compared, after the move
+            if terms.any() or truncs.any():
+                break  # an episode ended: the vector resets on its next step, the single envs would play on
         print(json.dumps({"moved": vec._runner.moved, "same": bool(same), "steps": step + 1}))
     finally:
         burner.kill()

@@ -13,6 +13,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+DASHER = Path(__file__).resolve().parent.parent / "games" / "Dasher-Genesis"
+
 
 @contextmanager
 def shared_verdicts(store: Path, data: Path) -> Iterator[Path]:
@@ -34,8 +36,8 @@ def shared_verdicts(store: Path, data: Path) -> Iterator[Path]:
             shutil.copy(verdict, store / verdict.name)
 
 
-def seed_shipped(store: Path, state_file: Path, rom: Path) -> Path:
-    """Seed ``store`` as a machine that once loaded the shipped ``state_file`` on ``rom`` knows it, and return it.
+def seed_shipped(store: Path, game: Path = DASHER, state: str = "Zone1.Act1") -> Path:
+    """Seed ``store`` as a machine that once loaded ``game``'s shipped ``state`` on its ROM knows it, and return it.
 
     A shipped state needs no probe and is then known by its bytes, so the same state in another file (re-gzipped,
     or a movie's Core.bin) is not probed again.
@@ -47,10 +49,11 @@ def seed_shipped(store: Path, state_file: Path, rom: Path) -> Path:
     from retrokit.data.states import read_state
 
     seed = store / ".seed"
-    system = find_game(state_file.parent).system.name  # the game folder the state ships in
+    found = find_game(game)
+    state_file = found.state_path(state)
     with pytest.MonkeyPatch.context() as patch:
         patch.setenv("RETROKIT_DATA", str(seed))
-        vet_state(read_state(state_file), system, rom, shipped=state_file)
+        vet_state(read_state(state_file), found.system.name, found.rom_path(), shipped=state_file)
     for verdict in (seed / "state-probes").glob("*"):
         shutil.copy(verdict, store / verdict.name)
     shutil.rmtree(seed)

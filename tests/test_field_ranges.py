@@ -37,8 +37,7 @@ def verdicts(tmp_path_factory: pytest.TempPathFactory) -> Path:
     Seeded as on a machine that once loaded Dasher's shipped Zone1.Act1 (which needs no probe and is then
     known): the copy's re-gzipped Zone1.Act1 is the same state on the same ROM.
     """
-    shipped = DASHER / "Zone1.Act1.state"
-    return seed_shipped(tmp_path_factory.mktemp("state-probes"), shipped, DASHER / "rom.md")
+    return seed_shipped(tmp_path_factory.mktemp("state-probes"))
 
 
 @pytest.fixture

@@ -407,7 +407,7 @@ def test_games_sharing_a_rom_may_share_states(tmp_path: Path, good_state: bytes,
     # as on a machine that loaded Dasher's shipped Zone1.Act1 before: known by its bytes, not probed again (what
     # is tested is that the twin's folder, another integration of the same ROM, does not refuse it)
     (tmp_path / "data" / "state-probes").mkdir(parents=True)
-    data = seed_shipped(tmp_path / "data" / "state-probes", DASHER / "Zone1.Act1.state", DASHER / "rom.md").parent
+    data = seed_shipped(tmp_path / "data" / "state-probes").parent
     monkeypatch.setenv("RETROKIT_DATA", str(data))
     twin = tmp_path / "DasherTwin-Genesis"  # another integration of Dasher's ROM, with a state of its own
     twin.mkdir()

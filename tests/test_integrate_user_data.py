@@ -34,7 +34,7 @@ SOLUTION = DASHER / "movies" / "Zone1.Act1.bk2"
 def verdicts(tmp_path_factory: pytest.TempPathFactory) -> Path:
     """Probe verdicts as a machine that once loaded Dasher's shipped Zone1.Act1 knows them: probing is not the claim
     here, and the solution movie starts from that state."""
-    return seed_shipped(tmp_path_factory.mktemp("state-probes"), DASHER / "Zone1.Act1.state", DASHER / "rom.md")
+    return seed_shipped(tmp_path_factory.mktemp("state-probes"))
 
 
 @pytest.fixture

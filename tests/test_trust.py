@@ -196,7 +196,7 @@ def test_a_state_retrokit_wrote_needs_no_probe(tmp_path: Path, monkeypatch) -> N
     monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
     # The movie starts from the shipped Zone1.Act1: known by its bytes, as on a machine that loaded it once, so
     # its Core.bin costs no probe child (3,300 frames); the state integrate writes at frame 100 is other bytes.
-    seed_shipped(tmp_path / "data" / "state-probes", DASHER / "Zone1.Act1.state", DASHER / "rom.md")
+    seed_shipped(tmp_path / "data" / "state-probes")
     movie = DASHER / "movies" / "Zone1.Act1.bk2"
     assert main(["integrate", "Dasher-Genesis", "Midway", "--movie", str(movie), "--frame", "100"]) == 0
     monkeypatch.setattr(probe, "probe_state", lambda *a, **k: pytest.fail("a state this machine wrote was probed"))

@@ -67,6 +67,17 @@ def test_open_the_studio_on_dasher(page):
     assert not page.errors()
     page.resume()
     page.shot("play")
+    # The search's listed candidates show live values while the game runs: cells change, and changed cells
+    # flash (the page restarts their animations with one layout a message, not one per cell).
+    first = page.driver.execute_script("return [...document.querySelectorAll('#search-rows td.live')].map(c => c.textContent)")
+    assert len(first) == 100
+
+    def flashing_changed() -> int:
+        cells = page.driver.execute_script("return [...document.querySelectorAll('#search-rows td.live')].map("
+                                           "c => [c.textContent, c.classList.contains('flash')])")
+        return sum(flash and text != before for (text, flash), before in zip(cells, first, strict=True))
+
+    until("several live values to change and flash", lambda: flashing_changed() >= 2)
 
 
 def test_validate(page):

@@ -47,10 +47,10 @@ def data(tmp_path: Path, monkeypatch: pytest.MonkeyPatch, verdicts: Path) -> Ite
         yield folder
 
 
-@pytest.fixture
-def copy(tmp_path: Path, data: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    """Dasher under another name, with its ROM, its Zone1.Act1 state and its ranges (no recipes, no movies)."""
-    folder = tmp_path / "games" / GAME
+def dasher_copy(root: Path) -> Path:
+    """Dasher under another name in ``root/games``, with its ROM, its Zone1.Act1 state and its ranges (no recipes,
+    no movies)."""
+    folder = root / "games" / GAME
     folder.mkdir(parents=True)
     text = (DASHER / "game.yaml").read_text()
     (folder / "game.yaml").write_text(text[: text.index("integrate:")].replace("by_players: [Zone1.Act1, Zone1.Act1.2P]", ""))
@@ -58,6 +58,13 @@ def copy(tmp_path: Path, data: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
         shutil.copy(DASHER / name, folder / name)
     # re-gzipped: the game's own state, not a byte-for-byte copy of Dasher's (which validate flags)
     (folder / "Zone1.Act1.state").write_bytes(gzip.compress(read_state(DASHER / "Zone1.Act1.state"), 1, mtime=0))
+    return folder
+
+
+@pytest.fixture
+def copy(tmp_path: Path, data: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """:func:`dasher_copy` in the test's folder, found by name through RETROKIT_GAMES."""
+    folder = dasher_copy(tmp_path)
     monkeypatch.setenv("RETROKIT_GAMES", str(folder.parent))
     return folder
 
@@ -97,9 +104,15 @@ def airstriker_played(airstriker_dir: Path, airstriker_rom: Path) -> bytes:
         return bytes(emu.get_state())
 
 
-def test_make_refuses_another_games_state_with_a_state_error(copy, airstriker_dir, airstriker_rom):
+@pytest.fixture(scope="module")
+def played(airstriker_dir: Path, airstriker_rom: Path) -> bytes:
+    """:func:`airstriker_played`, made once for the module."""
+    return airstriker_played(airstriker_dir, airstriker_rom)
+
+
+def test_make_refuses_another_games_state_with_a_state_error(copy, played):
     # (the wheel's own Airstriker state, even re-gzipped, is refused before this by its hash: test_other_games_state)
-    write_state(copy / "Level1.state", airstriker_played(airstriker_dir, airstriker_rom))
+    write_state(copy / "Level1.state", played)
     with pytest.raises(StateError, match=r"found, one frame in, .*game_mode=\d+ \(range 0 to 3\)"):
         retrokit.make(GAME, state="Level1")
     env = retrokit.make(GAME, state="Zone1.Act1", obs_type="ram")  # the game's own state is fine
@@ -110,38 +123,71 @@ def test_make_refuses_another_games_state_with_a_state_error(copy, airstriker_di
         env.close()
 
 
-def test_validate_names_the_game_a_known_state_belongs_to(copy, airstriker_dir):
+@dataclasses.dataclass
+class Shared:
+    """The copy validated once for the tests that each check their own state of it (a validate each was a
+    probe child and the smoke runs of every state each), and its environment."""
+
+    folder: Path
+    env: dict[str, str]
+    report: object
+
+
+@pytest.fixture(scope="module")
+def shared(tmp_path_factory: pytest.TempPathFactory, verdicts: Path, played: bytes, airstriker_dir: Path) -> Shared:
+    """One copy holding each test's state under its own name, validated once:
+
+    - ``Known``: the wheel's Airstriker state, re-gzipped (known by its hash);
+    - ``Played`` and ``Saved``: Airstriker's state played on, saved by a tool that records nothing (ranges only);
+    - ``Mine``: the game's own state with retrokit's record;
+    - movies ``Good.bk2`` (Dasher's) and ``Foreign.bk2`` (Airstriker's start state).
+    """
+    from retrokit.movie import read_bk2, write_bk2
+
+    root = tmp_path_factory.mktemp("shared")
+    folder = dasher_copy(root)
+    (folder / "Known.state").write_bytes(airstriker_regzipped(airstriker_dir))
+    write_state(folder / "Played.state", played)
+    write_state(folder / "Saved.state", played)
+    state = read_state(folder / "Zone1.Act1.state")
+    write_state(folder / "Mine.state", state, record=StateRecord.of(GAME, find_game(folder).sha1s[0], state))
+    movie = read_bk2(DASHER / "movies" / "Zone1.Act1.bk2")
+    (folder / "movies").mkdir()
+    write_bk2(folder / "movies" / "Good.bk2", movie)
+    foreign = gzip.decompress((airstriker_dir / "Level1.state").read_bytes())
+    write_bk2(folder / "movies" / "Foreign.bk2", dataclasses.replace(movie, state=foreign))
+    env = {"RETROKIT_DATA": str(root / "data"), "RETROKIT_GAMES": str(folder.parent)}
+    with pytest.MonkeyPatch.context() as patch, shared_verdicts(verdicts, root / "data"):
+        for name, value in env.items():
+            patch.setenv(name, value)
+        return Shared(folder, env, check_game(GAME, frames=30))
+
+
+def test_validate_names_the_game_a_known_state_belongs_to(shared):
     """The wheel's Airstriker state, re-gzipped: validate knows it by its hash, as make(state=...) does."""
-    (copy / "Level1.state").write_bytes(airstriker_regzipped(airstriker_dir))
-    report = check_game(GAME, frames=30)
-    status, message = results(report, "state is the game's")["Level1"]
+    status, message = results(shared.report, "state is the game's")["Known"]
     assert status == FAIL and "found Airstriker-Genesis's state" in message and "Load it with Airstriker-Genesis" in message
-    assert "Level1" not in results(report, "fields in range") and not report.passed
+    assert "Known" not in results(shared.report, "fields in range") and not shared.report.passed
 
 
-def test_validate_names_the_fields_of_another_games_state_out_of_range(copy, airstriker_dir, airstriker_rom):
-    write_state(copy / "Level1.state", airstriker_played(airstriker_dir, airstriker_rom))
-    report = check_game(GAME, frames=30)
-    ranges = results(report, "fields in range")
+def test_validate_names_the_fields_of_another_games_state_out_of_range(shared):
+    ranges = results(shared.report, "fields in range")
     assert ranges["Zone1.Act1"][0] == PASS
-    status, message = ranges["Level1"]
+    status, message = ranges["Played"]
     assert status == FAIL and "game_mode=" in message and "(range 0 to 3)" in message
-    assert results(report, "state is the game's")["Level1"][0] == PASS  # no other check sees it
-    assert not report.passed
+    assert results(shared.report, "state is the game's")["Played"][0] == PASS  # no other check sees it
+    assert not shared.report.passed
 
 
-def test_validate_catches_a_state_saved_on_another_games_rom(copy, airstriker_dir, airstriker_rom):
+def test_validate_catches_a_state_saved_on_another_games_rom(shared):
     """Saved with Airstriker's ROM by a tool that records nothing: only the ranges can tell."""
-    write_state(copy / "Saved.state", airstriker_played(airstriker_dir, airstriker_rom))
-    report = check_game(GAME, frames=30)
-    assert results(report, "fields in range")["Saved"][0] == FAIL
+    assert results(shared.report, "fields in range")["Saved"][0] == FAIL
 
 
-def test_validate_covers_the_states_in_the_data_folder_of_a_game_given_by_folder(copy, data, airstriker_dir,
-                                                                                 airstriker_rom):
+def test_validate_covers_the_states_in_the_data_folder_of_a_game_given_by_folder(copy, data, played):
     made = data / "games" / GAME
     made.mkdir(parents=True)
-    write_state(made / "Dropped.state", airstriker_played(airstriker_dir, airstriker_rom))
+    write_state(made / "Dropped.state", played)
     report = check_game(copy, frames=30)  # validate FOLDER, as docs/integrate.md runs it in the game's folder
     assert results(report, "fields in range")["Dropped"][0] == FAIL
     assert results(report, "state loads")["Dropped"][0] == PASS
@@ -157,24 +203,15 @@ def test_validate_flags_a_default_that_names_no_state(copy):
     assert status == FAIL and f"retrokit integrate {GAME} Zone2.Act1" in message
 
 
-def test_validate_checks_each_movies_start_state(copy, airstriker_dir):
-    from retrokit.movie import read_bk2, write_bk2
-
-    movie = read_bk2(DASHER / "movies" / "Zone1.Act1.bk2")
-    (copy / "movies").mkdir()
-    write_bk2(copy / "movies" / "Good.bk2", movie)
-    foreign = gzip.decompress((airstriker_dir / "Level1.state").read_bytes())
-    write_bk2(copy / "movies" / "Foreign.bk2", dataclasses.replace(movie, state=foreign))
-    report = check_game(GAME, frames=30)
-    ranges = results(report, "fields in range")
+def test_validate_checks_each_movies_start_state(shared):
+    ranges = results(shared.report, "fields in range")
     assert ranges["Good.bk2 start"][0] == PASS and ranges["Foreign.bk2 start"][0] == FAIL
 
 
-def test_a_state_recorded_on_this_rom_in_range_is_trusted_as_before(copy):
+def test_a_state_recorded_on_this_rom_in_range_is_trusted_as_before(shared, monkeypatch):
     """The range check adds no refusal of the game's own states (make() and validate agree)."""
-    state = read_state(copy / "Zone1.Act1.state")
-    record = StateRecord.of(GAME, find_game(GAME).sha1s[0], state)
-    write_state(copy / "Mine.state", state, record=record)
+    for name, value in shared.env.items():
+        monkeypatch.setenv(name, value)
     env = retrokit.make(GAME, state="Mine")
     env.close()
-    assert results(check_game(GAME, frames=30), "fields in range")["Mine"][0] == PASS
+    assert results(shared.report, "fields in range")["Mine"][0] == PASS

@@ -160,39 +160,53 @@ def test_an_unreadable_game_yaml_fails_the_data_check(tmp_path: Path, special: s
 OVERLAYS = {"fifo": _fifo, "folder": lambda p: p.mkdir(), "symlink-loop": _loop}
 
 
-@pytest.mark.parametrize("overlay", list(OVERLAYS), ids=list(OVERLAYS))
-def test_an_overlay_game_yaml_that_cannot_be_read_is_said_not_skipped(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, overlay: str
-) -> None:
-    """A game.yaml in a folder searched first is the game's data file: one that is no file is an error."""
-    overlay_folder = tmp_path / "first" / "Dasher-Genesis"
-    overlay_folder.mkdir(parents=True)
-    OVERLAYS[overlay](overlay_folder / "game.yaml")
-    monkeypatch.setenv("RETROKIT_GAMES", str(tmp_path / "first"))
-    out = tmp_path / "report.json"
-    # validate, then make, in one child (a child each was two starts): make's error is printed, not raised, so a
-    # traceback on stderr is validate's
+@pytest.fixture(scope="module")
+def overlaid(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, object]:
+    """Each overlay case's validate, then make, all in ONE child (a child each was three starts), each case with
+    RETROKIT_GAMES at a folder of its own searched first, holding Dasher-Genesis/game.yaml made hostile.
+
+    Returns:
+        The root (``<case>/first/Dasher-Genesis/game.yaml`` and ``<case>/report.json`` in it), and the child.
+    """
+    root = tmp_path_factory.mktemp("overlays")
+    for overlay, make in OVERLAYS.items():
+        (root / overlay / "first" / "Dasher-Genesis").mkdir(parents=True)
+        make(root / overlay / "first" / "Dasher-Genesis" / "game.yaml")
+    # make's error is printed, not raised, so a traceback on stderr is validate's
     child = run_child(
         f"""
+        import os
         import retrokit
         from retrokit.cli import main
         from retrokit.errors import RetrokitError
 
-        main(["validate", "Dasher-Genesis", "--frames", "5", "-q", "--json", {str(out)!r}])
-        try:
-            retrokit.make("Dasher-Genesis")
-        except RetrokitError as exc:
-            print("make refused:", " ".join(str(exc).split()))
+        for case in {list(OVERLAYS)!r}:
+            os.environ["RETROKIT_GAMES"] = os.path.join({str(root)!r}, case, "first")
+            main(["validate", "Dasher-Genesis", "--frames", "5", "-q", "--json",
+                  os.path.join({str(root)!r}, case, "report.json")])
+            try:
+                retrokit.make("Dasher-Genesis")
+            except RetrokitError as exc:
+                print(f"make refused {{case}}:", " ".join(str(exc).split()))
         """,
-        timeout=120, cwd=tmp_path,
+        timeout=240, cwd=root,
     )
+    return root, child
+
+
+@pytest.mark.parametrize("overlay", list(OVERLAYS), ids=list(OVERLAYS))
+def test_an_overlay_game_yaml_that_cannot_be_read_is_said_not_skipped(overlaid, overlay: str) -> None:
+    """A game.yaml in a folder searched first is the game's data file: one that is no file is an error."""
+    root, child = overlaid
+    overlay_yaml = root / overlay / "first" / "Dasher-Genesis" / "game.yaml"
+    out = root / overlay / "report.json"
     assert child.signal is None and child.peak_rss_mb < MAX_RSS_MB, child.describe()
     assert out.is_file() and "Traceback" not in child.stderr, child.describe()
     data = [r for r in json.loads(out.read_text())["games"][0]["results"] if r["check"] == "data file"]
     assert data and data[0]["status"] == "fail", child.describe()
-    assert str(overlay_folder / "game.yaml") in data[0]["message"], child.describe()
-    refused = [line for line in child.stdout.splitlines() if line.startswith("make refused:")]
-    assert len(refused) == 1 and str(overlay_folder / "game.yaml") in refused[0], child.describe()
+    assert str(overlay_yaml) in data[0]["message"], child.describe()
+    refused = [line for line in child.stdout.splitlines() if line.startswith(f"make refused {overlay}:")]
+    assert len(refused) == 1 and str(overlay_yaml) in refused[0], child.describe()
 
 
 def test_a_game_folder_linking_to_itself_breaks_no_command(tmp_path: Path) -> None:

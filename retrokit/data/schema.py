@@ -15,17 +15,16 @@ keep their positions, before it is validated.
 from __future__ import annotations
 
 import functools
-import hashlib
 import json
 import os
 import re
-import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import yaml
 
+from retrokit.data.textmemo import TextMemo
 from retrokit.data.yamlfile import compose_yaml, read_yaml_text
 from retrokit.errors import DataFileError, FileSystemError, did_you_mean
 
@@ -95,25 +94,12 @@ def check_file(path: str | os.PathLike[str], kind: str) -> list[SchemaIssue]:
 
 def check_text(text: str, kind: str, name: str = "<text>") -> list[SchemaIssue]:
     """Return every problem of YAML ``text`` against the schema of ``kind``; ``name`` labels it."""
-    # Every make() reads its game.yaml again (an edit must show), and checking it was 40% of a warm make()'s CPU:
-    # the answer depends only on the text, so a text checked before is known by its digest (not kept itself: a
-    # data file may hold megabytes).
-    key = (hashlib.sha256(text.encode("utf-8", "surrogatepass")).digest(), kind, name)
-    with _CHECKED_LOCK:
-        found = _CHECKED.get(key)
-    if found is None:
-        found = tuple(_check(text, kind, name))
-        with _CHECKED_LOCK:
-            if len(_CHECKED) >= _CHECKED_MAX:
-                del _CHECKED[next(iter(_CHECKED))]  # the oldest
-            _CHECKED[key] = found
-    return list(found)
+    # Every make() reads its game.yaml again (an edit must show): a text checked before is known by its digest.
+    return list(_CHECKED.get(text, (kind, name), lambda: tuple(_check(text, kind, name))))
 
 
-_CHECKED: dict[tuple[bytes, str, str], tuple[SchemaIssue, ...]] = {}
-""":func:`check_text`'s answers by the text's SHA-256, its kind and its name."""
-_CHECKED_MAX = 256
-_CHECKED_LOCK = threading.Lock()
+_CHECKED: TextMemo[tuple[SchemaIssue, ...]] = TextMemo()
+""":func:`check_text`'s answers by the text, its kind and its name."""
 
 
 def _check(text: str, kind: str, name: str) -> list[SchemaIssue]:

@@ -20,12 +20,14 @@ here, so the same limits hold for each:
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import yaml
 
+from retrokit.data.textmemo import TextMemo
 from retrokit.paths import read_regular_file
 
 _Base: type = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
@@ -151,6 +153,16 @@ def load_yaml(text: str) -> Any:
             (:class:`DuplicateKeyError`, with the line of the second one), or it
             holds too many values (:class:`TooManyValuesError`).
     """
+    # Every make() reads its game.yaml again (an edit must show): a text parsed before is known by its digest, and
+    # each caller gets its own copy to change.
+    return copy.deepcopy(_PARSED.get(text, None, lambda: _parse(text)))
+
+
+_PARSED: TextMemo[Any] = TextMemo()
+""":func:`load_yaml`'s documents by their text."""
+
+
+def _parse(text: str) -> Any:
     root = compose_yaml(text, StrictLoader)
     if root is None:
         return None

@@ -9,7 +9,9 @@ made when the env is made.
 
 from __future__ import annotations
 
+import functools
 import importlib.util
+import sys
 
 import numpy as np
 
@@ -18,9 +20,16 @@ from retrokit.errors import EnvError, MissingExtraError, install_extra
 
 def human_available() -> bool:
     """Whether pygame can be imported, without importing it (which takes a while and prints a banner)."""
+    if "pygame" in sys.modules:  # imported, or blocked with None (as tests do)
+        return sys.modules["pygame"] is not None
+    return _pygame_found()
+
+
+@functools.cache  # every make() asks (its render modes), and finding a module walks sys.path: ~1 ms a time
+def _pygame_found() -> bool:
     try:
         return importlib.util.find_spec("pygame") is not None
-    except (ImportError, ValueError):  # a broken or blocked pygame
+    except (ImportError, ValueError):  # a broken pygame
         return False
 
 

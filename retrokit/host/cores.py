@@ -12,6 +12,7 @@ Cores are searched, in order, in:
 
 from __future__ import annotations
 
+import functools
 import importlib.metadata
 import json
 import os
@@ -47,6 +48,7 @@ def core_filename(core: str) -> str:
     return f"{core}_libretro{suffix}"
 
 
+@functools.cache  # asked at every make(); reading the package's metadata took ~3 ms, and it is fixed for a process
 def stable_retro_version() -> str | None:
     """Return the installed stable-retro version, or ``None``."""
     try:

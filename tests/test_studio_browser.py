@@ -121,6 +121,7 @@ def test_play_with_the_keyboard(page):
     until("the player to run right", lambda: int(page.field("p1_x")) > x0 + 20)
     ActionChains(page.driver).key_up(Keys.ARROW_RIGHT).perform()
     until("the screen to move with the player", lambda: page.frame() > frame0 and canvas_pixels(page) != pixels0)
+    until("the frame number under it to run on", lambda: int(page.text("frame")) > frame0)  # a few times a second
     # Paused, a reset shows the state chosen (loading a state does not draw it: the server does).
     page.pause()
     page.reset("Zone2.Act1")
@@ -129,6 +130,7 @@ def test_play_with_the_keyboard(page):
     before = page.frame()
     page.advance(30)
     assert page.frame() == before + 30 and page.paused()
+    assert page.text("frame") == str(before + 30)  # paused, the number shown is the screen's exactly
     # The speed menu reaches the server: its status comes back with it.
     Select(page.el("speed")).select_by_value("2")
     until("2x", lambda: page.text("speed-shown") == "2×")

@@ -114,7 +114,10 @@ class Page:
         box.send_keys(text)
 
     def tab(self, name: str) -> None:
-        self.driver.find_element(By.CSS_SELECTOR, f'#tabs button[data-panel="{name}"]').click()
+        button = self.driver.find_element(By.CSS_SELECTOR, f'#tabs button[data-panel="{name}"]')
+        # Scrolled to the middle as a user would: scrolled down a long panel, the tab is under the sticky header.
+        self.driver.execute_script("arguments[0].scrollIntoView({block: 'center'});", button)
+        button.click()
         until(f"the {name} panel", lambda: self.el(name).is_displayed())
 
     # What the tests read often is read in one script: each WebDriver call is a round trip to a browser
@@ -265,11 +268,21 @@ def dasher_studio(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Studio]:
         yield server
 
 
-def studio_page(browser: webdriver.Chrome, studio: Studio) -> Page:
-    """The page of the module's studio in this test's browser (the ``page`` fixture of :func:`fixtures`)."""
-    return Page(browser, studio)
+def module_page(chromium_session: webdriver.Chrome, studio: Studio, tab: str = "search") -> Iterator[Page]:
+    """The studio's page loaded once for a test module, on ``tab``; its tests go to their panels by their tabs.
+
+    A load costs Chromium about a CPU-second (the page builds every panel) and the server a third of one: a fresh
+    load for each test cost a module more than its steps did. The tests that are about a load (a reload restores an
+    unsaved edit) call :meth:`Page.open` themselves.
+    """
+    from chromium import fresh
+
+    page = Page(fresh(chromium_session), studio).open(tab)
+    yield page
+    page.driver.get("about:blank")  # off the page: the server pauses, and the next module finds a blank browser
 
 
 def fixtures() -> tuple:
-    """The fixtures ``studio`` (a module's, on Dasher) and ``page``, to assign to names in a test module."""
-    return pytest.fixture(dasher_studio, scope="module", name="studio"), pytest.fixture(studio_page, name="page")
+    """The fixtures ``studio`` (a module's, on Dasher) and ``page`` (:func:`module_page`), to assign to names."""
+    return (pytest.fixture(dasher_studio, scope="module", name="studio"),
+            pytest.fixture(module_page, scope="module", name="page"))  # fmt: skip

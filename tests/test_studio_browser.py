@@ -3,9 +3,10 @@
 A real ``retrokit studio`` server runs in a child process on a free port, on a
 copy of Dasher's game folder and an empty data folder in tmp_path; headless
 Chromium (Debian's ``chromium`` and ``chromium-driver``, through Selenium)
-opens the URL it prints (tests/studiopage.py). Each test is one step of the
-issue: open the studio, validate, play with the keyboard and a gamepad, find
-the lives with the search and add the field, save a state
+opens the URL it prints (tests/studiopage.py), once for the module. Each test
+is one step of the issue, going to its panel by its tab as a user does: open
+the studio, validate, play with the keyboard, find the lives with the search
+and add the field, save a state, play with a gamepad
 (tests/test_studio_browser_panels.py has the scenario and the other panels).
 The results are checked where they land: the screen, the RAM fields the page
 shows, game.yaml, the .state file and its record.
@@ -33,7 +34,7 @@ from studiopage import (  # first: skips without Chromium
 pytestmark = pytest.mark.timeout(600)
 
 
-page_fixture = pytest.fixture(studiopage.studio_page, name="page")
+page_fixture = pytest.fixture(studiopage.module_page, scope="module", name="page")  # loaded once; tests go by tabs
 
 
 @pytest.fixture(scope="module")
@@ -53,7 +54,7 @@ def studio(tmp_path_factory: pytest.TempPathFactory):
 
 
 def test_open_the_studio_on_dasher(page):
-    page.open()
+    """The page as the module's fixture opened it (tests/studiopage.py's module_page, on the search tab)."""
     assert page.text("game-name") == "Dasher-Genesis (Genesis)"
     assert page.driver.title == "Dasher-Genesis · retrokit studio"
     screen = page.el("screen")
@@ -78,11 +79,12 @@ def test_open_the_studio_on_dasher(page):
         return sum(flash and text != before for (text, flash), before in zip(cells, first, strict=True))
 
     until("several live values to change and flash", lambda: flashing_changed() >= 2)
+    page.pause()  # the next steps play by frame advance or resume themselves
 
 
 def test_validate(page):
     """Before the other steps change the game: Dasher's copy passes, its progress shown while it runs."""
-    page.open("validate")
+    page.tab("validate")
     page.click("validate-run")
     until("its progress", lambda: page.text("validate-summary").startswith("checking Dasher-Genesis: "))
     page.said("Validated Dasher-Genesis: ")
@@ -109,7 +111,7 @@ def at_the_start(page) -> int:
 
 
 def test_play_with_the_keyboard(page):
-    page.open("watch")
+    page.tab("watch")
     x0 = at_the_start(page)
     frame0, pixels0 = page.frame(), canvas_pixels(page)
     page.resume()
@@ -119,6 +121,7 @@ def test_play_with_the_keyboard(page):
     until("the player to run right", lambda: int(page.field("p1_x")) > x0 + 20)
     ActionChains(page.driver).key_up(Keys.ARROW_RIGHT).perform()
     until("the screen to move with the player", lambda: page.frame() > frame0 and canvas_pixels(page) != pixels0)
+    until("the frame number under it to run on", lambda: int(page.text("frame")) > frame0)  # a few times a second
     # Paused, a reset shows the state chosen (loading a state does not draw it: the server does).
     page.pause()
     page.reset("Zone2.Act1")
@@ -127,6 +130,7 @@ def test_play_with_the_keyboard(page):
     before = page.frame()
     page.advance(30)
     assert page.frame() == before + 30 and page.paused()
+    assert page.text("frame") == str(before + 30)  # paused, the number shown is the screen's exactly
     # The speed menu reaches the server: its status comes back with it.
     Select(page.el("speed")).select_by_value("2")
     until("2x", lambda: page.text("speed-shown") == "2×")
@@ -134,30 +138,9 @@ def test_play_with_the_keyboard(page):
     until("1x", lambda: page.text("speed-shown") == "1×")
 
 
-def test_play_with_a_gamepad(page):
-    """The Gamepad API's standard layout: button 15 is the D-pad's right. Headless Chromium has no pad, so the page
-    is given one through the API it reads (navigator.getGamepads), as a browser would report a real pad."""
-    page.open("watch")
-    x0 = at_the_start(page)
-    page.resume()
-    page.driver.execute_script(
-        "const buttons = Array.from({length: 17}, (_, i) => ({pressed: i === 15, value: i === 15 ? 1 : 0}));"
-        "window.fakePad = {index: 0, connected: true, mapping: 'standard', axes: [0, 0, 0, 0], buttons};"
-        "navigator.getGamepads = () => [window.fakePad];"
-        "window.dispatchEvent(new Event('gamepadconnected'));"
-    )
-    until("RIGHT held", lambda: "held" in page.driver.find_element(
-        By.CSS_SELECTOR, '#buttons [data-button="RIGHT"]').get_attribute("class"))  # fmt: skip
-    until("the player to run right", lambda: int(page.field("p1_x")) > x0 + 20)
-    page.driver.execute_script("window.fakePad.buttons[15] = {pressed: false, value: 0};")
-    until("RIGHT let go", lambda: "held" not in page.driver.find_element(
-        By.CSS_SELECTOR, '#buttons [data-button="RIGHT"]').get_attribute("class"))  # fmt: skip
-    page.pause()
-
-
 def test_find_the_lives_with_the_search_and_add_the_field(page, studio):
     """docs/ramsearch.md's walkthrough, in the page: 3 lives, run into the pit twice, the byte is found."""
-    page.open("search")
+    page.tab("search")
     page.pause()
     page.reset("Zone1.Act1")
     page.click("search-new")
@@ -214,7 +197,7 @@ def test_find_the_lives_with_the_search_and_add_the_field(page, studio):
 def test_save_a_state(page, studio):
     from retrokit.data.states import read_state_file
 
-    page.open("search")
+    page.tab("search")
     page.pause()
     page.reset("Zone1.Act1")
     page.advance(40, Keys.ARROW_RIGHT)
@@ -244,3 +227,26 @@ def test_save_a_state(page, studio):
     page.driver.find_element(By.CSS_SELECTOR, '#states-rows tr[data-state="Zone1.Act2"] button.load').click()
     page.said("Loaded state Zone1.Act2.")
     until("Zone1.Act2 played", lambda: page.text("current-state") == "Zone1.Act2")
+
+
+def test_play_with_a_gamepad(page):
+    """The Gamepad API's standard layout: button 15 is the D-pad's right. Headless Chromium has no pad, so the page
+    is given one through the API it reads (navigator.getGamepads), as a browser would report a real pad.
+
+    Last: the pad stays plugged in the module's page (the page polls it every animation frame from then on)."""
+    page.tab("watch")
+    x0 = at_the_start(page)
+    page.resume()
+    page.driver.execute_script(
+        "const buttons = Array.from({length: 17}, (_, i) => ({pressed: i === 15, value: i === 15 ? 1 : 0}));"
+        "window.fakePad = {index: 0, connected: true, mapping: 'standard', axes: [0, 0, 0, 0], buttons};"
+        "navigator.getGamepads = () => [window.fakePad];"
+        "window.dispatchEvent(new Event('gamepadconnected'));"
+    )
+    until("RIGHT held", lambda: "held" in page.driver.find_element(
+        By.CSS_SELECTOR, '#buttons [data-button="RIGHT"]').get_attribute("class"))  # fmt: skip
+    until("the player to run right", lambda: int(page.field("p1_x")) > x0 + 20)
+    page.driver.execute_script("window.fakePad.buttons[15] = {pressed: false, value: 0};")
+    until("RIGHT let go", lambda: "held" not in page.driver.find_element(
+        By.CSS_SELECTOR, '#buttons [data-button="RIGHT"]').get_attribute("class"))  # fmt: skip
+    page.pause()

@@ -2,7 +2,9 @@
 
 As tests/test_studio_browser.py (the issue's first steps), on a studio of its
 own: a real ``retrokit studio`` child process on a copy of Dasher, and the
-session's headless Chromium driving its page as a user would.
+session's headless Chromium driving its page as a user would: the page is loaded
+once for the module and each test goes to its panel by its tab (a test about a
+reload loads it again itself).
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ studio_fixture, page_fixture = studiopage.fixtures()
 
 
 def test_write_a_scenario_and_watch_its_reward_live(page, studio):
-    page.open("scenario")
+    page.tab("scenario")
     page.pause()
     page.reset("Zone1.Act1")
     until("the scenario", lambda: "rewards:" in editor_text(page))
@@ -86,7 +88,7 @@ def test_write_a_scenario_and_watch_its_reward_live(page, studio):
 
 
 def test_the_page_asks_before_dropping_an_unsaved_edit(page, studio):
-    page.open("scenario")
+    page.tab("scenario")
     until("the scenario", lambda: editor_text(page))
     saved = editor_text(page)
     type_scenario(page, "reward: delta(p1_x) * 2\n")
@@ -108,7 +110,7 @@ def test_the_page_asks_before_dropping_an_unsaved_edit(page, studio):
 
 
 def test_watch_edits_a_field(page, studio):
-    page.open("watch")
+    page.tab("watch")
     row = until("the field p1_deaths", lambda: page.driver.find_element(By.CSS_SELECTOR, '#watch-rows tr[data-field="p1_deaths"]'))
     row.find_element(By.TAG_NAME, "button").click()
     for label, value in (("range low", "0"), ("range high", "99")):
@@ -142,7 +144,7 @@ def hud_lives_pixel() -> tuple[int, int]:
 
 def test_click_to_find_names_the_lives_under_the_hud_digit(page):
     x, y = hud_lives_pixel()
-    page.open("clickfind")
+    page.tab("clickfind")
     page.pause()
     page.reset("Zone1.Act1")
     page.el("cf-range").click()
@@ -160,7 +162,7 @@ def test_click_to_find_names_the_lives_under_the_hud_digit(page):
 
 
 def test_ram_view_highlights_what_changes(page):
-    page.open("ramview")
+    page.tab("ramview")
     page.resume()
     until("the grid", lambda: len(page.driver.find_elements(By.CSS_SELECTOR, "#ram-grid td")) == 256)
     # Dasher's frame counter (0xFF0004-7) changes every frame: its low byte is highlighted.
@@ -178,7 +180,7 @@ def test_ram_view_highlights_what_changes(page):
 def test_record_and_replay_a_movie(page, studio):
     from retrokit.movie import read_bk2
 
-    page.open("watch")
+    page.tab("watch")
     page.pause()
     page.reset("Zone1.Act1")
     page.click("record")
@@ -212,7 +214,7 @@ def test_a_new_game_from_a_rom_then_another_game(page, studio, tmp_path):
     from runner_rom import write_runner_rom
 
     rom = write_runner_rom(tmp_path / "runner.bin")
-    page.open("newgame")
+    page.tab("newgame")
     page.type("new-rom", str(rom))
     page.type("new-name", "Runner-Genesis")
     page.click("new-make")

@@ -66,7 +66,7 @@ def cartridge(request, studio: Studio) -> str:
 @pytest.fixture(scope="module")
 def page(chromium_session, studio: Studio, cartridge: str) -> Iterator[Page]:
     """The studio's page on the cartridge, loaded once for its tests: each goes to its panels by their tabs, as a
-    user does. A load costs about a second (the panels start one after the other, each asking the server), and
+    user does. A load costs Chromium about a CPU-second (the page builds every panel, each asking the server), and
     loading the page for each panel took three a cartridge."""
     from chromium import fresh
 

@@ -42,13 +42,15 @@ async function boot() {
   document.title = `${info.game} · retrokit studio`;
   byId("game-name").textContent = `${info.game} (${info.system})`;
   play.init(info);
-  for (const [name, module] of Object.entries({ states, ...TOOLS })) {
+  // The panels start at once, not one after the other: each waits for its own answers from the server, and in
+  // turn they kept the page from being ready for the sum of those waits.
+  await Promise.all(Object.entries({ states, ...TOOLS }).map(async ([name, module]) => {
     try {
       await module.init(info);
     } catch (error) {
       say(`The ${name} panel could not start: ${error.message}`, "error");
     }
-  }
+  }));
   for (const tab of byId("tabs").querySelectorAll("button")) tab.addEventListener("click", () => showTab(tab.dataset.panel));
   showTab(location.hash.slice(1));
   window.addEventListener("hashchange", () => showTab(location.hash.slice(1))); // a link or Back to #watch

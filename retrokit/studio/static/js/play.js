@@ -8,10 +8,26 @@ import * as input from "./input.js";
 import { on, onScreen, send } from "./socket.js";
 
 const SPEEDS = [0.25, 0.5, 1, 2, 4, 8];
+// Milliseconds between updates of the frame number shown under the screen while the game runs. Its text changing
+// on every frame laid out the page 60 times a second (a fifth of what Chromium spent on a playing page), for a
+// number no one reads at that rate; paused, it is the exact frame of the screen (showFrame).
+const FRAME_TEXT_PERIOD = 100;
 
 let pending = null; // the newest screen not drawn yet
 let image = null;
 let status = {};
+let frameTextAt = -Infinity; // when the frame number shown was last written (performance.now())
+
+/** Write the frame number of the canvas under the screen: at once when paused (or asked), else at most once a period. */
+function showFrame(now = false) {
+  const frame = byId("screen").dataset.frame;
+  if (frame === undefined) return;
+  const at = performance.now();
+  if (!now && !status.paused && at - frameTextAt < FRAME_TEXT_PERIOD) return;
+  frameTextAt = at;
+  const shown = byId("frame");
+  if (shown.textContent !== frame) shown.textContent = frame;
+}
 
 function draw(canvas) {
   const screen = pending;
@@ -37,7 +53,7 @@ function draw(canvas) {
   canvas.getContext("2d").putImageData(image, 0, 0);
   // The frame number shown is the one of the pixels on the canvas (tests and the benchmark read it here).
   canvas.dataset.frame = String(frame);
-  byId("frame").textContent = String(frame);
+  showFrame();
 }
 
 function showStatus(message) {
@@ -51,6 +67,7 @@ function showStatus(message) {
   byId("run-state").textContent = status.paused ? "paused" : status.replaying ? "replaying" : "running";
   if (typeof status.speed === "number") byId("speed").value = String(status.speed);
   if (status.state) byId("current-state").textContent = status.state;
+  if (status.paused) showFrame(true); // the screen drawn before this status said so
 }
 
 /** The buttons of the system, each with its key, pressable with the mouse too. */

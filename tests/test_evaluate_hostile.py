@@ -343,13 +343,39 @@ AT_IMPORT = {
 }
 
 
+@pytest.fixture(scope="module")
+def at_import(tmp_path_factory) -> tuple[dict[str, tuple[int, str]], Child, Path]:
+    """Each case's agent module evaluated in turn in ONE child: what each command said, the child, and the folder.
+
+    A module that ended the evaluation's own process would end the child before it answered the later cases;
+    anything a process under it wrote to the terminal is in the child's own stderr, which the test holds empty.
+    """
+    root = tmp_path_factory.mktemp("at-import")
+    commands = {}
+    for case, source in AT_IMPORT.items():
+        (root / case).mkdir()
+        agent = root / case / "quits.py"
+        agent.write_text(source + "def agent(env, budget, seed):\n    pass\n")
+        commands[case] = [*FAST, "--levels", "Zone1.Act1", "--agent", f"{agent}:agent", "--out", str(root / case / "run")]
+    child = run_child(f"""
+        import contextlib, io, json
+        from retrokit.cli import main
+
+        outcomes = {{}}
+        for case, command in {commands!r}.items():
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err):
+                outcomes[case] = [main(command), err.getvalue()]
+        print(json.dumps(outcomes))
+        """, timeout=240, cwd=root)
+    assert child.returncode == 0 and child.stderr == "", child.describe()
+    return json.loads(child.stdout.splitlines()[-1]), child, root
+
+
 @pytest.mark.parametrize("case", AT_IMPORT, ids=list(AT_IMPORT))
-def test_an_agent_module_that_exits_at_import_is_one_line_and_a_failure(tmp_path, case) -> None:
-    agent = tmp_path / "quits.py"
-    agent.write_text(AT_IMPORT[case] + "def agent(env, budget, seed):\n    pass\n")
-    out = tmp_path / "run"
-    child = run_cli([*FAST, "--levels", "Zone1.Act1", "--agent", f"{agent}:agent", "--out", str(out)],
-                    timeout=240, cwd=tmp_path)  # fmt: skip
-    assert child.returncode == 2 and child.signal is None, child.describe()
-    assert child.stderr.count("\n") == 1 and "Traceback" not in child.stderr, child.describe()
-    assert "quits.py:agent" in child.stderr and not out.exists(), child.describe()
+def test_an_agent_module_that_exits_at_import_is_one_line_and_a_failure(at_import, case) -> None:
+    outcomes, child, root = at_import
+    code, stderr = outcomes[case]
+    assert code == 2, (code, stderr, child.describe())
+    assert stderr.count("\n") == 1 and "Traceback" not in stderr, stderr
+    assert "quits.py:agent" in stderr and not (root / case / "run").exists(), stderr

@@ -11,7 +11,7 @@ import time
 from pathlib import Path
 
 import pytest
-from evaluating import SMALL, TWO_LEVELS, evaluate, session_processes, wait_for, write_agents
+from evaluating import SMALL, evaluate, session_processes, wait_for, write_agents
 from PIL import Image
 
 from retrokit.cli import main
@@ -23,39 +23,36 @@ def summary(out: Path) -> bytes:
 
 @pytest.fixture(scope="module")
 def reference(tmp_path_factory) -> Path:
-    """JERK on two levels, 300 timesteps each, seed 0, one worker."""
+    """JERK on two levels, 300 timesteps each, seed 0, on two workers, saving GIFs.
+
+    JERK ends 1 episode on Zone2.Act2 and 8 on Zone3.Act2, and scores over 2.5 times random's aggregate (1016 to
+    374); GIFs and the number of workers change nothing in the summary (the same-seed test shows it).
+    """
     out = tmp_path_factory.mktemp("reference") / "run"
-    assert evaluate(out, "--agent", "jerk", "--workers", "1") == 0
+    assert evaluate(out, "--agent", "jerk", "--workers", "2", "--gif") == 0
     return out
 
 
 @pytest.fixture(scope="module")
-def jerk_and_random(tmp_path_factory) -> dict[str, Path]:
-    """Both agents on the same two levels with 600 timesteps, on two workers; JERK saves GIFs.
-
-    600 timesteps are enough for JERK to score almost three times random's aggregate (836 to 303), and for
-    JERK's long runs on Zone2.Act2 to end 3 episodes.
-    """
-    outs = {}
-    for agent in ("jerk", "random"):
-        outs[agent] = tmp_path_factory.mktemp(agent) / "run"
-        extra = ["--gif"] if agent == "jerk" else []
-        assert main(["evaluate", "--levels", TWO_LEVELS, "--timesteps", "600", "--agent", agent, "--workers", "2",
-                     "--no-progress", "--out", str(outs[agent]), *extra]) == 0
-    return outs
+def random_run(tmp_path_factory) -> Path:
+    """Random on the reference's levels and timesteps."""
+    out = tmp_path_factory.mktemp("random") / "run"
+    assert evaluate(out, "--agent", "random", "--workers", "2") == 0
+    return out
 
 
-def test_dasher_writes_every_file(jerk_and_random) -> None:
-    out = jerk_and_random["jerk"]
+def test_dasher_writes_every_file(reference) -> None:
+    out = reference
     episodes = [json.loads(line) for line in (out / "episodes.jsonl").read_text().splitlines()]
     assert {e["level"] for e in episodes} == {"Dasher-Genesis/Zone2.Act2", "Dasher-Genesis/Zone3.Act2"}
     assert set(episodes[0]) == {"level", "episode", "steps", "reward", "timesteps", "wall"}
     data = json.loads((out / "summary.json").read_text())
     for level, entry in data["levels"].items():
         mine = [e for e in episodes if e["level"] == level]
-        assert entry["episodes"] == len(mine) >= 3
+        assert entry["episodes"] == len(mine) >= 1
         assert entry["mean_score"] == pytest.approx(sum(e["reward"] for e in mine) / len(mine))
-        assert entry["timesteps"] == 600 and max(e["timesteps"] for e in mine) <= 600
+        assert entry["timesteps"] == 300 and max(e["timesteps"] for e in mine) <= 300
+    assert max(e["episodes"] for e in data["levels"].values()) >= 3  # a mean over several episodes is checked
     assert data["aggregate"] == pytest.approx(sum(e["mean_score"] for e in data["levels"].values()) / 2)
     rows = (out / "summary.csv").read_text().splitlines()
     assert rows[0].startswith("level,mean_score") and len(rows) == 4 and rows[-1].startswith("aggregate,")
@@ -69,17 +66,20 @@ def test_dasher_writes_every_file(jerk_and_random) -> None:
             assert gif.n_frames > 10 and gif.size == (320, 224)
 
 
-def test_jerk_beats_random_by_a_clear_margin(jerk_and_random) -> None:
-    jerk, rand = (json.loads((jerk_and_random[a] / "summary.json").read_text())["aggregate"] for a in ("jerk", "random"))
+def test_jerk_beats_random_by_a_clear_margin(reference, random_run) -> None:
+    jerk, rand = (json.loads(summary(run))["aggregate"] for run in (reference, random_run))
     assert jerk > 1.5 * rand, (jerk, rand)
 
 
 def test_the_same_seed_gives_the_same_summary_twice_and_on_two_workers(reference, tmp_path) -> None:
+    # The reference played on two workers (saving GIFs): once more on one worker, without.
     assert evaluate(tmp_path / "again", "--agent", "jerk", "--workers", "1") == 0
-    assert evaluate(tmp_path / "two", "--agent", "jerk", "--workers", "2") == 0
-    assert summary(tmp_path / "again") == summary(reference) == summary(tmp_path / "two")
-    assert evaluate(tmp_path / "other", "--agent", "jerk", "--seed", "1") == 0
-    assert summary(tmp_path / "other") != summary(reference)
+    assert summary(tmp_path / "again") == summary(reference)
+    # Each level's seed derives from the run's seed: another seed plays the level otherwise.
+    assert evaluate(tmp_path / "other", "--agent", "jerk", "--seed", "1", "--levels", "Zone3.Act2") == 0
+    level = "Dasher-Genesis/Zone3.Act2"
+    other, same = (json.loads(summary(run))["levels"][level] for run in (tmp_path / "other", reference))
+    assert other != same and other["timesteps"] == same["timesteps"], (other, same)
 
 
 def test_an_interrupted_run_resumes_to_the_uninterrupted_result(reference, agents_file, tmp_path, monkeypatch) -> None:

@@ -114,14 +114,49 @@ def report(out: Path) -> str:
     return (out / "report.md").read_text()
 
 
+def in_one_child(commands: dict[str, list[str]], *, timeout: float = 240,
+                 cwd: Path | None = None) -> tuple[dict[str, tuple[int, str]], Child]:
+    """Run each of ``commands`` (``retrokit ARGS...``) in turn in ONE child: each one's status and stderr, and the child.
+
+    One interpreter (and one fork server) for all spares their start per command. Whatever a process under the
+    child writes to the terminal itself is in the child's own stderr, which callers hold empty.
+    """
+    child = run_child(f"""
+        import contextlib, io, json
+        from retrokit.cli import main
+
+        outcomes = {{}}
+        for name, command in {commands!r}.items():
+            err = io.StringIO()
+            with contextlib.redirect_stderr(err):
+                outcomes[name] = [main(command), err.getvalue()]
+        print(json.dumps(outcomes))
+        """, timeout=timeout, cwd=cwd)
+    assert child.returncode == 0, child.describe()
+    return json.loads(child.stdout.splitlines()[-1]), child
+
+
+@pytest.fixture(scope="module")
+def ended(tmp_path_factory) -> tuple[dict[str, tuple[int, str]], Child, Path]:
+    """The agent that ends its process on five levels, on one worker and on two, in one child: what each run said,
+    the child, and the folder of the runs (``1``, ``2``)."""
+    root = tmp_path_factory.mktemp("ended")
+    agents = write_agents(root, AGENTS)
+    commands = {workers: [*FAST, "--levels", f"{THREE},Zone1.Act1,Zone2.Act1", "--agent", f"{agents}:ends_its_process",
+                          "--workers", workers, "--out", str(root / workers)] for workers in ("1", "2")}
+    outcomes, child = in_one_child(commands)
+    assert child.stderr == "", child.describe()  # no worker printed anything of its own
+    return outcomes, child, root
+
+
 @pytest.mark.parametrize("workers", ["1", "2"])
-def test_an_agent_that_ends_its_process_fails_its_level_and_the_others_are_kept(agents, tmp_path, workers) -> None:
-    out = tmp_path / "run"
-    child = run_cli([*FAST, "--levels", f"{THREE},Zone1.Act1,Zone2.Act1", "--agent", f"{agents}:ends_its_process",
-                     "--workers", workers, "--out", str(out)], timeout=240)
-    assert child.returncode == 2 and child.signal is None, child.describe()
-    assert child.stderr.count("\n") == 1 and "Traceback" not in child.stderr, child.describe()
-    assert "4 more level(s) failed" not in child.stderr and "3 more level(s) failed" in child.stderr
+def test_an_agent_that_ends_its_process_fails_its_level_and_the_others_are_kept(ended, workers) -> None:
+    outcomes, child, root = ended
+    code, stderr = outcomes[workers]
+    out = root / workers
+    assert code == 2, (code, stderr, child.describe())
+    assert stderr.count("\n") == 1 and "Traceback" not in stderr, stderr
+    assert "4 more level(s) failed" not in stderr and "3 more level(s) failed" in stderr, stderr
     data = json.loads((out / "summary.json").read_text())
     assert list(data["levels"]) == ["Dasher-Genesis/Zone2.Act1"] and data["complete"] is False
     text = report(out)
@@ -301,20 +336,9 @@ def resumed_damages(finished, tmp_path_factory) -> tuple[dict[str, tuple[int, st
         folders[damage] = str(tmp_path_factory.mktemp(damage) / "run")
         shutil.copytree(finished, folders[damage])
         make(Path(folders[damage]))
-    child = run_child(f"""
-        import contextlib, io, json
-        from retrokit.cli import main
-
-        outcomes = {{}}
-        for damage, out in {folders!r}.items():
-            err = io.StringIO()
-            with contextlib.redirect_stderr(err):
-                code = main({[*FAST, "--levels", LEVEL, "--agent", "jerk"]!r} + ["--out", out, "--resume"])
-            outcomes[damage] = [code, err.getvalue()]
-        print(json.dumps(outcomes))
-        """, timeout=120)
-    assert child.returncode == 0, child.describe()
-    return json.loads(child.stdout.splitlines()[-1]), child
+    commands = {damage: [*FAST, "--levels", LEVEL, "--agent", "jerk", "--out", out, "--resume"]
+                for damage, out in folders.items()}
+    return in_one_child(commands, timeout=120)
 
 
 @pytest.mark.parametrize("damage", list(DAMAGES))
@@ -343,13 +367,29 @@ AT_IMPORT = {
 }
 
 
+@pytest.fixture(scope="module")
+def at_import(tmp_path_factory) -> tuple[dict[str, tuple[int, str]], Child, Path]:
+    """Each case's agent module evaluated in turn in ONE child: what each command said, the child, and the folder.
+
+    A module that ended the evaluation's own process would end the child before it answered the later cases;
+    anything a process under it wrote to the terminal is in the child's own stderr, which the test holds empty.
+    """
+    root = tmp_path_factory.mktemp("at-import")
+    commands = {}
+    for case, source in AT_IMPORT.items():
+        (root / case).mkdir()
+        agent = root / case / "quits.py"
+        agent.write_text(source + "def agent(env, budget, seed):\n    pass\n")
+        commands[case] = [*FAST, "--levels", "Zone1.Act1", "--agent", f"{agent}:agent", "--out", str(root / case / "run")]
+    outcomes, child = in_one_child(commands, cwd=root)
+    assert child.stderr == "", child.describe()
+    return outcomes, child, root
+
+
 @pytest.mark.parametrize("case", AT_IMPORT, ids=list(AT_IMPORT))
-def test_an_agent_module_that_exits_at_import_is_one_line_and_a_failure(tmp_path, case) -> None:
-    agent = tmp_path / "quits.py"
-    agent.write_text(AT_IMPORT[case] + "def agent(env, budget, seed):\n    pass\n")
-    out = tmp_path / "run"
-    child = run_cli([*FAST, "--levels", "Zone1.Act1", "--agent", f"{agent}:agent", "--out", str(out)],
-                    timeout=240, cwd=tmp_path)  # fmt: skip
-    assert child.returncode == 2 and child.signal is None, child.describe()
-    assert child.stderr.count("\n") == 1 and "Traceback" not in child.stderr, child.describe()
-    assert "quits.py:agent" in child.stderr and not out.exists(), child.describe()
+def test_an_agent_module_that_exits_at_import_is_one_line_and_a_failure(at_import, case) -> None:
+    outcomes, child, root = at_import
+    code, stderr = outcomes[case]
+    assert code == 2, (code, stderr, child.describe())
+    assert stderr.count("\n") == 1 and "Traceback" not in stderr, stderr
+    assert "quits.py:agent" in stderr and not (root / case / "run").exists(), stderr

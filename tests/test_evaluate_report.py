@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import io
 import json
+from pathlib import Path
 
 import pytest
 from PIL import Image
@@ -93,12 +95,25 @@ def test_our_agents_are_matched_to_the_papers_by_name(ours, theirs) -> None:
     assert paper.agent(ours) == theirs
 
 
-def test_a_level_that_finished_no_episode_scores_its_unfinished_episode(tmp_path, monkeypatch) -> None:
-    # 60 timesteps: JERK finishes no episode on Zone2.Act2 (its episodes last hundreds of steps), two on Zone3.Act2.
-    monkeypatch.setenv(PAPER_ENV, str(tmp_path))  # no paper: a Dasher report must not mention it anyway
-    out = tmp_path / "run"
-    assert main(["evaluate", "--levels", "Zone2.Act2,Zone3.Act2", "--timesteps", "60", "--agent", "jerk",
-                 "--no-progress", "--out", str(out)]) == 0
+@pytest.fixture(scope="module")
+def short_jerk(tmp_path_factory) -> tuple[Path, str, str]:
+    """JERK on two levels for 60 timesteps, showing its progress, without the paper: the run, its stdout, stderr.
+
+    60 timesteps: JERK finishes no episode on Zone2.Act2 (its episodes last hundreds of steps), two on Zone3.Act2.
+    Its output goes to strings, which are no terminal (as pytest's captured stdout and stderr are not).
+    """
+    folder = tmp_path_factory.mktemp("short-jerk")
+    out, stdout, stderr = folder / "run", io.StringIO(), io.StringIO()
+    with pytest.MonkeyPatch.context() as patch, contextlib.redirect_stdout(stdout), contextlib.redirect_stderr(stderr):
+        patch.setenv(PAPER_ENV, str(folder))  # no paper: a Dasher report must not mention it anyway
+        code = main(["evaluate", "--levels", "Zone2.Act2,Zone3.Act2", "--timesteps", "60", "--agent", "jerk",
+                     "--out", str(out)])
+    assert code == 0, stderr.getvalue()
+    return out, stdout.getvalue(), stderr.getvalue()
+
+
+def test_a_level_that_finished_no_episode_scores_its_unfinished_episode(short_jerk) -> None:
+    out = short_jerk[0]
     data = json.loads((out / "summary.json").read_text())
     empty, played = data["levels"]["Dasher-Genesis/Zone2.Act2"], data["levels"]["Dasher-Genesis/Zone3.Act2"]
     assert empty["episodes"] == 0 and empty["scored_from"] == FROM_UNFINISHED and empty["mean_score"] > 0
@@ -110,11 +125,8 @@ def test_a_level_that_finished_no_episode_scores_its_unfinished_episode(tmp_path
     assert "paper" not in report.lower()
 
 
-def test_without_a_terminal_each_level_prints_one_line(tmp_path, capsys) -> None:
-    # In this process: pytest's captured stdout and stderr are no terminal either.
-    assert main(["evaluate", "--levels", "Zone2.Act2,Zone3.Act2", "--timesteps", "100", "--agent", "random",
-                 "--out", str(tmp_path / "run")]) == 0
-    out, err = capsys.readouterr()
+def test_without_a_terminal_each_level_prints_one_line(short_jerk) -> None:
+    _, out, err = short_jerk
     lines = [line for line in out.splitlines() if line.startswith("[")]
     assert sorted(line[:5] for line in lines) == ["[1/2]", "[2/2]"], out
     assert all(": done, " in line and "score" in line for line in lines)

@@ -80,6 +80,12 @@ def _validator(kind: str) -> Any:  # a jsonschema validator
     return jsonschema.Draft202012Validator(schema, registry=registry)
 
 
+def warm() -> None:
+    """Build every kind's validator now, once for every process forked from this one (an evaluation's fork server)."""
+    for kind in SCHEMAS:
+        _validator(kind)
+
+
 def check_file(path: str | os.PathLike[str], kind: str) -> list[SchemaIssue]:
     """Return every problem of a YAML data file against its kind's schema (empty: it conforms)."""
     path = Path(path)

@@ -184,6 +184,13 @@ def _shipped_states() -> dict[str, Path]:
     return found
 
 
+def warm() -> None:
+    """Read the digests of retrokit's and the wheel's shipped states now, once for every process forked from this one
+    (an evaluation's fork server): they are the same for every state a process loads."""
+    _shipped_states()
+    _wheel_states()
+
+
 @functools.cache
 def _shipped_owner(folder: Path | None) -> Owner | None:
     """The game of retrokit's shipped game folder ``folder``."""

@@ -78,6 +78,11 @@ def _lark() -> Lark:
     return Lark(_GRAMMAR.read_text(), parser="lalr", propagate_positions=True, maybe_placeholders=True)
 
 
+def warm() -> None:
+    """Build the grammar's parser now, once for every process forked from this one (an evaluation's fork server)."""
+    _lark()
+
+
 def _literal(token: Token) -> str:
     """The digits of a number token, without ``_`` separators."""
     return str(token).replace("_", "")

@@ -120,8 +120,17 @@ def run_cli_cases(
         env: Environment variables for the child.
         case_env: Environment variables set before a case's command (e.g. its own RETROKIT_DATA).
     """
+    return run_cli_cases_in_child(cases, timeout=timeout, env=env, case_env=case_env)[0]
+
+
+def run_cli_cases_in_child(
+    cases: dict[str, list[str]], *, timeout: float = 120, env: dict[str, str] | None = None,
+    case_env: dict[str, dict[str, str]] | None = None, cwd: Path | None = None,
+) -> tuple[dict[str, Child], Child]:
+    """:func:`run_cli_cases`'s answers, and the child itself: its own stderr holds what processes under it
+    (an evaluation's workers) wrote to the terminal, which no case's redirected stderr catches."""
     runs = [(name, argv, (case_env or {}).get(name, {})) for name, argv in cases.items()]
-    child = run_child(f"CASES = {runs!r}\nANSWER = {_ANSWER!r}\n" + _CASES, timeout=timeout, env=env)
+    child = run_child(f"CASES = {runs!r}\nANSWER = {_ANSWER!r}\n" + _CASES, timeout=timeout, env=env, cwd=cwd)
     answers: dict[str, Child] = {}
     rest = []
     for line in child.stdout.splitlines():
@@ -131,4 +140,4 @@ def run_cli_cases(
         else:
             rest.append(line)
     ended = Child(child.returncode or 1, "\n".join(rest), child.stderr, child.peak_rss_mb)
-    return {name: answers.get(name, ended) for name in cases}
+    return {name: answers.get(name, ended) for name in cases}, child

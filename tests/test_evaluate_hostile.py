@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 import pytest
-from childproc import MAX_RSS_MB, Child, run_child, run_cli
+from childproc import MAX_RSS_MB, Child, run_cli, run_cli_cases_in_child
 from evaluating import session_processes, wait_for, write_agents
 
 from retrokit.cli import main
@@ -114,45 +114,23 @@ def report(out: Path) -> str:
     return (out / "report.md").read_text()
 
 
-def in_one_child(commands: dict[str, list[str]], *, timeout: float = 240,
-                 cwd: Path | None = None) -> tuple[dict[str, tuple[int, str]], Child]:
-    """Run each of ``commands`` (``retrokit ARGS...``) in turn in ONE child: each one's status and stderr, and the child.
-
-    One interpreter (and one fork server) for all spares their start per command. Whatever a process under the
-    child writes to the terminal itself is in the child's own stderr, which callers hold empty.
-    """
-    child = run_child(f"""
-        import contextlib, io, json
-        from retrokit.cli import main
-
-        outcomes = {{}}
-        for name, command in {commands!r}.items():
-            err = io.StringIO()
-            with contextlib.redirect_stderr(err):
-                outcomes[name] = [main(command), err.getvalue()]
-        print(json.dumps(outcomes))
-        """, timeout=timeout, cwd=cwd)
-    assert child.returncode == 0, child.describe()
-    return json.loads(child.stdout.splitlines()[-1]), child
-
-
 @pytest.fixture(scope="module")
-def ended(tmp_path_factory) -> tuple[dict[str, tuple[int, str]], Child, Path]:
+def ended(tmp_path_factory) -> tuple[dict[str, Child], Child, Path]:
     """The agent that ends its process on five levels, on one worker and on two, in one child: what each run said,
     the child, and the folder of the runs (``1``, ``2``)."""
     root = tmp_path_factory.mktemp("ended")
     agents = write_agents(root, AGENTS)
     commands = {workers: [*FAST, "--levels", f"{THREE},Zone1.Act1,Zone2.Act1", "--agent", f"{agents}:ends_its_process",
                           "--workers", workers, "--out", str(root / workers)] for workers in ("1", "2")}
-    outcomes, child = in_one_child(commands)
-    assert child.stderr == "", child.describe()  # no worker printed anything of its own
+    outcomes, child = run_cli_cases_in_child(commands, timeout=240)
+    assert child.returncode == 0 and child.stderr == "", child.describe()  # no worker printed anything of its own
     return outcomes, child, root
 
 
 @pytest.mark.parametrize("workers", ["1", "2"])
 def test_an_agent_that_ends_its_process_fails_its_level_and_the_others_are_kept(ended, workers) -> None:
     outcomes, child, root = ended
-    code, stderr = outcomes[workers]
+    code, stderr = outcomes[workers].returncode, outcomes[workers].stderr
     out = root / workers
     assert code == 2, (code, stderr, child.describe())
     assert stderr.count("\n") == 1 and "Traceback" not in stderr, stderr
@@ -325,7 +303,7 @@ DAMAGES = {
 
 
 @pytest.fixture(scope="module")
-def resumed_damages(finished, tmp_path_factory) -> tuple[dict[str, tuple[int, str]], Child]:
+def resumed_damages(finished, tmp_path_factory) -> tuple[dict[str, Child], Child]:
     """Each damaged copy of the finished run, resumed in turn in one child: what each said, and the child.
 
     One interpreter for all of them spares its start per damage; its peak memory is the largest any of them
@@ -338,13 +316,15 @@ def resumed_damages(finished, tmp_path_factory) -> tuple[dict[str, tuple[int, st
         make(Path(folders[damage]))
     commands = {damage: [*FAST, "--levels", LEVEL, "--agent", "jerk", "--out", out, "--resume"]
                 for damage, out in folders.items()}
-    return in_one_child(commands, timeout=120)
+    outcomes, child = run_cli_cases_in_child(commands, timeout=120)
+    assert child.returncode == 0, child.describe()
+    return outcomes, child
 
 
 @pytest.mark.parametrize("damage", list(DAMAGES))
 def test_a_damaged_run_folder_is_refused_in_one_line(resumed_damages, damage) -> None:
     outcomes, child = resumed_damages
-    code, stderr = outcomes[damage]
+    code, stderr = outcomes[damage].returncode, outcomes[damage].stderr
     expected = DAMAGES[damage][1]
     assert code == 2 and expected in stderr, (code, stderr)
     assert stderr.count("\n") == 1 and "Traceback" not in stderr, stderr
@@ -368,7 +348,7 @@ AT_IMPORT = {
 
 
 @pytest.fixture(scope="module")
-def at_import(tmp_path_factory) -> tuple[dict[str, tuple[int, str]], Child, Path]:
+def at_import(tmp_path_factory) -> tuple[dict[str, Child], Child, Path]:
     """Each case's agent module evaluated in turn in ONE child: what each command said, the child, and the folder.
 
     A module that ended the evaluation's own process would end the child before it answered the later cases;
@@ -381,15 +361,15 @@ def at_import(tmp_path_factory) -> tuple[dict[str, tuple[int, str]], Child, Path
         agent = root / case / "quits.py"
         agent.write_text(source + "def agent(env, budget, seed):\n    pass\n")
         commands[case] = [*FAST, "--levels", "Zone1.Act1", "--agent", f"{agent}:agent", "--out", str(root / case / "run")]
-    outcomes, child = in_one_child(commands, cwd=root)
-    assert child.stderr == "", child.describe()
+    outcomes, child = run_cli_cases_in_child(commands, timeout=240, cwd=root)
+    assert child.returncode == 0 and child.stderr == "", child.describe()
     return outcomes, child, root
 
 
 @pytest.mark.parametrize("case", AT_IMPORT, ids=list(AT_IMPORT))
 def test_an_agent_module_that_exits_at_import_is_one_line_and_a_failure(at_import, case) -> None:
     outcomes, child, root = at_import
-    code, stderr = outcomes[case]
+    code, stderr = outcomes[case].returncode, outcomes[case].stderr
     assert code == 2, (code, stderr, child.describe())
     assert stderr.count("\n") == 1 and "Traceback" not in stderr, stderr
     assert "quits.py:agent" in stderr and not (root / case / "run").exists(), stderr

@@ -154,10 +154,14 @@ def check_states(game: Game, report: GameReport, rom: Path | None) -> dict[str, 
             names.append(name)
         except RetrokitError as exc:
             report.add("state file", FAIL, str(exc), state=name)
-    with tempfile.TemporaryDirectory(prefix="retrokit-movie-states-") as scratch:
-        movies = _movie_state_files(game, Path(scratch)) if rom is not None else {}
-        files = {name: game.state_path(name) for name in names} | {_MOVIE + label: path for label, path in movies.items()}
-        probes = probe_states(game, list(files), rom, files=files) if rom is not None else parse_states(game, names)
+    if rom is None:  # nothing loads: the states are parsed, and movies' start states are left alone
+        movies, probes = {}, parse_states(game, names)
+    else:
+        with tempfile.TemporaryDirectory(prefix="retrokit-movie-states-") as scratch:
+            movies = _movie_state_files(game, Path(scratch))
+            files = {name: game.state_path(name) for name in names}
+            files |= {_MOVIE + label: path for label, path in movies.items()}
+            probes = probe_states(game, list(files), rom, files=files)
     good = _check_loaded(game, report, rom, names, {name: probes[name] for name in names})
     _check_movie_states(game, report, {label: probes[_MOVIE + label] for label in movies})
     return good
@@ -269,8 +273,9 @@ def _movie_state_files(game: Game, scratch: Path) -> dict[str, Path]:
             continue
         if state is None:  # a movie from power-on: nothing to check
             continue
-        files[f"{path.name} start"] = scratch / f"{name}.state"
-        write_state(files[f"{path.name} start"], state)
+        label = f"{path.name} start"
+        files[label] = scratch / f"{name}.state"
+        write_state(files[label], state)
     return files
 
 

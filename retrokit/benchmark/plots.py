@@ -62,7 +62,8 @@ def learning_curves(episodes: dict[str, list[Episode]], budget: int, title: str)
         records = sorted(episodes[level], key=lambda e: e.episode)
         x = [e.timesteps for e in records]
         y = [e.reward for e in records]
-        axes.scatter(x, y, s=6, alpha=0.35, color="tab:blue", label="episode")
+        # Markers on a line without its segments: drawn as one path, a little cheaper than a scatter's collection.
+        axes.plot(x, y, linestyle="none", marker="o", markersize=2.5, alpha=0.35, color="tab:blue", label="episode")
         if records:
             axes.plot(x, _smooth(y, max(1, len(y) // 10)), color="tab:red", linewidth=1.5, label="running mean")
         axes.set_title(level, fontsize=9)
@@ -91,12 +92,11 @@ def mean_learning_curve(curves: dict[str, dict[str, list]], budget: int, title: 
         axes.plot([t for t, _ in points], [s for _, s in points], marker="." if len(points) < 3 else None,
                   linewidth=1.6, label=label)
     figure.suptitle(title, fontsize=10)
-    axes.set_title("instantaneous score: the mean reward of the episodes that ended in the last 10% of the budget, "
-                   "averaged over the levels",
+    axes.set_title("the mean reward of the episodes that ended in the last 10% of the budget, averaged over levels",
                    fontsize=7)
     axes.set_xlim(0, budget)
     axes.set_xlabel("timesteps", fontsize=8)
-    axes.set_ylabel("score", fontsize=8)
+    axes.set_ylabel("instantaneous score", fontsize=8)
     axes.tick_params(labelsize=7)
     axes.grid(alpha=0.3)
     if curves:

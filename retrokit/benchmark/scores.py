@@ -115,7 +115,7 @@ class Episodes:
         ordered = sorted(episodes, key=lambda e: e.episode)
         self.ends = [e.timesteps for e in ordered]
         self.rewards = [e.reward for e in ordered]
-        self._sums = [0.0]  # running sums: each window's mean in O(log n)
+        self._sums = [0.0]  # running sums: each window's mean in O(log n), for the curve's many windows
         for reward in self.rewards:
             self._sums.append(self._sums[-1] + reward)
 
@@ -128,8 +128,7 @@ class Episodes:
         if stop == 0:
             return None
         start = min(bisect.bisect_right(self.ends, t - width), stop - 1)
-        window = self.rewards[start:stop]
-        return math.fsum(window) / len(window), len(window)
+        return (self._sums[stop] - self._sums[start]) / (stop - start), stop - start
 
 
 def level_score(episodes: list[Episode], finished: FinishedLevel) -> LevelScore:

@@ -163,8 +163,8 @@ def table_one(paper: PaperScores, summaries: dict[str, Summary]) -> list[str]:
                 lines.append(_our_row(agent, summary))
                 placed.add(agent)
     lines += [_our_row(agent, summary) for agent, summary in summaries.items() if agent not in placed]
-    return [*lines, "", ("The paper's standard deviations are over its runs of each agent (with other seeds); a run "
-                         "of ours is one, so it has none."), ""]
+    return [*lines, "", ("The paper's standard deviations are over its several runs of each agent; a run of ours is "
+                         "one run, so it has none."), ""]
 
 
 def _our_row(agent: str, summary: Summary) -> str:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import csv
+import io
 import json
 import os
 import signal
@@ -69,6 +71,35 @@ def test_dasher_writes_every_file(reference) -> None:
 def test_jerk_beats_random_by_a_clear_margin(reference, random_run) -> None:
     jerk, rand = (json.loads(summary(run))["aggregate"] for run in (reference, random_run))
     assert jerk > 1.5 * rand, (jerk, rand)
+
+
+@pytest.mark.parametrize("run", ["reference", "random_run"])
+def test_the_final_score_averages_the_episodes_of_the_budgets_last_tenth(run, request) -> None:
+    out = request.getfixturevalue(run)
+    episodes = [json.loads(line) for line in (out / "episodes.jsonl").read_text().splitlines()]
+    data = json.loads(summary(out))
+    finals, windows = [], []
+    for level, entry in data["levels"].items():
+        mine = [e for e in episodes if e["level"] == level]
+        # The episodes that ended in the last 30 of the 300 timesteps; with none, the last that ended.
+        window = [e["reward"] for e in mine if e["timesteps"] > 270] or [mine[-1]["reward"]]
+        windows.append(any(e["timesteps"] > 270 for e in mine))
+        assert entry["final_score"] == pytest.approx(sum(window) / len(window)), level
+        assert entry["final_episodes"] == len(window)
+        finals.append(entry["final_score"])
+    assert any(windows)  # a window held an episode (and, in JERK's run, one level had none: the fallback)
+    assert data["final_aggregate"] == pytest.approx(sum(finals) / len(finals))
+    curve = data["curve"]
+    assert len(curve["timesteps"]) == 50 and curve["timesteps"][-1] == 300
+    assert curve["score"][-1] == pytest.approx(data["final_aggregate"])  # Figure 3's curve ends at the final score
+    rows = list(csv.DictReader(io.StringIO((out / "summary.csv").read_text())))
+    assert [float(r["final_score"]) for r in rows[:-1]] == pytest.approx(finals)
+    assert float(rows[-1]["final_score"]) == pytest.approx(data["final_aggregate"])
+    report = (out / "report.md").read_text()
+    assert "| mean score | sd | final score |" in report and f"**{data['final_aggregate']:,.1f}**" in report
+    assert "![mean-learning-curve](mean-learning-curve.png)" in report
+    with Image.open(out / "mean-learning-curve.png") as image:
+        assert image.format == "PNG" and image.size == (640, 400)
 
 
 def test_the_same_seed_gives_the_same_summary_twice_and_on_two_workers(reference, tmp_path) -> None:

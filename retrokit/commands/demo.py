@@ -29,8 +29,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="evaluate JERK against random on the bundled Dasher benchmark: table, report, plots and a GIF",
         description="Run the Dasher benchmark (no ROM import needed) with the paper's JERK agent and with random "
         "actions, with a progress bar per level (a line per level when the output is not a terminal); print the "
-        "per-level scores and aggregates, and write each agent's run folder, a side-by-side report.md and "
-        "scores.png, and a GIF of JERK's best episode. It is `retrokit evaluate --benchmark dasher --agent jerk "
+        "per-level scores and aggregates, and write each agent's run folder, a side-by-side report.md, "
+        "scores.png and mean-learning-curve.png, and a GIF of JERK's best episode. It is `retrokit evaluate --benchmark dasher --agent jerk "
         "--agent random`.",
     )
     add_evaluation_options(parser, "processes (default: up to 2)")
@@ -82,7 +82,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"JERK's aggregate is {jerk / rand:.2f}x random's.")
     folders = agent_folders(list(AGENTS))
     written = [f"{out / folders[agent]}/ (report.md, summary.json, plots)" for agent in AGENTS]
-    written.append(f"{out / 'report.md'} and {out / 'scores.png'} (the two agents side by side)")
+    written.append(f"{out / 'report.md'}, {out / 'scores.png'} and {out / 'mean-learning-curve.png'} "
+                   "(the two agents side by side)")
     best = max(summaries["jerk"].levels.items(), key=lambda item: item[1].best or float("-inf"))[0]
     gif = out / folders["jerk"] / "gifs" / f"{level_file_name(best)}.gif"
     if gif.is_file():

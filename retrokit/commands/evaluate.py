@@ -43,7 +43,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Play each level of a benchmark for its budget of timesteps with an agent, each level in a worker "
         "process, and write episodes.jsonl, summary.json, summary.csv, report.md (beside the paper's scores) and "
         "PNG plots into --out. Progress shows as a bar per level on a terminal, else as a line per finished level. "
-        "With several --agent, each runs into OUT/<agent>/ and OUT/report.md and OUT/scores.png compare them.",
+        "With several --agent, each runs into OUT/<agent>/ and OUT/report.md, OUT/scores.png and "
+        "OUT/mean-learning-curve.png compare them.",
         epilog=AGENT_NOTE,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -104,8 +105,8 @@ def run(args: argparse.Namespace) -> int:
         return 130
     print_table(summaries)
     print(f"wrote {args.out}/: " + ("episodes.jsonl, summary.json, summary.csv, report.md, learning-curves.png, "
-                                    "scores.png" if len(agents) == 1 else
-                                    "report.md, scores.png, and a run folder per agent"))
+                                    "scores.png, mean-learning-curve.png" if len(agents) == 1 else
+                                    "report.md, scores.png, mean-learning-curve.png, and a run folder per agent"))
     print_speed(made)
     return 0
 

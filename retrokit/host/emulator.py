@@ -321,9 +321,20 @@ class Emulator:
 
         Args:
             out: A buffer of that shape to fill instead of allocating one.
+
+        Raises:
+            CoreError: The core drew a frame larger than its system's largest (a corrupt state's
+                garbage width, which would ask for terabytes).
         """
+        height, width = self._emu.screen_shape()
+        av = self._emu.av_info()
+        if not (0 < height <= av["max_height"] and 0 < width <= av["max_width"]):
+            raise CoreError(
+                f"Expected a frame of at most {av['max_width']}x{av['max_height']} pixels from the {self.system.name} "
+                f"core; found {width}x{height}: the state it runs is corrupt. Load another state, or reset to the game's."
+            )
         if out is None:
-            out = np.empty(self._emu.screen_shape() + (3,), dtype=np.uint8)
+            out = np.empty((height, width, 3), dtype=np.uint8)
         self._emu.screen(out)
         return out
 

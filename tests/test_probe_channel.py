@@ -1,0 +1,162 @@
+"""A state cannot answer for itself: the crash probe's verdict travels on a channel no core writes to.
+
+pce_fast prints every variable name of a state it does not know on stdout
+(``Unknown variable in save state: <name>``), byte for byte from the state.
+The forged state here (issue 42) is Skipper-PCEngine's Level1 whose VRAM
+variable is renamed into 41 unknown ones: the first name holds a line of the
+probe child's own answer (``{"name": "state", ..., "loaded": true}``) and a
+byte that is not UTF-8, the others pad the core's stdout past its buffer so
+the line is written; its CPU timestamp is then the largest an ``int32``
+holds, and the core's first frame dies by SIGSEGV. The state keeps its
+size, so it reaches the core. Before the fix, the probe read that line as its
+child's answer and called the state safe (or raised a raw UnicodeDecodeError).
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pytest
+from childproc import MAX_RSS_MB, REPO, run_child
+from pcestate import renamed, with_variable
+
+from retrokit.data.states import compress_state, read_state
+
+SKIPPER = REPO / "games" / "Skipper-PCEngine"
+FORGED_LINE = json.dumps({"name": "state", "path": "", "loaded": True}).encode()
+
+
+@pytest.fixture(scope="module")
+def forged(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The forged state's file, in a copy of Skipper's folder (as ``Forged``)."""
+    state = read_state(SKIPPER / "Level1.state")
+    first = b"\n" + FORGED_LINE + b"\n\xff"
+    names = [first + b"x" * (250 - len(first))] + [b"pad%03d" % i + b"y" * 240 for i in range(40)]
+    state = with_variable(renamed(state, b"VDC0", b"VRAM", names), b"CPU", b"timestamp", b"\xff\xff\xff\x7f")
+    assert len(state) == len(read_state(SKIPPER / "Level1.state"))
+    folder = tmp_path_factory.mktemp("games") / "Skipper-PCEngine"
+    shutil.copytree(SKIPPER, folder)
+    (folder / "Forged.state").write_bytes(compress_state(state))
+    return folder
+
+
+def test_the_raw_core_prints_the_forged_answer_then_dies(forged: Path) -> None:
+    """What the probe faces: past every check (the mint taken directly), the core writes the line and crashes."""
+    child = run_child(f"""
+        from retrokit.data.states import read_state
+        from retrokit.host.emulator import Emulator, claim_mint
+        emu = Emulator("PCEngine", {str(forged / 'rom.pce')!r})
+        emu.set_state(claim_mint()(read_state({str(forged / 'Forged.state')!r}), "PCEngine"))
+        emu.run([0], 60)
+        print("survived")
+    """)
+    assert child.signal == "SIGSEGV", child.describe()
+    assert FORGED_LINE.decode() in child.stdout.splitlines(), child.describe()
+
+
+def test_the_probe_answers_by_how_its_child_ended_not_by_what_it_printed(forged: Path, tmp_path: Path, monkeypatch) -> None:
+    from retrokit.data.probe import probe_state
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path))
+    verdict = probe_state(read_state(forged / "Forged.state"), "PCEngine", forged / "rom.pce", frames=60, input_frames=0)
+    assert not verdict.safe and "crashed (SIGSEGV)" in verdict.reason, verdict
+
+
+ENTRY_POINTS = """
+import contextlib, io, json, os, traceback
+from starlette.testclient import TestClient
+import retrokit
+from retrokit.cli import main
+from retrokit.errors import RetrokitError
+from retrokit.studio.app import create_app
+from retrokit.studio.session import Session
+
+def make():
+    env = retrokit.make("Skipper-PCEngine", "Forged")
+    env.reset(seed=0)
+    for _ in range(300):
+        env.step(env.action_space.sample())
+    env.close()
+
+def validate():
+    with contextlib.redirect_stdout(io.StringIO()):
+        main(["validate", "Skipper-PCEngine", "--frames", "10", "--json", REPORT])
+    found = [r for r in json.load(open(REPORT))["games"][0]["results"] if r.get("state") == "Forged"]
+    loads = [r for r in found if r["check"] == "state loads"]
+    raise RetrokitError(loads[0]["status"] + ": " + loads[0]["message"]) if loads else AssertionError(found)
+
+def studio():
+    session = Session("Skipper-PCEngine", "Level1")
+    session.paused = True
+    try:
+        with TestClient(create_app(session, token="t", port=8765), base_url="http://127.0.0.1:8765",
+                        headers={"X-Retrokit-Token": "t"}) as client:
+            answer = client.post("/api/states/load", json={"name": "Forged"})
+    finally:
+        session.close()
+    raise RetrokitError(f"{answer.status_code} {answer.json()['kind']}: {answer.json()['error']}")
+
+answers = {}
+for name, run in [("make", make), ("validate", validate), ("studio", studio)]:
+    os.environ["RETROKIT_DATA"] = os.path.join(DATA, name)  # each asks the probe itself: no verdict carried over
+    try:
+        run()
+        answers[name] = "accepted"
+    except RetrokitError as exc:
+        answers[name] = f"{type(exc).__name__}: {exc}"
+    except BaseException:
+        answers[name] = "raw: " + traceback.format_exc()
+    print(json.dumps([name, answers[name]]), flush=True)
+"""
+
+
+@pytest.fixture(scope="module")
+def entry_points(forged: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, str], Path]:
+    """make() with 300 steps, validate and the studio's load of the forged state, in one child; each one's answer."""
+    data = tmp_path_factory.mktemp("data")
+    code = f"DATA = {str(data)!r}\nREPORT = {str(data / 'report.json')!r}\n" + ENTRY_POINTS
+    child = run_child(code, env={"RETROKIT_GAMES": str(forged.parent)}, timeout=600)
+    assert child.returncode == 0 and child.peak_rss_mb < MAX_RSS_MB, child.describe()
+    return dict(json.loads(line) for line in child.stdout.splitlines() if line.startswith("[")), data
+
+
+@pytest.mark.parametrize("entry", ["make", "validate", "studio"])
+def test_every_entry_point_refuses_the_forged_state(entry_points, entry: str) -> None:
+    answers, _ = entry_points
+    answer = answers[entry]
+    assert "crashed (SIGSEGV)" in answer and "\n" not in answer, answer
+    assert answer.startswith({"make": "StateError", "validate": "RetrokitError: fail", "studio": "RetrokitError: 400"}[entry])
+
+
+def test_no_verdict_calls_the_forged_state_safe(entry_points, forged: Path) -> None:
+    from retrokit.data.games import cached_rom_sha1
+    from retrokit.data.probe import probe_key
+
+    _, data = entry_points
+    key = probe_key(read_state(forged / "Forged.state"), "PCEngine", cached_rom_sha1(forged / "rom.pce", "PCEngine"))
+    verdicts = [p.read_text() for p in data.glob(f"*/state-probes/{key}")]
+    # each entry point's own probe kept its verdict
+    assert verdicts == ["the emulator crashed (SIGSEGV) within the frames run after loading it"] * 3, verdicts
+
+
+def test_a_frame_wider_than_the_system_draws_is_one_line(tmp_path: Path) -> None:
+    """A dot clock of 10 makes pce_fast read its frame width past its table of three (a zero there; other values
+    read garbage of gigapixels): ``screen()`` refuses the size instead of allocating it."""
+    state = tmp_path / "dot-clock.state"
+    state.write_bytes(with_variable(read_state(SKIPPER / "Level1.state"), b"VCE", b"dot clock", bytes([10])))
+    child = run_child(f"""
+        from retrokit.errors import CoreError
+        from retrokit.host.emulator import Emulator, claim_mint
+        emu = Emulator("PCEngine", {str(SKIPPER / 'rom.pce')!r})
+        emu.set_state(claim_mint()(open({str(state)!r}, "rb").read(), "PCEngine"))
+        emu.run([0], 2)
+        try:
+            emu.screen()
+        except CoreError as exc:
+            print("refused:", exc)
+    """)
+    refused = [line for line in child.stdout.splitlines() if line.startswith("refused:")]
+    assert child.returncode == 0 and len(refused) == 1, child.describe()
+    assert "expected a frame of at most 512x243 pixels from the pcengine core; found 0x242" in refused[0].lower()

@@ -10,11 +10,16 @@ the line is written; its CPU timestamp is then the largest an ``int32``
 holds, and the core's first frame dies by SIGSEGV. The state keeps its
 size, so it reaches the core. Before the fix, the probe read that line as its
 child's answer and called the state safe (or raised a raw UnicodeDecodeError).
+
+The probe is what stands behind the layout checks (:mod:`retrokit.host.statelayout`):
+these tests run with them switched off in every process (a ``sitecustomize`` on
+the path), so they show the probe alone refusing a state those checks miss.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import shutil
 from pathlib import Path
 
@@ -26,6 +31,29 @@ from retrokit.data.states import compress_state, read_state
 
 SKIPPER = REPO / "games" / "Skipper-PCEngine"
 FORGED_LINE = json.dumps({"name": "state", "path": "", "loaded": True}).encode()
+
+
+NO_LAYOUT_CHECK = """
+import retrokit.host.statelayout as layout
+layout.state_layout_problem = lambda system, state: ""  # the probe alone decides
+"""
+
+
+@pytest.fixture(scope="module")
+def unchecked(tmp_path_factory: pytest.TempPathFactory) -> str:
+    """A PYTHONPATH whose sitecustomize switches the layout checks off in every process that starts with it."""
+    folder = tmp_path_factory.mktemp("unchecked")
+    (folder / "sitecustomize.py").write_text(NO_LAYOUT_CHECK)
+    return f"{folder}{os.pathsep}{REPO}"
+
+
+@pytest.fixture
+def probe_alone(unchecked: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The layout checks off here and in the children this process starts."""
+    from retrokit.data import probe
+
+    monkeypatch.setenv("PYTHONPATH", unchecked)
+    monkeypatch.setattr(probe, "state_layout_problem", lambda system, state: "")
 
 
 @pytest.fixture(scope="module")
@@ -56,7 +84,9 @@ def test_the_raw_core_prints_the_forged_answer_then_dies(forged: Path) -> None:
     assert FORGED_LINE.decode() in child.stdout.splitlines(), child.describe()
 
 
-def test_the_probe_answers_by_how_its_child_ended_not_by_what_it_printed(forged: Path, tmp_path: Path, monkeypatch) -> None:
+def test_the_probe_answers_by_how_its_child_ended_not_by_what_it_printed(
+    forged: Path, tmp_path: Path, monkeypatch, probe_alone: None
+) -> None:
     from retrokit.data.probe import probe_state
 
     monkeypatch.setenv("RETROKIT_DATA", str(tmp_path))
@@ -113,11 +143,13 @@ for name, run in [("make", make), ("validate", validate), ("studio", studio)]:
 
 
 @pytest.fixture(scope="module")
-def entry_points(forged: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[dict[str, str], Path]:
+def entry_points(
+    forged: Path, unchecked: str, tmp_path_factory: pytest.TempPathFactory
+) -> tuple[dict[str, str], Path]:
     """make() with 300 steps, validate and the studio's load of the forged state, in one child; each one's answer."""
     data = tmp_path_factory.mktemp("data")
     code = f"DATA = {str(data)!r}\nREPORT = {str(data / 'report.json')!r}\n" + ENTRY_POINTS
-    child = run_child(code, env={"RETROKIT_GAMES": str(forged.parent)}, timeout=600)
+    child = run_child(code, env={"RETROKIT_GAMES": str(forged.parent), "PYTHONPATH": unchecked}, timeout=600)
     assert child.returncode == 0 and child.peak_rss_mb < MAX_RSS_MB, child.describe()
     return dict(json.loads(line) for line in child.stdout.splitlines() if line.startswith("[")), data
 
@@ -160,3 +192,18 @@ def test_a_frame_wider_than_the_system_draws_is_one_line(tmp_path: Path) -> None
     refused = [line for line in child.stdout.splitlines() if line.startswith("refused:")]
     assert child.returncode == 0 and len(refused) == 1, child.describe()
     assert "expected a frame of at most 512x243 pixels from the pcengine core; found 0x242" in refused[0].lower()
+
+
+def test_a_child_that_failed_before_any_state_leaves_no_verdict(tmp_path: Path, monkeypatch) -> None:
+    """A child that could not load the ROM (no memory, say) says nothing of the states it never began: reported,
+    and nothing kept, so the next run probes them."""
+    from retrokit.data import probe
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
+    state = bytearray(read_state(SKIPPER / "Level1.state"))
+    state[100] ^= 0xFF  # nothing ships or vouches for it
+    (tmp_path / "Unknown.state").write_bytes(compress_state(bytes(state)))
+    monkeypatch.setattr(probe, "run_child", lambda *a, **k: ({}, None, "the state loader exited with status 1: x"))
+    results = probe.probe_files("PCEngine", SKIPPER / "rom.pce", "0" * 40, {"Unknown": tmp_path / "Unknown.state"})
+    assert results["Unknown"].error == "the state loader exited with status 1: x" and not results["Unknown"].loaded
+    assert not (tmp_path / "data" / "state-probes").exists()

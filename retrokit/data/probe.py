@@ -201,9 +201,10 @@ def probe_files(
     while todo:
         done, blamed, failure = run_child(system, rom, [plans[n] for n in todo], fields=fields, timeout=timeout)
         results.update(done)
-        if blamed is None and failure:  # the child failed before any state: report, do not loop
-            blamed = todo[0]
-        if blamed is not None:
+        if blamed is None and failure:  # the child failed before any state: it says nothing of them, keep nothing
+            results.update({n: ChildResult(n, plans[n][1], error=failure) for n in todo})
+            keys = {n: key for n, key in keys.items() if n not in todo}
+        elif blamed is not None:
             results[blamed] = ChildResult(blamed, plans[blamed][1], error=failure)
         todo = [n for n in todo if n not in results]
     for name, key in keys.items():

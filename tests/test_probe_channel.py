@@ -117,6 +117,17 @@ def validate():
     loads = [r for r in found if r["check"] == "state loads"]
     raise RetrokitError(loads[0]["status"] + ": " + loads[0]["message"]) if loads else AssertionError(found)
 
+def playback():
+    from retrokit.data.states import read_state
+    from retrokit.movie import Movie, write_bk2
+
+    movie = os.path.join(DATA, "forged.bk2")
+    state = read_state(os.path.join(GAMES, "Skipper-PCEngine", "Forged.state"))
+    write_bk2(movie, Movie("Skipper-PCEngine", "PCEngine", 1, state, [(0,)] * 300))
+    with contextlib.redirect_stderr(io.StringIO()) as err:
+        status = main(["playback", movie, os.path.join(DATA, "forged.gif")])
+    raise RetrokitError(f"status {status}: {err.getvalue().strip().splitlines()[-1]}")  # after its progress bar
+
 def studio():
     session = Session("Skipper-PCEngine", "Level1")
     session.paused = True
@@ -129,7 +140,7 @@ def studio():
     raise RetrokitError(f"{answer.status_code} {answer.json()['kind']}: {answer.json()['error']}")
 
 answers = {}
-for name, run in [("make", make), ("validate", validate), ("studio", studio)]:
+for name, run in [("make", make), ("validate", validate), ("playback", playback), ("studio", studio)]:
     os.environ["RETROKIT_DATA"] = os.path.join(DATA, name)  # each asks the probe itself: no verdict carried over
     try:
         run()
@@ -146,20 +157,23 @@ for name, run in [("make", make), ("validate", validate), ("studio", studio)]:
 def entry_points(
     forged: Path, unchecked: str, tmp_path_factory: pytest.TempPathFactory
 ) -> tuple[dict[str, str], Path]:
-    """make() with 300 steps, validate and the studio's load of the forged state, in one child; each one's answer."""
+    """make() with 300 steps, validate, playback of a movie from it and the studio's load of the forged state, in one
+    child; each one's answer."""
     data = tmp_path_factory.mktemp("data")
-    code = f"DATA = {str(data)!r}\nREPORT = {str(data / 'report.json')!r}\n" + ENTRY_POINTS
+    code = f"DATA = {str(data)!r}\nGAMES = {str(forged.parent)!r}\nREPORT = {str(data / 'report.json')!r}\n" + ENTRY_POINTS
     child = run_child(code, env={"RETROKIT_GAMES": str(forged.parent), "PYTHONPATH": unchecked}, timeout=600)
     assert child.returncode == 0 and child.peak_rss_mb < MAX_RSS_MB, child.describe()
     return dict(json.loads(line) for line in child.stdout.splitlines() if line.startswith("[")), data
 
 
-@pytest.mark.parametrize("entry", ["make", "validate", "studio"])
+@pytest.mark.parametrize("entry", ["make", "validate", "playback", "studio"])
 def test_every_entry_point_refuses_the_forged_state(entry_points, entry: str) -> None:
     answers, _ = entry_points
     answer = answers[entry]
     assert "crashed (SIGSEGV)" in answer and "\n" not in answer, answer
-    assert answer.startswith({"make": "StateError", "validate": "RetrokitError: fail", "studio": "RetrokitError: 400"}[entry])
+    starts = {"make": "StateError", "validate": "RetrokitError: fail", "playback": "RetrokitError: status 2",
+              "studio": "RetrokitError: 400"}
+    assert answer.startswith(starts[entry]), answer
 
 
 def test_no_verdict_calls_the_forged_state_safe(entry_points, forged: Path) -> None:
@@ -170,7 +184,7 @@ def test_no_verdict_calls_the_forged_state_safe(entry_points, forged: Path) -> N
     key = probe_key(read_state(forged / "Forged.state"), "PCEngine", cached_rom_sha1(forged / "rom.pce", "PCEngine"))
     verdicts = [p.read_text() for p in data.glob(f"*/state-probes/{key}")]
     # each entry point's own probe kept its verdict
-    assert verdicts == ["the emulator crashed (SIGSEGV) within the frames run after loading it"] * 3, verdicts
+    assert verdicts == ["the emulator crashed (SIGSEGV) within the frames run after loading it"] * 4, verdicts
 
 
 def test_a_frame_wider_than_the_system_draws_is_one_line(tmp_path: Path) -> None:

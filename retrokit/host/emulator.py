@@ -172,6 +172,8 @@ class Emulator:
         self.rom = rom
         self.space = AddressSpace.for_emulator(self.system, self._emu)
         self._actions = np.zeros(ports, dtype=np.uint16)
+        av = self._emu.av_info()
+        self._largest = (av["max_height"], av["max_width"])  # the frame the core said it may draw, when it loaded
 
     @classmethod
     def for_rom(cls, rom: str | os.PathLike[str], **kwargs: object) -> Emulator:
@@ -327,11 +329,12 @@ class Emulator:
                 garbage width, which would ask for terabytes).
         """
         height, width = self._emu.screen_shape()
-        av = self._emu.av_info()
-        if not (0 < height <= av["max_height"] and 0 < width <= av["max_width"]):
+        av = self._emu.av_info()  # a core may announce a larger one since (SET_SYSTEM_AV_INFO)
+        most_h, most_w = max(av["max_height"], self._largest[0]), max(av["max_width"], self._largest[1])
+        if not (0 < height <= most_h and 0 < width <= most_w):
             raise CoreError(
-                f"Expected a frame of at most {av['max_width']}x{av['max_height']} pixels from the {self.system.name} "
-                f"core; found {width}x{height}: the state it runs is corrupt. Load another state, or reset to the game's."
+                f"Expected a frame of at most {most_w}x{most_h} pixels from the {self.system.name} core; found "
+                f"{width}x{height}: the state it runs is corrupt. Load another state, or reset to the game's."
             )
         if out is None:
             out = np.empty((height, width, 3), dtype=np.uint8)

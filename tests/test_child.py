@@ -143,3 +143,16 @@ def test_the_users_limits_here_are_untouched() -> None:
         list(child.lines(first=120))
         child.end()
     assert (resource.getrlimit(resource.RLIMIT_AS), resource.getrlimit(resource.RLIMIT_CORE)) == before
+
+
+def test_a_child_whose_answers_were_not_all_read_still_ends(child_module: Path) -> None:
+    """end() reads the child's log while it waits: a caller that stopped reading answers early cannot leave the
+    child blocked on a full log pipe."""
+    import threading
+
+    with Child(MODULE, {"do": "chatty"}, memory=1 << 30) as child:
+        rescue = threading.Timer(120, child._kill)  # a blocked child fails this test, never hangs the suite
+        rescue.start()
+        end = child.end()  # not one answer read: the child writes megabytes of log first
+        rescue.cancel()
+    assert (end.status, end.hung, end.last_words) == (0, False, "last \ufffd words")

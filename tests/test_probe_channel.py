@@ -221,3 +221,18 @@ def test_a_child_that_failed_before_any_state_leaves_no_verdict(tmp_path: Path, 
     results = probe.probe_files("PCEngine", SKIPPER / "rom.pce", "0" * 40, {"Unknown": tmp_path / "Unknown.state"})
     assert results["Unknown"].error == "the state loader exited with status 1: x" and not results["Unknown"].loaded
     assert not (tmp_path / "data" / "state-probes").exists()
+
+
+def test_verdicts_of_the_probe_a_state_could_forge_count_for_nothing(forged: Path, tmp_path: Path, monkeypatch) -> None:
+    """A "safe" the old probe kept (under the old key: SHA-256 of system, ROM SHA-1 and state) is not read."""
+    import hashlib
+
+    from retrokit.data import probe
+    from retrokit.data.games import cached_rom_sha1
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path))
+    state, sha1 = read_state(forged / "Forged.state"), cached_rom_sha1(forged / "rom.pce", "PCEngine")
+    old = hashlib.sha256(f"PCEngine\0{sha1}\0".encode() + state).hexdigest()
+    (tmp_path / "state-probes").mkdir()
+    (tmp_path / "state-probes" / old).write_text("safe")
+    assert probe._cached(probe.probe_key(state, "PCEngine", sha1)) is None

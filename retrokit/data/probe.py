@@ -229,11 +229,16 @@ class ProbeVerdict:
     reason: str = ""
 
 
+PROBE_VERSION = 2
+"""The probe whose verdicts count. Version 1 read its child's answers from the stdout the core prints on, so a
+state could write its own "safe" (issue 42): its verdicts are under other keys, and every state is probed again."""
+
+
 def probe_key(state: bytes, system: str, rom_sha1: str) -> str:
-    """The cache key of a probe: SHA-256 of the system, the ROM's SHA-1 and the state."""
+    """The cache key of a probe: SHA-256 of the probe's version, the system, the ROM's SHA-1 and the state."""
     import hashlib
 
-    digest = hashlib.sha256(f"{system}\0{rom_sha1}\0".encode())
+    digest = hashlib.sha256(f"probe {PROBE_VERSION}\0{system}\0{rom_sha1}\0".encode())
     digest.update(state)
     return digest.hexdigest()
 

@@ -221,16 +221,28 @@ class Child:
         self._tail = (self._tail + chunk)[-_LOG_TAIL:]
         return bool(chunk)
 
+    def _drain(self, fd: int) -> bool:
+        """Read all the (non-blocking) log holds now; return whether more may come."""
+        try:
+            while self._keep_output(fd):
+                pass
+        except BlockingIOError:
+            return True
+        return False
+
     def end(self) -> ChildEnd:
         """Wait for the child to end; return how it did."""
+        output = self._proc.stdout.fileno()  # type: ignore[union-attr]
+        os.set_blocking(output, False)
+        with selectors.DefaultSelector() as selector:  # its log is read while it ends: a full pipe would block it
+            selector.register(output, selectors.EVENT_READ)
+            while self._proc.poll() is None:
+                if selector.select(timeout=0.1) and not self._drain(output):
+                    break
         status = self._proc.wait()
         with contextlib.suppress(ProcessLookupError, PermissionError):  # what it left running holds its log open
             os.killpg(self._proc.pid, signal.SIGKILL)
-        output = self._proc.stdout.fileno()  # type: ignore[union-attr]
-        os.set_blocking(output, False)
-        with contextlib.suppress(BlockingIOError):
-            while self._keep_output(output):
-                pass
+        self._drain(output)
         text = self._tail.decode("utf-8", errors="replace")
         return ChildEnd(status, self.hung, (text.strip().splitlines() or ["no message"])[-1])
 

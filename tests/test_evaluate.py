@@ -141,17 +141,30 @@ def test_an_interrupted_run_resumes_to_the_uninterrupted_result(reference, agent
     assert (out / "episodes.jsonl").read_text().count("\n") == sum(e["episodes"] for e in resumed["levels"].values())
 
 
-def test_a_half_written_episode_line_is_dropped_on_resume(reference, tmp_path) -> None:
+def _killed_copy(reference: Path, tmp_path: Path) -> Path:
+    """A copy of the reference's folder as if killed while playing its second level."""
     import shutil
 
     out = tmp_path / "run"
     shutil.copytree(reference, out)
     state = json.loads((out / "run.json").read_text())
-    del state["finished"]["Dasher-Genesis/Zone3.Act2"]  # as if killed while playing the second level
+    del state["finished"]["Dasher-Genesis/Zone3.Act2"]
     (out / "run.json").write_text(json.dumps(state))
+    return out
+
+
+def test_a_half_written_episode_line_is_dropped_on_resume(reference, tmp_path) -> None:
+    out = _killed_copy(reference, tmp_path)
     with (out / "episodes.jsonl").open("a") as log:
         log.write('{"level": "Dasher-Genesis/Zone3.Act2", "epis')
     assert evaluate(out, "--agent", "jerk", "--resume") == 0
+    assert summary(out) == summary(reference)
+
+
+def test_resume_alone_takes_the_options_from_the_run_folder(reference, tmp_path) -> None:
+    """The --help example `retrokit evaluate --out runs/mine --resume`: no option but the folder (issue 42)."""
+    out = _killed_copy(reference, tmp_path)
+    assert main(["evaluate", "--out", str(out), "--resume", "--no-progress"]) == 0
     assert summary(out) == summary(reference)
 
 
@@ -376,7 +389,7 @@ def test_a_second_run_on_a_folder_in_use_is_refused(agents_file, tmp_path, monke
         wait_for(lambda: (tmp_path / "waiting").exists() or first.poll() is not None, 120, "the first run to pause")
         assert evaluate(out, "--agent", f"{agents_file}:jerk_pausing", "--levels", "Zone3.Act2", "--resume") == 2
         err = capsys.readouterr().err
-        assert f"Expected no other evaluation running in {out}, but one is (process {first.pid})" in err
+        assert f"Expected no other evaluation running in the folder {str(out)!r}; found one there (process {first.pid})" in err
         assert err.count("\n") == 1
         assert json.loads((out / "run.json").read_text())["finished"] == {}
     finally:

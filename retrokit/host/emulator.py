@@ -172,6 +172,8 @@ class Emulator:
         self.rom = rom
         self.space = AddressSpace.for_emulator(self.system, self._emu)
         self._actions = np.zeros(ports, dtype=np.uint16)
+        av = self._emu.av_info()
+        self._largest = (av["max_height"], av["max_width"])  # the frame the core said it may draw, when it loaded
 
     @classmethod
     def for_rom(cls, rom: str | os.PathLike[str], **kwargs: object) -> Emulator:
@@ -321,9 +323,21 @@ class Emulator:
 
         Args:
             out: A buffer of that shape to fill instead of allocating one.
+
+        Raises:
+            CoreError: The core drew a frame larger than its system's largest (a corrupt state's
+                garbage width, which would ask for terabytes).
         """
+        height, width = self._emu.screen_shape()
+        av = self._emu.av_info()  # a core may announce a larger one since (SET_SYSTEM_AV_INFO)
+        most_h, most_w = max(av["max_height"], self._largest[0]), max(av["max_width"], self._largest[1])
+        if not (0 < height <= most_h and 0 < width <= most_w):
+            raise CoreError(
+                f"Expected a frame of at most {most_w}x{most_h} pixels from the {self.system.name} core; found "
+                f"{width}x{height}: the state it runs is corrupt. Load another state, or reset to the game's."
+            )
         if out is None:
-            out = np.empty(self._emu.screen_shape() + (3,), dtype=np.uint8)
+            out = np.empty((height, width, 3), dtype=np.uint8)
         self._emu.screen(out)
         return out
 

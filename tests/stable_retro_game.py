@@ -37,7 +37,7 @@ class Integration:
     """A stable-retro integration of one of our games.
 
     Attributes:
-        name: stable-retro's name for it, ``<Game>-v0``.
+        name: stable-retro's name for it, its folder's: ``<Game>-v0`` unless written under another.
         folder: The integration folder (its parent is the custom path).
         scenario: ``scenario.json``, which retrokit loads too.
         state: The start state's name.
@@ -65,9 +65,14 @@ def _scenario(game: Game, start: dict[str, int]) -> dict:
     return {"reward": {"variables": rewards}, "done": {"variables": dones, "condition": "any"}}
 
 
-def write_integration(game: Game, root: Path) -> Integration:
-    """Write a stable-retro integration of ``game`` (its default state) into ``root/<Game>-v0``."""
-    name = f"{game.name}-v0"
+def write_integration(game: Game, root: Path, name: str | None = None) -> Integration:
+    """Write a stable-retro integration of ``game`` (its default state) into ``root/<name>``.
+
+    Args:
+        name: The folder's name: by default ``<Game>-v0``, as stable-retro's stable games are named; its
+            experimental and contrib games' folders have no ``-v0``.
+    """
+    name = name or f"{game.name}-v0"
     folder = root / name
     folder.mkdir(parents=True)
     rom = game.require_rom()

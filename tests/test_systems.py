@@ -93,10 +93,10 @@ def cart(request, tmp_path_factory) -> Iterator[Cartridge]:
 
 
 def inputs(cart: Cartridge, seed: int, frames: int, *, recordable: bool = False) -> list[list[str]]:
-    """Button sets for ``frames`` frames; ``recordable``: only buttons a .bk2 movie has a letter for (a PC Engine's
-    I to VI have none: stable-retro drops them, retrokit refuses them, docs/movies.md)."""
+    """Button sets for ``frames`` frames; ``recordable``: only buttons stable-retro's .bk2 letters hold (a PC Engine's
+    I to VI and RUN have none: stable-retro drops them; retrokit writes them as BizHawk does, docs/movies.md)."""
     source = wandering(cart.system, seed)
-    keep = set(cart.system.buttons_of(layout(cart.system.name).allowed)) if recordable else None
+    keep = set(cart.system.buttons_of(layout(cart.system.name).stable_retro)) if recordable else None
     return [[b for b in next(source) if keep is None or b in keep] for _ in range(frames)]
 
 

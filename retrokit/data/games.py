@@ -53,6 +53,7 @@ __all__ = [
     "list_games",
     "load_game",
     "normalize_name",
+    "stable_retro_name",
 ]
 
 STATE_SUFFIX = ".state"
@@ -366,6 +367,23 @@ def _index() -> dict[str, tuple[Path, ...]]:
     _index_cache.clear()
     _index_cache[key] = result
     return result
+
+
+def stable_retro_name(name: str) -> str:
+    """The name stable-retro knows a game by, which it writes as a movie's ``GameName`` and looks the game up by.
+
+    stable-retro names a game by its integration folder: a folder with a ``rom.sha``
+    (``list_games``' test), named as it is, so ``Airstriker-Genesis-v0`` in its
+    ``stable`` folder and ``ActRaiser2-Snes`` (no ``-v0``) in ``experimental`` and
+    ``contrib``, or in a custom path. It is the first such folder of the game's
+    folders; a game none of whose folders is one (retrokit's own ``game.yaml``
+    games) gets ``<Name>-<System>-v0``, as its stable games are named.
+    """
+    key = normalize_name(name)
+    for folder in _index().get(key, ()):
+        if os.path.lexists(folder / "rom.sha"):
+            return folder.name
+    return f"{key}-v0"
 
 
 def list_games(pattern: str | None = None) -> list[Game]:

@@ -84,6 +84,8 @@ class System:
         jump: The button JERK jumps with, unless a scenario names another.
         switches: Console switches (not pad buttons), which default action sets, the random
             agent, JERK and validate's smoke run leave alone.
+        movie_buttons: Buttons stable-retro's ``.bk2`` letters lack, recorded all the same: the button's
+            ``(frame letter, key-line name)``, as BizHawk's own input log of the console writes them.
         proven_by: What proves retrokit runs the system right, by kind (``"cartridge"``,
             ``"stable-retro"``, ``"ale-py"``): a game's name, or ``""``; empty if nothing does.
     """
@@ -109,10 +111,13 @@ class System:
     start: str = "START"
     jump: str | None = None
     switches: tuple[str, ...] = ()
+    movie_buttons: dict[str, tuple[str, str]] = field(default_factory=dict)
     proven_by: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        for what, names in (("start", [self.start]), ("jump", [self.jump] if self.jump else []), ("switches", self.switches)):
+        named = (("start", [self.start]), ("jump", [self.jump] if self.jump else []), ("switches", self.switches),
+                 ("movie_buttons", list(self.movie_buttons)))  # fmt: skip
+        for what, names in named:
             for name in names:
                 if name not in self.button_names:
                     raise DataFileError(
@@ -160,6 +165,11 @@ class System:
     def proven(self) -> bool:
         """Whether anything proves retrokit runs this system right (``proven_by``)."""
         return bool(self.proven_by)
+
+    @property
+    def present_mask(self) -> int:
+        """The RetroPad bits of the buttons the console has (``buttons`` entries that are not ``None``)."""
+        return self.mask(self.button_names)
 
     @property
     def switch_mask(self) -> int:
@@ -212,10 +222,17 @@ def _parse(name: str, entry: object) -> System:
             start=str(entry.get("start", "START")),
             jump=str(entry["jump"]) if entry.get("jump") else None,
             switches=tuple(str(b) for b in entry.get("switches", ())),
+            movie_buttons={str(k): _letter_and_name(v) for k, v in (entry.get("movie_buttons") or {}).items()},
             proven_by={str(k): str(v or "") for k, v in (entry.get("proven_by") or {}).items()},
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise DataFileError(f"{_FILE}: system {name!r} is malformed: {exc!r}.") from exc
+
+
+def _letter_and_name(value: object) -> tuple[str, str]:
+    if not (isinstance(value, list) and len(value) == 2 and len(str(value[0])) == 1 and str(value[1])):
+        raise ValueError(f"a movie button is [one-character letter, key-line name], not {value!r}")
+    return str(value[0]), str(value[1])
 
 
 def _detect_rule(rule: dict) -> DetectRule:

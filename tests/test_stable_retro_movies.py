@@ -18,7 +18,7 @@ from stable_retro_game import write_integration
 
 import retrokit
 from retrokit.data.games import find_game, stable_retro_name
-from retrokit.movie import read_bk2
+from retrokit.movie import play, read_bk2
 
 stable_retro = pytest.importorskip("stable_retro")
 
@@ -88,3 +88,25 @@ def test_stable_retro_opens_and_plays_the_movie(recorded) -> None:
     finally:
         env.close()
     assert len({s.tobytes() for s in screens}) > STEPS // 4  # a game in motion, not one screen
+
+
+def test_a_pc_engine_movie_holds_i_ii_and_run_and_replays(tmp_path: Path) -> None:
+    # Skipper, our PC Engine cartridge: I jumps, RUN starts. The movie holds them (record= raised at the first
+    # press before) and retrokit replays it to the screens the episode showed; stable-retro opens it too.
+    names = [["RUN"]] * 3 + [[]] * 30 + [["RIGHT", "I"]] * 40 + [["II", "LEFT"]] * 20 + [["I"]] * 30
+    with retrokit.make("Skipper-PCEngine", action_type="all", record=tmp_path) as env:
+        env.reset(seed=0)
+        system = env.unwrapped.emulator.system
+        screens = [env.step([b in now for b in env.buttons])[0].copy() for now in names]
+    (path,) = tmp_path.glob("*.bk2")
+    frames = read_bk2(path).frames
+    assert frames == [(system.mask(now),) for now in names]
+    assert first_difference(list(play(path)), screens) is None
+    assert len({s.tobytes() for s in screens}) > 10  # I and RUN moved the game
+    movie = stable_retro.Movie(str(path))
+    assert sum(1 for _ in iter(movie.step, False)) == len(names)
+
+
+def first_difference(ours: list[np.ndarray], theirs: list[np.ndarray]) -> int | None:
+    assert len(ours) == len(theirs)
+    return next((i for i, (a, b) in enumerate(zip(ours, theirs)) if not np.array_equal(a, b)), None)

@@ -41,8 +41,8 @@ import zlib
 from pathlib import Path
 
 from retrokit.data.games import stable_retro_name
-from retrokit.data.states import MAX_STATE_SIZE
 from retrokit.errors import MovieError, UnsupportedSystemError
+from retrokit.host.systems import get_system
 from retrokit.movie.model import Layout, Movie, layout, platform_of, system_of_platform
 from retrokit.paths import atomic_write, require_regular_file
 
@@ -82,8 +82,10 @@ def read_bk2(path: str | os.PathLike[str]) -> Movie:
                         f"{', '.join(map(repr, names)) or 'no files'}. Was it made by another program?"
                     )
             header_text = _text(path, archive, HEADER)
+            system, game, header = _parse_header(path, header_text)
             log_text = _text(path, archive, INPUT_LOG)
-            state = _member(path, archive, STATE, MAX_STATE_SIZE) if STATE in names else None
+            # no larger than the movie's core writes a state (systems.yaml's state_max)
+            state = _member(path, archive, STATE, get_system(system).state_max) if STATE in names else None
     except FileNotFoundError:
         raise MovieError(f"Expected a .bk2 movie at {path}; found no such file.") from None
     except IsADirectoryError:
@@ -101,7 +103,6 @@ def read_bk2(path: str | os.PathLike[str]) -> Movie:
             f"{path}: expected {STATE!r} to hold the movie's start state; found 0 bytes. A movie that starts at "
             f"power-on has no {STATE!r}: record it again, or copy the movie again if it was cut short."
         )
-    system, game, header = _parse_header(path, header_text)
     players, frames = _parse_log(path, log_text, layout(system))
     return Movie(game, system, players, state, frames, header)
 

@@ -7,6 +7,8 @@
   on the real core, beside stable-retro.
 - A Game Boy cartridge whose header says it also runs on the Color is a Game Boy game when its file is a ``.gb``.
 - Each core's state has its own cap: parallel_n64's state is 16,789,312 bytes, past the 16 MiB all shared before.
+- A 2-byte field across two of FCEUmm's 1 KiB memory descriptors (one array in the core) reads the bytes that
+  follow, as stable-retro reads it.
 """
 
 from __future__ import annotations
@@ -16,7 +18,9 @@ import hashlib
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
+from stable_retro_game import write_integration
 
 import retrokit
 from retrokit.cli import main
@@ -115,3 +119,45 @@ def test_a_state_one_byte_past_its_cores_cap_is_refused(tmp_path: Path, system: 
         read_state(path, system)
     path.write_bytes(gzip.compress(bytes(cap), 1))
     assert len(read_state(path, system)) == cap
+
+
+ACROSS = {"across_ram": 0x3FF, "across_wram": 0x67FF}  # each the last byte of a 1 KiB descriptor, and the next's first
+
+
+@pytest.fixture(scope="module")
+def nes_across(tmp_path_factory: pytest.TempPathFactory):
+    """Hopper-Nes's stable-retro integration with 2-byte fields across FCEUmm's 1 KiB descriptors, found by both."""
+    root = tmp_path_factory.mktemp("nes-across")
+    integration = write_integration(find_game("Hopper-Nes"), root)
+    data = json.loads((integration.folder / "data.json").read_text())
+    data["info"].update({name: {"address": address, "type": "<u2"} for name, address in ACROSS.items()})
+    (integration.folder / "data.json").write_text(json.dumps(data))
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("RETROKIT_GAMES", str(root))
+        stable_retro.data.Integrations.add_custom_path(str(root))
+        try:
+            yield integration
+        finally:
+            stable_retro.data.Integrations.clear_custom_paths()
+
+
+def test_a_field_across_two_fceumm_descriptors_reads_as_stable_retro_reads_it(nes_across) -> None:
+    theirs = stable_retro.make(nes_across.name, inttype=stable_retro.data.Integrations.CUSTOM_ONLY, render_mode=None)
+    try:
+        with retrokit.make("Hopper-Nes", state=nes_across.after_reset) as ours:
+            ours.reset(seed=0)
+            emulator = ours.unwrapped.emulator
+            assert emulator.system.name == "Nes" and set(ACROSS) <= set(ours.unwrapped.game.fields)
+            rng = np.random.default_rng(0)
+            for _ in range(4):
+                for address in ACROSS.values():
+                    emulator.poke(address, int(rng.integers(256)))
+                    emulator.poke(address + 1, int(rng.integers(256)))
+                ours_now = ours.unwrapped.reader.read()
+                theirs.unwrapped.em.set_state(bytes(emulator.get_state()))
+                theirs.unwrapped.data.update_ram()
+                for name, address in ACROSS.items():
+                    expected = emulator.peek(address) | emulator.peek(address + 1) << 8
+                    assert ours_now[name] == theirs.unwrapped.data.lookup_value(name) == expected, name
+    finally:
+        theirs.close()

@@ -166,21 +166,41 @@ class AddressSpace:
         system's RAM base. stable-retro's RAM follows the same rule: the map's
         writable descriptors (one with no memory behind it too, as zeros), or
         else the system RAM at the descriptor's ``ram.base``.
+
+        Descriptors that follow each other in console addresses and in memory
+        make one region (FCEUmm maps the NES's 2 KiB of RAM as two 1 KiB
+        descriptors over one array), so a field across them reads the bytes
+        that follow, as stable-retro reads it.
         """
         regions: list[Region] = []
         descriptors: list[tuple[int, int, int | None]] = []
-        for desc in emulator.memory_maps():
+        run: tuple[int, int] | None = None  # the last region's first descriptor and how many it holds, if it may grow
+        for index, desc in enumerate(emulator.memory_maps()):
             if desc["flags"] & _CONST:
+                run = None
                 continue
             length = desc["length"]
             if desc["select"]:
                 by_select = ((~desc["select"] & ~desc["start"]) + 1) & desc["select"]
                 length = min(length, by_select) if length else by_select
-            if desc["memory"] is None:
+            memory = desc["memory"]
+            if memory is None:
                 descriptors.append((desc["start"], length, None))
+                run = None
                 continue
+            whole = length == len(memory)  # the region is all of the descriptor's memory: the next may follow it
+            last = regions[-1] if regions else None
+            if run is not None and whole and last is not None and desc["start"] == last.start + last.length:
+                first, count = run
+                span = emulator.memory_span(first, count + 1)  # None unless the memory follows too
+                if span is not None:
+                    regions[-1] = Region(last.start, last.length + length, span, system.ram_swap)
+                    descriptors.append((desc["start"], length, len(regions) - 1))
+                    run = (first, count + 1)
+                    continue
             descriptors.append((desc["start"], length, len(regions)))
-            regions.append(Region(desc["start"], length, desc["memory"], system.ram_swap))
+            regions.append(Region(desc["start"], length, memory, system.ram_swap))
+            run = (index, 1) if whole else None
         if not regions:
             ram = emulator.memory(primitives.MEMORY_SYSTEM_RAM)
             if ram is not None:

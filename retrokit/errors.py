@@ -241,3 +241,9 @@ class AccessDeniedError(StudioError, PermissionError):
 
 class RequestTooLargeError(StudioError):
     """A request's body is larger than the studio accepts."""
+
+
+class SkippedDataWarning(UserWarning):
+    """A stable-retro data file (``data.json``, ``scenario.json``) held what retrokit skips, as stable-retro does:
+    a field outside the system's memory, a key neither knows. The message, one line, names what was skipped.
+    retrokit's own files (``game.yaml``, YAML scenarios) never warn: what they hold that is wrong is an error."""

@@ -150,7 +150,7 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         if known_screen is not None:  # checked before any core is loaded
             self.preprocessing = preprocessing(observation, known_screen, obs_type=obs_type, scenario_crop=self._crop)
         self.emulator = Emulator(self.game.system, setup.rom, options=options, ports=max(players, 2))
-        self.reader = FieldReader(self.game.fields, self.emulator.space)
+        self.reader = self.game.reader(self.emulator.space)
         rate = self.emulator.system.frame_rate(self.emulator.av_info()["fps"])  # the core says NTSC or PAL
         self.metadata = {"render_modes": render_modes(), "render_fps": rate / frameskip}
         self.actions = ActionMap(self.emulator.system, action_type, getattr(self.scenario, "actions", None), players)

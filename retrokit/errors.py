@@ -41,6 +41,13 @@ def shown(value: object, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
+def listed(items: Iterable[str], limit: int = 10, width: int = 60) -> str:
+    """Items for a one-line message: the first ``limit``, each cut to ``width`` characters, then how many more."""
+    items = list(items)
+    cut = [i if len(i) <= width else i[: width - 3] + "..." for i in items[:limit]]
+    return ", ".join(cut) + (f" and {len(items) - limit} more" if len(items) > limit else "")
+
+
 DISTRIBUTION = "retrokit-rl"
 """retrokit's name on the package index ("retrokit" there is another project); the import name stays ``retrokit``."""
 

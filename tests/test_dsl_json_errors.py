@@ -77,3 +77,15 @@ def test_json_syntax_error(tmp_path) -> None:
     path.write_text('{"done": {,}}')
     with pytest.raises(ScenarioError, match=r"scenario.json:1:11: this is not valid JSON: Expecting property name"):
         load_scenario(path, FIELDS)
+
+
+def test_a_flood_of_unknown_keys_is_named_in_one_short_line(tmp_path) -> None:
+    path = tmp_path / "scenario.json"
+    data = {f"key{i}": i for i in range(5000)}
+    data["x" * 1_000_000] = 1  # a key of a megabyte
+    path.write_text(json.dumps({**data, "done": {}}))
+    with pytest.warns(SkippedDataWarning) as caught:
+        load_scenario(path, FIELDS)
+    (warning,) = caught
+    message = str(warning.message)
+    assert "\n" not in message and len(message) < 2000 and message.endswith("and 4991 more.")

@@ -72,3 +72,21 @@ def test_retrokits_own_game_yaml_stays_strict(tmp_path, monkeypatch) -> None:
     monkeypatch.setenv("RETROKIT_GAMES", str(tmp_path))
     with pytest.raises(InvalidArgumentError, match=r"Field 'at_Genesis' \(0xff0000, \|u1\): Expected an address inside"):
         retrokit.make(GAME)
+
+
+def test_a_data_json_of_thousands_of_foreign_fields_is_named_in_one_short_line(tmp_path, monkeypatch) -> None:
+    folder = tmp_path / GAME
+    shutil.copytree(REPO / "games" / GAME, folder, ignore=shutil.ignore_patterns("game.yaml"))
+    game = find_game(REPO / "games" / GAME)
+    info = {name: {"address": spec.address, "type": spec.type} for name, spec in game.fields.items()}
+    info.update({f"far{i}": {"address": 0x100000 + i, "type": "|u1"} for i in range(3000)})
+    (folder / "data.json").write_text(json.dumps({"info": info}))
+    (folder / "rom.sha").write_text("\n".join(game.sha1s) + "\n")
+    monkeypatch.setenv("RETROKIT_GAMES", str(tmp_path))
+    with pytest.warns(SkippedDataWarning) as caught:
+        env = retrokit.make(GAME)
+    env.close()
+    (warning,) = caught
+    message = str(warning.message)
+    assert "\n" not in message and len(message) < 1000 and "skipped 3000 field(s)" in message
+    assert message.endswith("and 2990 more.")

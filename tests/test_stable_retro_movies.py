@@ -62,6 +62,14 @@ def test_stable_retro_names_an_experimental_game_by_its_folder(experimental) -> 
     assert GAME in stable_retro.data.list_games(stable_retro.data.Integrations.CUSTOM_ONLY)
 
 
+def test_every_game_stable_retro_lists_gets_its_name() -> None:
+    # The wheel's 1,000-odd games: its stable ones with -v0, its experimental and contrib ones without.
+    names = stable_retro.data.list_games(stable_retro.data.Integrations.ALL)
+    experimental = stable_retro.data.list_games(stable_retro.data.Integrations.EXPERIMENTAL_ONLY)
+    assert len(names) > 1000 and experimental and not any(n.endswith("-v0") for n in experimental)
+    assert [n for n in names if stable_retro_name(n) != n] == []
+
+
 def test_stable_retro_opens_and_plays_the_movie(recorded) -> None:
     path, screens, unnamed = recorded
     assert unnamed > STEPS // 10  # the agent pressed id 1 often: every such frame was recorded, without it

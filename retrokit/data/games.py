@@ -43,6 +43,7 @@ from retrokit.errors import (
     UnknownNameError,
     UnsupportedSystemError,
     did_you_mean,
+    listed,
 )
 from retrokit.host.systems import System, get_system
 
@@ -149,7 +150,7 @@ class Game:
             if outside:
                 warnings.warn(
                     f"{self.info.source}: skipped {len(outside)} field(s) outside the {self.system.name} memory, "
-                    f"as stable-retro skips them: {', '.join(f'{s.name} ({s.address:#x})' for s in outside)}.",
+                    f"as stable-retro skips them: {listed(f'{s.name} ({s.address:#x})' for s in outside)}.",
                     SkippedDataWarning, stacklevel=3,
                 )
                 fields = {name: spec for name, spec in fields.items() if spec not in outside}

@@ -36,7 +36,7 @@ from retrokit.dsl.check import RESERVED
 from retrokit.dsl.document import document_from_dict
 from retrokit.dsl.source import SourceText, located, read_source
 from retrokit.dsl.spec import ScenarioSpec
-from retrokit.errors import ScenarioCompileError, ScenarioError, SkippedDataWarning, did_you_mean
+from retrokit.errors import ScenarioCompileError, ScenarioError, SkippedDataWarning, did_you_mean, listed
 
 TOP_KEYS = ("reward", "rewards", "done", "actions", "crop", "crops", "scripts")
 REWARD_KEYS = ("variables", "time", "script")
@@ -122,8 +122,9 @@ class _Converter:
             raise self.error(path, "expected an object ({...})")
         for key in obj:
             if key not in allowed:  # stable-retro's reader ignores it: skipped, and named in one warning
-                hint = did_you_mean(str(key), allowed).strip()
-                self.skipped.append(".".join([*path, str(key)]) + (f" ({hint[0].lower()}{hint[1:]})" if hint else ""))
+                key = str(key)[:60]  # a key of a megabyte names itself in 60 characters
+                hint = did_you_mean(key, allowed).strip()
+                self.skipped.append(".".join([*path, key]) + (f" ({hint[0].lower()}{hint[1:]})" if hint else ""))
         if "script" in obj:
             raise self.error(
                 [*path, "script"],
@@ -164,7 +165,7 @@ class _Converter:
             where = self.source.name if self.source is not None else "scenario.json"
             warnings.warn(
                 f"{where}: skipped {len(self.skipped)} key(s) no scenario.json has, as stable-retro skips them: "
-                f"{', '.join(self.skipped)}.",
+                f"{listed(self.skipped, width=120)}.",
                 SkippedDataWarning, stacklevel=2,
             )
         return out

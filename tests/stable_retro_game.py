@@ -14,6 +14,7 @@ the episode is done when a bounded field (lives, game mode, a level-done flag) l
 
 from __future__ import annotations
 
+import contextlib
 import gzip
 import json
 from collections.abc import Iterator
@@ -21,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from retrokit.data.games import Game
 from retrokit.data.roms import rom_sha1
@@ -103,6 +105,20 @@ def write_integration(game: Game, root: Path, name: str | None = None) -> Integr
         emu.close()
     _json(folder / "scenario.json", _scenario(game, start))
     return Integration(name, folder, folder / "scenario.json", state, after)
+
+
+@contextlib.contextmanager
+def found_by_both(root: Path) -> Iterator[None]:
+    """Game folders under ``root`` found by retrokit (``RETROKIT_GAMES``) and by stable-retro (a custom path)."""
+    import stable_retro
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("RETROKIT_GAMES", str(root))
+        stable_retro.data.Integrations.add_custom_path(str(root))
+        try:
+            yield
+        finally:
+            stable_retro.data.Integrations.clear_custom_paths()
 
 
 def wandering(system: System, seed: int, hold: int = 6) -> Iterator[list[str]]:

@@ -13,7 +13,7 @@ import shutil
 from pathlib import Path
 
 import pytest
-from stable_retro_game import write_integration
+from stable_retro_game import found_by_both, write_integration
 
 import retrokit
 from retrokit.data.games import find_game
@@ -34,13 +34,8 @@ def every_systems_field(tmp_path_factory: pytest.TempPathFactory):
     data = json.loads((integration.folder / "data.json").read_text())
     data["info"].update({f"at_{name}": {"address": s.ram_base, "type": "|u1"} for name, s in all_systems().items()})
     (integration.folder / "data.json").write_text(json.dumps(data))
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setenv("RETROKIT_GAMES", str(root))
-        stable_retro.data.Integrations.add_custom_path(str(root))
-        try:
-            yield integration
-        finally:
-            stable_retro.data.Integrations.clear_custom_paths()
+    with found_by_both(root):
+        yield integration
 
 
 def test_a_data_json_naming_other_systems_fields_loads_with_one_line_saying_what_was_skipped(every_systems_field):

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from stable_retro_game import write_integration
+from stable_retro_game import found_by_both, write_integration
 
 import retrokit
 from retrokit.data.games import find_game, stable_retro_name
@@ -31,13 +31,8 @@ def experimental(tmp_path_factory: pytest.TempPathFactory):
     """A folder holding ``Hopper-Nes/`` as stable-retro's experimental games are laid out, searched by both."""
     root = tmp_path_factory.mktemp("experimental")
     integration = write_integration(find_game(GAME), root, name=GAME)
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setenv("RETROKIT_GAMES", str(root))
-        stable_retro.data.Integrations.add_custom_path(str(root))
-        try:
-            yield integration
-        finally:
-            stable_retro.data.Integrations.clear_custom_paths()
+    with found_by_both(root):
+        yield integration
 
 
 @pytest.fixture(scope="module")

@@ -20,7 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from stable_retro_game import write_integration
+from stable_retro_game import found_by_both, write_integration
 
 import retrokit
 from retrokit.cli import main
@@ -75,13 +75,8 @@ def dasher_32x(tmp_path_factory: pytest.TempPathFactory):
     (folder / "data.json").write_text(json.dumps({"info": {}}))  # its RAM is the 32X's: at 0, no Genesis fields
     (folder / "scenario.json").write_text(json.dumps({"reward": {"variables": {}}, "done": {"variables": {}}}))
     (folder / "metadata.json").write_text("{}")
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setenv("RETROKIT_GAMES", str(root))
-        stable_retro.data.Integrations.add_custom_path(str(root))
-        try:
-            yield "Dasher-32x"
-        finally:
-            stable_retro.data.Integrations.clear_custom_paths()
+    with found_by_both(root):
+        yield "Dasher-32x"
 
 
 def test_a_32x_screen_is_240_rows_as_stable_retro_shows_it(dasher_32x: str) -> None:
@@ -132,13 +127,8 @@ def nes_across(tmp_path_factory: pytest.TempPathFactory):
     data = json.loads((integration.folder / "data.json").read_text())
     data["info"].update({name: {"address": address, "type": "<u2"} for name, address in ACROSS.items()})
     (integration.folder / "data.json").write_text(json.dumps(data))
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setenv("RETROKIT_GAMES", str(root))
-        stable_retro.data.Integrations.add_custom_path(str(root))
-        try:
-            yield integration
-        finally:
-            stable_retro.data.Integrations.clear_custom_paths()
+    with found_by_both(root):
+        yield integration
 
 
 def test_a_field_across_two_fceumm_descriptors_reads_as_stable_retro_reads_it(nes_across) -> None:

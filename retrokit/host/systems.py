@@ -80,6 +80,12 @@ class System:
             and loaded again before each state is loaded (then reset, if
             ``reset_before_state``), as a fresh core would take it, and before
             each hard reset.
+        reload_md5: With ``reload_before_state``, the ROMs (by MD5) whose state
+            loads need the reload; with ``reload_cartridges`` also empty, every
+            ROM's do. The others' state loads are a load, and their hard resets
+            restore what the first one (a reload) left: see :meth:`reloads_states`.
+        reload_cartridges: The cartridge classes (named in stella's states) whose
+            state loads need the reload too.
         start: The button that starts a game from its title screen.
         jump: The button JERK jumps with, unless a scenario names another.
         switches: Console switches (not pad buttons), which default action sets, the random
@@ -103,6 +109,8 @@ class System:
     state_length: str = "exact"
     reset_before_state: bool = False
     reload_before_state: bool = False
+    reload_md5: frozenset[str] = frozenset()
+    reload_cartridges: frozenset[str] = frozenset()
     detect: tuple[DetectRule, ...] = ()
     rom_format: str = ""
     missing_mappers: frozenset[int] = frozenset()
@@ -180,6 +188,19 @@ class System:
             value |= 1 << self.button_bit(name)
         return value
 
+    def reloads_states(self, rom_md5: str, cartridge: str) -> bool:
+        """Whether loading a state into a console of this ROM must load the game again first.
+
+        Args:
+            rom_md5: The ROM's MD5, hex.
+            cartridge: The cartridge class the core's states name (``""`` when they name none).
+        """
+        if not self.reload_before_state:
+            return False
+        if not (self.reload_md5 or self.reload_cartridges):
+            return True
+        return rom_md5 in self.reload_md5 or cartridge in self.reload_cartridges
+
     def buttons_of(self, mask: int) -> list[str]:
         """Return the names of the buttons a bit mask presses."""
         return [b for i, b in enumerate(self.buttons) if b is not None and mask >> i & 1]
@@ -206,6 +227,8 @@ def _parse(name: str, entry: object) -> System:
             state_length=_one_of(entry.get("state_length", "exact"), ("exact", "parsed"), "state_length"),
             reset_before_state=_one_of(entry.get("reset_before_state", False), (False, True), "reset_before_state"),
             reload_before_state=_one_of(entry.get("reload_before_state", False), (False, True), "reload_before_state"),
+            reload_md5=frozenset(str(m).lower() for m in (entry.get("reload_only_for") or {}).get("md5", ())),
+            reload_cartridges=frozenset(str(c) for c in (entry.get("reload_only_for") or {}).get("cartridges", ())),
             detect=tuple(_detect_rule(rule) for rule in entry.get("detect") or ()),
             rom_format=_one_of(str((entry.get("rom") or {}).get("format", "")), ("", "ines"), "rom.format"),
             missing_mappers=frozenset(int(m) for m in (entry.get("rom") or {}).get("missing_mappers", ())),

@@ -19,8 +19,11 @@ import pytest
 from retrokit.cli import main
 from retrokit.errors import PatchError
 from retrokit.host import build
+from retrokit.host.buildhint import build_hint
 from retrokit.host.cores import CORES_ENV, built_cores_dir, locate_core
 from retrokit.host.patching import apply_patch, parse_patch
+from retrokit.host.systems import get_system
+from retrokit.paths import wheel_cores_dir
 
 RECIPE = build.RECIPES["genesis_plus_gx"]
 PATCHED_FILE = "libretro/libretro.c"
@@ -296,7 +299,8 @@ def test_a_build_is_installed_recorded_and_found_first(monkeypatch, tmp_path, ca
     assert run_cli(capsys, "--sdist", str(sdist))[2].startswith("Already built")  # nothing fetched or compiled again
     monkeypatch.setenv("PATH", path)
     assert main(["cores"]) == 0
-    assert f"genesis_plus_gx    built           {installed}" in capsys.readouterr().out
+    assert f"genesis_plus_gx    yes      built           {installed}" in capsys.readouterr().out
+    assert build_hint("Genesis") == ""  # built: the line that tells of it is never shown again
 
 
 def test_a_build_for_another_stable_retro_version_is_not_used(monkeypatch, tmp_path, capsys, isolated) -> None:
@@ -355,10 +359,21 @@ def test_malformed_patches_are_refused(tmp_path, text: str, message: str) -> Non
 # --- what find_core and retrokit cores make of the data folder ------------------------------------
 
 
-def test_without_a_build_the_wheel_core_is_listed(capsys) -> None:
+def test_without_a_build_the_wheel_core_is_listed_unpatched_with_the_measured_gain(isolated, capsys) -> None:
+    genesis = get_system("Genesis")
     assert main(["cores"]) == 0
     out = capsys.readouterr().out
-    assert "Genesis     genesis_plus_gx    wheel " in out and "retrokit build-core CORE" in out
+    assert "Genesis     genesis_plus_gx    no       wheel " in out and "retrokit build-core CORE" in out
+    assert f"Genesis envs step {genesis.build_speedup:.1f}x faster, measured on {genesis.build_measured}" in out
+    hint = build_hint("Genesis")
+    assert f"Genesis envs step {genesis.build_speedup:.1f}x faster" in hint and "build-core genesis_plus_gx" in hint
+    assert "\n" not in hint
+    assert build_hint("Nes") == "" and build_hint("Sms") == ""  # no recipe; a recipe but no figure measured
+
+
+def test_no_line_tells_of_the_build_when_the_user_chose_a_core(isolated, monkeypatch) -> None:
+    monkeypatch.setenv(CORES_ENV, str(wheel_cores_dir()))
+    assert locate_core("genesis_plus_gx").origin == CORES_ENV and build_hint("Genesis") == ""
 
 
 @pytest.mark.parametrize("record", [b"{not json", b"[1, 2]", b""], ids=["corrupt", "not-a-dict", "empty"])

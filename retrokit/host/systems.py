@@ -92,6 +92,9 @@ class System:
             agent, JERK and validate's smoke run leave alone.
         proven_by: What proves retrokit runs the system right, by kind (``"cartridge"``,
             ``"stable-retro"``, ``"ale-py"``): a game's name, or ``""``; empty if nothing does.
+        build_speedup: How many times faster this system's env steps on the core ``retrokit
+            build-core`` makes than on the wheel's, as measured (``None``: not measured).
+        build_measured: On what, when and how loaded a machine ``build_speedup`` was measured.
     """
 
     name: str
@@ -118,6 +121,8 @@ class System:
     jump: str | None = None
     switches: tuple[str, ...] = ()
     proven_by: dict[str, str] = field(default_factory=dict)
+    build_speedup: float | None = None
+    build_measured: str = ""
 
     def __post_init__(self) -> None:
         for what, names in (("start", [self.start]), ("jump", [self.jump] if self.jump else []), ("switches", self.switches)):
@@ -236,6 +241,8 @@ def _parse(name: str, entry: object) -> System:
             jump=str(entry["jump"]) if entry.get("jump") else None,
             switches=tuple(str(b) for b in entry.get("switches", ())),
             proven_by={str(k): str(v or "") for k, v in (entry.get("proven_by") or {}).items()},
+            build_speedup=float(entry["build_core"]["speedup"]) if "build_core" in entry else None,
+            build_measured=str((entry.get("build_core") or {}).get("measured", "")),
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise DataFileError(f"{_FILE}: system {name!r} is malformed: {exc!r}.") from exc

@@ -9,9 +9,11 @@ One env of ``--game`` (default: Airstriker-Genesis, the wheel's free ROM),
 frame skip 4, sticky actions 0.25, RGB observations, random actions (the
 game's filtered set), reset when an episode ends. Each round runs two child
 processes in turn, each timing ``--seconds`` of steps after a warm-up: one
-with the data folder as it is (the built core, which it must find) and one
-with an empty data folder (the wheel's core). The ratio is the median of the
-rounds' built/wheel; the load average is printed before and after.
+with the built core (which it must find in the data folder) and one with the
+wheel's (named by ``RETROKIT_CORES``), the same data folder for both, so any
+game imported there runs (``--game Pong-Atari2600`` after ``retrokit import
+--from ale-py``). The ratio is the median of the rounds' built/wheel; the load
+average is printed before and after.
 
 Usage: python tools/bench_built_core.py [--game Airstriker-Genesis] [--rounds 5] [--seconds 3]
 """
@@ -24,7 +26,6 @@ import os
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -64,10 +65,11 @@ def child(game: str, seconds: float) -> None:
     print(json.dumps({"rate": steps / elapsed, "origin": origin}))
 
 
-def measure(game: str, seconds: float, data: str | None) -> dict:
+def measure(game: str, seconds: float, cores: str | None) -> dict:
     env = dict(os.environ, PYTHONPATH=str(REPO))
-    if data is not None:
-        env["RETROKIT_DATA"] = data
+    env.pop("RETROKIT_CORES", None)
+    if cores is not None:
+        env["RETROKIT_CORES"] = cores
     out = subprocess.run([sys.executable, __file__, "--child", game, str(seconds)], env=env, check=True,
                          capture_output=True, text=True).stdout
     return json.loads(out.strip().splitlines()[-1])
@@ -83,12 +85,14 @@ def main() -> int:
     if args.child:
         child(args.child[0], float(args.child[1]))
         return 0
-    empty = tempfile.mkdtemp(prefix="bench-built-core-")  # no built core there: the wheel's is found
+    sys.path.insert(0, str(REPO))
+    from retrokit.paths import wheel_cores_dir
+
     print(f"{args.game}, frame skip 4, sticky 0.25, RGB; env steps/s\nbefore: {load()}")
     built, wheel = [], []
     for r in range(args.rounds):
-        ours, theirs = measure(args.game, args.seconds, None), measure(args.game, args.seconds, empty)
-        if ours["origin"] != "built" or theirs["origin"] != "wheel":
+        ours, theirs = measure(args.game, args.seconds, None), measure(args.game, args.seconds, str(wheel_cores_dir()))
+        if ours["origin"] != "built" or theirs["origin"] != "RETROKIT_CORES":
             print(f"Expected the built core and the wheel's; found {ours['origin']} and {theirs['origin']}: "
                   "run retrokit build-core first.")
             return 1

@@ -40,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
     gains = {core: [f"{s.name} envs step {speedup_text(s)}, measured on {s.build_measured}"
                     for s in systems.values() if s.core == core and speedup_text(s)] for core in RECIPES}
     buildable = ", ".join(core + (f" ({'; '.join(gains[core])})" if gains[core] else "") for core in RECIPES)
-    print(f"PATCHED: built by retrokit build-core, skipping the drawing and sound of frames an env does not show. "
+    print(f"PATCHED: built by retrokit build-core, which skips work on the frames an env does not show. "
           f"Cores it can build: {buildable} (retrokit build-core CORE).")
     return 0
 

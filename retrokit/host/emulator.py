@@ -177,8 +177,8 @@ class Emulator:
         self._actions = np.zeros(ports, dtype=np.uint16)
         # Whether a state load must reload the game (what this ROM's console keeps outside its states would
         # differ), and, where it need not, the console as the first hard reset (a reload) left it.
-        self._reload_states = data is not None and self.system.reloads_states(
-            hashlib.md5(data).hexdigest(), cartridge_class(self._emu.serialize())
+        self._reload_states = self.system.reload_before_state and self.system.reloads_states(
+            hashlib.md5(data or b"", usedforsecurity=False).hexdigest(), cartridge_class(self._emu.serialize())
         )
         self._power_on: bytes | None = None
 

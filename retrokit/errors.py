@@ -41,6 +41,13 @@ def shown(value: object, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
+def listed(items: Iterable[str], limit: int = 10, width: int = 60) -> str:
+    """Items for a one-line message: the first ``limit``, each cut to ``width`` characters, then how many more."""
+    items = list(items)
+    cut = [i if len(i) <= width else i[: width - 3] + "..." for i in items[:limit]]
+    return ", ".join(cut) + (f" and {len(items) - limit} more" if len(items) > limit else "")
+
+
 DISTRIBUTION = "retrokit-rl"
 """retrokit's name on the package index ("retrokit" there is another project); the import name stays ``retrokit``."""
 
@@ -241,3 +248,9 @@ class AccessDeniedError(StudioError, PermissionError):
 
 class RequestTooLargeError(StudioError):
     """A request's body is larger than the studio accepts."""
+
+
+class SkippedDataWarning(UserWarning):
+    """A stable-retro data file (``data.json``, ``scenario.json``) held what retrokit skips, as stable-retro does:
+    a field outside the system's memory, a key neither knows. The message, one line, names what was skipped.
+    retrokit's own files (``game.yaml``, YAML scenarios) never warn: what they hold that is wrong is an error."""

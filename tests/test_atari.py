@@ -158,6 +158,30 @@ def test_game_matches_stable_retro_frame_for_frame_and_movies_pass_both_ways(
     assert _first_difference(replayed, our_screens[:shown]) is None, "retrokit's movie in stable-retro"
 
 
+@pytest.mark.parametrize("game", ["Pong", "Breakout", "MontezumaRevenge"])
+def test_ram_observations_are_stable_retros_across_resets(game: str, integrations) -> None:
+    # stella gives no memory map: both show its 128 bytes of RAM (at 0x80). Each reset reloads the game (the
+    # core frees the memory and maps it anew), so the second episode reads the new memory, not the freed one.
+    theirs = stable_retro.make(f"{game}-Atari2600-v0", inttype=integrations, render_mode=None,
+                               obs_type=stable_retro.Observations.RAM, use_restricted_actions=stable_retro.Actions.ALL)
+    try:
+        with retrokit.make(f"{game}-Atari2600", action_type="all", noop_max=1, obs_type="ram") as ours:
+            actions = _inputs(theirs.unwrapped.buttons, 30)
+            for episode in range(2):
+                mine, _ = ours.reset(seed=0)
+                their_obs, _ = theirs.reset(seed=0)
+                seen = {mine.tobytes()}
+                assert np.array_equal(mine, their_obs) and mine.shape == (128,), f"episode {episode}"
+                for step, action in enumerate(actions):
+                    mine, their_obs = ours.step(action)[0], theirs.step(action)[0]
+                    assert np.array_equal(mine, their_obs), f"episode {episode}, step {step}"
+                    seen.add(mine.tobytes())
+                assert np.array_equal(ours.get_ram(), theirs.unwrapped.get_ram())
+                assert len(seen) > 10  # the game ran
+    finally:
+        theirs.close()
+
+
 def integrations_rom(game: str) -> Path:
     return Path(os.environ["RETROKIT_DATA"]) / "roms" / f"{game}-Atari2600" / "rom.a26"
 

@@ -23,6 +23,7 @@ from __future__ import annotations
 import fnmatch
 import os
 import re
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
@@ -37,15 +38,18 @@ from retrokit.errors import (
     GameNotFoundError,
     RomMismatchError,
     RomNotFoundError,
+    SkippedDataWarning,
     StateNotFoundError,
     UnknownNameError,
     UnsupportedSystemError,
     did_you_mean,
+    listed,
 )
 from retrokit.host.systems import System, get_system
 
 if TYPE_CHECKING:
     from retrokit.host.fields import FieldSpec
+    from retrokit.host.memory import AddressSpace, FieldReader
 
 __all__ = [
     "Game",
@@ -53,6 +57,7 @@ __all__ = [
     "list_games",
     "load_game",
     "normalize_name",
+    "stable_retro_name",
 ]
 
 STATE_SUFFIX = ".state"
@@ -124,6 +129,32 @@ class Game:
     def players(self) -> int:
         """How many players the game supports."""
         return self.info.players
+
+    def reader(self, space: AddressSpace) -> FieldReader:
+        """The reader of the game's fields over an emulator's memory: the one rule for which fields are read.
+
+        A field of a stable-retro ``data.json`` outside the memory (stable-retro's own
+        test data names a field at each system's RAM address, for every system) is
+        skipped, as stable-retro's ``lookup_all`` skips it, with one
+        :class:`~retrokit.errors.SkippedDataWarning` naming them. retrokit's own
+        ``game.yaml`` stays strict: such a field is an error there.
+
+        Raises:
+            InvalidArgumentError: A field of the game's ``game.yaml`` lies outside the memory.
+        """
+        from retrokit.host.memory import FieldReader
+
+        fields = self.fields
+        if self.info.source.name == "data.json":
+            outside = [s for s in fields.values() if not space.holds(s.address, s.field_type.width)]
+            if outside:
+                warnings.warn(
+                    f"{self.info.source}: skipped {len(outside)} field(s) outside the {self.system.name} memory, "
+                    f"as stable-retro skips them: {listed(f'{s.name} ({s.address:#x})' for s in outside)}.",
+                    SkippedDataWarning, stacklevel=3,
+                )
+                fields = {name: spec for name, spec in fields.items() if spec not in outside}
+        return FieldReader(fields, space)
 
     @property
     def default_player_states(self) -> tuple[str, ...]:
@@ -366,6 +397,23 @@ def _index() -> dict[str, tuple[Path, ...]]:
     _index_cache.clear()
     _index_cache[key] = result
     return result
+
+
+def stable_retro_name(name: str) -> str:
+    """The name stable-retro knows a game by, which it writes as a movie's ``GameName`` and looks the game up by.
+
+    stable-retro names a game by its integration folder: a folder with a ``rom.sha``
+    (``list_games``' test), named as it is, so ``Airstriker-Genesis-v0`` in its
+    ``stable`` folder and ``ActRaiser2-Snes`` (no ``-v0``) in ``experimental`` and
+    ``contrib``, or in a custom path. It is the first such folder of the game's
+    folders; a game none of whose folders is one (retrokit's own ``game.yaml``
+    games) gets ``<Name>-<System>-v0``, as its stable games are named.
+    """
+    key = normalize_name(name)
+    for folder in _index().get(key, ()):
+        if os.path.lexists(folder / "rom.sha"):
+            return folder.name
+    return f"{key}-v0"
 
 
 def list_games(pattern: str | None = None) -> list[Game]:

@@ -235,19 +235,24 @@ def rom_problem(system: System, data: bytes) -> str:
 def guess_system(data: bytes, filename: str | os.PathLike[str]) -> tuple[System | None, str]:
     """The likely system of a file: from its header, else its size, else its extension; and how it was told.
 
+    The extension wins over a header where its system's ROMs carry that header (``extension_wins_over``:
+    a ``.32x`` file's Genesis header, a ``.gb`` file's header saying it also runs on the Color).
+
     This is the one place a ROM's system is told from the file (retrokit new, retrokit import).
 
     Returns:
         The system (``None`` if nothing tells it) and ``"header"``, ``"size"``, ``"extension"`` or ``""``.
     """
     named = header_system(data)
+    ext = extension_of(filename)
+    known = systems_by_extension()
     if named is not None:
+        if ext in known and named in known[ext].extension_wins_over:  # a .32x file with a Genesis header
+            return known[ext], "extension"
         return get_system(named), "header"
     by_size = size_system(len(data), filename)
     if by_size is not None:
         return by_size, "size"
-    ext = extension_of(filename)
-    known = systems_by_extension()
     if ext in known and ext != "bin":  # .bin is any dump: only a header or a size tells what it is
         return known[ext], "extension"
     return None, ""

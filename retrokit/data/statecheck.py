@@ -236,7 +236,7 @@ def load_state(game: Game, path: str | os.PathLike[str]) -> VettedState:
         StateError: The file is not a valid state, is for another game's ROM, or crashes the core.
     """
     path = Path(path)
-    state = read_state_file(path)
+    state = read_state_file(path, game.system)
     if state.record is None:
         _check_folder(game, path)
     return check_state(game, state.data, state.record, source=str(path), shipped=path)

@@ -347,6 +347,22 @@ class Emulator:
             raise InvalidArgumentError(f"The {self.system.name} core exposes no system RAM.")
         return np.frombuffer(view, dtype=np.uint8)
 
+    def retro_ram(self, out: np.ndarray | None = None) -> np.ndarray:
+        """A copy of the RAM as stable-retro's ``get_ram()`` gives it: its bytes, in its order and length.
+
+        That is the core's memory map's writable blocks in ascending order of
+        address, or its system RAM where it gives no map (``AddressSpace.ram_blocks``):
+        on the NES the 2 KiB of internal RAM then the 8 KiB of cartridge RAM at
+        0x6000, on a Game Boy video RAM, cartridge RAM, work RAM, OAM and high
+        RAM. :attr:`ram` is the system RAM alone.
+
+        Args:
+            out: A ``uint8`` array of ``space.ram_size`` bytes to fill instead of allocating one.
+        """
+        if out is None:
+            out = np.empty(self.space.ram_size, dtype=np.uint8)
+        return self.space.copy_ram(out)
+
     def peek(self, address: int, type_code: str = "|u1") -> int:
         """Read a value at a console address, e.g. ``peek(0xFF0366, ">u2")``."""
         return self.space.peek(address, type_code)

@@ -17,6 +17,8 @@ import yaml
 from retrokit.errors import DataFileError, InvalidArgumentError, UnknownNameError, UnsupportedSystemError, did_you_mean
 
 _FILE = Path(__file__).with_name("systems.yaml")
+#: The state cap of a core whose descriptor names none: far above every such core's (Genesis Plus GX's is 1 MiB).
+DEFAULT_STATE_MAX = 16 * 2**20
 _T = TypeVar("_T")
 
 
@@ -84,6 +86,11 @@ class System:
         jump: The button JERK jumps with, unless a scenario names another.
         switches: Console switches (not pad buttons), which default action sets, the random
             agent, JERK and validate's smoke run leave alone.
+        extension_wins_over: Systems whose header this system's ROMs carry: a file with this system's
+            extension whose header names one of them is this system's (stable-retro goes by the extension).
+        state_max: The largest state the core writes, in bytes: a state inflating past it is refused.
+        movie_buttons: Buttons stable-retro's ``.bk2`` letters lack, recorded all the same: the button's
+            ``(frame letter, key-line name)``, as BizHawk's own input log of the console writes them.
         proven_by: What proves retrokit runs the system right, by kind (``"cartridge"``,
             ``"stable-retro"``, ``"ale-py"``): a game's name, or ``""``; empty if nothing does.
     """
@@ -109,10 +116,15 @@ class System:
     start: str = "START"
     jump: str | None = None
     switches: tuple[str, ...] = ()
+    movie_buttons: dict[str, tuple[str, str]] = field(default_factory=dict)
+    extension_wins_over: tuple[str, ...] = ()
+    state_max: int = DEFAULT_STATE_MAX
     proven_by: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        for what, names in (("start", [self.start]), ("jump", [self.jump] if self.jump else []), ("switches", self.switches)):
+        named = (("start", [self.start]), ("jump", [self.jump] if self.jump else []), ("switches", self.switches),
+                 ("movie_buttons", list(self.movie_buttons)))  # fmt: skip
+        for what, names in named:
             for name in names:
                 if name not in self.button_names:
                     raise DataFileError(
@@ -160,6 +172,11 @@ class System:
     def proven(self) -> bool:
         """Whether anything proves retrokit runs this system right (``proven_by``)."""
         return bool(self.proven_by)
+
+    @property
+    def present_mask(self) -> int:
+        """The RetroPad bits of the buttons the console has (``buttons`` entries that are not ``None``)."""
+        return self.mask(self.button_names)
 
     @property
     def switch_mask(self) -> int:
@@ -212,10 +229,25 @@ def _parse(name: str, entry: object) -> System:
             start=str(entry.get("start", "START")),
             jump=str(entry["jump"]) if entry.get("jump") else None,
             switches=tuple(str(b) for b in entry.get("switches", ())),
+            extension_wins_over=tuple(str(n) for n in entry.get("extension_wins_over", ())),
+            state_max=_positive(entry.get("state_max", DEFAULT_STATE_MAX), "state_max"),
+            movie_buttons={str(k): _letter_and_name(v) for k, v in (entry.get("movie_buttons") or {}).items()},
             proven_by={str(k): str(v or "") for k, v in (entry.get("proven_by") or {}).items()},
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise DataFileError(f"{_FILE}: system {name!r} is malformed: {exc!r}.") from exc
+
+
+def _positive(value: object, key: str) -> int:
+    if type(value) is not int or value <= 0:
+        raise ValueError(f"{key} must be a positive number of bytes, not {value!r}")
+    return value
+
+
+def _letter_and_name(value: object) -> tuple[str, str]:
+    if not (isinstance(value, list) and len(value) == 2 and len(str(value[0])) == 1 and str(value[1])):
+        raise ValueError(f"a movie button is [one-character letter, key-line name], not {value!r}")
+    return str(value[0]), str(value[1])
 
 
 def _detect_rule(rule: dict) -> DetectRule:
@@ -251,7 +283,20 @@ def all_systems() -> dict[str, System]:
         # libyaml's loader where PyYAML has it: every process that makes an env reads this file, and the
         # pure-Python one takes a fifth of a second over it.
         data = yaml.load(f, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-    return {name: _parse(name, entry) for name, entry in data.items()}
+    systems = {name: _parse(name, entry) for name, entry in data.items()}
+    for system in systems.values():
+        for other in system.extension_wins_over:
+            if other not in systems:
+                raise DataFileError(
+                    f"{_FILE}: system {system.name!r}: expected extension_wins_over to name systems; found {other!r}."
+                    + did_you_mean(other, systems)
+                )
+    return systems
+
+
+def largest_state() -> int:
+    """The largest state any core writes (the largest ``state_max``): what a state read for no known system may be."""
+    return max(system.state_max for system in all_systems().values())
 
 
 def get_system(name: str | System) -> System:

@@ -14,6 +14,7 @@ from typing import Self
 from retrokit.data.games import cached_rom_sha1, find_game
 from retrokit.data.states import StateRecord
 from retrokit.errors import FileConflictError, MovieError, RetrokitError
+from retrokit.host.systems import get_system
 from retrokit.movie.bk2 import encode_bk2, write_bk2
 from retrokit.movie.model import STATE_DIGEST, Movie, layout
 from retrokit.paths import atomic_write, ensure_folder
@@ -167,6 +168,10 @@ class MovieRecorder:
         if start_state is not None:
             self.movie.header.update(state_header(self.movie.game, start_state))
         self._layout = layout(self.movie.system)
+        # RetroPad ids among the console's that no button sits on (the NES's 1, under action_type="all") reach
+        # no game; stable-retro's recording drops them, and so does this. Bits past the pad are refused.
+        system = get_system(self.movie.system)
+        self._kept = ~(((1 << len(system.buttons)) - 1) & ~system.present_mask)
         self._players = self.movie.players
         self._file = _MovieFile(path, self.movie, overwrite)
         self._file.write()  # now, whole and atomically: a recorder killed before its first flush leaves a movie that plays
@@ -182,7 +187,8 @@ class MovieRecorder:
     def record(self, masks: Sequence[int]) -> None:
         """Append one frame: one RetroPad bit mask per port.
 
-        Masks beyond the movie's players must be 0 (e.g. an emulator's idle second port).
+        Masks beyond the movie's players must be 0 (e.g. an emulator's idle second port). Bits of
+        RetroPad ids the console has no button on are dropped, as stable-retro's recording drops them.
 
         Raises:
             MovieError: The recorder is closed, too few masks are given, a port beyond
@@ -191,7 +197,8 @@ class MovieRecorder:
         """
         if self._closed:
             raise MovieError(f"Expected an open recorder; found it closed after writing {self.path}. Make a new one.")
-        frame = tuple(int(m) for m in masks[: self._players])
+        kept = self._kept
+        frame = tuple(int(m) & kept for m in masks[: self._players])
         frames = self.movie.frames
         if len(frame) < self._players or any(int(m) for m in masks[self._players :]):
             raise MovieError(

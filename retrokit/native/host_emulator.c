@@ -406,6 +406,32 @@ static PyObject *emulator_memory_maps(EmulatorObject *self, PyObject *unused) {
     return list;
 }
 
+/* One view over the memory of descriptors first..first+count-1, when each one's console addresses and memory
+ * begin where the one before ends (FCEUmm maps its 2 KiB of RAM as two 1 KiB descriptors over one array): a
+ * field across them is read as stable-retro reads it, from the bytes that follow. None where they do not follow. */
+static PyObject *emulator_memory_span(EmulatorObject *self, PyObject *args) {
+    int first, count;
+    if (!PyArg_ParseTuple(args, "ii", &first, &count)) return NULL;
+    if (rk_py_enter(self, 1)) return NULL;
+    rk_py_leave(self);
+    rk_core *c = &self->core;
+    if (first < 0 || count < 1 || first >= c->n_maps || count > c->n_maps - first)
+        return PyErr_Format(InvalidArgumentError, "expected descriptors within the core's %d, got %d from %d", c->n_maps,
+                            count, first);
+    const rk_memmap *m = &c->maps[first];
+    if (!m->ptr || !m->len) Py_RETURN_NONE;
+    uint8_t *base = (uint8_t *)m->ptr + m->offset;
+    size_t total = m->len;
+    for (int i = first + 1; i < first + count; i++) {
+        const rk_memmap *n = &c->maps[i];
+        if (!n->ptr || !n->len || (uint8_t *)n->ptr + n->offset != base + total || n->start != m->start + total ||
+            (n->flags ^ m->flags))
+            Py_RETURN_NONE;
+        total += n->len;
+    }
+    return memory_view(self, base, total);
+}
+
 static PyObject *emulator_capture_audio(EmulatorObject *self, PyObject *arg) {
     int on = PyObject_IsTrue(arg);
     if (on < 0) return NULL;
@@ -443,6 +469,8 @@ static PyMethodDef emulator_methods[] = {
     {"screen_shape", (PyCFunction)emulator_screen_shape, METH_NOARGS, "(height, width) of the last frame."},
     {"screen", (PyCFunction)emulator_screen, METH_O, "Write the last frame as RGB into a uint8 array."},
     {"memory", (PyCFunction)emulator_memory, METH_O, "A writable zero-copy view of a core memory, or None."},
+    {"memory_span", (PyCFunction)emulator_memory_span, METH_VARARGS,
+     "memory_span(first, count): one view over descriptors that follow each other in addresses and memory, or None."},
     {"memory_maps", (PyCFunction)emulator_memory_maps, METH_NOARGS, "The core's memory descriptors, with views."},
     {"capture_audio", (PyCFunction)emulator_capture_audio, METH_O, "Start or stop keeping audio samples."},
     {"take_audio", (PyCFunction)emulator_take_audio, METH_NOARGS, "Return and clear the captured int16 stereo samples."},

@@ -247,6 +247,9 @@ def test_data_lists_and_finds_games_as_stable_retro() -> None:
     assert Path(retro.data.get_romfile_path(GAME)).samefile(stable_retro.data.get_romfile_path(f"{GAME}-v0"))
     with pytest.raises(GameNotFoundError, match="Airstriker-Genesis"):
         retro.data.list_states("Airstriker-Genesys")
+    for escape in ("../../../../etc/passwd", "/etc/passwd"):
+        with pytest.raises(InvalidArgumentError, match="leads out of"):
+            retro.data.get_file_path(GAME, escape)
     with pytest.raises(AttributeError, match="retrokit validate"):
         retro.data.verify_hash  # noqa: B018
 
@@ -312,6 +315,23 @@ def test_foreign_bytes_are_checked_before_they_reach_the_core(tmp_path: Path, ai
         env.reset()
     finally:
         env.close()
+
+
+def test_bad_buttons_and_keys_fail_in_one_line(tmp_path: Path) -> None:
+    env = retro.make(GAME, render_mode=None)
+    try:
+        with pytest.raises(InvalidArgumentError, match="players=2"):
+            env.em.set_button_mask(np.ones(12), 5)
+        with pytest.raises(InvalidArgumentError, match="at most 16"):
+            env.em.set_button_mask(np.ones(10_000))
+        with pytest.raises(AttributeError, match="no cheats"):
+            env.em.add_cheat  # noqa: B018
+    finally:
+        env.close()
+    movie = retro.Movie(tmp_path / "keys.bk2", True)
+    for key, player in ((16, 0), (-1, 0), (0, 1)):
+        with pytest.raises(MovieError, match="expected a key from 0 to 15"):
+            movie.set_key(key, True, player)
 
 
 @pytest.mark.parametrize(

@@ -17,7 +17,7 @@ from typing import Any
 from retrokit import paths
 from retrokit.data.games import Game, find_game, stable_retro_name
 from retrokit.data.games import list_games as _all_games
-from retrokit.errors import GameNotFoundError
+from retrokit.errors import GameNotFoundError, InvalidArgumentError
 
 __all__ = [
     "Integrations", "add_custom_integration", "add_integrations", "get_file_path", "get_romfile_path",
@@ -122,12 +122,25 @@ def list_scenarios(game: str, inttype: Integrations = Integrations.DEFAULT) -> l
 
 
 def get_file_path(game: str, file: str, inttype: Integrations = Integrations.DEFAULT) -> str | None:
-    """The path of the file ``file`` in the game's folders (the first that has it), or ``None``, as in stable-retro."""
+    """The path of the file ``file`` in the game's folders (the first that has it), or ``None``, as in stable-retro.
+
+    Raises:
+        InvalidArgumentError: ``file`` leads out of the game's folder (``../``, an absolute path).
+    """
     try:
         found = find_game(game, check=False)
     except GameNotFoundError:
         return None
-    return next((str(folder / file) for folder in found.folders if (folder / file).is_file()), None)
+    for folder in found.folders:
+        path = folder / file
+        if not path.resolve().is_relative_to(folder.resolve()):
+            raise InvalidArgumentError(
+                f"Expected a file of the game's folder, e.g. 'rom.sha' or 'Level1.state'; got {file!r}, which leads "
+                f"out of {folder}. Name a file inside it."
+            )
+        if path.is_file():
+            return str(path)
+    return None
 
 
 def get_romfile_path(game: str, inttype: Integrations = Integrations.DEFAULT) -> str:

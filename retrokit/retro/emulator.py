@@ -130,6 +130,7 @@ class RetroEmulator(EmulatorFace):
 
     def __init__(self, rom_path: str | os.PathLike[str]) -> None:
         super().__init__(Emulator.for_rom(rom_path))
+        self.step()  # stable-retro's emulator runs one frame as it loads the game (its screen exists from then on)
 
     def close(self) -> None:
         """Unload the game and the core."""

@@ -6,8 +6,9 @@ stable-retro's does where the two differ:
 
 - ``reset()`` runs one frame without buttons after the start state (``reset_frame=True``);
 - from power-on (``State.NONE``, or a game without a default state) nothing presses the
-  console's reset: the console is as the core loaded it, one frame in at ``make``, and a
-  ``reset()`` goes on from where the console is, as stable-retro's does;
+  console's reset: the console is as the core loaded it, two frames in at ``make`` (stable-retro's
+  emulator runs one as it loads the game, its env one more), and a ``reset()`` goes on from where
+  the console is, as stable-retro's does;
 - with ``players=2`` the reward is a list, one per player (``env.multi_rewards = False``
   gives stable-retro 1.0.1's default, the first player's reward);
 - ``render_mode`` defaults to ``"human"``, and its window, as stable-retro's, shows frames as fast as they come.
@@ -35,7 +36,10 @@ from retrokit.retro.enums import ACTION_TYPES, OBS_TYPES, Actions, Observations,
 from retrokit.retro.gamedata import GameData
 from retrokit.retro.movie import open_recorder
 
-__all__ = ["RetroEnv", "make"]
+__all__ = ["POWER_ON_FRAMES", "RetroEnv", "make"]
+
+#: Frames stable-retro has run when its env is made: one as its emulator loads the game, one in the env's constructor.
+POWER_ON_FRAMES = 2
 
 
 class RetroEnv(BaseEnv):
@@ -90,8 +94,10 @@ class RetroEnv(BaseEnv):
         self.em = EmulatorFace(self.emulator, self.game)
         self.data = GameData(self)
         self._one: EpisodeMovies | None = None  # the movie record_movie() started
-        if self._state is None and self.emulator.frame == 0:
-            self.emulator.run(self._noop, 1)  # stable-retro runs one frame when it makes the env
+        if self._state is None and self.emulator.frame < POWER_ON_FRAMES:
+            # From power-on the console is where stable-retro's is at make: its emulator runs a frame when it loads
+            # the game, and its env one more (the base env may have run one to learn the screen's size).
+            self.emulator.run(self._noop, POWER_ON_FRAMES - self.emulator.frame)
 
     # --- stable-retro's attributes ------------------------------------------------------------
 

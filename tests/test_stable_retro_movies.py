@@ -1,4 +1,4 @@
-"""A retrokit movie of a game in a folder laid out as stable-retro's experimental games are, played by stable-retro.
+"""Movies of a game in a folder laid out as stable-retro's experimental games are, both ways.
 
 stable-retro names a game by its integration folder: ``-v0`` for its stable games, none for its 58 experimental
 (and contrib) ones, and writes that name as a movie's ``GameName``, by which its player looks the game up. No
@@ -10,6 +10,7 @@ presses the NES's unnamed RetroPad id 1 at once: stable-retro's recording drops 
 
 from __future__ import annotations
 
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -91,6 +92,29 @@ def test_stable_retro_opens_and_plays_the_movie(recorded) -> None:
     finally:
         env.close()
     assert len({s.tobytes() for s in screens}) > STEPS // 4  # a game in motion, not one screen
+
+
+def test_stable_retros_movie_of_the_experimental_game_plays_in_retrokit(experimental, tmp_path: Path) -> None:
+    env = stable_retro.make(GAME, inttype=stable_retro.data.Integrations.CUSTOM_ONLY, render_mode=None,
+                            use_restricted_actions=stable_retro.Actions.ALL, record=str(tmp_path))  # fmt: skip
+    rng = np.random.default_rng(1)
+    try:
+        env.reset(seed=0)
+        screens = [env.unwrapped.em.get_screen().copy()]  # its movie's first frame is the one its reset ran
+        for _ in range(60):
+            screens.append(env.step((rng.random(len(env.unwrapped.buttons)) < 0.3).astype(np.int8))[0].copy())
+        env.unwrapped.stop_record()
+    finally:
+        env.close()
+    (path,) = tmp_path.glob("*.bk2")
+    movie = read_bk2(path)
+    assert movie.game == GAME and "GameName Hopper-Nes\n" in unzip_member(path, "Header.txt")
+    assert first_difference(list(play(path)), screens) is None
+
+
+def unzip_member(path: Path, member: str) -> str:
+    with zipfile.ZipFile(path) as archive:
+        return archive.read(member).decode()
 
 
 def test_a_pc_engine_movie_holds_i_ii_and_run_and_replays(tmp_path: Path) -> None:

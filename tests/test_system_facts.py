@@ -52,6 +52,9 @@ def test_a_game_boy_rom_that_also_runs_on_the_color_is_a_game_boy_rom_as_a_gb(tm
     assert data[0x143] == 0x80
     assert roms.guess_system(bytes(data), "game.gb") == (get_system("GameBoy"), "extension")
     assert roms.guess_system(bytes(data), "game.gbc") == (get_system("GbColor"), "header")
+    plain = (REPO / "games" / "Trekker-GameBoy" / "rom.gb").read_bytes()  # CGB flag 0: a Game Boy header
+    assert roms.guess_system(plain, "game.gbc") == (get_system("GbColor"), "extension")  # stable-retro's Color game
+    assert roms.guess_system(plain, "game.gb") == (get_system("GameBoy"), "header")
     # `retrokit new` under a -GameBoy name, as stable-retro takes the .gb: one byte past the code changed, so no
     # game knows the ROM yet.
     data[-1] ^= 0xFF

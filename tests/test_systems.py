@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import gzip
 import json
+import re
 import shutil
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -160,6 +161,10 @@ def test_ram_observations_and_get_ram_are_stable_retros(cart: Cartridge) -> None
             changed += not np.array_equal(before, obs)
         assert np.array_equal(ours.get_ram(), theirs.unwrapped.get_ram())
         assert changed > RAM_STEPS // 2  # a game writing its RAM, not two frozen copies
+        # docs/systems.md says the system's layout, with its length
+        page = (REPO / "docs" / "systems.md").read_text()
+        row = re.search(rf"(?ms)^## {cart.system.name}\n.*?^\| `get_ram\(\)`, `obs_type=\"ram\"` \| ([^\n]*)", page)
+        assert row is not None and row[1].startswith(f"{len(their_obs):,} bytes"), cart.system.name
     finally:
         vec.close()
         ours.close()

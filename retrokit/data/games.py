@@ -133,11 +133,8 @@ class Game:
     def reader(self, space: AddressSpace) -> FieldReader:
         """The reader of the game's fields over an emulator's memory: the one rule for which fields are read.
 
-        A field of a stable-retro ``data.json`` outside the memory (stable-retro's own
-        test data names a field at each system's RAM address, for every system) is
-        skipped, as stable-retro's ``lookup_all`` skips it, with one
-        :class:`~retrokit.errors.SkippedDataWarning` naming them. retrokit's own
-        ``game.yaml`` stays strict: such a field is an error there.
+        A stable-retro ``data.json``'s field outside the memory (its test data names one per system) is skipped,
+        as its ``lookup_all`` skips it, in one :class:`~retrokit.errors.SkippedDataWarning`; a ``game.yaml`` is strict.
 
         Raises:
             InvalidArgumentError: A field of the game's ``game.yaml`` lies outside the memory.
@@ -402,12 +399,9 @@ def _index() -> dict[str, tuple[Path, ...]]:
 def stable_retro_name(name: str) -> str:
     """The name stable-retro knows a game by, which it writes as a movie's ``GameName`` and looks the game up by.
 
-    stable-retro names a game by its integration folder: a folder with a ``rom.sha``
-    (``list_games``' test), named as it is, so ``Airstriker-Genesis-v0`` in its
-    ``stable`` folder and ``ActRaiser2-Snes`` (no ``-v0``) in ``experimental`` and
-    ``contrib``, or in a custom path. It is the first such folder of the game's
-    folders; a game none of whose folders is one (retrokit's own ``game.yaml``
-    games) gets ``<Name>-<System>-v0``, as its stable games are named.
+    Its integration folder's name (a folder with a ``rom.sha``): ``Airstriker-Genesis-v0`` in its ``stable``
+    folder, ``ActRaiser2-Snes`` (no ``-v0``) in ``experimental``, ``contrib`` or a custom path; the first such
+    folder of the game's. Else (retrokit's own ``game.yaml`` games) ``<Name>-<System>-v0``, as its stable games.
     """
     key = normalize_name(name)
     for folder in _index().get(key, ()):

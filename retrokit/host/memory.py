@@ -93,7 +93,12 @@ class AddressSpace:
         at = 0
         for block in self.ram_blocks:
             rel = 0 if block.region is None else block.start - self.regions[block.region].start
-            self._ram_plan.append((at, at + block.length, block.region, rel, rel + block.length))
+            last = self._ram_plan[-1] if self._ram_plan else None
+            if last is not None and block.region is not None and last[2] == block.region and last[4] == rel:
+                # the block follows the last one in the same buffer (the NES's ten): one copy for both
+                self._ram_plan[-1] = (last[0], at + block.length, block.region, last[3], rel + block.length)
+            else:
+                self._ram_plan.append((at, at + block.length, block.region, rel, rel + block.length))
             at += block.length
         self._layout = self._describe(self.regions, self.ram_blocks)
 

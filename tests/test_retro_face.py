@@ -383,3 +383,16 @@ def test_retroemulator_from_power_on_shows_stable_retros_screens(rom: str) -> No
         ours.close()
         del theirs
         gc.collect()  # stable-retro keeps one emulator a process
+
+
+def test_ram_observations_are_stable_retros() -> None:
+    theirs = stable_retro.make(f"{GAME}-v0", render_mode=None, obs_type=stable_retro.Observations.RAM)
+    ours = retro.make(GAME, render_mode=None, obs_type=retro.Observations.RAM)
+    try:
+        assert ours.observation_space == theirs.observation_space
+        assert (ours.reset()[0] == theirs.reset()[0]).all()
+        for step, action in enumerate(random_buttons(60, seed=7)):
+            assert (ours.step(action)[0] == theirs.step(action)[0]).all(), f"step {step}"
+    finally:
+        theirs.close()
+        ours.close()

@@ -244,6 +244,9 @@ def test_data_lists_and_finds_games_as_stable_retro() -> None:
     assert Path(retro.data.get_romfile_path(GAME)).samefile(stable_retro.data.get_romfile_path(f"{GAME}-v0"))
     with pytest.raises(GameNotFoundError, match="Airstriker-Genesis"):
         retro.data.list_states("Airstriker-Genesys")
+    assert retro.get_romfile_system("x/rom.md") == stable_retro.get_romfile_system("x/rom.md") == "Genesis"
+    with pytest.raises(AttributeError, match="no FBNeo"):
+        retro.is_fbneo_game  # noqa: B018
     for escape in ("../../../../etc/passwd", "/etc/passwd"):
         with pytest.raises(InvalidArgumentError, match="leads out of"):
             retro.data.get_file_path(GAME, escape)

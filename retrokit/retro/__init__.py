@@ -12,13 +12,13 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import Any
 
 from retrokit.host.systems import system_for_extension
 from retrokit.retro import data
 from retrokit.retro.emulator import RetroEmulator
 from retrokit.retro.enums import Actions, Observations, State
 from retrokit.retro.env import RetroEnv, make
+from retrokit.retro.missing import missing_names
 from retrokit.retro.movie import Movie
 
 __version__ = "1.0.1"  # the stable-retro version whose names and behaviours this follows
@@ -37,17 +37,10 @@ def get_romfile_system(rom_path: str | os.PathLike[str]) -> str:
     return system_for_extension(Path(rom_path).suffix).name
 
 
-#: stable-retro's names that retrokit.retro does not have, and what to use instead.
-_ELSEWHERE = {
+__getattr__ = missing_names(__name__, {
     "get_core_path": "retrokit.host.cores.find_core(core), or `retrokit cores`",
     "core_path": "`retrokit cores` (the folders searched for cores)",
     "get_system_info": "retrokit.host.systems.get_system(name) (buttons, RAM, screen)",
     "get_fbneo_rom_name": "nothing: retrokit has no FBNeo (arcade) core",
     "is_fbneo_game": "nothing: retrokit has no FBNeo (arcade) core",
-}
-
-
-def __getattr__(name: str) -> Any:
-    if name in _ELSEWHERE:
-        raise AttributeError(f"retrokit.retro has no {name} (stable-retro's); use {_ELSEWHERE[name]}.")
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+})  # stable-retro's names that retrokit.retro does not have, and what to use instead

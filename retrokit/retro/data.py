@@ -12,12 +12,12 @@ from __future__ import annotations
 import os
 from enum import Flag
 from pathlib import Path
-from typing import Any
 
 from retrokit import paths
 from retrokit.data.games import Game, find_game, stable_retro_name
 from retrokit.data.games import list_games as _all_games
 from retrokit.errors import GameNotFoundError, InvalidArgumentError
+from retrokit.retro.missing import missing_names
 
 __all__ = [
     "Integrations", "add_custom_integration", "add_integrations", "get_file_path", "get_romfile_path",
@@ -159,18 +159,11 @@ def path(hint: str | None = None) -> str:
     return str(root / "data") if root is not None else str(paths.user_games_dir())
 
 
-#: stable-retro's names that retrokit.retro does not have, and what to use instead.
-_ELSEWHERE = {
+__getattr__ = missing_names(__name__, {
     "GameData": "env.data (an env's fields), or retrokit.data.games.find_game(game).reader(emulator.space)",
     "get_original_romfile_path": "get_romfile_path(game)",
     "verify_hash": "retrokit validate GAME (it checks the ROM's SHA-1)",
     "get_known_hashes": "retrokit import, which knows every game's SHA-1s",
     "merge": "retrokit import (it copies ROMs into retrokit's data folder)",
     "EMU_EXTENSIONS": "retrokit.host.systems.get_system(name).extensions",
-}
-
-
-def __getattr__(name: str) -> Any:
-    if name in _ELSEWHERE:
-        raise AttributeError(f"retrokit.retro.data has no {name} (stable-retro's); use {_ELSEWHERE[name]}.")
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+})  # stable-retro's names that retrokit.retro.data does not have, and what to use instead

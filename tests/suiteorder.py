@@ -25,7 +25,7 @@ SECONDS = {
     "test_sound_skip": 25, "test_cartridges": 24, "test_hostile_game_folders": 24, "test_ramsearch_cli": 23,
     "test_studio_browser_guard": 20, "test_trust": 20, "test_evaluate_compare": 20, "test_recording_safety": 15,
     "test_host": 13, "test_hostile_movies": 12, "test_studio_ctrl_c": 12, "test_build_core_hostile": 11,
-    "test_preprocessing": 11, "test_pcecart": 10,
+    "test_preprocessing": 11, "test_pcecart": 10, "test_retro_scripts": 37, "test_retro_face": 14,
 }  # fmt: skip
 
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import pytest
 
 from retrokit.cli import main
-from retrokit.errors import PatchError
+from retrokit.errors import CoreBuildError, PatchError
 from retrokit.host import build
 from retrokit.host.buildhint import build_hint
 from retrokit.host.cores import CORES_ENV, built_cores_dir, locate_core
@@ -414,3 +414,22 @@ def test_the_patch_applies_to_sources_with_crlf_line_ends_and_keeps_them(tmp_pat
         text = path.read_bytes()
         assert text.count(b"\n") == text.count(b"\r\n") > 0, path
     assert b"sound_skip = !(av_enable & 2)" in (tmp_path / PATCHED_FILE).read_bytes()
+
+
+def test_the_sdist_is_fetched_once_and_a_failed_fetch_leaves_nothing(monkeypatch, tmp_path, isolated,
+                                                                    pip_without_config, http_index) -> None:
+    from retrokit.host.sdist import cached_sdist
+
+    monkeypatch.setenv("PIP_NO_CACHE_DIR", "1")  # the same URL serves two sdists here
+    (tmp_path / "broken").mkdir()
+
+    broken = {**METADATA_ONLY_BACKEND, "backend.py": b"raise SystemExit('this sdist is broken')\n"}
+    with pytest.raises(CoreBuildError, match="exit 1"):
+        cached_sdist("1.0.1", index_url=http_index(fake_sdist(tmp_path / "broken", broken)))
+    assert list((isolated / "sdist").iterdir()) == []  # no half file, no fetch folder
+    sdist = fake_sdist(tmp_path, METADATA_ONLY_BACKEND)
+    kept = cached_sdist("1.0.1", index_url=http_index(sdist))
+    assert kept == isolated / "sdist" / "stable_retro-1.0.1.tar.gz" and kept.read_bytes() == sdist.read_bytes()
+    # Kept: the next call reads no index (this one answers nothing).
+    assert cached_sdist("1.0.1", index_url="http://127.0.0.1:9/", timeout=1) == kept
+    assert sorted(p.name for p in (isolated / "sdist").iterdir()) == [kept.name]

@@ -38,7 +38,7 @@ from retrokit.errors import (
 )
 from retrokit.host.cores import build_record_path, built_cores_dir, core_filename, read_build_record
 from retrokit.host.patching import apply_patch
-from retrokit.host.sdist import Progress, check_index_url, fetch_sdist, no_progress, shorten
+from retrokit.host.sdist import Progress, cached_sdist, check_index_url, no_progress, shorten
 from retrokit.host.workdirs import work_folder
 from retrokit.paths import atomic_write, require_regular_file
 
@@ -315,8 +315,8 @@ def build_core(
     cc, _ = check_tools()
     with work_folder() as work:  # removes the folders of builds that were killed, too
         if sdist is None:
-            step(f"Fetching stable-retro {version}'s source from {index_url or 'the package index'} (about 150 MB)")
-            sdist = fetch_sdist(version, work / "sdist", index_url=index_url, progress=progress, **fetch_limits)
+            step(f"Fetching stable-retro {version}'s source from {index_url or 'the package index'} (about 150 MB, once: it is kept in the data folder's sdist/)")
+            sdist = cached_sdist(version, data=data, index_url=index_url, progress=progress, **fetch_limits)
         step(f"Unpacking {recipe.folder}/ from {sdist.name}")
         source = unpack_core_source(sdist, recipe.folder, work / "src", progress=progress)
         step(f"Applying {recipe.patch}")

@@ -14,15 +14,18 @@ import contextlib
 import os
 import re
 import shlex
+import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from urllib.parse import urlsplit
 
 from retrokit.errors import BuildToolError, CoreBuildError, InvalidArgumentError, SourceFetchError, SourceNotFoundError
+from retrokit.paths import data_dir, ensure_folder, locked
 
 Progress = Callable[[str, int, int], None]  # (what, done, total): total 0 when unknown
 
@@ -234,3 +237,49 @@ def shorten(text: str, limit: int = 200) -> str:
     """A tool's message line on one line of at most ``limit`` characters, without its ``ERROR:``."""
     text = " ".join(text.replace("ERROR:", "").split())
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+#: The data folder's subfolder that keeps stable-retro's sdists once fetched (one file per version).
+SDIST_FOLDER = "sdist"
+
+
+def cached_sdist(
+    version: str,
+    *,
+    data: Path | None = None,
+    index_url: str | None = None,
+    progress: Progress = no_progress,
+    **fetch_limits: float,
+) -> Path:
+    """stable-retro's sdist of ``version``, kept in ``<data>/sdist/``: fetched with :func:`fetch_sdist` the first time.
+
+    ``build-core`` and the tests that run stable-retro's own scripts share it,
+    so its 150 MB are downloaded once per machine. It is fetched into a folder
+    of its own and renamed into place under the folder's lock, so two
+    processes fetching at once keep one whole file and a killed fetch leaves none.
+
+    Args:
+        version: The stable-retro version.
+        data: The data folder; by default :func:`retrokit.paths.data_dir`.
+        index_url: The index to fetch from; by default pip's configuration.
+        progress: Called as the download advances.
+        fetch_limits: ``timeout`` and ``deadline`` of :func:`fetch_sdist`, in seconds.
+
+    Raises:
+        SourceFetchError, SourceNotFoundError, BuildToolError, CoreBuildError: As :func:`fetch_sdist`.
+        FileSystemError: The data folder cannot be written.
+    """
+    folder = ensure_folder((data if data is not None else data_dir()) / SDIST_FOLDER, "to keep stable-retro's sdist in")
+    target = folder / f"stable_retro-{version}.tar.gz"
+    if target.is_file():
+        return target
+    with locked(target):
+        if target.is_file():  # another process fetched it while this one waited
+            return target
+        work = Path(tempfile.mkdtemp(prefix=".fetch-", dir=folder))
+        try:
+            fetched = fetch_sdist(version, work, index_url=index_url, progress=progress, **fetch_limits)
+            os.replace(fetched, target)
+        finally:
+            shutil.rmtree(work, ignore_errors=True)
+    return target

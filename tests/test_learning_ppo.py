@@ -90,6 +90,7 @@ def test_evaluate_learns_from_scratch_and_from_the_trained_policy(folder, tiny, 
         setup = run["settings"]["agent_setup"]
         assert setup["config"]["values"]["horizon"] == 32 and setup["learn"] == (out != "zero-shot")
         assert (setup["init"] is None) == (out == "scratch")
+        assert setup["paper_agent"] == {"scratch": "PPO", "from-folder": "Joint PPO", "zero-shot": None}[out]
         if setup["init"]:
             assert setup["init"]["weights_sha256"] == read_policy(trained).sha256
     # --resume refuses another config or start policy

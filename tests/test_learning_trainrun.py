@@ -58,6 +58,16 @@ def test_a_new_run_never_takes_a_used_folder_and_resume_needs_one(saved, tmp_pat
         TrainRun(saved, other, resume=True, progress=False)
 
 
+def test_a_folder_in_use_is_refused(saved, training) -> None:
+    first = TrainRun(saved, training, resume=True, progress=False)
+    try:
+        with pytest.raises(RunFolderError, match="Expected no other training run running in .*, but one is"):
+            TrainRun(saved, training, resume=True, progress=False)
+    finally:
+        first.close()
+    TrainRun(saved, training, resume=True, progress=False).close()  # free again once the first is closed
+
+
 def _edit_run(saved, change) -> None:
     data = json.loads((saved / "run.json").read_text())
     change(data)

@@ -5,6 +5,8 @@ importing its library at module level:
 
 - ``LIBRARY``: the library it trains with (``"stable-baselines3"``), for messages and ``policy.json``;
 - ``KEYS``: its config's keys, a mapping of name to :class:`Key` (the loader checks every config against it);
+- optionally ``check_values(values)``: the problem of keys taken together (``v_min`` above ``v_max``), as a
+  sentence, or ``None``;
 - ``observation_options(config)``: the native preprocessing options (``grayscale``, ``resize``, ...) the runner
   adds to a level's env for it;
 - ``require()``: raise :class:`~retrokit.errors.MissingExtraError` if its library is not installed;
@@ -26,6 +28,7 @@ from retrokit.errors import UnknownNameError, did_you_mean
 #: Every learning agent, by its ``--agent`` name: the module that implements it.
 ALGORITHMS = {
     "ppo": "retrokit.learning.ppo",
+    "rainbow": "retrokit.learning.rainbow",
 }
 
 

@@ -1,0 +1,222 @@
+"""Rainbow: its configs against Hessel et al.'s table and the paper's changes, its network and replay, and end to
+end at tiny budgets: evaluate (learning, --init from a train folder, zero-shot), train and its resume.
+
+Tiny means 36-pixel frames (the Nature CNN's smallest input), minibatches of 8 and learning from 16 transitions:
+what is tested is the plumbing and the settings, never how well Rainbow learns.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+import yaml
+from incli import retrokit_in_process
+
+from retrokit.errors import AgentConfigError
+from retrokit.learning.config import CONFIG_DIR, load_config
+
+#: Hessel et al. (2018), Table 1 and the DQN settings they keep, in agent steps: the benchmark's frame skip is 4,
+#: so their 32K frames between target updates are 8,192 steps and their 80K frames before learning 20,000.
+HESSEL = {
+    "learning_rate": 0.0000625, "adam_epsilon": 0.00015, "gamma": 0.99, "atoms": 51, "n_step": 3,
+    "noisy": True, "noisy_sigma0": 0.5, "dueling": True, "priority_alpha": 0.5,
+    "priority_beta": 0.4,  # its initial value: the paper keeps it there (no schedules)
+    "minibatch": 32, "target_update": 32_768 // 4, "learning_starts": 80_000 // 4, "update_every": 4,
+    "frame_size": 84, "frame_stack": 4, "grayscale": True, "network": "nature_cnn",
+}  # fmt: skip
+#: "Gotta Learn Fast"'s changes: V_max 200 (V_min its mirror, as the paper's code has it), a replay of 0.5M,
+#: and the max-x reward unscaled.
+PAPER_CHANGES = {"v_min": -200.0, "v_max": 200.0, "replay": 500_000, "reward_scale": 1.0}
+TINY = {"frame_size": 36, "minibatch": 8, "learning_starts": 16, "target_update": 16, "replay": 1000, "train_envs": 2}
+
+
+def test_paper_config_is_hessels_with_the_papers_changes() -> None:
+    values = load_config("rainbow").values
+    assert load_config("rainbow").name == "paper"
+    assert {key: values[key] for key in HESSEL} == HESSEL
+    assert {key: values[key] for key in PAPER_CHANGES} == PAPER_CHANGES
+
+
+def test_quick_config_says_why_it_changes_each_key() -> None:
+    """Every key quick.yaml changes from paper.yaml is named in the comment above it (or above its group)."""
+    paper, quick = load_config("rainbow", "paper").values, load_config("rainbow", "quick").values
+    changed = [key for key in paper if paper[key] != quick[key]]
+    assert changed, "quick.yaml should differ from paper.yaml"
+    lines = (CONFIG_DIR / "rainbow" / "quick.yaml").read_text().splitlines()
+    for key in changed:
+        at = next(i for i, line in enumerate(lines) if line.startswith(f"{key}:"))
+        comments = []
+        for line in reversed(lines[:at]):
+            if line.split(":")[0] in changed and not comments:
+                continue  # keys changed together share the comment above them
+            if not line.startswith("#"):
+                break
+            comments.append(line)
+        words = key.replace("_", " ")
+        assert any(key in c or words in c.lower() for c in comments), f"quick.yaml changes {key} without a comment"
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    ({"v_min": 300.0}, "v_min (300) must be below v_max (200)"),
+    ({"atoms": 1}, "atoms in the rainbow config"),
+    ({"noisy": "yes"}, "must be bool"),
+    ({"replay_size": 10}, "Did you mean 'replay'"),
+], ids=["empty-support", "one-atom", "noisy-not-bool", "typo"])
+def test_a_wrong_config_is_one_line(tmp_path, change, message) -> None:
+    values = {**load_config("rainbow").values, **change}
+    if "replay_size" in change:
+        del values["replay"]
+    path = tmp_path / "mine.yaml"
+    path.write_text(yaml.safe_dump(values))
+    with pytest.raises(AgentConfigError) as caught:
+        load_config("rainbow", path)
+    assert message in str(caught.value) and "\n" not in str(caught.value)
+
+
+# --- with Tianshou and torch ---------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def tianshou():
+    return pytest.importorskip(
+        "tianshou",
+        reason="needs Tianshou and torch's CPU build: pip install torch --index-url "
+        "https://download.pytorch.org/whl/cpu && pip install 'retrokit-rl[train]'",
+    )
+
+
+def test_network_replay_and_updates_are_the_papers(tianshou) -> None:
+    import torch
+    from tianshou.utils.net.discrete import NoisyLinear
+
+    from retrokit.learning.rainbow import build, replay
+
+    config = load_config("rainbow").values
+    learner = build(config, (4, 84, 84), 7)
+    convs = [m for m in learner.network.modules() if isinstance(m, torch.nn.Conv2d)]
+    assert [(c.in_channels, c.out_channels, c.kernel_size[0], c.stride[0]) for c in convs] == [
+        (4, 32, 8, 4), (64 // 2, 64, 4, 2), (64, 64, 3, 1)]  # Mnih et al.'s CNN
+    noisy = [m for m in learner.network.modules() if isinstance(m, NoisyLinear)]
+    # dueling: an advantage head (7 actions x 51 atoms) and a value head (51 atoms), each 512 noisy units wide
+    assert sorted((m.in_features, m.out_features) for m in noisy) == sorted(
+        [(3136, 512), (512, 7 * 51), (3136, 512), (512, 51)])
+    assert {m.sigma for m in noisy} == {0.5}
+    support = learner.policy.support
+    assert len(support) == 51 and support[0] == -200 and support[-1] == 200
+    algorithm = learner.algorithm
+    assert algorithm.n_step == 3 and algorithm.gamma == 0.99
+    assert algorithm.target_update_freq == 8192 // 4  # Tianshou counts updates: one per 4 steps
+    adam = algorithm.optim._optim  # the torch optimizer Tianshou wraps
+    assert isinstance(adam, torch.optim.Adam)
+    assert adam.defaults["lr"] == 0.0000625 and adam.defaults["eps"] == 0.00015
+    buffer = replay({**config, "replay": 64}, 1)
+    assert buffer.maxsize == 64 and buffer.stack_num == 4
+    assert buffer.options["alpha"] == 0.5 and buffer.options["beta"] == 0.4
+    # the paper's replay holds 500,000 frames of 84 x 84 bytes: 3.5 GB, once each (not 4 stacked, nor next obs)
+    assert buffer.options["ignore_obs_next"] and buffer.options["save_only_last_obs"]
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory) -> Path:
+    return tmp_path_factory.mktemp("rainbow")
+
+
+@pytest.fixture(scope="module")
+def tiny(tianshou, folder) -> Path:
+    path = folder / "tiny.yaml"
+    path.write_text(yaml.safe_dump({**load_config("rainbow", "quick").values, **TINY}))
+    return path
+
+
+@pytest.fixture(scope="module")
+def trained(folder, tiny) -> Path:
+    """`retrokit train --agent rainbow` on Dasher's training levels: 2 envs, each drawing a level per episode."""
+    out = folder / "joint"
+    done = retrokit_in_process(folder, "train", "--agent", "rainbow", "--agent-config", str(tiny),
+                               "--timesteps", "64", "--checkpoint-every", "0", "--no-progress", "--out", str(out))
+    assert done.returncode == 0, done.stderr
+    assert "trained rainbow for 64 timesteps" in done.stdout
+    return out
+
+
+def test_train_writes_a_policy_evaluate_reads(trained) -> None:
+    from retrokit.learning.policy import read_policy
+
+    policy = read_policy(trained, "rainbow")
+    assert policy.meta["timesteps"] == 64 and policy.meta["library"].startswith("tianshou ")
+    assert policy.meta["observation"]["shape"] == [4, 36, 36] and policy.meta["observation"]["dtype"] == "uint8"
+    assert policy.meta["actions"][-1] == ["B"] and policy.meta["x"] == "p1_x"
+    run = json.loads((trained / "run.json").read_text())
+    assert run["checkpoint"]["timesteps"] == 64 and set(run["checkpoint"]) >= {"weights", "state"}
+    with pytest.raises(Exception, match="rainbow|ppo"):
+        read_policy(trained, "ppo")  # another agent's policy is refused
+
+
+def test_an_interrupted_train_resumes_from_its_checkpoint(folder, tiny, monkeypatch) -> None:
+    """Interrupted after its checkpoint at 40 timesteps (collections of 2 envs x 4 steps), it goes on from there."""
+    from retrokit.learning.trainrun import TrainRun
+
+    out = folder / "resumed"
+    args = ("train", "--agent", "rainbow", "--agent-config", str(tiny), "--timesteps", "96", "--checkpoint-every",
+            "0", "--no-progress", "--out", str(out))
+    seen: list[int] = []
+    interrupted: list[int] = []
+    updated = TrainRun.updated
+
+    def interrupt_at_48(self, timesteps):
+        seen.append(timesteps)
+        if timesteps == 48 and not interrupted:
+            interrupted.append(timesteps)
+            raise KeyboardInterrupt
+        return updated(self, timesteps)
+
+    monkeypatch.setattr(TrainRun, "updated", interrupt_at_48)
+    first = retrokit_in_process(folder, *args)
+    assert first.returncode == 130 and "add --resume" in first.stderr, first.stderr
+    assert json.loads((out / "run.json").read_text())["checkpoint"]["timesteps"] == 40
+    seen.clear()
+    done = retrokit_in_process(folder, *args, "--resume")
+    assert done.returncode == 0, done.stderr
+    assert seen[0] == 48  # the first collection after the checkpoint
+    assert json.loads((out / "run.json").read_text())["checkpoint"]["timesteps"] == 96
+
+
+def _evaluate(folder: Path, out: str, *args: str):
+    return retrokit_in_process(folder, "evaluate", "--agent", "rainbow", "--levels", "Zone1.Act2", "--timesteps", "40",
+                               "--workers", "1", "--no-progress", "--out", str(folder / out), *args)
+
+
+def test_evaluate_learns_from_scratch_and_from_the_trained_policy(folder, tiny, trained) -> None:
+    for out, args in (("scratch", ()), ("from-folder", ("--init", str(trained))),
+                      ("zero-shot", ("--init", str(trained / "policy.json"), "--no-learn"))):
+        done = _evaluate(folder, out, "--agent-config", str(tiny), *args)
+        assert done.returncode == 0, done.stderr
+        run = json.loads((folder / out / "run.json").read_text())
+        assert run["finished"]["Dasher-Genesis/Zone1.Act2"]["timesteps"] == 40
+        setup = run["settings"]["agent_setup"]
+        assert setup["config"]["values"]["minibatch"] == 8 and setup["learn"] == (out != "zero-shot")
+        assert (setup["init"] is None) == (out == "scratch")
+
+
+def test_learning_updates_during_the_budget_and_zero_shot_never(folder, tiny, trained, monkeypatch) -> None:
+    """Played in this process, updates counted: one per 4 steps once 16 transitions are in; none zero-shot."""
+    from tianshou.algorithm.modelfree.rainbow import RainbowDQN
+
+    from retrokit.benchmark.definition import load_benchmark
+    from retrokit.benchmark.level import LevelDone, LevelTask, run_level
+    from retrokit.learning.setup import prepare
+
+    updates = []
+    update = RainbowDQN.update
+    monkeypatch.setattr(RainbowDQN, "update", lambda self, **kw: updates.append(1) or update(self, **kw))
+    benchmark = load_benchmark("dasher")
+    for learn in (True, False):
+        updates.clear()
+        setup = prepare("rainbow", benchmark, tiny, trained, learn=learn)
+        messages = []
+        run_level(LevelTask(benchmark, benchmark.test[0], "rainbow", 40, 0, False, setup), messages.append)
+        assert isinstance(messages[-1], LevelDone), messages[-1]
+        # 40 steps in collections of 4: an update after each that ends at 16, 20, ..., 40 (the 41st step ends it)
+        assert len(updates) == (7 if learn else 0)

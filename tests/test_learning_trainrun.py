@@ -61,7 +61,7 @@ def test_a_new_run_never_takes_a_used_folder_and_resume_needs_one(saved, tmp_pat
 def test_a_folder_in_use_is_refused(saved, training) -> None:
     first = TrainRun(saved, training, resume=True, progress=False)
     try:
-        with pytest.raises(RunFolderError, match="Expected no other training run running in .*, but one is"):
+        with pytest.raises(RunFolderError, match="Expected no other training run running in the folder .*; found one there"):
             TrainRun(saved, training, resume=True, progress=False)
     finally:
         first.close()

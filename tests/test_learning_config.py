@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib.util
 import os
 from pathlib import Path
 
@@ -105,3 +106,17 @@ def test_unknown_names_suggest() -> None:
         load_config("ppp")
     with pytest.raises(AgentConfigError, match="Expected an agent config"):
         load_config("ppo", "missing/config.yaml")
+
+
+@pytest.mark.skipif(importlib.util.find_spec("stable_baselines3") is not None,
+                    reason="Stable-Baselines3 is installed here: the refusal is for machines without it")
+def test_without_the_library_ppo_says_how_to_install_it(tmp_path, capsys) -> None:
+    from retrokit.cli import main
+
+    for argv in (["evaluate", "--agent", "ppo", "--out", str(tmp_path / "e")],
+                 ["train", "--timesteps", "10", "--out", str(tmp_path / "t")]):
+        assert main([*argv, "--no-progress"]) == 2
+        err = capsys.readouterr().err
+        assert "download.pytorch.org/whl/cpu`, then `pip install 'retrokit-rl[train]'" in err
+        assert len(err.strip().splitlines()) == 1
+    assert not any(tmp_path.iterdir())  # refused before anything was made

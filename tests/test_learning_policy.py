@@ -72,7 +72,8 @@ def test_bad_policy_files_are_one_line(saved, damage, message) -> None:
     (lambda s: s.weights_path.write_bytes(b"weights-v2"), "its size or digest differs"),
     (lambda s: s.weights_path.unlink(), "No such file"),
     (lambda s: (s.weights_path.unlink(), s.weights_path.symlink_to("/dev/zero")), "a device"),
-], ids=["changed", "missing", "dev-zero"])
+    (lambda s: os.truncate(s.weights_path, (64 << 20) + 1), "of at most 64 MiB"),
+], ids=["changed", "missing", "dev-zero", "huge"])
 def test_weights_that_are_not_the_named_ones_are_refused(saved, damage, message) -> None:
     damage(saved)
     with pytest.raises(PolicyFileError, match=message):

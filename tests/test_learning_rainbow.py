@@ -201,8 +201,9 @@ def test_an_interrupted_train_resumes_from_its_checkpoint(folder, tiny, monkeypa
 def test_evaluate_learns_from_scratch_and_from_the_trained_policy(folder, tiny, trained) -> None:
     from retrokit.learning.policy import read_policy
 
-    for setup in evaluate_three_ways(folder, "rainbow", 40, tiny, trained).values():
+    for out, setup in evaluate_three_ways(folder, "rainbow", 40, tiny, trained).items():
         assert setup["config"]["values"]["minibatch"] == 8
+        assert setup["paper_agent"] == {"scratch": "Rainbow", "from-folder": "Joint Rainbow", "zero-shot": None}[out]
         if setup["init"]:
             assert setup["init"]["weights_sha256"] == read_policy(trained).sha256
 

@@ -13,7 +13,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from retrokit.commands._common import add_evaluation_options
+from retrokit.commands._common import add_evaluation_options, add_learning_options
 
 AGENT_NOTE = """\
 An agent is random, jerk, ppo, rainbow, or MODULE:CALLABLE (an importable module or a .py file), a callable
@@ -57,10 +57,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--benchmark", default="dasher", help="sonic, dasher, or another cartridge's benchmark (hopper-nes, hopper-sms, hopper-gg, trekker, trekker-color, skipper-pce, skipper-snes: tools/cartridges.yaml), or a benchmark YAML file (default: dasher)")
     parser.add_argument("--agent", action="append", default=None, metavar="AGENT",
                         help="random, jerk, ppo, rainbow, or MODULE:CALLABLE; repeat it to compare agents (default: jerk)")
-    parser.add_argument("--agent-config", default=None, metavar="NAME|FILE",
-                        help="a learning agent's config: paper (the default), quick, or a YAML file (a changed copy)")
-    parser.add_argument("--init", default=None, metavar="PATH",
-                        help="start a learning agent from a trained policy: a `retrokit train` folder or its policy.json")
+    add_learning_options(parser)
     parser.add_argument("--no-learn", action="store_true",
                         help="play the --init policy without learning (its zero-shot score, the paper's Figure 4)")
     add_evaluation_options(parser, "processes (or Ray CPUs) sharing the levels (default: up to 2)")

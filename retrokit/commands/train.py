@@ -12,6 +12,8 @@ import argparse
 import sys
 from pathlib import Path
 
+from retrokit.commands._common import add_learning_options
+
 EXAMPLES = [
     "retrokit train --benchmark dasher --agent ppo --agent-config quick --timesteps 200000 --out runs/joint",
     "retrokit train --benchmark dasher --agent ppo --timesteps 200000 --out runs/joint --resume   # after a kill",
@@ -34,10 +36,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--benchmark", default="dasher", help="sonic, dasher, another cartridge's, or a YAML file (default: dasher)")
     parser.add_argument("--agent", default="ppo", help="the learning agent: ppo or rainbow (default: ppo)")
-    parser.add_argument("--agent-config", default=None, metavar="NAME|FILE", help="paper (the default), quick, or a YAML file")
+    add_learning_options(parser)
     parser.add_argument("--timesteps", type=int, required=True, help="timesteps to train for, over all levels")
     parser.add_argument("--levels", default="train", help="train (the default), test, all, or LEVEL,...")
-    parser.add_argument("--init", default=None, metavar="PATH", help="start from a trained policy (a train folder or its policy.json)")
     parser.add_argument("--seed", type=int, default=0, help="the run's seed (default: 0)")
     parser.add_argument("--out", type=Path, required=True, metavar="DIR", help="the run folder")
     parser.add_argument("--resume", action="store_true", help="continue the killed run in --out from its last checkpoint")

@@ -12,6 +12,7 @@ ones the stable-retro wheel ships.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 import gymnasium
@@ -132,7 +133,7 @@ class AllowBacktracking(gymnasium.Wrapper):
         return obs, self._progress.advance(now), terminated, truncated, info
 
 
-def progress_of(info: dict[str, Any], x: str | None) -> float:
+def progress_of(info: Mapping[str, Any], x: str | None) -> float:
     """The field ``x`` of a step's ``info`` (0.0 without ``x``: progress is then the reward so far).
 
     Raises:

@@ -45,9 +45,19 @@ class LearnerSetup:
     init_sha256: str | None = None
     learn: bool = True
 
+    @property
+    def paper_agent(self) -> str | None:
+        """The paper's name for this play of the agent: ``PPO`` from scratch, ``Joint PPO`` from a trained policy
+        (the reports set it beside that row); ``None`` for a zero-shot play, which the paper's tables lack."""
+        if not self.learn:
+            return None
+        name = self.agent.upper() if self.agent == "ppo" else self.agent.capitalize()
+        return name if self.init is None else f"Joint {name}"
+
     def settings(self) -> dict[str, Any]:
         """What determines the agent's play, for ``run.json`` (``--resume`` requires the same)."""
         return {
+            "paper_agent": self.paper_agent,
             "config": self.config.as_dict(),
             "task": self.task.as_dict(),
             "init": None if self.init is None else {"policy": self.init, "weights_sha256": self.init_sha256},

@@ -88,7 +88,7 @@ class TaskView:
 
     def start(self, index: int, info: Mapping[str, Any]) -> None:
         """An episode of env ``index`` began, with ``info`` from its reset."""
-        self._progress[index].start(progress_of(dict(info), self.task.x))
+        self._progress[index].start(progress_of(info, self.task.x))
         self._returns[index], self._steps[index] = 0.0, 0
 
     def rewards(self, rewards: Sequence[float], infos: Sequence[Mapping[str, Any]], dones: Sequence[bool]) -> np.ndarray:
@@ -99,7 +99,7 @@ class TaskView:
             self._returns[i] += reward
             self._steps[i] += 1
             tracker = self._progress[i]
-            now = tracker.current + reward if self.task.x is None else progress_of(dict(infos[i]), self.task.x)
+            now = tracker.current + reward if self.task.x is None else progress_of(infos[i], self.task.x)
             out[i] = tracker.advance(now) * self.scale
             if dones[i] and self.on_episode is not None:
                 self.on_episode(i, float(self._returns[i]), int(self._steps[i]))

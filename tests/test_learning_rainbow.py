@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 import yaml
 from incli import retrokit_in_process
+from learningruns import evaluate_three_ways
 
 from retrokit.errors import AgentConfigError
 from retrokit.learning.config import CONFIG_DIR, load_config
@@ -29,6 +30,9 @@ HESSEL = {
 #: "Gotta Learn Fast"'s changes: V_max 200 (V_min its mirror, as the paper's code has it), a replay of 0.5M,
 #: and the max-x reward unscaled.
 PAPER_CHANGES = {"v_min": -200.0, "v_max": 200.0, "replay": 500_000, "reward_scale": 1.0}
+#: Each evaluation's worker imports torch and Tianshou (tens of CPU-seconds on a shared 2-core machine), and
+#: the Ray test starts a Ray: more than the suite's 300 s on a busy machine, never a hang.
+pytestmark = pytest.mark.timeout(900)
 TINY = {"frame_size": 36, "minibatch": 8, "learning_starts": 16, "target_update": 16, "replay": 1000, "train_envs": 2}
 
 
@@ -91,7 +95,7 @@ def test_network_replay_and_updates_are_the_papers(tianshou) -> None:
     import torch
     from tianshou.utils.net.discrete import NoisyLinear
 
-    from retrokit.learning.rainbow import build, replay
+    from retrokit.learning.rainbow import build, replay, replay_bytes
 
     config = load_config("rainbow").values
     learner = build(config, (4, 84, 84), 7)
@@ -116,6 +120,17 @@ def test_network_replay_and_updates_are_the_papers(tianshou) -> None:
     assert buffer.options["alpha"] == 0.5 and buffer.options["beta"] == 0.4
     # the paper's replay holds 500,000 frames of 84 x 84 bytes: 3.5 GB, once each (not 4 stacked, nor next obs)
     assert buffer.options["ignore_obs_next"] and buffer.options["save_only_last_obs"]
+    assert 3.5e9 < replay_bytes(config, 500_000) < 3.6e9
+
+
+def test_a_replay_that_would_not_fit_is_refused_before_play(tianshou, monkeypatch) -> None:
+    import retrokit.envs.memory
+    from retrokit.errors import InvalidArgumentError
+    from retrokit.learning.rainbow import replay
+
+    monkeypatch.setattr(retrokit.envs.memory, "available_memory", lambda: 2 << 30)
+    with pytest.raises(InvalidArgumentError, match=r"replay of 500,000 transitions .* 3.3 GiB, and 2.0 GiB"):
+        replay(load_config("rainbow").values, 1)
 
 
 @pytest.fixture(scope="module")
@@ -183,21 +198,14 @@ def test_an_interrupted_train_resumes_from_its_checkpoint(folder, tiny, monkeypa
     assert json.loads((out / "run.json").read_text())["checkpoint"]["timesteps"] == 96
 
 
-def _evaluate(folder: Path, out: str, *args: str):
-    return retrokit_in_process(folder, "evaluate", "--agent", "rainbow", "--levels", "Zone1.Act2", "--timesteps", "40",
-                               "--workers", "1", "--no-progress", "--out", str(folder / out), *args)
-
-
 def test_evaluate_learns_from_scratch_and_from_the_trained_policy(folder, tiny, trained) -> None:
-    for out, args in (("scratch", ()), ("from-folder", ("--init", str(trained))),
-                      ("zero-shot", ("--init", str(trained / "policy.json"), "--no-learn"))):
-        done = _evaluate(folder, out, "--agent-config", str(tiny), *args)
-        assert done.returncode == 0, done.stderr
-        run = json.loads((folder / out / "run.json").read_text())
-        assert run["finished"]["Dasher-Genesis/Zone1.Act2"]["timesteps"] == 40
-        setup = run["settings"]["agent_setup"]
-        assert setup["config"]["values"]["minibatch"] == 8 and setup["learn"] == (out != "zero-shot")
-        assert (setup["init"] is None) == (out == "scratch")
+    from retrokit.learning.policy import read_policy
+
+    for out, setup in evaluate_three_ways(folder, "rainbow", 40, tiny, trained).items():
+        assert setup["config"]["values"]["minibatch"] == 8
+        assert setup["paper_agent"] == {"scratch": "Rainbow", "from-folder": "Joint Rainbow", "zero-shot": None}[out]
+        if setup["init"]:
+            assert setup["init"]["weights_sha256"] == read_policy(trained).sha256
 
 
 def test_learning_updates_during_the_budget_and_zero_shot_never(folder, tiny, trained, monkeypatch) -> None:
@@ -220,3 +228,31 @@ def test_learning_updates_during_the_budget_and_zero_shot_never(folder, tiny, tr
         assert isinstance(messages[-1], LevelDone), messages[-1]
         # 40 steps in collections of 4: an update after each that ends at 16, 20, ..., 40 (the 41st step ends it)
         assert len(updates) == (7 if learn else 0)
+
+
+def test_a_start_policy_of_another_network_fails_its_level_in_one_line(folder, tiny, trained) -> None:
+    """Weights of 51 atoms into a config of 21: refused by names and shapes, before any step."""
+    from retrokit.benchmark.definition import load_benchmark
+    from retrokit.benchmark.level import LevelFailed, LevelTask, run_level
+    from retrokit.learning.setup import prepare
+
+    other = folder / "atoms21.yaml"
+    other.write_text(yaml.safe_dump({**yaml.safe_load(tiny.read_text()), "atoms": 21}))
+    benchmark = load_benchmark("dasher")
+    messages = []
+    setup = prepare("rainbow", benchmark, other, trained)
+    run_level(LevelTask(benchmark, benchmark.test[0], "rainbow", 40, 0, False, setup), messages.append)
+    assert isinstance(messages[-1], LevelFailed) and messages[-1].timesteps == 0
+    assert "names or shapes differ" in messages[-1].error and "\n" not in messages[-1].error
+
+
+def test_evaluate_learns_on_a_local_ray(folder, tiny) -> None:
+    """`--backend ray`: the level is a Ray task on a local 1-CPU Ray, and Rainbow learns inside it as locally."""
+    pytest.importorskip("ray", reason="needs Ray: pip install 'retrokit-rl[ray]'")
+    from learningruns import evaluate
+
+    done = evaluate(folder, "rainbow", 40, "on-ray", "--agent-config", str(tiny), "--backend", "ray")
+    assert done.returncode == 0, done.stderr
+    run = json.loads((folder / "on-ray" / "run.json").read_text())
+    assert run["finished"]["Dasher-Genesis/Zone1.Act2"]["timesteps"] == 40
+    assert run["settings"]["agent_setup"]["learn"] is True

@@ -33,8 +33,8 @@ from typing import TYPE_CHECKING, Any
 import gymnasium
 import numpy as np
 
-from retrokit.errors import MissingExtraError, PolicyFileError, install_extra
-from retrokit.learning.algorithms import Key
+from retrokit.errors import InvalidArgumentError
+from retrokit.learning.algorithms import Key, require_libraries
 from retrokit.learning.task import TaskView, image_options
 
 if TYPE_CHECKING:
@@ -46,6 +46,8 @@ LIBRARY = "tianshou"
 MAX_REPLAY = 10_000_000  # 70 GB of 84x84 frames: more is a typo
 #: Transitions a zero-shot run keeps (it never samples them).
 ZERO_SHOT_REPLAY = 1000
+#: A transition's bytes besides its frame: action, reward, flags, index, priority (Tianshou 2.0: about 54).
+TRANSITION_EXTRA_BYTES = 64
 
 #: The keys of a Rainbow config: its type, range and meaning (the loader checks every config against it).
 KEYS: dict[str, Key] = {
@@ -82,22 +84,13 @@ def check_values(values: Mapping[str, Any]) -> str | None:
     return None
 
 
-def observation_options(config: Mapping[str, Any]) -> dict[str, Any]:
-    """The native preprocessing options of the config's frames."""
-    return image_options(config)
+#: The native preprocessing options of the config's frames (PPO's: the same frames).
+observation_options = image_options
 
 
 def require() -> None:
     """Raise :class:`~retrokit.errors.MissingExtraError` unless Tianshou and torch are installed."""
-    try:
-        import tianshou  # noqa: F401
-        import torch  # noqa: F401
-    except ImportError as exc:
-        raise MissingExtraError(
-            f"Expected Tianshou and torch for --agent rainbow, but importing them failed ({exc}). Install "
-            "torch's CPU build with `pip install torch --index-url https://download.pytorch.org/whl/cpu`, then "
-            f"`{install_extra('train')}`."
-        ) from None
+    require_libraries("rainbow", {"tianshou": "Tianshou", "torch": "torch"})
 
 
 def library() -> str:
@@ -124,15 +117,18 @@ class TaskEnv(gymnasium.Wrapper):
         self.view = TaskView(env, task, reward_scale, 1, ended)
         self.action_space = self.view.action_space
 
+    # The infos (every RAM field) are read here and not passed on: the replay would keep them, 8 bytes a field
+    # a transition (Dasher's fields would add 6% to the frames).
+
     def reset(self, **kwargs: Any):
         obs, info = self.env.reset(**kwargs)
         self.view.start(0, info)
-        return obs, info
+        return obs, {}
 
     def step(self, action: Any):
         obs, reward, terminated, truncated, info = self.env.step(self.view.buttons(np.asarray([action]))[0])
         learned = self.view.rewards([reward], [info], [terminated or truncated])[0]
-        return obs, float(learned), terminated, truncated, info
+        return obs, float(learned), terminated, truncated, {}
 
 
 @dataclass
@@ -195,12 +191,34 @@ def _draw_noise(network: Any) -> None:  # a torch.nn.Module
             layer.sample()
 
 
+def replay_bytes(config: Mapping[str, Any], size: int) -> int:
+    """What a replay of ``size`` transitions takes: its frames (one a transition when stacked) and the rest."""
+    side = config["frame_size"]
+    frame = side * side * (1 if config["grayscale"] else 3)
+    stacked = config["grayscale"] and config["frame_stack"] > 1
+    return size * (frame * (1 if stacked else config["frame_stack"]) + TRANSITION_EXTRA_BYTES)
+
+
 def replay(config: Mapping[str, Any], envs: int, size: int | None = None) -> Any:  # a tianshou buffer
-    """The prioritized replay: each gray frame stored once, as bytes, the stacks rebuilt when sampled."""
+    """The prioritized replay: each gray frame stored once, as bytes, the stacks rebuilt when sampled.
+
+    Raises:
+        InvalidArgumentError: It would not fit in the memory available (it fills as the agent plays: refused
+            now, not killed by the system hours later).
+    """
     from tianshou.data import PrioritizedVectorReplayBuffer
+
+    from retrokit.envs.memory import available_memory
 
     stacked = config["grayscale"] and config["frame_stack"] > 1
     total = max(envs, size or config["replay"])
+    needed, room = replay_bytes(config, total), available_memory()
+    if room is not None and needed > room:
+        raise InvalidArgumentError(
+            f"Expected Rainbow's replay of {total:,} transitions to fit in memory: it takes {needed / 2**30:,.1f} "
+            f"GiB, and {max(room, 0) / 2**30:,.1f} GiB are available; use a config with a smaller replay "
+            "(quick.yaml keeps 100,000), or a machine with more memory."
+        )
     return PrioritizedVectorReplayBuffer(
         total, buffer_num=envs, ignore_obs_next=True, save_only_last_obs=stacked,
         stack_num=config["frame_stack"] if stacked else 1, alpha=config["priority_alpha"],
@@ -218,26 +236,14 @@ def weights_of(learner: Learner) -> bytes:
 
 
 def load_weights(learner: Learner, data: bytes, what: str) -> None:
-    """Load a network's weights: the same names and shapes only.
+    """Load a network's weights, the same names and shapes only; the target network starts as the online one.
 
     Raises:
         PolicyFileError: They are not tensors, or their names or shapes are not this network's.
     """
-    import torch
+    from retrokit.learning.ppo import load_into
 
-    from retrokit.learning.ppo import load_tensors
-
-    state = load_tensors(data, what)
-    ours = learner.network.state_dict()
-    if set(state) != set(ours) or any(
-        not isinstance(state[key], torch.Tensor) or state[key].shape != ours[key].shape for key in ours
-    ):
-        raise PolicyFileError(
-            f"Expected {what} to be the weights of this config's Rainbow network ({len(ours)} tensors), but their "
-            "names or shapes differ; it was saved from another network."
-        )
-    learner.network.load_state_dict(state)
-    learner.algorithm.model_old.load_state_dict(state)  # the target starts as the online network
+    learner.algorithm.model_old.load_state_dict(load_into(learner.network, data, what))
 
 
 def run_steps(learner: Learner, collector: Any, buffer: Any, config: Mapping[str, Any], envs: int, *,

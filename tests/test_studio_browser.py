@@ -144,7 +144,7 @@ def test_find_the_lives_with_the_search_and_add_the_field(page, studio):
     page.pause()
     page.reset("Zone1.Act1")
     page.click("search-new")
-    page.said("New search: 2,097,072 candidates.")
+    page.said("New search: 2,490,276 candidates.")
 
     def filter_(op: str, value: str = "") -> str:
         Select(page.el("search-op")).select_by_value(op)
@@ -153,7 +153,7 @@ def test_find_the_lives_with_the_search_and_add_the_field(page, studio):
         page.click("search-apply")
         return page.said(f"{op}")
 
-    assert filter_("equal", "3").startswith("equal 3: 2,097,072 -> ")
+    assert filter_("equal", "3").startswith("equal 3: 2,490,276 -> ")
     page.advance(150, Keys.ARROW_RIGHT)  # into the first pit: a life lost
     assert "decreased --than previous" in filter_("decreased")
     page.advance(130)  # the respawn: the lives stay put

@@ -13,6 +13,8 @@ thing and writes it back. See ``docs/ramsearch.md``::
     retrokit ramsearch poke ADDRESS VALUE [--type TYPE] [--session FILE]
     retrokit ramsearch screenshot FILE.png [--session FILE]
     retrokit ramsearch save NAME ADDRESS TYPE [--range LO HI] [--game-file PATH] [--session FILE]
+    retrokit ramsearch find NAME --changes SCRIPT --keeps SCRIPT [--kind increases|decreases|changes|becomes N]
+                            [--save [--range LO HI] [--game-file PATH] [--force]] [--rounds N] [--session FILE]
     retrokit ramsearch savestate NAME [--default] [--force] [--session FILE]
     retrokit ramsearch movie FILE.bk2 [--force] [--session FILE]
     retrokit ramsearch shell [--session FILE]       # the others typed at a prompt, one a line
@@ -117,6 +119,27 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--range", nargs=2, metavar=("LO", "HI"), help="the values the field may hold, written as range: [LO, HI]"
     )
 
+    p = sub(
+        "find",
+        "find a field in one command: play a script that changes it and one that keeps it, in turn, filtering "
+        "after each, until one value is left; show it, and with --save write it into the game's game.yaml",
+        _find,
+    )
+    p.add_argument("name", metavar="NAME", help="the field's name, e.g. lives")
+    p.add_argument("--changes", required=True, metavar="SCRIPT", help=f"play that changes the field: {SYNTAX}")
+    p.add_argument("--keeps", required=True, metavar="SCRIPT", help="play that leaves it as it is, e.g. '_*60'")
+    p.add_argument(
+        "--kind", nargs="+", default=["changes"], metavar="KIND",
+        help="how --changes changes it: increases, decreases, changes (the default) or becomes N",
+    )
+    p.add_argument("--rounds", default="10", metavar="N", help="play both scripts at most N times (1 to 10; default 10)")
+    p.add_argument("--save", action="store_true", help="write the field found into the game's game.yaml")
+    p.add_argument(
+        "--range", nargs=2, metavar=("LO", "HI"), help="with --save: the values the field may hold, as range: [LO, HI]"
+    )
+    p.add_argument("--game-file", metavar="PATH", help="with --save: the game.yaml to write (default: the game's own)")
+    p.add_argument("--force", action="store_true", help="with --save: replace a field of the same name")
+
     p = sub("savestate", "save the game's state now as a state of the game, in the data folder", _savestate)
     p.add_argument("name", metavar="NAME", help="the state's name, e.g. Level1")
     p.add_argument("--default", action="store_true", help="make it the state make(game) starts from")
@@ -129,8 +152,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 SUBCOMMANDS = (
-    "new", "run", "filter", "show", "history", "undo", "redo", "poke", "screenshot", "save", "savestate", "movie",
-    "shell",
+    "new", "run", "filter", "show", "history", "undo", "redo", "poke", "screenshot", "save", "find", "savestate",
+    "movie", "shell",
 )  # fmt: skip
 
 
@@ -246,6 +269,16 @@ def _rows(search: RamSearch, groups: list[list[Candidate]]) -> list[list[str]]:
     return rows
 
 
+def _print_groups(search: RamSearch, groups: list[list[Candidate]]) -> None:
+    """The table ``show`` prints: a header, then a row per group, its values at the newest snapshots."""
+    first = max(0, len(search.labels) - _VALUES_SHOWN)
+    header = ["address", "type", "scale", "changes", f"values at snapshots {first}-{len(search.labels) - 1}"]
+    rows = [header, *_rows(search, groups)]
+    widths = [max(len(r[i]) for r in rows) for i in range(4)]
+    for row in rows:
+        print("  ".join(cell.ljust(width) for cell, width in zip(row[:4], widths)) + "  " + row[4])
+
+
 def _show(args: argparse.Namespace) -> int:
     from retrokit.ramsearch.candidates import check_listable, list_groups
 
@@ -271,12 +304,8 @@ def _show(args: argparse.Namespace) -> int:
         )
         if not shown:
             return 0
+        _print_groups(search, shown)
         first = max(0, len(search.labels) - _VALUES_SHOWN)
-        header = ["address", "type", "scale", "changes", f"values at snapshots {first}-{len(search.labels) - 1}"]
-        rows = [header, *_rows(search, shown)]
-        widths = [max(len(r[i]) for r in rows) for i in range(4)]
-        for row in rows:
-            print("  ".join(cell.ljust(width) for cell, width in zip(row[:4], widths)) + "  " + row[4])
         print("snapshots: " + "; ".join(f"{i} {label}" for i, label in enumerate(search.labels) if i >= first))
     return 0
 
@@ -367,14 +396,52 @@ def _shell(args: argparse.Namespace) -> int:
 
 
 def _save(args: argparse.Namespace) -> int:
-    address = _number(args.address, "ADDRESS")
-    value_range = None if args.range is None else tuple(_number(v, "--range") for v in args.range)
     with _open(args) as search:
-        path = search.save_field(
-            args.name, address, args.type, game_file=args.game_file, force=args.force, value_range=value_range
-        )
-        extra = "" if value_range is None else f", range [{value_range[0]}, {value_range[1]}]"
-        print(f"Wrote field {args.name} ({search.layout.format(address)}, {args.type}{extra}) into {path}.")
+        _save_field(args, search, _number(args.address, "ADDRESS"), args.type)
+    return 0
+
+
+def _save_field(args: argparse.Namespace, search: RamSearch, address: int, type_code: str) -> None:
+    """Write ``args.name`` at ``address`` as ``type_code`` (with ``--range``, ``--game-file``, ``--force``) and say so."""
+    value_range = None if args.range is None else tuple(_number(v, "--range") for v in args.range)
+    path = search.save_field(
+        args.name, address, type_code, game_file=args.game_file, force=args.force, value_range=value_range
+    )
+    extra = "" if value_range is None else f", range [{value_range[0]}, {value_range[1]}]"
+    print(f"Wrote field {args.name} ({search.layout.format(address)}, {type_code}{extra}) into {path}.")
+
+
+def _find(args: argparse.Namespace) -> int:
+    from retrokit.errors import RamSearchError
+    from retrokit.ramsearch.find import find_field
+
+    kind, *rest = args.kind
+    if len(rest) > 1:
+        raise InvalidArgumentError(f"Expected --kind KIND, or --kind becomes N; got --kind {' '.join(args.kind)}.")
+    value = _number(rest[0], "the number after becomes") if rest else None
+    if not args.save and (args.range is not None or args.game_file is not None or args.force):
+        raise InvalidArgumentError("Expected --range, --game-file and --force with --save; got them without it.")
+    rounds = _number(args.rounds, "--rounds")
+    with _open(args) as search:
+        before = search.count
+        try:
+            finding = find_field(
+                search, args.changes, args.keeps, kind, value, rounds=rounds, progress=lambda line: print(line, flush=True)
+            )
+        finally:
+            if search.count != before or len(search.labels) > 1:
+                search.save(_session(args))  # what was played and filtered stays in the session, found or not
+        if finding.groups:  # the find's own group, or the first groups left
+            _print_groups(search, finding.groups[:1] if finding.found else finding.groups)
+        found = finding.candidate
+        if found is None:
+            raise RamSearchError(
+                f"Expected one value left to call {args.name}; after {finding.rounds} round(s), {finding.reason} "
+                f"({finding.count:,} candidates). `retrokit ramsearch show` lists them, `history` the filters."
+            )
+        print(f"Found {args.name}: {search.layout.format(found.address)} {found.type} ({finding.reason}).")
+        if args.save:
+            _save_field(args, search, found.address, found.type)
     return 0
 
 
@@ -418,6 +485,8 @@ EXAMPLES = [
     "retrokit ramsearch screenshot poked.png",
     "retrokit ramsearch save lives 0xFF002B '|u1'",
     "retrokit ramsearch save lives 0xFF002B '|u1' --range 0 9",
+    "retrokit ramsearch find lives --changes 'RIGHT*200' --keeps '_*130' --kind decreases --save --range 0 9",
+    "retrokit ramsearch find score --changes '(RIGHT*10 A*2)*5' --keeps '_*30' --kind increases",
     "retrokit ramsearch savestate Level1 --default",
     "retrokit ramsearch movie level1.bk2",
     "retrokit ramsearch shell --session dasher.session",

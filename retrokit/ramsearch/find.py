@@ -26,7 +26,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from retrokit.data.script import parse_script
+from retrokit.data.script import parse_script, script_frames
 from retrokit.errors import InvalidArgumentError, did_you_mean, shown
 from retrokit.ramsearch.candidates import Candidate, group_candidates, list_groups
 from retrokit.ramsearch.filters import check_filter
@@ -53,6 +53,7 @@ class Finding:
         rounds: How many rounds were played.
         reason: Why it stopped, in words (one value left, none left, nothing narrowed, out of rounds).
         found: Whether one value is left: then the first group holds its narrowest reading first.
+        frames: How many frames the scripts played.
     """
 
     count: int
@@ -62,6 +63,7 @@ class Finding:
     reason: str = ""
 
     found: bool = False
+    frames: int = 0
 
     @property
     def candidate(self) -> Candidate | None:
@@ -113,8 +115,7 @@ def find_field(
     """
     op = check_kind(kind, value)
     check_filter(op, value)  # a number no filter takes is refused before anything plays
-    for script in (changes, keeps):
-        parse_script(script, search.buttons)
+    frames = {script: script_frames(parse_script(script, search.buttons)) for script in (changes, keeps)}
     if not isinstance(rounds, int) or not 1 <= rounds <= MAX_ROUNDS:
         raise InvalidArgumentError(f"Expected from 1 to {MAX_ROUNDS} rounds; got {shown(rounds)}.")
     finding = Finding(search.count)
@@ -122,6 +123,7 @@ def find_field(
         start = search.count
         for script, filter_op, filter_value in ((changes, op, value), (keeps, "unchanged", None)):
             search.run_script(script)
+            finding.frames += frames[script]
             before = search.count
             search.filter(filter_op, filter_value)
             finding.steps.append(f"{search.labels[-1]}; {search.history[-1]}: {before:,} -> {search.count:,} candidates")

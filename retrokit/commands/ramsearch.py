@@ -15,6 +15,7 @@ thing and writes it back. See ``docs/ramsearch.md``::
     retrokit ramsearch save NAME ADDRESS TYPE [--range LO HI] [--game-file PATH] [--session FILE]
     retrokit ramsearch find NAME --changes SCRIPT --keeps SCRIPT [--kind increases|decreases|changes|becomes N]
                             [--save [--range LO HI] [--game-file PATH] [--force]] [--rounds N] [--session FILE]
+    retrokit ramsearch suggest --at FRAME [--at FRAME ...] (--script SCRIPT | --movie FILE.bk2) [--window N] [--limit N]
     retrokit ramsearch savestate NAME [--default] [--force] [--session FILE]
     retrokit ramsearch movie FILE.bk2 [--force] [--session FILE]
     retrokit ramsearch shell [--session FILE]       # the others typed at a prompt, one a line
@@ -27,16 +28,19 @@ from __future__ import annotations
 
 import argparse
 import json
-from typing import TYPE_CHECKING
 
 from retrokit.commands._common import add_force_option
+from retrokit.commands._ramsearch_common import (
+    SESSION_HELP,
+    VALUES_SHOWN,
+    number,
+    open_search,
+    print_groups,
+    save_field_from,
+    session_path,
+)
+from retrokit.commands._ramsearch_loops import register_loops
 from retrokit.errors import InvalidArgumentError
-
-if TYPE_CHECKING:
-    from retrokit.ramsearch import Candidate, RamSearch
-
-_SESSION_HELP = "the session file (default: ramsearch.session in the current folder)"
-_VALUES_SHOWN = 8  # snapshots whose values `show` prints; older ones are elided
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -55,7 +59,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     def sub(name: str, help_text: str, run) -> argparse.ArgumentParser:
         p = commands.add_parser(name, help=help_text, description=help_text[0].upper() + help_text[1:] + ".")
-        p.add_argument("--session", metavar="FILE", default=None, help=_SESSION_HELP)
+        p.add_argument("--session", metavar="FILE", default=None, help=SESSION_HELP)
         p.set_defaults(run=run)
         return p
 
@@ -119,26 +123,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--range", nargs=2, metavar=("LO", "HI"), help="the values the field may hold, written as range: [LO, HI]"
     )
 
-    p = sub(
-        "find",
-        "find a field in one command: play a script that changes it and one that keeps it, in turn, filtering "
-        "after each, until one value is left; show it, and with --save write it into the game's game.yaml",
-        _find,
-    )
-    p.add_argument("name", metavar="NAME", help="the field's name, e.g. lives")
-    p.add_argument("--changes", required=True, metavar="SCRIPT", help=f"play that changes the field: {SYNTAX}")
-    p.add_argument("--keeps", required=True, metavar="SCRIPT", help="play that leaves it as it is, e.g. '_*60'")
-    p.add_argument(
-        "--kind", nargs="+", default=["changes"], metavar="KIND",
-        help="how --changes changes it: increases, decreases, changes (the default) or becomes N",
-    )
-    p.add_argument("--rounds", default="10", metavar="N", help="play both scripts at most N times (1 to 10; default 10)")
-    p.add_argument("--save", action="store_true", help="write the field found into the game's game.yaml")
-    p.add_argument(
-        "--range", nargs=2, metavar=("LO", "HI"), help="with --save: the values the field may hold, as range: [LO, HI]"
-    )
-    p.add_argument("--game-file", metavar="PATH", help="with --save: the game.yaml to write (default: the game's own)")
-    p.add_argument("--force", action="store_true", help="with --save: replace a field of the same name")
+    register_loops(sub)
 
     p = sub("savestate", "save the game's state now as a state of the game, in the data folder", _savestate)
     p.add_argument("name", metavar="NAME", help="the state's name, e.g. Level1")
@@ -152,8 +137,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 SUBCOMMANDS = (
-    "new", "run", "filter", "show", "history", "undo", "redo", "poke", "screenshot", "save", "find", "savestate",
-    "movie", "shell",
+    "new", "run", "filter", "show", "history", "undo", "redo", "poke", "screenshot", "save", "find", "suggest",
+    "savestate", "movie", "shell",
 )  # fmt: skip
 
 
@@ -164,32 +149,6 @@ def run(args: argparse.Namespace) -> int:
     )
 
 
-# --- helpers --------------------------------------------------------------------------------------
-
-
-def _number(text: str | None, what: str) -> int | None:
-    if text is None:
-        return None
-    try:
-        return int(text, 0)
-    except ValueError:
-        raise InvalidArgumentError(
-            f"Expected {what} as a whole number (decimal, or hex as 0xFF002B), got {text!r}."
-        ) from None
-
-
-def _session(args: argparse.Namespace) -> str:
-    from retrokit.ramsearch import DEFAULT_SESSION
-
-    return args.session or DEFAULT_SESSION
-
-
-def _open(args: argparse.Namespace) -> RamSearch:
-    from retrokit.ramsearch import RamSearch
-
-    return RamSearch.load(_session(args))
-
-
 # --- subcommands ----------------------------------------------------------------------------------
 
 
@@ -198,7 +157,7 @@ def _new(args: argparse.Namespace) -> int:
     from retrokit.ramsearch import RamSearch
     from retrokit.ramsearch.session import check_new_session
 
-    path = _session(args)
+    path = session_path(args)
     game = find_game(args.game)
     check_new_session(path, game.name, force=args.force)
     with RamSearch(game, args.state, types=args.types) as search:
@@ -211,7 +170,7 @@ def _new(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    frames, until = _number(args.frames, "--frames"), _number(args.until, "--until")
+    frames, until = number(args.frames, "--frames"), number(args.until, "--until")
     if args.movie is None and until is not None:
         raise InvalidArgumentError("Expected --until with --movie FILE.bk2; got --until alone.")
     if args.movie is not None and (args.press or frames is not None or args.state or args.script is not None):
@@ -223,14 +182,14 @@ def _run(args: argparse.Namespace) -> int:
             "Expected either --script or --press/--frames, not both: a script holds its own buttons, e.g. RIGHT*30."
         )
     snapshot = not args.no_snapshot
-    with _open(args) as search:
+    with open_search(args) as search:
         if args.movie is not None:
             index = search.play(args.movie, until, snapshot=snapshot)
         elif args.script is not None:
             index = search.run_script(args.script, state=args.state, snapshot=snapshot)
         else:
             index = search.run(args.press, 1 if frames is None else frames, state=args.state, snapshot=snapshot)
-        search.save(_session(args))
+        search.save(session_path(args))
         if index is None:
             frames_played = sum(count for count, _ in search.inputs)
             print(f"Moved on, no snapshot taken ({frames_played} frames played since the start state).")
@@ -246,46 +205,21 @@ def _filter(args: argparse.Namespace) -> int:
             than = int(than, 16)
         except ValueError:
             pass  # the engine names what --than takes, and the closest one
-    with _open(args) as search:
+    with open_search(args) as search:
         before = search.count
-        after = search.filter(args.op, _number(args.value, "VALUE"), than)
-        search.save(_session(args))
+        after = search.filter(args.op, number(args.value, "VALUE"), than)
+        search.save(session_path(args))
         print(f"{search.history[-1]}: {before:,} -> {after:,} candidates.")
     return 0
-
-
-def _rows(search: RamSearch, groups: list[list[Candidate]]) -> list[list[str]]:
-    """One row per group of candidates that read the same bytes the same way (the narrowest type first)."""
-    first = max(0, len(search.labels) - _VALUES_SHOWN)
-    rows = []
-    for group in groups:
-        head = group[0]
-        shown = ("... " if first else "") + " ".join(str(v) for v in head.values[first:])
-        others = [
-            c.type if c.address == head.address else f"{c.type}@{search.layout.format(c.address)}" for c in group[1:]
-        ]
-        also = f"  (also {' '.join(others)})" if others else ""
-        rows.append([search.layout.format(head.address), head.type, head.scale or "-", str(head.changes), shown + also])
-    return rows
-
-
-def _print_groups(search: RamSearch, groups: list[list[Candidate]]) -> None:
-    """The table ``show`` prints: a header, then a row per group, its values at the newest snapshots."""
-    first = max(0, len(search.labels) - _VALUES_SHOWN)
-    header = ["address", "type", "scale", "changes", f"values at snapshots {first}-{len(search.labels) - 1}"]
-    rows = [header, *_rows(search, groups)]
-    widths = [max(len(r[i]) for r in rows) for i in range(4)]
-    for row in rows:
-        print("  ".join(cell.ljust(width) for cell, width in zip(row[:4], widths)) + "  " + row[4])
 
 
 def _show(args: argparse.Namespace) -> int:
     from retrokit.ramsearch.candidates import check_listable, list_groups
 
-    limit = _number(args.limit, "--limit")
+    limit = number(args.limit, "--limit")
     if limit is None or limit < 0:
         raise InvalidArgumentError(f"Expected --limit of 0 (all) or more, got {args.limit!r}.")
-    with _open(args) as search:
+    with open_search(args) as search:
         if args.json:
             check_listable(search.count, limit)
             candidates = search.candidates(limit or None)
@@ -304,14 +238,14 @@ def _show(args: argparse.Namespace) -> int:
         )
         if not shown:
             return 0
-        _print_groups(search, shown)
-        first = max(0, len(search.labels) - _VALUES_SHOWN)
+        print_groups(search, shown)
+        first = max(0, len(search.labels) - VALUES_SHOWN)
         print("snapshots: " + "; ".join(f"{i} {label}" for i, label in enumerate(search.labels) if i >= first))
     return 0
 
 
 def _history(args: argparse.Namespace) -> int:
-    with _open(args) as search:
+    with open_search(args) as search:
         print(f"{len(search.labels)} snapshot{'s' * (len(search.labels) != 1)} (--than N compares with snapshot N):")
         for index, label in enumerate(search.labels):
             print(f"  {index}  {label}")
@@ -332,25 +266,25 @@ def _redo(args: argparse.Namespace) -> int:
 
 
 def _step_history(args: argparse.Namespace, *, redo: bool) -> int:
-    with _open(args) as search:
+    with open_search(args) as search:
         before = search.count
         label = search.redo() if redo else search.undo()
-        search.save(_session(args))
+        search.save(session_path(args))
         print(f"{'Redid' if redo else 'Undid'} {label}: {before:,} -> {search.count:,} candidates.")
     return 0
 
 
 def _poke(args: argparse.Namespace) -> int:
-    address, value = _number(args.address, "ADDRESS"), _number(args.value, "VALUE")
-    with _open(args) as search:
+    address, value = number(args.address, "ADDRESS"), number(args.value, "VALUE")
+    with open_search(args) as search:
         search.poke(address, value, args.type)
-        search.save(_session(args))
+        search.save(session_path(args))
         print(f"Wrote {value} as {args.type} at {search.layout.format(address)}; the next run starts from it.")
     return 0
 
 
 def _screenshot(args: argparse.Namespace) -> int:
-    with _open(args) as search:
+    with open_search(args) as search:
         path = search.screenshot(args.file, overwrite=args.force)
         height, width = search.emulator.screen_shape()
         print(f"Saved the screen ({width}x{height}) to {path}.")
@@ -396,57 +330,13 @@ def _shell(args: argparse.Namespace) -> int:
 
 
 def _save(args: argparse.Namespace) -> int:
-    with _open(args) as search:
-        _save_field(args, search, _number(args.address, "ADDRESS"), args.type)
-    return 0
-
-
-def _save_field(args: argparse.Namespace, search: RamSearch, address: int, type_code: str) -> None:
-    """Write ``args.name`` at ``address`` as ``type_code`` (with ``--range``, ``--game-file``, ``--force``) and say so."""
-    value_range = None if args.range is None else tuple(_number(v, "--range") for v in args.range)
-    path = search.save_field(
-        args.name, address, type_code, game_file=args.game_file, force=args.force, value_range=value_range
-    )
-    extra = "" if value_range is None else f", range [{value_range[0]}, {value_range[1]}]"
-    print(f"Wrote field {args.name} ({search.layout.format(address)}, {type_code}{extra}) into {path}.")
-
-
-def _find(args: argparse.Namespace) -> int:
-    from retrokit.errors import RamSearchError
-    from retrokit.ramsearch.find import find_field
-
-    kind, *rest = args.kind
-    if len(rest) > 1:
-        raise InvalidArgumentError(f"Expected --kind KIND, or --kind becomes N; got --kind {' '.join(args.kind)}.")
-    value = _number(rest[0], "the number after becomes") if rest else None
-    if not args.save and (args.range is not None or args.game_file is not None or args.force):
-        raise InvalidArgumentError("Expected --range, --game-file and --force with --save; got them without it.")
-    rounds = _number(args.rounds, "--rounds")
-    with _open(args) as search:
-        before = search.count
-        try:
-            finding = find_field(
-                search, args.changes, args.keeps, kind, value, rounds=rounds, progress=lambda line: print(line, flush=True)
-            )
-        finally:
-            if search.count != before or len(search.labels) > 1:
-                search.save(_session(args))  # what was played and filtered stays in the session, found or not
-        if finding.groups:  # the find's own group, or the first groups left
-            _print_groups(search, finding.groups[:1] if finding.found else finding.groups)
-        found = finding.candidate
-        if found is None:
-            raise RamSearchError(
-                f"Expected one value left to call {args.name}; after {finding.rounds} round(s), {finding.reason} "
-                f"({finding.count:,} candidates). `retrokit ramsearch show` lists them, `history` the filters."
-            )
-        print(f"Found {args.name}: {search.layout.format(found.address)} {found.type} ({finding.reason}).")
-        if args.save:
-            _save_field(args, search, found.address, found.type)
+    with open_search(args) as search:
+        save_field_from(args, search, number(args.address, "ADDRESS"), args.type)
     return 0
 
 
 def _savestate(args: argparse.Namespace) -> int:
-    with _open(args) as search:
+    with open_search(args) as search:
         outcome = search.save_state(args.name, default=args.default, force=args.force)
         done = {"made": "Saved", "replaced": "Replaced", "up to date": "Kept (already the same state)"}[outcome.status]
         print(f"{done} state {args.name} of {search.game.name}: {outcome.path}.")
@@ -456,7 +346,7 @@ def _savestate(args: argparse.Namespace) -> int:
 
 
 def _movie(args: argparse.Namespace) -> int:
-    with _open(args) as search:
+    with open_search(args) as search:
         path = search.write_movie(args.file, overwrite=args.force)
         frames = sum(count for count, _ in search.inputs)
         print(f"Wrote {frames} frames played since the start state to {path}.")
@@ -487,6 +377,8 @@ EXAMPLES = [
     "retrokit ramsearch save lives 0xFF002B '|u1' --range 0 9",
     "retrokit ramsearch find lives --changes 'RIGHT*200' --keeps '_*130' --kind decreases --save --range 0 9",
     "retrokit ramsearch find score --changes '(RIGHT*10 A*2)*5' --keeps '_*30' --kind increases",
+    "retrokit ramsearch suggest --script 'RIGHT*400' --at 133 --at 331   # bytes changing as the player dies",
+    "retrokit ramsearch suggest --movie level1.bk2 --at 1520 --window 0",
     "retrokit ramsearch savestate Level1 --default",
     "retrokit ramsearch movie level1.bk2",
     "retrokit ramsearch shell --session dasher.session",

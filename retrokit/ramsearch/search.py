@@ -285,6 +285,33 @@ class RamSearch(Keeping):
             self.emulator.run(held, step.frames)
             self._played(held, step.frames)
 
+    def ram_frames(self, script: str | None = None, movie: str | os.PathLike[str] | None = None) -> Iterator[np.ndarray]:
+        """The RAM now, then after each frame of a script, or of a movie from its start, played a frame at a time.
+
+        The script or movie is checked now, before anything plays; it plays as the iterator is advanced.
+
+        Raises:
+            InvalidArgumentError: Neither or both are given, or the script is malformed.
+            MovieError: The movie is malformed or of another game.
+        """
+        if (script is None) == (movie is None):
+            raise InvalidArgumentError("Expected a script or a movie to play, one of them; got " +
+                                       ("both." if script is not None else "neither."))  # fmt: skip
+        if movie is not None:
+            return (self.layout.read(self.emulator.space) for _ in self.replaying(movie)[1])
+        steps = parse_script(script, self.buttons)
+
+        def play() -> Iterator[np.ndarray]:
+            yield self.layout.read(self.emulator.space)
+            for step in steps:
+                masks = self.buttons(step.buttons)
+                for _ in range(step.frames):
+                    self.emulator.run(masks, 1)
+                    self._played(masks, 1)
+                    yield self.layout.read(self.emulator.space)
+
+        return play()
+
     def _snap(self, label: str, snapshot: bool) -> int | None:
         return self.snapshot(label) if snapshot else None
 

@@ -151,10 +151,13 @@ def _left(search: RamSearch, finding: Finding, reason: str) -> Finding:
 def _one_value(search: RamSearch, finding: Finding) -> bool:
     """Whether the candidates left are one value read several ways; if so, it is put into ``finding``.
 
-    The value is the narrowest reading left (the simplest type, then the lowest address). Another candidate
-    is the same value when it reads a byte of it, or of a copy, and changed at the same snapshots (the byte
-    read with the constant bytes around it: ``>u2`` over lives and the zero after them reads 768 for 3), or
-    when it is a copy: its values equal the value's at every snapshot (a HUD's digit, a C stack's copy).
+    The value is the simplest reading left: the narrowest type, then the values spanning least (``<u2`` over
+    a byte and the zero before it reads the byte times 256), then the type searched first, then the lowest
+    address. Another candidate is the same value when it is a copy of it (its values differ from the value's
+    by the same number at every snapshot: a HUD's digit, a C stack's copy, a sprite's position on a screen
+    that has not scrolled), or when it reads a byte of the value or of a copy and changed at the same
+    snapshots (the byte read with the constant bytes around it: ``>u2`` over lives and the zero after them
+    reads 768 for 3).
     """
     finding.count = search.count
     if not finding.count or finding.count > MAX_ALIASES:
@@ -162,20 +165,19 @@ def _one_value(search: RamSearch, finding: Finding) -> bool:
     candidates = search.candidates()
     order = {code: index for index, code in enumerate(search.types)}
     width = {c.type: search_type(c.type).width for c in candidates}
-    best = min(candidates, key=lambda c: (width[c.type], order[c.type], c.address))
-    copies = [c for c in candidates if c.values == best.values]
+    best = min(candidates, key=lambda c: (width[c.type], max(c.values) - min(c.values), order[c.type], c.address))
+    copies = [c for c in candidates if len({v - b for v, b in zip(c.values, best.values)}) == 1]
     bytes_of = {a for c in copies for a in range(c.address, c.address + width[c.type])}
     moves = _moves(best)
     if not all(
-        c.values == best.values
-        or _moves(c) == moves and not bytes_of.isdisjoint(range(c.address, c.address + width[c.type]))
+        c in copies or _moves(c) == moves and not bytes_of.isdisjoint(range(c.address, c.address + width[c.type]))
         for c in candidates
     ):
         return False
     groups = group_candidates(candidates)
     finding.groups = sorted(groups, key=lambda g: best not in g)[:SHOWN]  # its group first
     finding.groups[0].sort(key=lambda c: c is not best)
-    others = sorted({c.address for c in copies} - {best.address})
+    others = sorted({c.address for c in copies if c.values == best.values} - {best.address})  # the exact ones
     finding.reason = (
         "one value is left"
         + (f", read {len(candidates)} ways" if len(candidates) > 1 else "")

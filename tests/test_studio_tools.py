@@ -83,6 +83,18 @@ def test_a_search_takes_at_most_64_snapshots(client):
     assert len(ok(client.post("/api/search/new"))["snapshots"]) == 1
 
 
+def test_find_plays_scripts_with_repeats_and_finds_the_lives(client, game):
+    """The studio's scripts are the one script language: repeats, as ramsearch and state recipes take them."""
+    ok(client.post("/api/search/new"))
+    frame = ok(client.get("/api/status"))["frame"]
+    found = ok(client.post("/api/search/find", json={
+        "changes": "(RIGHT*100)*2", "keeps": "(_*65)*2", "kind": "decreases", "name": "lives_again", "save": True}))
+    assert found["found"] and (found["rows"][0]["address"], found["rows"][0]["type"]) == (LIVES, "|u1")
+    assert found["steps"][0].startswith("script (RIGHT*100)*2 (200 frames); decreased --than previous: ")
+    assert found["field"]["name"] == "lives_again" and "lives_again:" in game.read_text()
+    assert ok(client.get("/api/status"))["frame"] == frame + found["frames"] == frame + 3 * 200 + 2 * 130
+
+
 @pytest.mark.parametrize(
     ("body", "message"),
     [

@@ -24,7 +24,7 @@ import numpy as np
 
 from retrokit.errors import InvalidArgumentError, shown
 
-MAX_FRAMES = 100_000  # about 28 minutes of play: a death or a level's end is reached sooner
+MAX_FRAMES = 36_000  # ten minutes of play: a death or a level's end is reached sooner
 MAX_EVENTS = 16
 MAX_WINDOW = 60
 
@@ -82,7 +82,8 @@ def suggest_done(
     """Rank the bytes of RAM by how well their changes line up with the marked frames.
 
     Args:
-        ram: The RAM (console-order bytes) at the start, then after each frame played (frame 1, 2, ...).
+        ram: The RAM (console-order bytes) at the start, then after each frame played (frame 1, 2, ...), each a
+            new array (some are kept as they are).
         marks: The frames of the event, counted from 1.
         window: How many frames before and after a mark a change still counts as at it.
         limit: How many suggestions to return.
@@ -97,11 +98,11 @@ def suggest_done(
     """
     frames = check_marks(marks, window)
     start = next(ram)
-    previous = start.copy()
+    previous = start
     size = len(start)
     hits = np.zeros((len(frames), size), dtype=bool)
     others = np.zeros(size, dtype=np.int64)
-    before = [start.copy() if frame - window <= 1 else None for frame in frames]
+    before = [start if frame - window <= 1 else None for frame in frames]
     after: list[np.ndarray | None] = [None] * len(frames)
     played = 0
     for played, now in enumerate(ram, 1):
@@ -113,12 +114,12 @@ def suggest_done(
             others += changed
         else:
             hits[event] |= changed
-        for k, frame in enumerate(frames):
+        for k, frame in enumerate(frames):  # each frame's RAM is a new array: kept as it is, never copied
             if played == frame - window - 1:
-                before[k] = now.copy()
+                before[k] = now
             if played == frame + window:
-                after[k] = now.copy()
-        previous = now.copy()
+                after[k] = now
+        previous = now
     if frames[-1] > played:
         raise InvalidArgumentError(
             f"Expected marks within the {played:,} frames played; got {frames[-1]:,}. Mark a frame of the play."

@@ -1,4 +1,4 @@
-"""A field in one command: play what changes it and what keeps it, in turn, until one candidate is left.
+"""A field in one command: play what changes it and what keeps it, in turn, until one value is left.
 
 Finding a field by hand is the same loop every time: play something that
 changes it and keep the candidates that changed (increased, decreased, or
@@ -14,7 +14,7 @@ it, which reads 768 for 3, are one find), or nothing narrows any more::
 
     with RamSearch("Dasher-Genesis", "Zone1.Act1") as search:
         finding = find_field(search, "RIGHT*200", "_*130", "decreases")
-        print(finding.candidate)          # Candidate(address=0xFF002B, type='|u1', ...)
+        print(finding.candidate)          # the lives: address 0xFF002B, type |u1
 
 Each script and filter is an ordinary snapshot and filter of the search, so
 ``history`` lists them and ``undo`` takes them back one at a time.
@@ -99,7 +99,7 @@ def find_field(
     rounds: int = MAX_ROUNDS,
     progress: Callable[[str], object] | None = None,
 ) -> Finding:
-    """Play ``changes`` and ``keeps`` in turn, filtering after each, until one group of candidates is left.
+    """Play ``changes`` and ``keeps`` in turn, filtering after each, until one value is left.
 
     Args:
         search: The search, at the game's moment to start from.
@@ -116,7 +116,7 @@ def find_field(
     op = check_kind(kind, value)
     check_filter(op, value)  # a number no filter takes is refused before anything plays
     frames = {script: script_frames(parse_script(script, search.buttons)) for script in (changes, keeps)}
-    if not isinstance(rounds, int) or not 1 <= rounds <= MAX_ROUNDS:
+    if not isinstance(rounds, int) or isinstance(rounds, bool) or not 1 <= rounds <= MAX_ROUNDS:
         raise InvalidArgumentError(f"Expected from 1 to {MAX_ROUNDS} rounds; got {shown(rounds)}.")
     finding = Finding(search.count)
     for finding.rounds in range(1, rounds + 1):

@@ -53,7 +53,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="find a game's variables in RAM (snapshots, filters, undo) and save them into its game.yaml",
         description="A RAM search in the spirit of BizHawk's RAM Search and Gym Retro's integration tool. Start "
         "with 'new', move the game with 'run', narrow the candidates with 'filter', look with 'show', and write "
-        "a find into the game's game.yaml with 'save'. The search is kept in a session file between commands.",
+        "a find into the game's game.yaml with 'save'; or let 'find' play and filter until one value is left, and "
+        "'suggest' rank the bytes that change at an event. The search is kept in a session file between commands.",
     )
     commands = parser.add_subparsers(title="subcommands", metavar="SUBCOMMAND")
 
@@ -67,7 +68,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("game", metavar="GAME", help="the game, e.g. Dasher-Genesis")
     p.add_argument("--state", help="the save state to start from (default: the game's default state)")
     p.add_argument(
-        "--types", metavar="CODES", help="comma-separated type codes to search (default: every type Gym Retro infers)"
+        "--types", metavar="CODES",
+        help="comma-separated type codes to search, or bits (default: every type Gym Retro infers, and the "
+        "3-byte ones: <u3 >u3 <i3 >i3 <d3 >d3)",
     )
     p.add_argument("--force", action="store_true", help="replace an existing session file")
 

@@ -53,13 +53,24 @@ DIES = "RIGHT*140"  # from Level1-1, into the first pit: a life lost after about
 RESPAWNS = "_*60"  # back at the start, standing
 
 
+@pytest.fixture(scope="module")
+def hopper_search(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A session of Hopper from Level1-1, made once: the tests copy it."""
+    root = tmp_path_factory.mktemp("hopper")
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("RETROKIT_DATA", str(root / "data"))
+        assert ramsearch(root, "new", "Hopper-Nes", "--state", "Level1-1").returncode == 0
+    return root / "ramsearch.session"
+
+
 @pytest.fixture
-def hopper(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    """A copy of Hopper's folder as a user's game (its game.yaml writable), the cwd in tmp_path; its game.yaml."""
+def hopper(hopper_search: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """A copy of Hopper's folder as a user's game (its game.yaml writable) and of the session; its game.yaml."""
     shutil.copytree(REPO / "games" / "Hopper-Nes", tmp_path / "games" / "Hopper-Nes")
+    shutil.copy(hopper_search, tmp_path / "ramsearch.session")
     monkeypatch.setenv("RETROKIT_GAMES", str(tmp_path / "games"))
-    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))
-    assert ramsearch(tmp_path, "new", "Hopper-Nes", "--state", "Level1-1").returncode == 0
+    # the data folder the session was made with: it knows the session's state (else a child probes it first)
+    monkeypatch.setenv("RETROKIT_DATA", str(hopper_search.parent / "data"))
     return tmp_path / "games" / "Hopper-Nes" / "game.yaml"
 
 

@@ -82,6 +82,10 @@ def test_hostile_sizes_are_refused_or_bounded():
     assert len(steps) == MAX_FRAMES and len({id(s) for s in steps}) == 2
     with pytest.raises(InvalidArgumentError, match="Expected a script of at most"):
         parse_script(b"A*3")  # not text
+    with pytest.raises(InvalidArgumentError) as caught:
+        parse_script("START " + "A" * 99_000, check_buttons=lambda names: names == ("START",) or pytest.fail(str(names)))
+    assert "line 1, column 7: Expected button names of at most 32 characters" in str(caught.value)
+    assert len(str(caught.value)) < 400  # the name is not quoted whole
 
 
 def test_ramsearch_plays_a_repeat_as_its_steps_written_out_on_the_nes_cartridge():

@@ -34,6 +34,7 @@ if TYPE_CHECKING:
 
 MAX_FRAMES = 1_000_000  # about 4.6 hours of play, as a state recipe's budget: more is a typo
 MAX_SCRIPT = 100_000  # characters
+MAX_NAME = 32  # characters of a button's name (2:START, C-RIGHT): a longer word is no button
 MAX_NESTING = 16  # groups inside groups: more is no script a person writes, and lark's tree is walked recursively
 WAIT = "_"
 SYNTAX = (
@@ -214,6 +215,9 @@ def _step(text: str, token: Token, frames: int, check: Callable[[Sequence[str]],
     if str(token) == WAIT:
         return Step((), frames)
     names = tuple(str(token).split("+"))
+    long = next((name for name in names if len(name) > MAX_NAME), None)
+    if long is not None:  # no button is named so: say so, without quoting it all in the message
+        raise _located(text, token.start_pos, f"Expected button names of at most {MAX_NAME} characters; got {shown(long)}")
     if WAIT in names:
         raise _located(text, token.start_pos, f"Expected button names, or {WAIT} alone for none; found {str(token)!r}")
     if check is not None:

@@ -63,7 +63,11 @@ def print_groups(search: RamSearch, groups: list[list[Candidate]]) -> None:
     """The table ``show`` prints: a header, then a row per group, its values at the newest snapshots."""
     first = max(0, len(search.labels) - VALUES_SHOWN)
     header = ["address", "type", "scale", "changes", f"values at snapshots {first}-{len(search.labels) - 1}"]
-    rows = [header, *group_rows(search, groups)]
+    print_table([header, *group_rows(search, groups)])
+
+
+def print_table(rows: list[list[str]]) -> None:
+    """Rows of five columns: the first four padded to their widest cell, the last as it is (it may be long)."""
     widths = [max(len(r[i]) for r in rows) for i in range(4)]
     for row in rows:
         print("  ".join(cell.ljust(width) for cell, width in zip(row[:4], widths)) + "  " + row[4])

@@ -11,7 +11,14 @@ from __future__ import annotations
 import argparse
 from collections.abc import Callable
 
-from retrokit.commands._ramsearch_common import number, open_search, print_groups, save_field_from, session_path
+from retrokit.commands._ramsearch_common import (
+    number,
+    open_search,
+    print_groups,
+    print_table,
+    save_field_from,
+    session_path,
+)
 from retrokit.errors import InvalidArgumentError
 
 
@@ -40,8 +47,6 @@ def register_loops(sub: Callable[[str, str, Callable], argparse.ArgumentParser])
     p.add_argument("--game-file", metavar="PATH", help="with --save: the game.yaml to write (default: the game's own)")
     p.add_argument("--force", action="store_true", help="with --save: replace a field of the same name")
 
-
-
     p = sub(
         "suggest",
         "suggest bytes for a done condition: play a script (or a movie) and rank the bytes that change at the "
@@ -55,6 +60,7 @@ def register_loops(sub: Callable[[str, str, Callable], argparse.ArgumentParser])
     p.add_argument("--window", default="2", metavar="N",
                    help="a change up to N frames before or after a mark counts as at it (default 2)")
     p.add_argument("--limit", default="10", metavar="N", help="list at most N bytes (default 10)")
+
 
 def _find(args: argparse.Namespace) -> int:
     from retrokit.errors import RamSearchError
@@ -113,9 +119,7 @@ def _suggest(args: argparse.Namespace) -> int:
         for s in found:
             moments = ", ".join(f"{old}->{new} @{frame}" for frame, old, new in s.moments)
             rows.append([search.layout.format(s.address), f"{s.hits}/{len(marks)}", str(s.others), moments, s.condition])
-        widths = [max(len(row[i]) for row in rows) for i in range(4)]
-        for row in rows:
-            print("  ".join(cell.ljust(width) for cell, width in zip(row[:4], widths)) + "  " + row[4])
+        print_table(rows)
         best = search.layout.format(found[0].address)
         print(f"Save one as a field to use it: retrokit ramsearch save NAME {best} '|u1'")
     return 0

@@ -42,6 +42,7 @@ host = Extension(
     sources=[
         "retrokit/native/host.c",
         "retrokit/native/host_emulator.c",
+        "retrokit/native/host_memory.c",
         "retrokit/native/host_functions.c",
         "retrokit/native/host_state.c",
         "retrokit/native/host_runner.c",

@@ -8,6 +8,8 @@ with a did-you-mean suggestion built by :func:`did_you_mean`.
 from __future__ import annotations
 
 import difflib
+import os
+import shlex
 from collections.abc import Iterable
 
 MIN_PART = 3
@@ -39,6 +41,46 @@ def shown(value: object, limit: int = 60) -> str:
     """``repr(value)`` for a message, cut to ``limit`` characters so a huge argument cannot flood it."""
     text = repr(value)
     return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def printable(text: str, *, escape: str = "") -> str:
+    """``text`` with every character that is not printable (an escape sequence's ESC, a newline) written as
+    ``\\xHH``, ``\\uHHHH`` or ``\\UHHHHHHHH``, and a byte that is not UTF-8 (a file name's, kept by Python as a
+    lone surrogate) as the byte: printing a file name can then never drive the terminal or break a line.
+
+    Args:
+        text: The text.
+        escape: Characters to put a backslash before as well (a quoting's own).
+    """
+    escaped = []
+    for char in text:
+        code = ord(char)
+        if char in escape:
+            escaped.append("\\" + char)
+        elif char.isprintable():
+            escaped.append(char)
+        elif code < 0x100 or 0xDC80 <= code <= 0xDCFF:  # a control character, or an undecodable byte
+            escaped.append(f"\\x{code & 0xFF:02x}")
+        else:
+            escaped.append(f"\\u{code:04x}" if code < 0x10000 else f"\\U{code:08x}")
+    return "".join(escaped)
+
+
+def shell_word(value: str | os.PathLike[str]) -> str:
+    """``value`` (a file name in a hint's command) as one word a shell reads back, that cannot drive the terminal.
+
+    Printable text is quoted as :func:`shlex.quote` does; text holding control characters (an escape
+    sequence, a newline) takes the ``$'...'`` form of bash, zsh and ksh, with them escaped (:func:`printable`).
+    """
+    text = os.fspath(value)
+    return shlex.quote(text) if text.isprintable() else "$'" + printable(text, escape="'\\") + "'"
+
+
+def listed(items: Iterable[str], limit: int = 10, width: int = 60) -> str:
+    """Items for a one-line message: the first ``limit``, each cut to ``width`` characters, then how many more."""
+    items = list(items)
+    cut = [i if len(i) <= width else i[: width - 3] + "..." for i in items[:limit]]
+    return ", ".join(cut) + (f" and {len(items) - limit} more" if len(items) > limit else "")
 
 
 DISTRIBUTION = "retrokit-rl"
@@ -241,3 +283,9 @@ class AccessDeniedError(StudioError, PermissionError):
 
 class RequestTooLargeError(StudioError):
     """A request's body is larger than the studio accepts."""
+
+
+class SkippedDataWarning(UserWarning):
+    """A stable-retro data file (``data.json``, ``scenario.json``) held what retrokit skips, as stable-retro does:
+    a field outside the system's memory, a key neither knows. The message, one line, names what was skipped.
+    retrokit's own files (``game.yaml``, YAML scenarios) never warn: what they hold that is wrong is an error."""

@@ -165,6 +165,25 @@ def data_dir() -> Path:
     return Path.home() / ".local" / "share" / "retrokit"
 
 
+def records_dir(kind: str) -> Path:
+    """``<data>/<kind>``: a folder of retrokit's own records (``state-probes``, ``state-owners``, ``core-probes``).
+
+    Records vouch for files (a verdict lets a state load unprobed), so the folder
+    must not be a symlink, which would send writes elsewhere and let files nobody
+    wrote here vouch; read its files with ``follow=False`` (:func:`read_regular_file`).
+
+    Raises:
+        FileSystemError: It is a symlink.
+    """
+    folder = data_dir() / kind
+    if os.path.islink(folder):
+        raise FileSystemError(
+            f"Expected {str(folder)!r} to be retrokit's own folder of {kind}; found a symlink, whose files vouch for "
+            "nothing. Remove the link: retrokit makes the folder again."
+        )
+    return folder
+
+
 def roms_dir(data: Path | str | None = None) -> Path:
     """Return the folder of imported ROMs: ``<data>/roms``."""
     return (Path(data) if data is not None else data_dir()) / "roms"
@@ -423,7 +442,7 @@ def _not_regular(path: Path, what: str, mode: int) -> FileSystemError:
     )
 
 
-def read_regular_file(path: Path | str, what: str, limit: int) -> bytes:
+def read_regular_file(path: Path | str, what: str, limit: int, *, follow: bool = True) -> bytes:
     """Read a data file whole: the one guarded way retrokit reads a game's files.
 
     The file is opened with ``O_NONBLOCK``, so a FIFO cannot block the open,
@@ -435,6 +454,7 @@ def read_regular_file(path: Path | str, what: str, limit: int) -> bytes:
         path: The file (symlinks followed; a loop is an error).
         what: What it should be, for the error (``"a game.yaml data file"``).
         limit: The most bytes a file of this kind may hold.
+        follow: Follow a symlink at ``path`` itself (else it is an error, as for a record: :func:`records_dir`).
 
     Raises:
         FileSystemError: ``path`` is missing, unreadable, a symlink loop, a folder,
@@ -442,9 +462,9 @@ def read_regular_file(path: Path | str, what: str, limit: int) -> bytes:
     """
     path = Path(path)
     try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_CLOEXEC | (0 if follow else os.O_NOFOLLOW))
     except OSError as exc:
-        found = "a symlink loop" if exc.errno == errno.ELOOP else exc.strerror or str(exc)
+        found = ("a symlink loop" if follow else "a symlink") if exc.errno == errno.ELOOP else exc.strerror or str(exc)
         raise FileSystemError(f"Expected {what} at {str(path)!r}; found {found}. Fix or remove it.") from None
     try:
         mode = os.fstat(fd).st_mode

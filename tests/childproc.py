@@ -66,7 +66,7 @@ def run_child(code: str, *, timeout: float = 60, env: dict[str, str] | None = No
     )
     try:
         done = subprocess.run(
-            [sys.executable, "-c", script], capture_output=True, text=True, timeout=timeout, check=False,
+            [sys.executable, "-c", script], capture_output=True, text=True, errors="replace", timeout=timeout, check=False,
             env={**os.environ, **(env or {})}, cwd=cwd or REPO, preexec_fn=_limits, stdin=subprocess.DEVNULL,
         )
     except subprocess.TimeoutExpired as exc:

@@ -14,6 +14,7 @@ the episode is done when a bounded field (lives, game mode, a level-done flag) l
 
 from __future__ import annotations
 
+import contextlib
 import gzip
 import json
 from collections.abc import Iterator
@@ -21,6 +22,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from retrokit.data.games import Game
 from retrokit.data.roms import rom_sha1
@@ -37,7 +39,7 @@ class Integration:
     """A stable-retro integration of one of our games.
 
     Attributes:
-        name: stable-retro's name for it, ``<Game>-v0``.
+        name: stable-retro's name for it, its folder's: ``<Game>-v0`` unless written under another.
         folder: The integration folder (its parent is the custom path).
         scenario: ``scenario.json``, which retrokit loads too.
         state: The start state's name.
@@ -65,9 +67,14 @@ def _scenario(game: Game, start: dict[str, int]) -> dict:
     return {"reward": {"variables": rewards}, "done": {"variables": dones, "condition": "any"}}
 
 
-def write_integration(game: Game, root: Path) -> Integration:
-    """Write a stable-retro integration of ``game`` (its default state) into ``root/<Game>-v0``."""
-    name = f"{game.name}-v0"
+def write_integration(game: Game, root: Path, name: str | None = None) -> Integration:
+    """Write a stable-retro integration of ``game`` (its default state) into ``root/<name>``.
+
+    Args:
+        name: The folder's name: by default ``<Game>-v0``, as stable-retro's stable games are named; its
+            experimental and contrib games' folders have no ``-v0``.
+    """
+    name = name or f"{game.name}-v0"
     folder = root / name
     folder.mkdir(parents=True)
     rom = game.require_rom()
@@ -98,6 +105,20 @@ def write_integration(game: Game, root: Path) -> Integration:
         emu.close()
     _json(folder / "scenario.json", _scenario(game, start))
     return Integration(name, folder, folder / "scenario.json", state, after)
+
+
+@contextlib.contextmanager
+def found_by_both(root: Path) -> Iterator[None]:
+    """Game folders under ``root`` found by retrokit (``RETROKIT_GAMES``) and by stable-retro (a custom path)."""
+    import stable_retro
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("RETROKIT_GAMES", str(root))
+        stable_retro.data.Integrations.add_custom_path(str(root))
+        try:
+            yield
+        finally:
+            stable_retro.data.Integrations.clear_custom_paths()
 
 
 def wandering(system: System, seed: int, hold: int = 6) -> Iterator[list[str]]:

@@ -21,19 +21,26 @@ from retrokit.host.child import Child
 
 MODULE = "house_child"
 CHILD = """
-import json, resource, subprocess, sys, time
+import json, os, resource, subprocess, sys, time
+from retrokit.host.child import answer_channel
 
 request = json.load(sys.stdin)
+answer = answer_channel(request)
 if request["do"] == "limits":
     limits = {"as": resource.getrlimit(resource.RLIMIT_AS), "core": resource.getrlimit(resource.RLIMIT_CORE)}
-    print(json.dumps({**limits, "echo": request["echo"]}), flush=True)
+    answer.write(json.dumps({**limits, "echo": request["echo"]}).encode() + b"\\n")
 elif request["do"] == "hang":  # a grandchild in its group, then silence
     sleeper = subprocess.Popen(["sleep", "600"])
-    print(sleeper.pid, flush=True)
+    answer.write(b"%d\\n" % sleeper.pid)
     time.sleep(600)
 elif request["do"] == "fail":
     print("first words\\nlast words", file=sys.stderr)
     sys.exit(5)
+elif request["do"] == "chatty":  # what a core prints: megabytes, a forged answer, bytes that are not UTF-8
+    for fd in (1, 2):
+        os.write(fd, b"noise\\n" * (1 << 18) + b'{"forged": true}\\n')
+    answer.write(b"real\\n")
+    os.write(1, b"last \\xff words\\n")
 """
 
 
@@ -101,6 +108,17 @@ def test_a_failing_child_gives_its_status_and_last_words(child_module: Path) -> 
     assert (end.status, end.hung, end.last_words) == (5, False, "last words")
 
 
+def test_only_the_answer_channel_answers_and_the_log_is_a_bounded_tail(child_module: Path) -> None:
+    """A core's stdout and stderr (megabytes, a forged answer line, a byte that is not UTF-8) are its log, not its answer."""
+    with Child(MODULE, {"do": "chatty"}, memory=1 << 30) as child:
+        lines = list(child.lines(first=120))
+        end = child.end()
+        kept = len(child._tail)
+    assert lines == [b"real"]
+    assert (end.status, end.hung, end.last_words) == (0, False, "last \ufffd words")
+    assert kept <= 1 << 16  # of the 3 MB it printed
+
+
 def test_a_child_that_cannot_start_is_one_error_line(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setattr(sys, "executable", str(tmp_path / "no-python"))
     with pytest.raises(ChildStartError) as info:
@@ -125,3 +143,16 @@ def test_the_users_limits_here_are_untouched() -> None:
         list(child.lines(first=120))
         child.end()
     assert (resource.getrlimit(resource.RLIMIT_AS), resource.getrlimit(resource.RLIMIT_CORE)) == before
+
+
+def test_a_child_whose_answers_were_not_all_read_still_ends(child_module: Path) -> None:
+    """end() reads the child's log while it waits: a caller that stopped reading answers early cannot leave the
+    child blocked on a full log pipe."""
+    import threading
+
+    with Child(MODULE, {"do": "chatty"}, memory=1 << 30) as child:
+        rescue = threading.Timer(120, child._kill)  # a blocked child fails this test, never hangs the suite
+        rescue.start()
+        end = child.end()  # not one answer read: the child writes megabytes of log first
+        rescue.cancel()
+    assert (end.status, end.hung, end.last_words) == (0, False, "last \ufffd words")

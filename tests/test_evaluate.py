@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import csv
+import io
 import json
 import os
 import signal
@@ -71,6 +73,35 @@ def test_jerk_beats_random_by_a_clear_margin(reference, random_run) -> None:
     assert jerk > 1.5 * rand, (jerk, rand)
 
 
+@pytest.mark.parametrize("run", ["reference", "random_run"])
+def test_the_final_score_averages_the_episodes_of_the_budgets_last_tenth(run, request) -> None:
+    out = request.getfixturevalue(run)
+    episodes = [json.loads(line) for line in (out / "episodes.jsonl").read_text().splitlines()]
+    data = json.loads(summary(out))
+    finals, windows = [], []
+    for level, entry in data["levels"].items():
+        mine = [e for e in episodes if e["level"] == level]
+        # The episodes that ended in the last 30 of the 300 timesteps; with none, the last that ended.
+        window = [e["reward"] for e in mine if e["timesteps"] > 270] or [mine[-1]["reward"]]
+        windows.append(any(e["timesteps"] > 270 for e in mine))
+        assert entry["final_score"] == pytest.approx(sum(window) / len(window)), level
+        assert entry["final_episodes"] == len(window)
+        finals.append(entry["final_score"])
+    assert any(windows)  # a window held an episode (and, in JERK's run, one level had none: the fallback)
+    assert data["final_aggregate"] == pytest.approx(sum(finals) / len(finals))
+    curve = data["curve"]
+    assert len(curve["timesteps"]) == 50 and curve["timesteps"][-1] == 300
+    assert curve["score"][-1] == pytest.approx(data["final_aggregate"])  # Figure 3's curve ends at the final score
+    rows = list(csv.DictReader(io.StringIO((out / "summary.csv").read_text())))
+    assert [float(r["final_score"]) for r in rows[:-1]] == pytest.approx(finals)
+    assert float(rows[-1]["final_score"]) == pytest.approx(data["final_aggregate"])
+    report = (out / "report.md").read_text()
+    assert "| mean score | sd | final score |" in report and f"**{data['final_aggregate']:,.1f}**" in report
+    assert "![mean-learning-curve](mean-learning-curve.png)" in report
+    with Image.open(out / "mean-learning-curve.png") as image:
+        assert image.format == "PNG" and image.size == (640, 400)
+
+
 def test_the_same_seed_gives_the_same_summary_twice_and_on_two_workers(reference, tmp_path) -> None:
     # The reference played on two workers (saving GIFs): once more on one worker, without.
     assert evaluate(tmp_path / "again", "--agent", "jerk", "--workers", "1") == 0
@@ -110,17 +141,30 @@ def test_an_interrupted_run_resumes_to_the_uninterrupted_result(reference, agent
     assert (out / "episodes.jsonl").read_text().count("\n") == sum(e["episodes"] for e in resumed["levels"].values())
 
 
-def test_a_half_written_episode_line_is_dropped_on_resume(reference, tmp_path) -> None:
+def _killed_copy(reference: Path, tmp_path: Path) -> Path:
+    """A copy of the reference's folder as if killed while playing its second level."""
     import shutil
 
     out = tmp_path / "run"
     shutil.copytree(reference, out)
     state = json.loads((out / "run.json").read_text())
-    del state["finished"]["Dasher-Genesis/Zone3.Act2"]  # as if killed while playing the second level
+    del state["finished"]["Dasher-Genesis/Zone3.Act2"]
     (out / "run.json").write_text(json.dumps(state))
+    return out
+
+
+def test_a_half_written_episode_line_is_dropped_on_resume(reference, tmp_path) -> None:
+    out = _killed_copy(reference, tmp_path)
     with (out / "episodes.jsonl").open("a") as log:
         log.write('{"level": "Dasher-Genesis/Zone3.Act2", "epis')
     assert evaluate(out, "--agent", "jerk", "--resume") == 0
+    assert summary(out) == summary(reference)
+
+
+def test_resume_alone_takes_the_options_from_the_run_folder(reference, tmp_path) -> None:
+    """The --help example `retrokit evaluate --out runs/mine --resume`: no option but the folder (issue 42)."""
+    out = _killed_copy(reference, tmp_path)
+    assert main(["evaluate", "--out", str(out), "--resume", "--no-progress"]) == 0
     assert summary(out) == summary(reference)
 
 
@@ -267,7 +311,10 @@ def test_sonic_lists_the_papers_split(capsys) -> None:
     assert sum(line.startswith("train") for line in lines) == 47
 
 
-def test_a_benchmark_file_runs(tmp_path) -> None:
+def test_a_benchmark_file_runs_and_says_what_a_built_core_would_gain(tmp_path, monkeypatch, capsys) -> None:
+    from retrokit.host.buildhint import build_hint
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))  # no built core there: the wheel's runs
     path = tmp_path / "mine.yaml"
     path.write_text("name: mine\nbudget: 200\nenv: {frameskip: 4, max_episode_steps: 100}\n"
                     "levels:\n  test: [Dasher-Genesis/Zone1.Act1]\n")
@@ -275,6 +322,8 @@ def test_a_benchmark_file_runs(tmp_path) -> None:
     assert main(["evaluate", "--benchmark", str(path), "--agent", "random", "--no-progress", "--out", str(out)]) == 0
     data = json.loads(summary(out))
     assert data["benchmark"] == "mine" and data["levels"]["Dasher-Genesis/Zone1.Act1"]["timesteps"] == 200
+    err = capsys.readouterr().err
+    assert err.splitlines().count(build_hint("Genesis")) == 1 and "retrokit build-core" in build_hint("Genesis")
 
 
 @pytest.mark.parametrize(
@@ -345,7 +394,7 @@ def test_a_second_run_on_a_folder_in_use_is_refused(agents_file, tmp_path, monke
         wait_for(lambda: (tmp_path / "waiting").exists() or first.poll() is not None, 120, "the first run to pause")
         assert evaluate(out, "--agent", f"{agents_file}:jerk_pausing", "--levels", "Zone3.Act2", "--resume") == 2
         err = capsys.readouterr().err
-        assert f"Expected no other evaluation running in {out}, but one is (process {first.pid})" in err
+        assert f"Expected no other evaluation running in the folder {str(out)!r}; found one there (process {first.pid})" in err
         assert err.count("\n") == 1
         assert json.loads((out / "run.json").read_text())["finished"] == {}
     finally:

@@ -59,8 +59,17 @@ def test_several_agents_run_into_their_folders_and_one_report_compares_them(mine
         assert any(line.startswith(f"| {level} | {cells[0]}") and all(c in line for c in cells)
                    for line in report.splitlines()), report
     assert "**aggregate**" in report and "[jerk](jerk/report.md)" in report
-    with Image.open(out / "scores.png") as image:
-        assert image.format == "PNG"
+    finals = report[report.index("## Final scores"):]
+    assert f"| level | jerk | random | {agents}:still |" in finals and "paper" not in report.lower()
+    for level in ("Dasher-Genesis/Zone1.Act1", "Dasher-Genesis/Zone3.Act2"):
+        cells = " | ".join(f"{s['levels'][level]['final_score']:,.1f}" for s in summaries.values())
+        assert f"| {level} | {cells} |" in finals
+    assert " | ".join(f"**{s['final_aggregate']:,.1f}**" for s in summaries.values()) in finals
+    for png, size in (("scores.png", None), ("mean-learning-curve.png", (640, 400))):
+        with Image.open(out / png) as image:
+            assert image.format == "PNG" and size in (None, image.size)
+        assert f"({png})" in report
+    assert all((out / name / "mean-learning-curve.png").is_file() for name in ("jerk", "random", "still"))
     before = (out / "report.md").read_bytes()
     assert run(mine, out, "jerk", "random", f"{agents}:still") == 2
     assert "already holds" in capsys.readouterr().err

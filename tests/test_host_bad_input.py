@@ -127,3 +127,22 @@ def test_a_packed_state_unpacks_checked_and_cannot_be_made_directly(airstriker: 
     airstriker.set_state(packed.unpack())
     with pytest.raises(StateError, match="made directly as PackedState"):
         PackedState(b"x", "Genesis")
+
+
+def test_memory_span_refuses_descriptors_the_core_lacks_and_joins_only_what_follows() -> None:
+    from retrokit.data.games import find_game
+
+    game = find_game("Hopper-Nes")
+    with Emulator(game.system, game.require_rom()) as emu:
+        native = emu.handle
+        count = len(native.memory_maps())  # FCEUmm's: 0x0, 0x400, then 0x6000 to 0x7C00, 1 KiB each
+        for first, many in [(-1, 1), (0, 0), (0, count + 1), (count, 1), (0, 2**31 - 1), (2**31 - 1, 2)]:
+            with pytest.raises(InvalidArgumentError, match="expected descriptors within the core's"):
+                native.memory_span(first, many)
+        with pytest.raises(TypeError):
+            native.memory_span("0", 1)
+        assert len(native.memory_span(0, 2)) == 2048  # the NES's RAM: one array
+        assert native.memory_span(1, 2) is None  # 0x400 then 0x6000: not adjacent addresses
+        view = native.memory_span(0, 1)
+        assert len(view) == 1024
+        view.release()

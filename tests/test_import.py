@@ -17,7 +17,7 @@ from retrokit.errors import RomNotFoundError
 
 AIRSTRIKER_ROM = paths.wheel_dir() / "data" / "stable" / "Airstriker-Genesis-v0" / "rom.md"
 NES_BODY = bytes(range(256)) * 128
-NES_ROM = b"NES\x1a" + bytes([2, 1, 0x10]) + bytes(9) + NES_BODY  # a 16-byte iNES header, then the body
+NES_ROM = b"NES\x1a" + bytes([2, 0, 0x10]) + bytes(9) + NES_BODY  # a 16-byte iNES header (mapper 1), then the body
 
 
 @pytest.fixture(autouse=True)
@@ -173,3 +173,62 @@ def test_a_zip_holding_no_rom_is_listed_once(src, data_dir, nested):
     inner = "!inner.zip" if nested else ""
     assert [u.source for u in report.unmatched] == [str(src / "empty.zip")]
     assert report.not_roms == [f"{src / 'docs.zip'}{inner}!readme.txt"]
+
+
+def _with_header(rom: bytes, **at: int) -> bytes:
+    """``rom`` with header bytes changed: ``b4=prg``, ``b6=flags6``, ``b7=flags7``."""
+    data = bytearray(rom)
+    for key, value in at.items():
+        data[int(key[1:])] = value
+    return bytes(data)
+
+
+def test_a_known_rom_whose_header_its_core_cannot_run_is_refused(src, data_dir):
+    """Issue 42: the SHA-1 leaves the iNES header out, so a known body under a header `new` refuses was imported,
+    and played with every pixel wrong. Import checks what `new` checks."""
+    (src / "mapper255.nes").write_bytes(_with_header(NES_ROM, b6=0xF0, b7=0xF0))
+    (src / "prg-too-big.nes").write_bytes(_with_header(NES_ROM, b4=4))
+    report = import_roms([src], games=[games.find_game("FakeQuest-Nes")])
+    assert report.imported == [] and not imported(data_dir, "FakeQuest-Nes", "nes").exists()
+    refused = {Path(label).name: (game, why) for label, game, why in report.refused}
+    mapper = "its iNES mapper 255 is one the fceumm core cannot run (it has no such board)"
+    assert refused["mapper255.nes"] == ("FakeQuest-Nes", mapper)
+    assert refused["prg-too-big.nes"][1].startswith("it is truncated: its iNES header gives 4 x 16 KiB of program ROM")
+
+
+def test_a_second_copy_names_both_files_and_how_their_headers_differ(src, data_dir, capsys):
+    from retrokit.cli import main
+
+    (src / "FakeQuest.nes").write_bytes(NES_ROM)
+    import_roms([src], games=[games.find_game("FakeQuest-Nes")])
+    other = src.parent / "other"
+    other.mkdir()
+    (other / "FakeQuest (mapper 2).nes").write_bytes(_with_header(NES_ROM, b6=0x20))  # a board the core has
+    capsys.readouterr()
+    assert main(["import", str(other)]) == 1
+    out = capsys.readouterr().out
+    dest = imported(data_dir, "FakeQuest-Nes", "nes")
+    line = next(line for line in out.splitlines() if line.startswith("  FakeQuest-Nes:"))
+    assert line == f"  FakeQuest-Nes: {dest} and {other / 'FakeQuest (mapper 2).nes'} differ (their iNES headers " \
+        "differ: mapper 1 against 2)", out
+    assert dest.read_bytes() == NES_ROM  # left as it was
+
+
+def test_a_hint_prints_a_hostile_file_name_escaped_and_quoted_for_the_shell(src, data_dir, capsys):
+    """Issue 42: a file name's escape sequence reached the terminal raw, and unquoted, through a hint's command."""
+    import shutil
+    import subprocess
+
+    from retrokit.cli import main
+
+    name = "\x1b[2J\x1b[31mevil\nname $(reboot).nes"
+    (src / name).write_bytes(_with_header(NES_ROM, b4=2)[:16] + bytes(range(255, -1, -1)) * 128)  # no game's
+    capsys.readouterr()
+    assert main(["import", str(src)]) == 0
+    out = capsys.readouterr().out
+    assert "\x1b" not in out and "\nname" not in out, out  # escaped everywhere it is printed
+    (hint,) = [line for line in out.splitlines() if line.startswith("A game nobody has integrated yet?")]
+    word = hint.split("retrokit new ", 1)[1].split(" --name NAME-Nes", 1)[0]
+    if shutil.which("bash"):  # the word is the file's name again, and runs nothing
+        done = subprocess.run(["bash", "-c", f"printf %s {word}"], capture_output=True, check=True)
+        assert done.stdout == str(src / name).encode()

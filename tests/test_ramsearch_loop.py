@@ -311,3 +311,22 @@ def test_the_inputs_of_a_played_movie_begin_at_its_start(tmp_path):
         search.run(["B"], 2)
         movie = search.movie()
     assert movie.state == state and movie.frames == [right] * 30 + [(1 << 0, 0)] * 2
+
+
+# --- fields of a shipped game: copy first, as the default state does ------------------------------------
+
+
+def test_a_field_of_a_shipped_game_goes_to_its_copy_in_the_data_folder(tmp_path, data):
+    """Issue 42: ``ramsearch save`` on a checkout's game wrote into the tracked games/<Game>/game.yaml."""
+    shipped = (DASHER / "game.yaml").read_bytes()
+    ok(ramsearch(tmp_path, "new", "Dasher-Genesis", "--state", "Zone1.Act1"))
+    out = ok(ramsearch(tmp_path, "save", "probe_lives", "0xFF002B", "|u1"))
+    copy = data / "games" / "Dasher-Genesis" / "game.yaml"
+    assert out == f"Wrote field probe_lives (0xFF002B, |u1) into {copy}.\n"
+    assert (DASHER / "game.yaml").read_bytes() == shipped  # the checkout's file is untouched
+    assert copy.read_text().startswith("# Dasher: retrokit's own test cartridge")  # a copy, comments kept
+    assert find_game("Dasher-Genesis").fields["probe_lives"].address == LIVES  # and it is the game's now
+    # the default state goes to the same file by the same rule: the copy is edited, not made again
+    ok(ramsearch(tmp_path, "savestate", "Mine", "--default"))
+    game = find_game("Dasher-Genesis")
+    assert game.default_state == "Mine" and "probe_lives" in game.fields

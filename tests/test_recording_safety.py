@@ -3,8 +3,10 @@
 Issue 19 section 5. The folder is made and tried when the env is made, so a
 file in the way, a name too long, a NUL byte or a folder under /proc is a
 retrokit error there, not a raw OSError at the first reset(). A recording
-movie is written whole every ``FLUSH_SECONDS``, so a process killed with
-SIGKILL leaves a movie that plays up to about a second before the kill; and a
+movie is written whole every ``FLUSH_SECONDS`` it has new frames, by a thread
+(issue 42: the check ran only as frames were recorded, so a script that paused
+after its steps lost them all to a kill), so a process killed with SIGKILL
+leaves a movie that plays up to about a second before the kill; and a
 finalizer writes the movie of a script that exits without ``env.close()``.
 """
 
@@ -286,3 +288,77 @@ def test_a_recorder_killed_at_any_moment_leaves_no_movie_or_one_that_plays(tmp_p
         launcher.kill()
         launcher.wait(timeout=30)
     assert played >= sum(mark == "recording" for mark, _ in KILL_AFTER)  # every kill after reset() left a movie
+
+
+#: Forks one recorder per line read ("<folder> <steps> <steps of a second episode, or -1 for none>"): it records
+#: that many steps, says how many frames its movie holds, then idles as a script that thinks or waits would,
+#: recording nothing more, until it is killed.
+IDLER = """
+import os, sys, tempfile, time
+import retrokit
+with tempfile.TemporaryDirectory() as warm:
+    retrokit.make("Dasher-Genesis", record=warm).close()
+for line in sys.stdin:
+    folder, steps, again = line.split()
+    pid = os.fork()
+    if pid == 0:
+        env = retrokit.make("Dasher-Genesis", record=folder)
+        env.reset(seed=0)
+        env.action_space.seed(0)
+        for episode_steps in (int(steps), int(again)):
+            if episode_steps < 0:
+                break
+            if episode_steps != int(steps):
+                env.reset()  # the first episode's movie is closed whole; the second one records
+            for _ in range(episode_steps):
+                env.step(env.action_space.sample())
+        os.write(1, f"{os.getpid()} {len(env.unwrapped.movies.recorder)}\\n".encode())
+        time.sleep(3600)
+        os._exit(1)
+    os.waitpid(pid, 0)
+    os.write(1, b"ended\\n")
+"""
+#: (steps, steps of a second episode): just after reset(), after one step, after 300 (the issue's case), and
+#: 20 steps into a second episode.
+IDLE_POINTS = [(0, -1), (1, -1), (300, -1), (300, 20)]
+
+
+def _movie_holding(folder: Path, frames: int) -> Path:
+    """The newest movie in ``folder`` once it holds ``frames`` frames (the recorder's thread writes it within a
+    second; a minute is slack for a loaded machine, not a measured time)."""
+    waited = time.monotonic()
+    while time.monotonic() - waited < 60:
+        newest = sorted(folder.glob("*.bk2"))[-1:]
+        if newest and len(read_bk2(newest[0]).frames) == frames:
+            return newest[0]
+        time.sleep(0.05)  # polling a condition, not timing it
+    raise AssertionError(f"no movie in {folder} came to hold the {frames} frames recorded before the kill")
+
+
+def test_a_recorder_killed_while_idle_keeps_every_frame_it_recorded(tmp_path: Path) -> None:
+    """Issue 42: 300 steps, then a pause, then SIGKILL left a movie with an empty input log (flushes waited for the
+    next step). Each point is killed once its movie holds all it recorded: every frame, and it plays back."""
+    launcher = subprocess.Popen(
+        [sys.executable, "-c", textwrap.dedent(IDLER)],
+        stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=REPO,
+    )  # fmt: skip
+    assert launcher.stdin is not None and launcher.stdout is not None
+    try:
+        for steps, again in IDLE_POINTS:
+            folder = tmp_path / f"{steps}-{again}"
+            launcher.stdin.write(f"{folder} {steps} {again}\n")
+            launcher.stdin.flush()
+            answer = launcher.stdout.readline().split()
+            assert len(answer) == 2, f"{answer}: {launcher.stderr.read() if launcher.stderr else ''}"
+            pid, frames = map(int, answer)
+            movie_file = _movie_holding(folder, frames)
+            os.kill(pid, signal.SIGKILL)
+            assert launcher.stdout.readline() == "ended\n"
+            movie = read_bk2(movie_file)
+            assert len(movie.frames) == frames == (again if again >= 0 else steps)  # a frame a step: no frameskip
+            assert movie.state and sum(1 for _ in play(movie)) == frames
+            assert len(list(folder.glob("*.bk2"))) == (2 if again >= 0 else 1)
+            assert not [p for p in folder.iterdir() if p.suffix != ".bk2"]
+    finally:
+        launcher.kill()
+        launcher.wait(timeout=30)

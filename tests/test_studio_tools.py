@@ -227,3 +227,20 @@ def test_ram_view_marks_what_changed_since_the_last_frame_and_a_snapshot(client)
     refused(client.get("/api/ram?start=0xFF0000&length=100000"))
     refused(client.get("/api/ram?start=0x10&length=4"))
     refused(client.get("/api/ram?start=0xFF0000&length=4&snapshot=9"))
+
+
+def test_add_field_on_a_shipped_game_writes_its_copy_in_the_data_folder(tmp_path, monkeypatch):
+    """Issue 42: the studio's Add field on the checkout's Dasher (its default game) wrote the tracked game.yaml."""
+    from retrokit import paths
+    from retrokit.data.games import find_game
+    from retrokit.studio.session import Session
+
+    shipped = (studioclient.DASHER / "game.yaml").read_bytes()
+    monkeypatch.delenv(paths.GAMES_ENV, raising=False)
+    monkeypatch.setenv(paths.DATA_ENV, str(tmp_path))
+    with studioclient.open_studio(Session("Dasher-Genesis", "Zone1.Act1")) as client:
+        added = ok(client.post("/api/search/field", json={"name": "lives_found", "address": LIVES, "type": "|u1"}))
+        assert fields(client)["lives_found"]["value"] == 3  # the session reads it from the copy at once
+    copy = tmp_path / "games" / "Dasher-Genesis" / "game.yaml"
+    assert added["path"] == str(copy) and "lives_found" in find_game("Dasher-Genesis").fields
+    assert (studioclient.DASHER / "game.yaml").read_bytes() == shipped

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import gzip
 import json
+import re
 import shutil
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -93,10 +94,10 @@ def cart(request, tmp_path_factory) -> Iterator[Cartridge]:
 
 
 def inputs(cart: Cartridge, seed: int, frames: int, *, recordable: bool = False) -> list[list[str]]:
-    """Button sets for ``frames`` frames; ``recordable``: only buttons a .bk2 movie has a letter for (a PC Engine's
-    I to VI have none: stable-retro drops them, retrokit refuses them, docs/movies.md)."""
+    """Button sets for ``frames`` frames; ``recordable``: only buttons stable-retro's .bk2 letters hold (a PC Engine's
+    I to VI and RUN have none: stable-retro drops them; retrokit writes them as BizHawk does, docs/movies.md)."""
     source = wandering(cart.system, seed)
-    keep = set(cart.system.buttons_of(layout(cart.system.name).allowed)) if recordable else None
+    keep = set(cart.system.buttons_of(layout(cart.system.name).stable_retro)) if recordable else None
     return [[b for b in next(source) if keep is None or b in keep] for _ in range(frames)]
 
 
@@ -131,6 +132,57 @@ def test_the_env_matches_stable_retro_frame_for_frame(cart: Cartridge) -> None:
     finally:
         ours.close()
         theirs.close()
+
+
+RAM_STEPS = 40  # steps of the RAM comparison: enough for the game to write its RAM, every block read each step
+
+
+def test_ram_observations_and_get_ram_are_stable_retros(cart: Cartridge) -> None:
+    # stable-retro's RAM is its memory map's blocks in address order: on the NES 10,240 bytes (the cartridge RAM at
+    # 0x6000 after the 2 KiB), on a Game Boy video, cartridge, work, object and high RAM; the env, get_ram() and the
+    # vector env all give those bytes, in that order and length.
+    theirs = cart.stable_env(obs_type=stable_retro.Observations.RAM)
+    ours = retrokit.make(cart.name, state=cart.integration.after_reset, obs_type="ram", action_type="all")
+    vec = retrokit.make_vec(cart.name, 2, state=cart.integration.after_reset, obs_type="ram", action_type="all")
+    try:
+        their_obs, _ = theirs.reset(seed=0)
+        obs, _ = ours.reset(seed=0)
+        batch, _ = vec.reset(seed=0)
+        assert ours.observation_space.shape == their_obs.shape == vec.single_observation_space.shape
+        changed = 0
+        for step, names in enumerate(inputs(cart, 7, RAM_STEPS)):
+            action = pressed(ours.buttons, names)
+            before = obs
+            their_obs = theirs.step(action)[0]
+            obs = ours.step(action)[0]
+            batch = vec.step(np.stack([action, action]))[0]
+            assert np.array_equal(obs, their_obs), f"step {step}: bytes {np.flatnonzero(obs != their_obs)[:5]}"
+            assert np.array_equal(batch[0], their_obs) and np.array_equal(batch[1], their_obs), f"vector env, step {step}"
+            changed += not np.array_equal(before, obs)
+        assert np.array_equal(ours.get_ram(), theirs.unwrapped.get_ram())
+        assert changed > RAM_STEPS // 2  # a game writing its RAM, not two frozen copies
+        # docs/systems.md says the system's layout, with its length
+        page = (REPO / "docs" / "systems.md").read_text()
+        row = re.search(rf"(?ms)^## {cart.system.name}\n.*?^\| `get_ram\(\)`, `obs_type=\"ram\"` \| ([^\n]*)", page)
+        assert row is not None and row[1].startswith(f"{len(their_obs):,} bytes"), cart.system.name
+    finally:
+        vec.close()
+        ours.close()
+        theirs.close()
+
+
+def test_the_nes_ram_is_the_internal_ram_then_the_cartridge_ram() -> None:
+    # The layout, on the console: 0x0000-0x07FF, then 0x6000-0x7FFF, each byte where peek finds it.
+    with retrokit.make("Hopper-Nes", obs_type="ram") as env:
+        env.reset(seed=0)
+        emulator = env.unwrapped.emulator
+        emulator.poke(0x0123, 0xA5)
+        emulator.poke(0x6001, 0x5A)
+        emulator.poke(0x7FFF, 0x3C)
+        ram = env.get_ram()
+        assert len(ram) == 10240 == env.observation_space.shape[0]
+        assert (ram[0x0123], ram[0x800 + 0x0001], ram[-1]) == (0xA5, 0x5A, 0x3C)
+        assert np.array_equal(ram[:0x800], emulator.ram)  # the system RAM is its first 2 KiB
 
 
 # --- states and movies, both ways ---------------------------------------------------------------------

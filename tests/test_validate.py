@@ -240,13 +240,14 @@ def test_a_gzip_bomb_state_fails_without_stopping_the_run(planted: GameReport) -
 
 
 def test_a_state_that_hangs_the_core_fails_and_the_next_child_goes_on(monkeypatch: pytest.MonkeyPatch) -> None:
+    from retrokit.data import probe
     from retrokit.data.games import find_game
     from retrokit.testing import states
 
     # A billion idle frames a state, with a second allowed for each: every state hangs on any machine. (A
     # millisecond for 60 frames raced instead: a parent busy when the child printed read the state's start and
     # its result in one read, and the first state passed.)
-    monkeypatch.setattr(states, "CHILD_TIMEOUT", 1.0)
+    monkeypatch.setattr(probe, "PROBE_TIMEOUT", 1.0)
     game = find_game("Dasher-Genesis")
     probes = states.probe_states(game, ["Zone1.Act1", "Zone1.Act2"], game.require_rom(), frames=10**9)
     assert ["hangs the core" in p.error for p in probes.values()] == [True, True]

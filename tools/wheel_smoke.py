@@ -60,7 +60,7 @@ def main() -> int:
             return fail(f"Sonic's missing-ROM error names no fix: {exc}")
     else:
         return fail("Sonic made without its ROM")
-    problem = check_docs(package)
+    problem = check_docs(package) or check_paper(package)
     if problem:
         return fail(problem)
     print(f"wheel smoke test: ok ({package}, Dasher reward {total:.1f}, {np.__version__=})")
@@ -84,6 +84,36 @@ def check_docs(package: Path) -> str:
     if typo.returncode != 2 or "Did you mean 'integrate'?" not in typo.stderr:
         return f"retrokit docs integrat said: {typo.stderr[-200:]!r}"
     return ""
+
+
+def check_paper(package: Path) -> str:
+    """What is wrong with the paper's scores in a report of the installed retrokit, or ``""``: they ship in the wheel.
+
+    No Sonic ROM is here, so the report is of JERK's episodes as if played on the paper's 11 test levels.
+    """
+    import os
+
+    import retrokit
+    from retrokit.benchmark.monitor import Episode
+    from retrokit.benchmark.paper import PAPER_ENV, load_paper
+    from retrokit.benchmark.report import render_report
+    from retrokit.benchmark.rundir import FinishedLevel
+    from retrokit.benchmark.scores import summarize
+
+    os.environ.pop(PAPER_ENV, None)  # retrokit's own copy, as a user has it
+    paper = load_paper()
+    if paper is None or package not in paper.path.parents or not (paper.path.parent / "README.md").is_file():
+        return f"the paper's scores are not in the wheel: {paper and paper.path}"
+    levels = [f"{game}/{state}" for game, state in retrokit.sonic.test_levels()]
+    settings = {"benchmark": {"name": "sonic"}, "agent": "jerk", "seed": 0, "budget": 1000, "levels": levels}
+    summary = summarize(settings, {level: FinishedLevel(1000, 1) for level in levels},
+                        {level: [Episode(1, 900, 1000.0, 900, 1.0)] for level in levels})
+    text = render_report(summary, paper, plots=[])
+    wanted = ["beside the paper's Table 3 (JERK)", "| JERK (paper) | 1,904.0 | 21.9 | 2,306.8 | 74.0 |",
+              "| Joint PPO (paper) | 3,127.9 | 116.9 | 3,926.3 | 78.1 |", "| **jerk** (this run) | **1,000.0** |",
+              "| 3,702.1 | 4,862.2 | -2,702.1 |"]  # GreenHillZone.Act2: the paper's JERK score and final score
+    missing = [line for line in wanted if line not in text]
+    return f"the report lacks the paper's {missing}" if missing else ""
 
 
 def fail(what: str) -> int:

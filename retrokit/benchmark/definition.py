@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import os
 import zlib
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -221,6 +221,20 @@ def read_benchmark(path: str | os.PathLike[str]) -> Benchmark:
         data = load_yaml(read_regular_file(path, "a benchmark file", MAX_FILE_BYTES).decode("utf-8-sig"))
     except (OSError, UnicodeDecodeError, yaml.YAMLError) as exc:
         raise fail(f"cannot be read as YAML ({str(exc).splitlines()[0]})") from None
+    return benchmark_from_data(data, fail, path.stem)
+
+
+def benchmark_from_data(data: Any, fail: Callable[[str], Exception], default_name: str) -> Benchmark:
+    """A benchmark from the data of its YAML file, or of a run's ``run.json`` (:meth:`Benchmark.as_dict`), checked.
+
+    Args:
+        data: The parsed data.
+        fail: Makes the error for a problem (it names the file).
+        default_name: The benchmark's name when the data gives none.
+
+    Raises:
+        Exception: ``fail``'s error, when the data is not of the benchmark shape.
+    """
     if not isinstance(data, dict):
         raise fail(f"holds a {type(data).__name__}, not a mapping")
     unknown = set(data) - {"name", "description", "budget", "env", "levels"}
@@ -246,7 +260,7 @@ def read_benchmark(path: str | os.PathLike[str]) -> Benchmark:
         except ValueError as exc:
             raise fail(f"'levels.{key}': {exc}") from None
     return Benchmark(
-        name=str(data.get("name") or path.stem),
+        name=str(data.get("name") or default_name),
         train=split["train"],
         test=split["test"],
         budget=budget,

@@ -226,11 +226,14 @@ def write_outputs(ev: Evaluation, run: RunDir, paper: PaperScores | None) -> Sum
         series: dict[str, dict[str, float | None]] = {
             ev.agent: {level: entry.mean_score for level, entry in summary.levels.items()}}
         if name is not None and any(level in theirs for level in summary.levels):
-            series[f"paper ({name})"] = {level: score for level, (score, _) in theirs.items()}
+            series[f"paper ({name})"] = {level: entry.score for level, entry in theirs.items()}
         atomic_write(ev.out / "scores.png",
                      plots.score_bars(series, list(summary.levels), f"{ev.agent} on {ev.benchmark.name}: level scores"),
                      overwrite=True)
-        written = ["learning-curves.png", "scores.png"]
+        atomic_write(ev.out / "mean-learning-curve.png",
+                     plots.mean_learning_curve({ev.agent: summary.curve}, summary.budget,
+                                               f"{ev.agent} on {ev.benchmark.name}: learning curve"), overwrite=True)
+        written = ["learning-curves.png", "scores.png", "mean-learning-curve.png"]
     text = render_report(summary, paper, plots=written, failed=ev.failed or run.failed,
                          env_rules=ev.benchmark.env_options(),
                          paper_levels=has_paper_scores(level.name for level in ev.levels))

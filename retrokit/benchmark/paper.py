@@ -1,27 +1,40 @@
-"""The paper's published scores, read from ``test-scores.csv`` (and its README.md).
+"""The paper's published scores, read from ``test-scores.csv``.
 
-The file is not part of the package: it is looked for in ``$RETROKIT_PAPER``,
-then in a ``shared/paper`` folder beside the repository or any folder above
-it (where the project keeps it), then beside the working folder. When it is
-nowhere, reports say so and go on without it.
+The file ships in the package (``paper_scores/``, whose README.md says what
+its columns hold), so an installed retrokit's reports have the paper's
+numbers; ``$RETROKIT_PAPER`` names another folder holding a
+``test-scores.csv`` to use instead. When the file named is absent or damaged,
+reports say so and go on without it.
 """
 
 from __future__ import annotations
 
 import csv
+import math
 import os
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import NamedTuple
 
 from retrokit.data.sonic_levels import TEST_LEVELS
+from retrokit.errors import RetrokitError
+from retrokit.paths import read_regular_file
 
 PAPER_ENV = "RETROKIT_PAPER"
 SCORES_FILE = "test-scores.csv"
-#: Our agent names that the paper also ran.
-AGENT_NAMES = {"jerk": "JERK"}
+#: The copy that ships with retrokit.
+SHIPPED_DIR = Path(__file__).resolve().parent / "paper_scores"
+#: Our agents that the paper also ran, by name, and the paper's name for them.
+AGENT_NAMES = {"jerk": "JERK", "ppo": "PPO", "rainbow": "Rainbow"}
+#: The paper's names of our learning agents when they start from a jointly trained policy (``--init``).
+JOINT_NAMES = {"PPO": "Joint PPO", "Rainbow": "Joint Rainbow"}
 #: The levels the paper scored: its 11 test levels.
 PAPER_LEVELS = frozenset(f"{game}/{state}" for game, states in TEST_LEVELS.items() for state in states)
+#: The number of the paper's first per-level table (Appendix C); the agents' tables follow in the file's order.
+FIRST_LEVEL_TABLE = 2
+#: A larger file is refused (a link to /dev/zero must not fill memory): the paper's is 5 kB.
+MAX_SCORES_BYTES = 1 << 20
 
 
 def has_paper_scores(levels: Iterable[str]) -> bool:
@@ -29,42 +42,68 @@ def has_paper_scores(levels: Iterable[str]) -> bool:
     return any(level in PAPER_LEVELS for level in levels)
 
 
+def paper_name(agent: str, init: str | None = None) -> str | None:
+    """The paper's name for our agent ``agent`` (run with ``--init init``), or ``None`` if the paper did not run it.
+
+    Case does not matter, and a user agent ``MODULE:CALLABLE`` goes by its
+    callable's name, so ``my_agents.py:ppo`` is compared with the paper's PPO.
+    A learning agent that starts from a trained policy is the paper's "Joint" one.
+    """
+    name = AGENT_NAMES.get(agent.rpartition(":")[2].lower())
+    return JOINT_NAMES.get(name, name) if init and name is not None else name
+
+
+class PaperEntry(NamedTuple):
+    """One row of the paper's tables: the score and the final score, with their standard deviations.
+
+    The final score and its deviation are ``None`` where the paper gives none (Human).
+    """
+
+    score: float
+    sd: float
+    final: float | None
+    final_sd: float | None
+
+
 @dataclass
 class PaperScores:
-    """The paper's per-level test scores, by agent.
+    """The paper's per-level test scores and aggregates, by agent, in the file's order.
 
     Attributes:
         path: The CSV file.
-        levels: ``{agent: {"Game/State": (score, sd)}}``.
-        aggregates: ``{agent: (score, sd)}``.
+        shipped: Whether it is retrokit's own copy (not one named by ``$RETROKIT_PAPER``).
+        levels: ``{agent: {"Game/State": entry}}``.
+        aggregates: ``{agent: entry}``: the paper's Table 1.
     """
 
     path: Path
-    levels: dict[str, dict[str, tuple[float, float]]] = field(default_factory=dict)
-    aggregates: dict[str, tuple[float, float]] = field(default_factory=dict)
+    shipped: bool = True
+    levels: dict[str, dict[str, PaperEntry]] = field(default_factory=dict)
+    aggregates: dict[str, PaperEntry] = field(default_factory=dict)
 
-    def agent(self, name: str) -> str | None:
-        """The paper's name of our agent ``name``, if the paper ran it.
+    def agent(self, name: str, init: str | None = None) -> str | None:
+        """The paper's name of our agent ``name`` (see :func:`paper_name`), if the file has its scores."""
+        wanted = paper_name(name, init)
+        return wanted if wanted in self.levels or wanted in self.aggregates else None
 
-        Case does not matter, and a user agent ``MODULE:CALLABLE`` goes by its
-        callable's name, so ``my_agents.py:ppo`` is compared with the paper's PPO.
-        """
-        wanted = AGENT_NAMES.get(name, name.rpartition(":")[2]).lower()
-        return next((a for a in self.levels if a.lower() == wanted), None)
+    def table(self, name: str) -> int:
+        """The number of the paper's per-level table of agent ``name`` (Appendix C's Tables 2 to 7)."""
+        return FIRST_LEVEL_TABLE + list(self.levels).index(name)
+
+    @property
+    def source(self) -> str:
+        """Where the scores come from, for a report: the same words on every install for retrokit's own copy."""
+        where = "retrokit's copy" if self.shipped else f"`{self.path}` (${PAPER_ENV})"
+        return f"Paper: Nichol et al., *Gotta Learn Fast* (2018), Table 1 and Appendix C, from {where}."
 
 
-def find_paper_dir(start: Path | None = None) -> Path | None:
-    """The folder that holds ``test-scores.csv``, or ``None``."""
+def find_paper_dir() -> Path | None:
+    """The folder of ``test-scores.csv``: ``$RETROKIT_PAPER`` when set (``None`` if it has none), else retrokit's."""
     override = os.environ.get(PAPER_ENV)
     if override:
-        return Path(override).expanduser() if (Path(override).expanduser() / SCORES_FILE).is_file() else None
-    roots = [Path(__file__).resolve().parents[2], (start or Path.cwd()).resolve()]
-    for root in roots:
-        for folder in (root, *root.parents):
-            candidate = folder / "shared" / "paper"
-            if (candidate / SCORES_FILE).is_file():
-                return candidate
-    return None
+        folder = Path(override).expanduser()
+        return folder if (folder / SCORES_FILE).is_file() else None
+    return SHIPPED_DIR
 
 
 def load_paper(folder: Path | None = None) -> PaperScores | None:
@@ -73,16 +112,28 @@ def load_paper(folder: Path | None = None) -> PaperScores | None:
     if folder is None:
         return None
     path = folder / SCORES_FILE
-    scores = PaperScores(path)
+    scores = PaperScores(path, shipped=folder.resolve() == SHIPPED_DIR)
     try:
-        with path.open(encoding="utf-8", newline="") as f:
-            for row in csv.DictReader(f):
-                agent, game, state = row["agent"], row["game"], row["state"]
-                value = (float(row["score"]), float(row["score_sd"] or 0.0))
-                if state == "Aggregate":
-                    scores.aggregates[agent] = value
-                else:
-                    scores.levels.setdefault(agent, {})[f"{game}/{state}"] = value
-    except (OSError, KeyError, ValueError, csv.Error):
+        data = read_regular_file(path, "the paper's scores (a CSV file)", MAX_SCORES_BYTES)
+        for row in csv.DictReader(data.decode("utf-8").splitlines()):
+            entry = PaperEntry(_number(row["score"]), _number(row["score_sd"] or "0"),
+                               _optional(row["final_score"]), _optional(row["final_score_sd"]))
+            agent, game, state = row["agent"], row["game"], row["state"]
+            if state == "Aggregate":
+                scores.aggregates[agent] = entry
+            else:
+                scores.levels.setdefault(agent, {})[f"{game}/{state}"] = entry
+    except (RetrokitError, KeyError, ValueError, TypeError, csv.Error):
         return None
     return scores
+
+
+def _number(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(f"not a finite number: {text!r}")
+    return value
+
+
+def _optional(text: str | None) -> float | None:
+    return _number(text) if text else None

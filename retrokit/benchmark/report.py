@@ -1,24 +1,35 @@
-"""The files a user reads: ``summary.json``, ``summary.csv`` and ``report.md``."""
+"""The files a user reads: ``summary.json``, ``summary.csv`` and ``report.md``.
+
+On levels the paper scored (the Sonic benchmark's test levels), ``report.md``
+sets the run beside the paper: its per-level table beside the paper's table of
+the same agent (Appendix C's Tables 2 to 6: score and final score), and its
+aggregates among the paper's Table 1, which :func:`table_one` writes for the
+side-by-side report of several agents too (:mod:`.comparison`).
+"""
 
 from __future__ import annotations
 
 import csv
 import io
 import json
+import math
 from pathlib import Path
 from typing import Any
 
-from retrokit.benchmark.paper import PAPER_ENV, PaperScores
-from retrokit.benchmark.scores import FROM_UNFINISHED, Summary
+from retrokit.benchmark.paper import PAPER_ENV, PAPER_LEVELS, PaperEntry, PaperScores
+from retrokit.benchmark.scores import FINAL_SCORE_NOTE, FROM_UNFINISHED, Summary
 from retrokit.paths import atomic_write
 
-COLUMNS = ("level", "mean_score", "std", "episodes", "timesteps", "best", "paper_score", "paper_sd")
+COLUMNS = ("level", "mean_score", "std", "episodes", "timesteps", "best", "final_score", "final_episodes",
+           "paper_score", "paper_sd", "paper_final_score", "paper_final_sd")
+SCORE_WORDS = ("The score of a level is the mean total reward of its finished episodes; the aggregate is the mean "
+               f"of the level scores. {FINAL_SCORE_NOTE} The final aggregate is the mean of the final scores.")
 
 
-def paper_column(summary: Summary, paper: PaperScores | None) -> tuple[str | None, dict[str, tuple[float, float]]]:
+def paper_column(summary: Summary, paper: PaperScores | None) -> tuple[str | None, dict[str, PaperEntry]]:
     """The paper's name for the summary's agent and its per-level scores, when the paper ran it."""
-    name = paper.agent(summary.agent) if paper is not None else None
-    return name, (paper.levels.get(name, {}) if paper is not None and name is not None else {})
+    name = summary.paper_agent if paper is not None and summary.paper_agent in paper.levels else None
+    return name, (paper.levels[name] if paper is not None and name is not None else {})
 
 
 def write_summary(folder: Path, summary: Summary, paper: PaperScores | None) -> None:
@@ -31,9 +42,10 @@ def write_summary(folder: Path, summary: Summary, paper: PaperScores | None) -> 
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(COLUMNS)
     for level, entry in summary.levels.items():
-        score, sd = theirs.get(level, (None, None))
-        writer.writerow([level, *(_cell(getattr(entry, k)) for k in COLUMNS[1:6]), _cell(score), _cell(sd)])
-    writer.writerow(["aggregate", _cell(summary.aggregate), "", "", "", "", "", ""])
+        row = theirs.get(level, (None, None, None, None))
+        writer.writerow([level, *(_cell(getattr(entry, k)) for k in COLUMNS[1:8]), *map(_cell, row)])
+    writer.writerow(["aggregate", _cell(summary.aggregate), "", "", "", "", _cell(summary.final_aggregate),
+                     "", "", "", "", ""])
     atomic_write(folder / "summary.csv", out.getvalue().encode(), overwrite=True)
 
 
@@ -43,14 +55,25 @@ def _cell(value: Any) -> str:
     return f"{value:.6g}" if isinstance(value, float) else str(value)
 
 
-def _number(value: float | None, digits: int = 1) -> str:
+def number(value: float | None, digits: int = 1) -> str:
+    """A score as the reports write it: ``1,234.5``, or ``–`` for none."""
     return "–" if value is None else f"{value:,.{digits}f}"
+
+
+def _mean(values: list[float]) -> float | None:
+    return math.fsum(values) / len(values) if values else None
+
+
+def paper_means(theirs: dict[str, PaperEntry], levels: list[str]) -> tuple[float | None, float | None]:
+    """The paper's mean score and mean final score over those of ``levels`` it has (the aggregate row's)."""
+    rows = [theirs[level] for level in levels if level in theirs]
+    return _mean([r.score for r in rows]), _mean([r.final for r in rows if r.final is not None])
 
 
 def render_report(summary: Summary, paper: PaperScores | None, *, plots: list[str],
                   failed: dict[str, str] | None = None, env_rules: dict[str, Any] | None = None,
                   paper_levels: bool = True) -> str:
-    """``report.md``: the per-level table beside the paper's scores for the same agent.
+    """``report.md``: the per-level table beside the paper's scores for the same agent, and Table 1.
 
     Args:
         summary: The run's summary.
@@ -69,34 +92,36 @@ def render_report(summary: Summary, paper: PaperScores | None, *, plots: list[st
         f"{len(summary.levels)} level(s) finished{'' if summary.complete else ' (the run is not complete)'}, "
         f"{summary.budget:,} timesteps each, seed {summary.seed}."
         + (f" Env rules: {', '.join(f'{k}={v}' for k, v in env_rules.items())}." if env_rules else ""),
-        ("The score of a level is the mean total reward of its finished episodes; the aggregate is the mean "
-        "of the level scores."),
+        SCORE_WORDS,
         *(f"{note} Such levels are marked * below." for note in summary.notes),
         "",
     ]
-    header = "| level | mean score | sd | episodes | timesteps | best |"
-    rule = "|---|---:|---:|---:|---:|---:|"
+    if theirs and paper is not None and name is not None:
+        lines += [f"## Per level, beside the paper's Table {paper.table(name)} ({name})", ""]
+    header = "| level | mean score | sd | final score | episodes | timesteps | best |"
+    rule = "|---|---:|---:|---:|---:|---:|---:|"
     if theirs:
-        header += f" paper ({name}) | ours − paper |"
-        rule += "---:|---:|"
+        header += f" paper ({name}) | paper final score | ours − paper |"
+        rule += "---:|---:|---:|"
     lines += [header, rule]
     for level, e in summary.levels.items():
         mark = " *" if e.scored_from == FROM_UNFINISHED else ""
-        row = (f"| {level}{mark} | {_number(e.mean_score)} | {_number(e.std)} | {e.episodes} | "
-               f"{e.timesteps:,} | {_number(e.best)} |")
+        row = (f"| {level}{mark} | {number(e.mean_score)} | {number(e.std)} | {number(e.final_score)} | "
+               f"{e.episodes} | {e.timesteps:,} | {number(e.best)} |")
         if theirs:
-            score = theirs.get(level, (None, None))[0]
-            diff = None if score is None else e.mean_score - score
-            row += f" {_number(score)} | {_number(diff)} |"
+            entry = theirs.get(level)
+            diff = None if entry is None else e.mean_score - entry.score
+            row += (f" {number(entry and entry.score)} | {number(entry and entry.final)} | {number(diff)} |")
         lines.append(row)
-    aggregate = f"| **aggregate** | **{_number(summary.aggregate)}** | | | | |"
+    aggregate = f"| **aggregate** | **{number(summary.aggregate)}** | | **{number(summary.final_aggregate)}** | | | |"
     if theirs:
-        ours_in_paper = [lv for lv in summary.levels if lv in theirs]
-        paper_mean = sum(theirs[lv][0] for lv in ours_in_paper) / len(ours_in_paper) if ours_in_paper else None
-        aggregate += f" {_number(paper_mean)} | |"
+        score, final = paper_means(theirs, list(summary.levels))
+        aggregate += f" {number(score)} | {number(final)} | |"
     lines += [aggregate, ""]
     if paper_levels:
         lines += _paper_notes(summary, paper, name, theirs)
+        if paper is not None:
+            lines += table_one(paper, {summary.agent: summary})
     if failed:
         lines += ["## Levels that failed", "", *(f"- {level}: {error}" for level, error in failed.items()),
                   "", "Fix the cause and run the same command with `--resume` to finish them.", ""]
@@ -106,22 +131,48 @@ def render_report(summary: Summary, paper: PaperScores | None, *, plots: list[st
 
 
 def _paper_notes(summary: Summary, paper: PaperScores | None, name: str | None,
-                 theirs: dict[str, tuple[float, float]]) -> list[str]:
+                 theirs: dict[str, PaperEntry]) -> list[str]:
     if paper is None:
-        return [(f"The paper's scores were not found (looked in ${PAPER_ENV}, then shared/paper beside the repository "
-                "and the folders above it), so they are not shown."), ""]
-    source = f"Paper: Nichol et al., *Gotta Learn Fast* (2018), Appendix C, from `{paper.path}`."
+        return [(f"The paper's scores were not found (${PAPER_ENV} names a folder without a readable "
+                 "test-scores.csv, or retrokit's copy is damaged), so they are not shown."), ""]
     if name is None:
-        others = ", ".join(f"{agent} {score:,.1f}" for agent, (score, _) in paper.aggregates.items())
-        return [source, f"The paper did not run {summary.agent!r}; its aggregates over its 11 test levels: {others}.", ""]
+        return [paper.source, f"The paper did not run {summary.agent!r}: Table 1 below lists it after the paper's agents.",
+                ""]
     compared = sum(1 for level in summary.levels if level in theirs)
     if not compared:
-        return [source, (f"None of these levels is among the paper's test levels, so there is no paper column; "
-                f"its {name} aggregate over its 11 test levels is {paper.aggregates.get(name, (0.0,))[0]:,.1f}."), ""]
-    notes = [source, f"{compared} of these levels have a paper score; the paper column's aggregate is their mean."]
-    if name in paper.aggregates:
-        notes.append(f"The paper's own {name} aggregate over its 11 test levels: {paper.aggregates[name][0]:,.1f}.")
-    return [*notes, ""]
+        return [paper.source, (f"None of these levels is among the paper's test levels, so there is no paper column; "
+                f"its {name} aggregate over its 11 test levels is in Table 1 below."), ""]
+    return [paper.source, f"{compared} of these levels have a paper score; the paper columns' aggregates are their means.",
+            ""]
+
+
+def table_one(paper: PaperScores, summaries: dict[str, Summary]) -> list[str]:
+    """The paper's Table 1 (each agent's aggregate over its 11 test levels), each of ours under the paper's row for it.
+
+    Our rows average our scores on the paper's test levels only; a run that finished fewer says how many. Agents
+    the paper did not run come last.
+    """
+    lines = ["## Beside the paper's Table 1", "",
+             "| agent | score | sd | final score | final sd |", "|---|---:|---:|---:|---:|"]
+    placed: set[str] = set()
+    for name, entry in paper.aggregates.items():
+        lines.append(f"| {name} (paper) | {number(entry.score)} | {number(entry.sd)} | {number(entry.final)} | "
+                     f"{number(entry.final_sd)} |")
+        for agent, summary in summaries.items():
+            if summary.paper_agent == name:
+                lines.append(_our_row(agent, summary))
+                placed.add(agent)
+    lines += [_our_row(agent, summary) for agent, summary in summaries.items() if agent not in placed]
+    return [*lines, "", ("The paper's standard deviations are over its several runs of each agent; a run of ours is "
+                         "one run, so it has none."), ""]
+
+
+def _our_row(agent: str, summary: Summary) -> str:
+    ours = [e for level, e in summary.levels.items() if level in PAPER_LEVELS]
+    score = _mean([e.mean_score for e in ours])
+    final = _mean([e.mean_score if e.final_score is None else e.final_score for e in ours])
+    count = "" if len(ours) == len(PAPER_LEVELS) else f", {len(ours)} of the {len(PAPER_LEVELS)} levels"
+    return f"| **{agent}** (this run{count}) | **{number(score)}** | – | **{number(final)}** | – |"
 
 
 def write_report(folder: Path, text: str) -> None:

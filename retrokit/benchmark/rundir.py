@@ -90,11 +90,8 @@ class RunDir:
         self.failed: dict[str, str] = {}
         self.episodes: dict[str, list[Episode]] = {}
         self.replayed: list[str] = []  # finished levels of an older run that did not spend their budget
-        if resume and not (self.path / RUN_FILE).exists() and not (self.path / RUN_FILE).is_symlink():
-            raise RunFolderError(
-                f"Expected {self.path} to hold an evaluation to resume ({RUN_FILE}), but it has none; "
-                "drop --resume to start one."
-            )
+        if resume and not os.path.lexists(self.path / RUN_FILE):
+            raise _nothing_to_resume(self.path)
         if not resume:
             self._refuse_earlier()
             ensure_folder(self.path, "for the evaluation's results")
@@ -120,23 +117,10 @@ class RunDir:
             )
 
     def _damaged(self, name: str, problem: str) -> RunFolderError:
-        return RunFolderError(
-            f"Expected a readable {self.path / name} to resume, but {problem}; the folder is damaged: "
-            "start in a new --out."
-        )
+        return _damaged(self.path, name, problem)
 
     def _load(self) -> None:
-        with self._open(RUN_FILE) as f:
-            raw = f.read(MAX_RUN_FILE_BYTES + 1)
-        if len(raw) > MAX_RUN_FILE_BYTES:
-            raise self._damaged(RUN_FILE, f"it is larger than {MAX_RUN_FILE_BYTES >> 20} MB")
-        try:
-            saved = json.loads(raw.decode("utf-8"))
-        except (UnicodeDecodeError, ValueError, RecursionError) as exc:
-            raise self._damaged(RUN_FILE, f"it is not JSON ({type(exc).__name__})") from None
-        if not isinstance(saved, dict) or not isinstance(saved.get("settings"), dict) \
-                or not isinstance(saved.get("finished"), dict):
-            raise self._damaged(RUN_FILE, "it does not map 'settings' and 'finished' to mappings")
+        saved = read_run_file(self.path)
         settings = saved["settings"]
         if settings != self.settings:
             differ = sorted(k for k in {*settings, *self.settings} if settings.get(k) != self.settings.get(k))
@@ -195,16 +179,7 @@ class RunDir:
         return kept
 
     def _open(self, name: str) -> BinaryIO:
-        """Open one of the folder's files for reading: a regular file only (a FIFO would block, a device never end)."""
-        path = self.path / name
-        try:
-            fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
-        except OSError as exc:
-            raise self._damaged(name, f"it cannot be opened ({exc.strerror or exc})") from None
-        if not stat.S_ISREG(os.fstat(fd).st_mode):
-            os.close(fd)
-            raise self._damaged(name, "it is not a regular file (a FIFO, a device or a folder)")
-        return os.fdopen(fd, "rb")
+        return _open(self.path, name)
 
     def _save(self) -> None:
         data = {"settings": self.settings, "finished": {k: asdict(v) for k, v in self.finished.items()},
@@ -277,6 +252,52 @@ def _lock(path: Path) -> int:
     raise RunFolderError(f"Expected to lock {path} for this run, but it kept being replaced; use another --out.")
 
 
+def _nothing_to_resume(folder: Path) -> RunFolderError:
+    return RunFolderError(
+        f"Expected {folder} to hold an evaluation to resume ({RUN_FILE}), but it has none; drop --resume to start one."
+    )
+
+
+def _damaged(folder: Path, name: str, problem: str) -> RunFolderError:
+    return RunFolderError(
+        f"Expected a readable {folder / name} to resume, but {problem}; the folder is damaged: start in a new --out."
+    )
+
+
+def _open(folder: Path, name: str) -> BinaryIO:
+    """Open one of a run folder's files for reading: a regular file only (a FIFO would block, a device never end)."""
+    try:
+        fd = os.open(folder / name, os.O_RDONLY | os.O_NONBLOCK)
+    except OSError as exc:
+        raise _damaged(folder, name, f"it cannot be opened ({exc.strerror or exc})") from None
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise _damaged(folder, name, "it is not a regular file (a FIFO, a device or a folder)")
+    return os.fdopen(fd, "rb")
+
+
+def read_run_file(folder: Path) -> dict[str, Any]:
+    """The ``run.json`` of a run folder: its ``settings`` and ``finished`` mappings, checked for that shape.
+
+    Raises:
+        RunFolderError: It is missing, unreadable, too large, not JSON, or not of that shape.
+    """
+    if not os.path.lexists(folder / RUN_FILE):
+        raise _nothing_to_resume(folder)
+    with _open(folder, RUN_FILE) as f:
+        raw = f.read(MAX_RUN_FILE_BYTES + 1)
+    if len(raw) > MAX_RUN_FILE_BYTES:
+        raise _damaged(folder, RUN_FILE, f"it is larger than {MAX_RUN_FILE_BYTES >> 20} MB")
+    try:
+        saved = json.loads(raw.decode("utf-8"))
+    except (UnicodeDecodeError, ValueError, RecursionError) as exc:
+        raise _damaged(folder, RUN_FILE, f"it is not JSON ({type(exc).__name__})") from None
+    if not isinstance(saved, dict) or not isinstance(saved.get("settings"), dict) \
+            or not isinstance(saved.get("finished"), dict):
+        raise _damaged(folder, RUN_FILE, "it does not map 'settings' and 'finished' to mappings")
+    return saved
+
+
 def _lock_once(path: Path) -> int:
     """Open ``path`` and take its lock; return the descriptor."""
     try:
@@ -292,10 +313,11 @@ def _lock_once(path: Path) -> int:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip() or "another process"
+            holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip()
+            who = f"process {holder}" if holder.isdigit() else "a process that has not written its number yet"
             raise RunFolderError(
-                f"Expected no other evaluation running in {path.parent}, but one is (process {holder}); "
-                "wait for it to end, or use another --out."
+                f"Expected no other evaluation running in the folder {str(path.parent)!r}; found one there ({who}). "
+                "Wait for it to end, or use another --out."
             ) from None
     except (RetrokitError, OSError):
         os.close(fd)

@@ -29,8 +29,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="evaluate JERK against random on the bundled Dasher benchmark: table, report, plots and a GIF",
         description="Run the Dasher benchmark (no ROM import needed) with the paper's JERK agent and with random "
         "actions, with a progress bar per level (a line per level when the output is not a terminal); print the "
-        "per-level scores and aggregates, and write each agent's run folder, a side-by-side report.md and "
-        "scores.png, and a GIF of JERK's best episode. It is `retrokit evaluate --benchmark dasher --agent jerk "
+        "per-level scores and aggregates, and write each agent's run folder, a side-by-side report.md, "
+        "scores.png and mean-learning-curve.png, and a GIF of JERK's best episode. It is `retrokit evaluate --benchmark dasher --agent jerk "
         "--agent random`.",
     )
     add_evaluation_options(parser, "processes (default: up to 2)")
@@ -62,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
     from retrokit.benchmark.comparison import agent_folders, compare
     from retrokit.benchmark.definition import load_benchmark
     from retrokit.benchmark.evaluation import Evaluation, level_file_name
-    from retrokit.commands.evaluate import print_speed, print_table
+    from retrokit.commands.evaluate import print_build_hints, print_speed, print_table
 
     benchmark = load_benchmark("dasher")
     levels = benchmark.select(args.levels)
@@ -82,7 +82,8 @@ def run(args: argparse.Namespace) -> int:
         print(f"JERK's aggregate is {jerk / rand:.2f}x random's.")
     folders = agent_folders(list(AGENTS))
     written = [f"{out / folders[agent]}/ (report.md, summary.json, plots)" for agent in AGENTS]
-    written.append(f"{out / 'report.md'} and {out / 'scores.png'} (the two agents side by side)")
+    written.append(f"{out / 'report.md'}, {out / 'scores.png'} and {out / 'mean-learning-curve.png'} "
+                   "(the two agents side by side)")
     best = max(summaries["jerk"].levels.items(), key=lambda item: item[1].best or float("-inf"))[0]
     gif = out / folders["jerk"] / "gifs" / f"{level_file_name(best)}.gif"
     if gif.is_file():
@@ -90,6 +91,7 @@ def run(args: argparse.Namespace) -> int:
         written.append(f"{out / 'jerk-best.gif'} (JERK's best episode, on {best})")
     print("wrote " + "\n      ".join(written))
     print_speed(made)  # as `retrokit evaluate` prints it: each agent's speed
+    print_build_hints(levels)  # and how much faster a built core would make it
     return 0
 
 

@@ -10,6 +10,7 @@ side. See docs/evaluate.md.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 from pathlib import Path
 
@@ -43,7 +44,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description="Play each level of a benchmark for its budget of timesteps with an agent, each level in a worker "
         "process, and write episodes.jsonl, summary.json, summary.csv, report.md (beside the paper's scores) and "
         "PNG plots into --out. Progress shows as a bar per level on a terminal, else as a line per finished level. "
-        "With several --agent, each runs into OUT/<agent>/ and OUT/report.md and OUT/scores.png compare them.",
+        "With several --agent, each runs into OUT/<agent>/ and OUT/report.md, OUT/scores.png and "
+        "OUT/mean-learning-curve.png compare them.",
         epilog=AGENT_NOTE,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -63,17 +65,60 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--gif", action="store_true", help="save a GIF of each level's best episode in --out/gifs")
     parser.add_argument("--list", action="store_true", help="list the benchmark's levels and stop")
     parser.add_argument("--no-progress", action="store_true", help="no progress bars or lines")
-    parser.set_defaults(run=run)
+    # None: not given. A --resume takes what was not given from the run folder; else the defaults the help names.
+    parser.set_defaults(run=run, benchmark=None, levels=None, seed=None)
+
+
+def _resumed(args: argparse.Namespace) -> None:
+    """Fill the options not given from the run folder's ``run.json`` (``--out DIR --resume`` alone continues a run).
+
+    A comparison's folder holds one run folder per agent: their settings are the same but the agent, so the
+    other options come from the first, and ``--agent`` must name the agents.
+
+    Raises:
+        RunFolderError: The folder holds no evaluation, or a damaged one.
+        InvalidArgumentError: A comparison's folder, and no --agent.
+    """
+    from retrokit.benchmark.definition import benchmark_from_data
+    from retrokit.benchmark.rundir import RUN_FILE, read_run_file
+    from retrokit.errors import InvalidArgumentError, RunFolderError
+
+    folder = args.out
+    if not os.path.lexists(folder / RUN_FILE):
+        agents = sorted(p.parent for p in folder.glob(f"*/{RUN_FILE}"))
+        if agents and not args.agent:
+            raise InvalidArgumentError(
+                f"Expected --agent for each agent of the comparison in {str(folder)!r} (its folders: "
+                f"{', '.join(p.name for p in agents)}); found none. Pass them as the interrupted command did."
+            )
+        folder = agents[0] if agents else folder
+    settings = read_run_file(folder)["settings"]
+
+    def fail(problem: str) -> RunFolderError:
+        return RunFolderError(f"Expected {folder / RUN_FILE}'s benchmark to resume, but {problem}; start in a new --out.")
+
+    if args.benchmark is None:
+        args.benchmark = benchmark_from_data(settings.get("benchmark"), fail, "benchmark")
+    if not args.agent and isinstance(settings.get("agent"), str):
+        args.agent = [settings["agent"]]
+    if args.levels is None and isinstance(settings.get("levels"), list):
+        args.levels = ",".join(map(str, settings["levels"]))
+    for option, key in (("timesteps", "budget"), ("seed", "seed")):
+        if getattr(args, option) is None and isinstance(settings.get(key), int):
+            setattr(args, option, settings[key])
 
 
 def run(args: argparse.Namespace) -> int:
     """Evaluate, then print the per-level table and the aggregate."""
     from retrokit.benchmark.comparison import compare
-    from retrokit.benchmark.definition import load_benchmark
+    from retrokit.benchmark.definition import Benchmark, load_benchmark
     from retrokit.benchmark.evaluation import Evaluation, evaluate
     from retrokit.errors import InvalidArgumentError
 
-    benchmark = load_benchmark(args.benchmark)
+    if args.resume and args.out is not None:
+        _resumed(args)
+    benchmark = load_benchmark(args.benchmark or "dasher") if not isinstance(args.benchmark, Benchmark) else args.benchmark
+    levels_spec, seed = args.levels or "test", args.seed or 0
     if args.list:
         for split, levels in (("test", benchmark.test), ("train", benchmark.train)):
             for level in levels:
@@ -82,12 +127,12 @@ def run(args: argparse.Namespace) -> int:
     if args.out is None:
         raise InvalidArgumentError("Expected --out DIR, the folder for the results; got none.")
     agents = args.agent or ["jerk"]
-    levels = benchmark.select(args.levels)
+    levels = benchmark.select(levels_spec)
     made: list[Evaluation] = []
 
     def make(agent: str, out: Path) -> Evaluation:
         made.append(Evaluation(
-            benchmark=benchmark, levels=levels, agent=agent, out=out, budget=args.timesteps, seed=args.seed,
+            benchmark=benchmark, levels=levels, agent=agent, out=out, budget=args.timesteps, seed=seed,
             workers=args.workers, backend=args.backend, ray_address=args.ray_address, resume=args.resume,
             gif=args.gif, progress=not args.no_progress, stall_timeout=args.stall_timeout,
         ))
@@ -104,10 +149,20 @@ def run(args: argparse.Namespace) -> int:
         return 130
     print_table(summaries)
     print(f"wrote {args.out}/: " + ("episodes.jsonl, summary.json, summary.csv, report.md, learning-curves.png, "
-                                    "scores.png" if len(agents) == 1 else
-                                    "report.md, scores.png, and a run folder per agent"))
+                                    "scores.png, mean-learning-curve.png" if len(agents) == 1 else
+                                    "report.md, scores.png, mean-learning-curve.png, and a run folder per agent"))
     print_speed(made)
+    print_build_hints(levels)
     return 0
+
+
+def print_build_hints(levels: list) -> None:  # retrokit.benchmark.definition.Level
+    """Say, on stderr, how much faster the levels' systems would run on a core ``retrokit build-core`` makes."""
+    from retrokit.data.games import find_game
+    from retrokit.host.buildhint import build_hints
+
+    for line in build_hints(find_game(level.game).system for level in levels):
+        print(line, file=sys.stderr)  # stdout is the results, the same on every machine
 
 
 def print_speed(made: list) -> None:  # retrokit.benchmark.evaluation.Evaluation

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import argparse
 import os
-import shlex
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from retrokit.commands._common import add_data_dir_option, add_force_option, rom_status
+from retrokit.errors import printable
 
 if TYPE_CHECKING:
     from retrokit.data.importer import UnmatchedFile
@@ -42,7 +42,7 @@ def _section(title: str, lines: list[str], verbose: bool) -> None:
     print(f"{title} ({len(lines)}):")
     shown = lines if verbose else lines[:SHOWN]
     for line in shown:
-        print(f"  {line}")
+        print(f"  {printable(line)}")  # file names: a control character in one must not reach the terminal
     if len(shown) < len(lines):
         print(f"  ... and {len(lines) - len(shown)} more (-v lists them all)")
 
@@ -56,7 +56,7 @@ def run(args: argparse.Namespace) -> int:
     from retrokit.benchmark.progress import is_terminal
     from retrokit.data.games import find_game
     from retrokit.data.importer import import_roms, package_roms
-    from retrokit.errors import FileSystemError, InvalidArgumentError
+    from retrokit.errors import FileSystemError, InvalidArgumentError, shell_word
 
     if args.package:
         args.paths = [*args.paths, str(package_roms(args.package))]
@@ -79,7 +79,12 @@ def run(args: argparse.Namespace) -> int:
         _section("Already imported", [f"{r.game} <- {r.source}" for r in report.already_present], args.verbose)
         _section(
             "Not overwritten, a different file is there (pass --force to replace it)",
-            [f"{c.game}: {c.path} has SHA-1 {c.existing_sha1}; {c.source} has {c.sha1}" for c in report.conflicts],
+            [f"{c.game}: {c.path} and {c.source} differ ({c.differs})" for c in report.conflicts],
+            True,
+        )
+        _section(
+            "Refused: a known game's ROM whose header its core cannot run (fix the header, or import a good dump)",
+            [f"{game}: {label}: {why}" for label, game, why in report.refused],
             True,
         )
         _section("Matched no known game (SHA-1, likely system)", [_unmatched(u) for u in report.unmatched], args.verbose)
@@ -91,9 +96,9 @@ def run(args: argparse.Namespace) -> int:
         _section("Games whose data files cannot be read", [f"{n}: {e}" for n, e in report.broken_games], args.verbose)
         likely = [u for u in report.unmatched if u.system is not None]
         if likely:
-            print(f"A game nobody has integrated yet? Start one with: retrokit new {shlex.quote(likely[0].source)} "
+            print(f"A game nobody has integrated yet? Start one with: retrokit new {shell_word(likely[0].source)} "
                   f"--name NAME-{likely[0].system} (retrokit docs integrate)")
-        status = 1 if report.conflicts else 0
+        status = 1 if report.conflicts or report.refused else 0
     if game is not None:
         where, path = rom_status(game, args.data_dir)
         print(f"{game.name} ({game.system}) accepts a ROM with SHA-1:")

@@ -32,7 +32,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     """Integrate the states; exit 1 if any differs from what was made."""
     from retrokit.data.integrate import integrate, place_state, target_folder
-    from retrokit.errors import InvalidArgumentError
+    from retrokit.errors import InvalidArgumentError, shell_word
     from retrokit.movie.playback import state_from_movie
 
     if len(args.names) > 2:
@@ -44,7 +44,7 @@ def run(args: argparse.Namespace) -> int:
     if args.state and args.movie:
         raise InvalidArgumentError(
             f"Expected --state or --movie, not both; found --state {args.state[0]} with --movie {args.movie}. "
-            f"To make a state from the movie, name it: retrokit integrate [GAME] NAME --movie {args.movie}"
+            f"To make a state from the movie, name it: retrokit integrate [GAME] NAME --movie {shell_word(args.movie)}"
         )
     out = Path(args.out) if args.out else None
     if args.movie:

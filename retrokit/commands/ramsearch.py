@@ -120,7 +120,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("name", metavar="NAME", help="the field's name, e.g. lives")
     p.add_argument("address", metavar="ADDRESS", help="its console address, e.g. 0xFF002B")
     p.add_argument("type", metavar="TYPE", help="its type code, e.g. '|u1'")
-    p.add_argument("--game-file", metavar="PATH", help="the game.yaml to write (default: the game's own)")
+    p.add_argument(
+        "--game-file", metavar="PATH",
+        help="the game.yaml to write (default: the game's own; a shipped game's copy in the data folder, made first)",
+    )
     p.add_argument("--force", action="store_true", help="replace a field of the same name")
     p.add_argument(
         "--range", nargs=2, metavar=("LO", "HI"), help="the values the field may hold, written as range: [LO, HI]"

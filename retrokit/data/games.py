@@ -23,6 +23,7 @@ from __future__ import annotations
 import fnmatch
 import os
 import re
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import cached_property
@@ -37,15 +38,18 @@ from retrokit.errors import (
     GameNotFoundError,
     RomMismatchError,
     RomNotFoundError,
+    SkippedDataWarning,
     StateNotFoundError,
     UnknownNameError,
     UnsupportedSystemError,
     did_you_mean,
+    listed,
 )
 from retrokit.host.systems import System, get_system
 
 if TYPE_CHECKING:
     from retrokit.host.fields import FieldSpec
+    from retrokit.host.memory import AddressSpace, FieldReader
 
 __all__ = [
     "Game",
@@ -53,6 +57,7 @@ __all__ = [
     "list_games",
     "load_game",
     "normalize_name",
+    "stable_retro_name",
 ]
 
 STATE_SUFFIX = ".state"
@@ -124,6 +129,29 @@ class Game:
     def players(self) -> int:
         """How many players the game supports."""
         return self.info.players
+
+    def reader(self, space: AddressSpace) -> FieldReader:
+        """The reader of the game's fields over an emulator's memory: the one rule for which fields are read.
+
+        A stable-retro ``data.json``'s field outside the memory (its test data names one per system) is skipped,
+        as its ``lookup_all`` skips it, in one :class:`~retrokit.errors.SkippedDataWarning`; a ``game.yaml`` is strict.
+
+        Raises:
+            InvalidArgumentError: A field of the game's ``game.yaml`` lies outside the memory.
+        """
+        from retrokit.host.memory import FieldReader
+
+        fields = self.fields
+        if self.info.source.name == "data.json":
+            outside = [s for s in fields.values() if not space.holds(s.address, s.field_type.width)]
+            if outside:
+                warnings.warn(
+                    f"{self.info.source}: skipped {len(outside)} field(s) outside the {self.system.name} memory, "
+                    f"as stable-retro skips them: {listed(f'{s.name} ({s.address:#x})' for s in outside)}.",
+                    SkippedDataWarning, stacklevel=3,
+                )
+                fields = {name: spec for name, spec in fields.items() if spec not in outside}
+        return FieldReader(fields, space)
 
     @property
     def default_player_states(self) -> tuple[str, ...]:
@@ -366,6 +394,20 @@ def _index() -> dict[str, tuple[Path, ...]]:
     _index_cache.clear()
     _index_cache[key] = result
     return result
+
+
+def stable_retro_name(name: str) -> str:
+    """The name stable-retro knows a game by, which it writes as a movie's ``GameName`` and looks the game up by.
+
+    Its integration folder's name (a folder with a ``rom.sha``): ``Airstriker-Genesis-v0`` in its ``stable``
+    folder, ``ActRaiser2-Snes`` (no ``-v0``) in ``experimental``, ``contrib`` or a custom path; the first such
+    folder of the game's. Else (retrokit's own ``game.yaml`` games) ``<Name>-<System>-v0``, as its stable games.
+    """
+    key = normalize_name(name)
+    for folder in _index().get(key, ()):
+        if os.path.lexists(folder / "rom.sha"):
+            return folder.name
+    return f"{key}-v0"
 
 
 def list_games(pattern: str | None = None) -> list[Game]:

@@ -75,6 +75,8 @@ class ImportConflict:
         path: The existing file, left as it was.
         sha1: The new ROM's SHA-1.
         existing_sha1: The existing file's SHA-1 (by the same rules).
+        differs: How the two files differ: their SHA-1s, or, when those are one (an NES ROM's leaves
+            its iNES header out), their headers.
     """
 
     game: str
@@ -82,6 +84,7 @@ class ImportConflict:
     path: Path
     sha1: str
     existing_sha1: str
+    differs: str = ""
 
 
 @dataclass(frozen=True)
@@ -108,6 +111,8 @@ class ImportReport:
         imported: ROMs written (or replaced, with ``overwrite``).
         already_present: ROMs identical to the file already in place.
         conflicts: ROMs not written because a different file is in place.
+        refused: Known games' ROMs not written because their header says the core cannot run them
+            (what ``retrokit new`` refuses: an unknown mapper, sizes the file lacks), with the game and why.
         unmatched: Candidates whose SHA-1 matches no known game.
         skipped: Candidates not hashed, with the reason (unreadable, too big, bad zip).
         broken_games: Games whose data file could not be read, with the error.
@@ -118,6 +123,7 @@ class ImportReport:
     imported: list[ImportedRom] = field(default_factory=list)
     already_present: list[ImportedRom] = field(default_factory=list)
     conflicts: list[ImportConflict] = field(default_factory=list)
+    refused: list[tuple[str, str, str]] = field(default_factory=list)
     unmatched: list[UnmatchedFile] = field(default_factory=list)
     skipped: list[tuple[str, str]] = field(default_factory=list)
     broken_games: list[tuple[str, str]] = field(default_factory=list)
@@ -305,12 +311,14 @@ def _store(game: Game, source: str, data: bytes, sha1: str, report: ImportReport
                 continue
             if not overwrite:
                 existing_sha1 = roms.rom_sha1(existing, game.system)
-                report.conflicts.append(ImportConflict(game.name, source, target, sha1, existing_sha1))
+                differs = roms.header_difference(game.system, existing, data) if existing_sha1 == sha1 else ""
+                differs = differs or f"SHA-1 {existing_sha1} against {sha1}"
+                report.conflicts.append(ImportConflict(game.name, source, target, sha1, existing_sha1, differs))
                 continue
         try:
             paths.atomic_write(target, data, overwrite=overwrite)
         except FileConflictError:  # appeared meanwhile
-            report.conflicts.append(ImportConflict(game.name, source, target, sha1, "(unknown)"))
+            report.conflicts.append(ImportConflict(game.name, source, target, sha1, "(unknown)", "it appeared meanwhile"))
             continue
         report.imported.append(entry)
 
@@ -355,7 +363,11 @@ def import_roms(
                 report.unmatched.append(UnmatchedFile(label, sha1, system.name if system is not None else None))
                 continue
             for game in matches:
-                _store(game, label, data, sha1, report, overwrite)
+                problem = roms.rom_problem(game.system, data)  # what `retrokit new` checks: the SHA-1 skips a header
+                if problem:
+                    report.refused.append((label, game.name, problem))
+                else:
+                    _store(game, label, data, sha1, report, overwrite)
     report.unmatched = _once_per_zip(report.unmatched, report.not_roms)
     return report
 

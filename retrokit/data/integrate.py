@@ -56,7 +56,6 @@ from retrokit.errors import (
     did_you_mean,
 )
 from retrokit.host.emulator import Emulator, VettedState
-from retrokit.host.memory import FieldReader
 
 HOLD_FRAMES = 2  # a press is held this long, then released as long, until arrival
 CHECK_FRAMES = 60  # frames run from a state to compare two states
@@ -243,7 +242,7 @@ def make_state(game: Game, recipe: Recipe) -> VettedState:
         StateError: The recipe did not arrive within its frame budget.
     """
     with Emulator(game.system, game.require_rom(), ports=_ports(game)) as emu:
-        reader = FieldReader(game.fields, emu.space)
+        reader = game.reader(emu.space)
         masks = [0] * emu.ports
         for port, buttons in recipe.press.items():
             if not 1 <= port <= emu.ports:

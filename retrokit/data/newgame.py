@@ -29,6 +29,7 @@ from retrokit.errors import (
     InvalidArgumentError,
     RomError,
     did_you_mean,
+    shell_word,
 )
 from retrokit.host.systems import System, all_systems, extension_of, get_system
 
@@ -172,7 +173,7 @@ def new_game(
     if owners:
         raise FileConflictError(
             f"Expected a ROM no game knows; found that {str(rom)!r} (SHA-1 {sha1}) is the ROM of "
-            f"{', '.join(g.name for g in owners)}. Import it with: retrokit import {rom}"
+            f"{', '.join(g.name for g in owners)}. Import it with: retrokit import {shell_word(rom)}"
         )
     folder = paths.user_games_dir(data_dir) / name
     if folder.exists():
@@ -196,7 +197,7 @@ def new_game(
 def _not_imported(rom: str | os.PathLike[str], chosen: System, sha1: str, target: Path, report: Any) -> str:
     """Why ``new`` could not import the ROM it made a game for (the game's folder is removed)."""
     if report.conflicts:
-        found = "; ".join(f"{c.path} has SHA-1 {c.existing_sha1}" for c in report.conflicts)
+        found = "; ".join(f"{c.path}: {c.differs}" for c in report.conflicts)
         return (
             f"Expected to import the ROM into {target}; found another file there ({found}). Nothing was made. "
             f"Move that file away, then run `retrokit new` again."

@@ -25,13 +25,15 @@ Nothing inside the file (retrokit's ``RK`` record, a movie's header) makes a
 state trusted: a record may only refuse one (:mod:`retrokit.data.statecheck`).
 
 The child (``python -m retrokit.data.probe``, reading a JSON request on
-stdin) is shared with ``retrokit validate`` (:mod:`retrokit.testing.states`),
-which wants a report per state rather than a cached verdict: the child loads
-each state of the request in turn and prints one JSON line before and one
-after each, with the fields' values. It runs as every risky child does
-(:mod:`retrokit.host.child`): under a memory cap, with no core file,
-importing the retrokit its parent imported, killed with its process group if
-it hangs.
+stdin) loads each state of the request in turn and answers one JSON line
+before and one after each, with the fields' values, on the answer channel
+of :mod:`retrokit.host.child` (a pipe of its own: the core prints on stdout,
+and pce_fast prints bytes a state chooses there). ``retrokit validate``
+(:mod:`retrokit.testing.states`) asks the same probe for its report per state
+(:func:`probe_files`). The child runs as every risky child does: under a
+memory cap, with no core file, importing the retrokit its parent imported,
+killed with its process group if it hangs; how it ended is read before what
+it answered.
 """
 
 from __future__ import annotations
@@ -99,55 +101,116 @@ class ChildResult:
 
 
 def run_child(
-    system: str, rom: str | os.PathLike[str], states: Sequence[tuple[str, str] | tuple[str, str, int]], *,
-    frames: int,
-    input_frames: int, fields: Sequence[Mapping[str, Any]] = (), timeout: float = PROBE_TIMEOUT,
+    system: str, rom: str | os.PathLike[str], states: Sequence[tuple[str, str, int, int]], *,
+    fields: Sequence[Mapping[str, Any]] = (), timeout: float | None = None,
 ) -> tuple[dict[str, ChildResult], str | None, str]:
-    """Run one child over ``states``; return the results it finished, the state it was on when it stopped, and why.
+    """Run one child over ``states``; return the results it finished, the state to blame if it failed, and why.
 
-    The child (run as every risky child is: :mod:`retrokit.host.child`) prints a
-    line before and after each state; a state that prints nothing for ``timeout``
-    seconds has hung the core, and the child is killed.
+    The child (run as every risky child is: :mod:`retrokit.host.child`) answers
+    on a pipe of its own, a line before and after each state; a state that
+    answers nothing for ``timeout`` seconds has hung the core, and the child
+    is killed. A child that died by a signal, hung or failed proves nothing
+    of any state it ran, whatever it answered before: its results are
+    dropped, and the state it was on (or, between two, the last it finished)
+    is blamed.
 
     Args:
         system: The system's name.
         rom: The ROM to load the states on.
-        states: ``(name, path)`` of each state file, in order; or ``(name, path, input_frames)``
-            for one that needs other than ``input_frames``.
-        frames: Idle frames to run after the first load of each state.
-        input_frames: Frames of random input to run after loading it again.
+        states: ``(name, path, frames, input_frames)`` of each state file, in order: idle frames to
+            run after its first load, then frames of random input after loading it again.
         fields: RAM fields (``name``, ``address``, ``type``, ``mask``) to read after loading.
-        timeout: Seconds one state may take.
+        timeout: Seconds one state may take (by default :data:`PROBE_TIMEOUT`).
 
     Raises:
         ChildStartError: The child could not start.
     """
-    request = {"system": system, "rom": os.fspath(rom), "frames": frames, "input_frames": input_frames,
-               "fields": list(fields),
-               "states": [[*s[:2], input_frames if len(s) < 3 else s[2]] for s in states]}
+    timeout = PROBE_TIMEOUT if timeout is None else timeout
+    request = {"system": system, "rom": os.fspath(rom), "fields": list(fields), "states": [list(s) for s in states]}
     results: dict[str, ChildResult] = {}
     current = None
     with Child("retrokit.data.probe", request, memory=CHILD_MEMORY) as child:
         for line in child.lines(first=CHILD_STARTUP + timeout, each=timeout):
-            try:
+            try:  # only the child's own code writes on its channel; a torn line from a crash is no answer
                 message = json.loads(line)
-            except json.JSONDecodeError:
+                if "begin" in message:
+                    current = message["begin"]
+                else:
+                    results[message["name"]] = ChildResult(**message)
+                    current = None
+            except (ValueError, TypeError, KeyError):
                 continue
-            if "begin" in message:
-                current = message["begin"]
-            else:
-                results[message["name"]] = ChildResult(**message)
-                current = None
         end = child.end()
     if end.hung:
         failure = f"the emulator still ran {timeout:g} s after loading it (it hangs the core)"
     elif end.signal is not None:
-        failure = f"the emulator crashed ({end.signal}) within {frames + input_frames} frames of loading it"
+        failure = f"the emulator crashed ({end.signal}) within the frames run after loading it"
     elif end.status != 0:
         failure = f"the state loader exited with status {end.status}: {end.last_words}"
     else:
-        failure = ""
-    return results, current, failure
+        return results, None, ""
+    return {}, current if current is not None else next(reversed(results), None), failure
+
+
+def probe_files(
+    system: str, rom: str | os.PathLike[str], rom_sha1: str, files: Mapping[str, str | os.PathLike[str]], *,
+    frames: int = PROBE_FRAMES, fields: Sequence[Mapping[str, Any]] = (), timeout: float | None = None,
+) -> dict[str, ChildResult]:
+    """Try each state file on ``rom`` in a child, by the one rule :func:`vet_state` trusts a state by; return each
+    one's result (``retrokit validate``'s view: every field's values, not only a verdict).
+
+    A state this machine knows (shipped, or probed here before: :func:`vet_state`'s
+    order of trust) is loaded and run ``frames`` idle frames; a state it knows
+    to be unsafe fails with the known reason; any other is probed as
+    :func:`vet_state` probes it (at least :data:`PROBE_FRAMES` idle frames,
+    then :data:`PROBE_INPUT_FRAMES` under input, reloads around them), and its
+    verdict is kept as :func:`vet_state` keeps it. A child that dies or hangs
+    fails the state it was blamed on (:func:`run_child`), and a new child
+    carries on with the others.
+
+    Args:
+        system: The system's name.
+        rom: The ROM.
+        rom_sha1: Its SHA-1 (the verdicts' key).
+        files: Each state's file, by name.
+        frames: Idle frames to run after each state's first load.
+        fields: RAM fields to read (see :func:`run_child`).
+        timeout: Seconds one state may take (by default :data:`PROBE_TIMEOUT`).
+    """
+    from retrokit.data.states import read_state
+
+    results: dict[str, ChildResult] = {}
+    plans: dict[str, tuple[str, str, int, int]] = {}
+    keys: dict[str, str] = {}
+    for name, path in files.items():
+        try:
+            state = read_state(path)
+        except RetrokitError as exc:
+            results[name] = ChildResult(name, os.fspath(path), error=str(exc))
+            continue
+        key = probe_key(state, system, rom_sha1)
+        verdict, _ = _known(state, system, key, lambda: _ships(Path(path), state))  # noqa: B023 (called at once)
+        if verdict is None:
+            keys[name] = key
+            plans[name] = (name, os.fspath(path), max(frames, PROBE_FRAMES), PROBE_INPUT_FRAMES)
+        elif verdict.safe:
+            plans[name] = (name, os.fspath(path), frames, 0)
+        else:
+            results[name] = ChildResult(name, os.fspath(path), error=f"the core cannot run the state: {verdict.reason}")
+    todo = list(plans)
+    while todo:
+        done, blamed, failure = run_child(system, rom, [plans[n] for n in todo], fields=fields, timeout=timeout)
+        results.update(done)
+        if blamed is None and failure:  # the child failed before any state: it says nothing of them, keep nothing
+            results.update({n: ChildResult(n, plans[n][1], error=failure) for n in todo})
+            keys = {n: key for n, key in keys.items() if n not in todo}
+        elif blamed is not None:
+            results[blamed] = ChildResult(blamed, plans[blamed][1], error=failure)
+        todo = [n for n in todo if n not in results]
+    for name, key in keys.items():
+        result = results[name]
+        _remember(key, ProbeVerdict(True) if result.loaded else ProbeVerdict(False, result.error))
+    return {name: results[name] for name in files}
 
 
 # --- One state's verdict -------------------------------------------------------------------------
@@ -166,18 +229,23 @@ class ProbeVerdict:
     reason: str = ""
 
 
+PROBE_VERSION = 2
+"""The probe whose verdicts count. Version 1 read its child's answers from the stdout the core prints on, so a
+state could write its own "safe" (issue 42): its verdicts are under other keys, and every state is probed again."""
+
+
 def probe_key(state: bytes, system: str, rom_sha1: str) -> str:
-    """The cache key of a probe: SHA-256 of the system, the ROM's SHA-1 and the state."""
+    """The cache key of a probe: SHA-256 of the probe's version, the system, the ROM's SHA-1 and the state."""
     import hashlib
 
-    digest = hashlib.sha256(f"{system}\0{rom_sha1}\0".encode())
+    digest = hashlib.sha256(f"probe {PROBE_VERSION}\0{system}\0{rom_sha1}\0".encode())
     digest.update(state)
     return digest.hexdigest()
 
 
 def probe_state(
     state: bytes, system: str | System, rom: str | os.PathLike[str], *, frames: int = PROBE_FRAMES,
-    input_frames: int = PROBE_INPUT_FRAMES, timeout: float = PROBE_TIMEOUT,
+    input_frames: int = PROBE_INPUT_FRAMES, timeout: float | None = None,
 ) -> ProbeVerdict:
     """Load ``state`` on ``rom`` in a child process, run, load again, run under input; report how it ended.
 
@@ -189,7 +257,7 @@ def probe_state(
         rom: The ROM to load it on.
         frames: Idle frames to run after the first load.
         input_frames: Frames of random input to run after the second.
-        timeout: Seconds before the child counts as hung, and is killed.
+        timeout: Seconds before the child counts as hung, and is killed (by default :data:`PROBE_TIMEOUT`).
     """
     from retrokit.data.states import compress_state
 
@@ -197,33 +265,34 @@ def probe_state(
     with tempfile.NamedTemporaryFile(prefix="retrokit-probe-", suffix=".state") as tmp:
         tmp.write(compress_state(state))
         tmp.flush()
-        results, _, failure = run_child(
-            system, rom, [("state", tmp.name)], frames=frames, input_frames=input_frames, timeout=timeout
-        )
+        results, _, failure = run_child(system, rom, [("state", tmp.name, frames, input_frames)], timeout=timeout)
+    if failure:  # how the child ended comes first: a dead or hung child vouches for nothing it answered
+        return ProbeVerdict(False, failure)
     result = results.get("state")
     if result is None:
-        return ProbeVerdict(False, failure or "the probe stopped before it loaded the state")
+        return ProbeVerdict(False, "the probe stopped before it loaded the state")
     return ProbeVerdict(True) if result.loaded else ProbeVerdict(False, result.error)
 
 
-def _cache_file(key: str) -> Path:
-    return paths.data_dir() / "state-probes" / key
+PROBES = "state-probes"
+"""The data folder's folder of verdicts (:func:`retrokit.paths.records_dir`: never a link)."""
 
 
 def _cached(key: str) -> ProbeVerdict | None:
     try:
-        with open(_cache_file(key), "rb") as f:
-            text = f.read(4096).decode("utf-8")
-    except (OSError, UnicodeDecodeError):
+        text = paths.read_regular_file(paths.records_dir(PROBES) / key, "a probe's verdict", 4096, follow=False)
+        text = text.decode("utf-8")
+    except (RetrokitError, UnicodeDecodeError):  # none, unreadable, or through a link: only a probe can tell
         return None
     return ProbeVerdict(True) if text == _SAFE else ProbeVerdict(False, text)
 
 
 def _remember(key: str, verdict: ProbeVerdict) -> None:
     try:
-        paths.atomic_write(_cache_file(key), (_SAFE if verdict.safe else verdict.reason).encode(), overwrite=True)
-    except OSError:
-        pass  # an unwritable data folder only means probing again next time
+        text = (_SAFE if verdict.safe else verdict.reason).encode()
+        paths.atomic_write(paths.records_dir(PROBES) / key, text, overwrite=True)
+    except RetrokitError:
+        pass  # an unwritable data folder (or a link planted in it) only means probing again next time
 
 
 def remember(state: VettedState, rom_sha1: str) -> None:
@@ -270,23 +339,6 @@ def vet_state(
     if not verdict.safe:
         raise _unrunnable(source, system, verdict.reason)
     return _mint(state, system)
-
-
-def known_safe(path: str | os.PathLike[str], system: str, rom_sha1: str) -> bool:
-    """Whether the state file at ``path`` needs no probe on this ROM: shipped, or found safe here before.
-
-    The same trust :func:`vet_state` gives, for a caller that runs the state in
-    a child anyway but may spare it the long run under input (``retrokit
-    validate``). Any doubt (an unreadable file, a layout the core cannot
-    run, no record) is ``False``.
-    """
-    try:
-        blob = paths.read_regular_file(path, "a save state file", MAX_STATE_FILE_SIZE)
-        state = decompress_state(blob)
-    except (RetrokitError, OSError):
-        return False
-    verdict, _ = _known(state, system, probe_key(state, system, rom_sha1), lambda: is_shipped_blob(blob))
-    return verdict is not None and verdict.safe
 
 
 def _known(state: bytes, system: str, key: str, ships: Callable[[], bool]) -> tuple[ProbeVerdict | None, bool]:
@@ -337,23 +389,27 @@ def _ships(path: Path, state: bytes) -> bool:
 
 
 def _child_main() -> int:
-    """Load the states a request names, one by one; print one JSON line per state (and one before each)."""
+    """Load the states a request names, one by one; answer one JSON line per state (and one before each).
+
+    The answers go on the channel :mod:`retrokit.host.child` gives (never stdout, which the core prints on).
+    """
     import random
 
     from retrokit.data.states import read_state, state_format
+    from retrokit.host.child import answer_channel
     from retrokit.host.emulator import Emulator
     from retrokit.host.fields import FieldSpec
     from retrokit.host.memory import FieldReader
 
     request = json.load(sys.stdin)  # its limits are set by now (retrokit.host.child)
-    frames = int(request["frames"])
+    answer = answer_channel(request)
     emu = Emulator(request["system"], request["rom"])
     specs = [FieldSpec(f["name"], f["address"], f["type"], f["mask"]) for f in request["fields"]]
     reader = FieldReader([s for s in specs if emu.space.holds(s.address, s.field_type.width)], emu.space)
     idle = [0] * emu.ports
     rng = random.Random(0)
-    for name, path, input_frames in request["states"]:
-        print(json.dumps({"begin": name}), flush=True)
+    for name, path, frames, input_frames in request["states"]:
+        answer.write(json.dumps({"begin": name}).encode() + b"\n")
         result: dict[str, Any] = {"name": name, "path": path}
         try:
             data = read_state(path)
@@ -365,7 +421,7 @@ def _child_main() -> int:
             result["start"] = reader.read()
             emu.run(idle, 1)  # one frame in: where validate checks the fields' declared ranges
             result["first"] = reader.read()
-            emu.run(idle, max(frames - 1, 0))
+            emu.run(idle, max(int(frames) - 1, 0))
             result["after"] = reader.read()
             emu.set_state(state)  # every reset() loads the state again: some crash only then
             for _ in range(0, int(input_frames), 10):  # and some only under input
@@ -380,7 +436,7 @@ def _child_main() -> int:
             result["detail"] = f"{state_format(data) or 'no core signature'}, {len(data)} bytes"
         except (RetrokitError, MemoryError) as exc:
             result["error"] = str(exc) if not isinstance(exc, MemoryError) else "the state needs too much memory"
-        print(json.dumps(result), flush=True)
+        answer.write(json.dumps(result).encode() + b"\n")
     emu.close()
     return 0
 

@@ -201,23 +201,45 @@ INES_CHR_UNIT = 8 * 1024
 INES_TRAINER = 512
 
 
+def _ines_header(data: bytes) -> dict[str, int]:
+    """What an iNES header says (the file is at least its 16 bytes): sizes in units, the mapper, a trainer."""
+    prg, chr_, flags6, flags7 = data[4], data[5], data[6], data[7]
+    mapper = (flags6 >> 4) | (flags7 & 0xF0)
+    if flags7 & 0x0C == 0x08:  # NES 2.0: 4 more bits of mapper in byte 8 (numbers past 255 are left to the core)
+        mapper |= (data[8] & 0x0F) << 8
+    return {"program ROM (16 KiB units)": prg, "character ROM (8 KiB units)": chr_, "mapper": mapper,
+            "trainer": int(bool(flags6 & 0x04)), "mirroring and battery flags": flags6 & 0x0B}
+
+
 def _ines_problem(system: System, data: bytes) -> str:
     """What is wrong with an iNES ROM for ``system``'s core: too short for its header's sizes, or an unknown mapper."""
     if len(data) < NES_HEADER_SIZE:
         return f"it is {len(data)} bytes, shorter than the {NES_HEADER_SIZE}-byte iNES header"
-    prg, chr_, flags6, flags7 = data[4], data[5], data[6], data[7]
-    need = NES_HEADER_SIZE + (INES_TRAINER if flags6 & 0x04 else 0) + prg * INES_PRG_UNIT + chr_ * INES_CHR_UNIT
+    header = _ines_header(data)
+    prg, chr_ = header["program ROM (16 KiB units)"], header["character ROM (8 KiB units)"]
+    need = NES_HEADER_SIZE + INES_TRAINER * header["trainer"] + prg * INES_PRG_UNIT + chr_ * INES_CHR_UNIT
     if prg == 0:
         return "its iNES header gives it no program ROM (byte 4 is 0)"
     if len(data) < need:
         return (f"it is truncated: its iNES header gives {prg} x 16 KiB of program ROM and {chr_} x 8 KiB of "
                 f"character ROM, {need} bytes with the header, and the file has {len(data)}")
-    mapper = (flags6 >> 4) | (flags7 & 0xF0)
-    if flags7 & 0x0C == 0x08:  # NES 2.0: 4 more bits of mapper in byte 8 (numbers past 255 are left to the core)
-        mapper |= (data[8] & 0x0F) << 8
-    if mapper in system.missing_mappers:
-        return f"its iNES mapper {mapper} is one the {system.core} core cannot run (it has no such board)"
+    if header["mapper"] in system.missing_mappers:
+        return f"its iNES mapper {header['mapper']} is one the {system.core} core cannot run (it has no such board)"
     return ""
+
+
+def header_difference(system: System, first: bytes, second: bytes) -> str:
+    """How the headers of two ROMs of ``system`` differ, where its format has one (``""``: none, or the same).
+
+    Two files with one SHA-1 (which leaves an iNES header out) differ only there: this says how.
+    """
+    if system.rom_format != "ines" or min(len(first), len(second)) < NES_HEADER_SIZE:
+        return ""
+    one, two = _ines_header(first), _ines_header(second)
+    changed = [f"{key} {one[key]} against {two[key]}" for key in one if one[key] != two[key]]
+    if not changed and first[:NES_HEADER_SIZE] != second[:NES_HEADER_SIZE]:
+        changed = [f"header bytes {first[:NES_HEADER_SIZE].hex()} against {second[:NES_HEADER_SIZE].hex()}"]
+    return "their iNES headers differ: " + ", ".join(changed) if changed else ""
 
 
 _FORMATS = {"ines": _ines_problem}
@@ -235,19 +257,24 @@ def rom_problem(system: System, data: bytes) -> str:
 def guess_system(data: bytes, filename: str | os.PathLike[str]) -> tuple[System | None, str]:
     """The likely system of a file: from its header, else its size, else its extension; and how it was told.
 
+    The extension wins over a header where its system's ROMs carry that header (``extension_wins_over``:
+    a ``.32x`` file's Genesis header, a ``.gb`` file's header saying it also runs on the Color).
+
     This is the one place a ROM's system is told from the file (retrokit new, retrokit import).
 
     Returns:
         The system (``None`` if nothing tells it) and ``"header"``, ``"size"``, ``"extension"`` or ``""``.
     """
     named = header_system(data)
+    ext = extension_of(filename)
+    known = systems_by_extension()
     if named is not None:
+        if ext in known and named in known[ext].extension_wins_over:  # a .32x file with a Genesis header
+            return known[ext], "extension"
         return get_system(named), "header"
     by_size = size_system(len(data), filename)
     if by_size is not None:
         return by_size, "size"
-    ext = extension_of(filename)
-    known = systems_by_extension()
     if ext in known and ext != "bin":  # .bin is any dump: only a header or a size tells what it is
         return known[ext], "extension"
     return None, ""

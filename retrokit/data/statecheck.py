@@ -128,7 +128,7 @@ def check_identity(game: Game, data: bytes, rom_sha1: str, source: str, file: Pa
 
 
 def _owner_file(digest: str) -> Path:
-    return paths.data_dir() / OWNERS / digest
+    return paths.records_dir(OWNERS) / digest  # never through a link: a planted record would vouch
 
 
 def _record_owner(game: Game, state: bytes, rom_sha1: str) -> None:
@@ -142,9 +142,9 @@ def _record_owner(game: Game, state: bytes, rom_sha1: str) -> None:
 
 def _recorded_owner(digest: str) -> Owner | None:
     try:
-        with open(_owner_file(digest), "rb") as f:
-            rom_sha1, name = f.read(512).decode("utf-8").split(maxsplit=1)
-    except (OSError, UnicodeDecodeError, ValueError):
+        text = paths.read_regular_file(_owner_file(digest), "a state's owner record", 512, follow=False)
+        rom_sha1, name = text.decode("utf-8").split(maxsplit=1)
+    except (RetrokitError, UnicodeDecodeError, ValueError):
         return None
     name = name.strip()
     return Owner(name, frozenset({rom_sha1}), f"this machine saved it for {name}")
@@ -236,7 +236,7 @@ def load_state(game: Game, path: str | os.PathLike[str]) -> VettedState:
         StateError: The file is not a valid state, is for another game's ROM, or crashes the core.
     """
     path = Path(path)
-    state = read_state_file(path)
+    state = read_state_file(path, game.system)
     if state.record is None:
         _check_folder(game, path)
     return check_state(game, state.data, state.record, source=str(path), shipped=path)

@@ -23,11 +23,13 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from retrokit.errors import FileConflictError, FileSystemError, StateError
+from retrokit.host.systems import System, get_system, largest_state
 from retrokit.paths import REPLACE_HINT, atomic_write, read_regular_file
 
 GZIP_MAGIC = b"\x1f\x8b"
-MAX_STATE_SIZE = 16 * 2**20
-"""The largest core state read (Genesis Plus GX's is 1 MiB; no supported core's is near 16 MiB)."""
+MAX_STATE_SIZE = largest_state()
+"""The largest core state read for no known system: the largest any core writes (``state_max`` in systems.yaml:
+parallel_n64's 16,789,312 bytes, mednafen_saturn's up to 22 MiB; Genesis Plus GX's is 1 MiB)."""
 MAX_STATE_FILE_SIZE = MAX_STATE_SIZE + 2**20
 """The largest ``.state`` file read: a state that deflate could not shrink, with room for gzip's framing."""
 
@@ -43,19 +45,26 @@ def _inflate(blob: bytes, max_size: int) -> bytes | None:
     return None if len(data) > max_size else data
 
 
-def decompress_state(blob: bytes, *, source: str = "the state", max_size: int | None = None) -> bytes:
+def decompress_state(
+    blob: bytes, *, source: str = "the state", max_size: int | None = None, system: str | System | None = None
+) -> bytes:
     """Return the core state inside a gzip-compressed ``blob``.
 
     Args:
         blob: The contents of a ``.state`` file.
         source: What to call the blob in error messages (usually its path).
         max_size: Refuse a state that inflates past this many bytes (by default
-            :data:`MAX_STATE_SIZE`; the core's own size when it is known).
+            ``system``'s ``state_max``, or :data:`MAX_STATE_SIZE` for no system).
+        system: The system whose core the state is for, when it is known.
 
     Raises:
         StateError: ``blob`` is empty, not gzip, truncated, corrupt or too large.
     """
-    max_size = MAX_STATE_SIZE if max_size is None else max_size
+    known = get_system(system) if system is not None else None
+    if max_size is None:
+        max_size = known.state_max if known is not None else MAX_STATE_SIZE
+    whose = f"no state of the {known.core} core" if known is not None else "no core's state"
+    of = f" of {known.name}" if known is not None else ""
     fix = "Record the state again, or copy it again from where it came from."
     if not blob:
         raise StateError(f"{source}: expected a gzip-compressed save state; found an empty file. {fix}")
@@ -76,35 +85,44 @@ def decompress_state(blob: bytes, *, source: str = "the state", max_size: int | 
         raise StateError(f"{source}: expected a valid gzip stream; found a corrupt one ({exc}). {fix}") from exc
     if data is None:
         raise StateError(
-            f"{source}: expected a save state of at most {max_size} bytes once inflated (no core's state is "
-            f"larger); found a gzip stream of {len(blob)} bytes that inflates past that: it is not a save state."
+            f"{source}: expected a save state of at most {max_size:,} bytes once inflated ({whose} is larger); "
+            f"found a gzip stream of {len(blob):,} bytes that inflates past that: it is not a save state{of}."
         )
     if not data:
         raise StateError(f"{source}: expected a serialized core state; found a gzip stream of 0 bytes. {fix}")
     return data
 
 
-def read_state(path: str | os.PathLike[str]) -> bytes:
+def read_state(path: str | os.PathLike[str], system: str | System | None = None) -> bytes:
     """Read a ``.state`` file and return the serialized core state.
+
+    Args:
+        path: The file.
+        system: The system whose core it is for, if known: its ``state_max`` caps it.
 
     Raises:
         StateError: The file is missing, empty, not gzip, truncated, corrupt or too large.
     """
-    return read_state_file(path).data
+    return read_state_file(path, system).data
 
 
-def read_state_file(path: str | os.PathLike[str]) -> StateFile:
+def read_state_file(path: str | os.PathLike[str], system: str | System | None = None) -> StateFile:
     """Read a ``.state`` file: the serialized core state, and retrokit's record if it has one.
 
+    Args:
+        path: The file.
+        system: The system whose core it is for, if known: a state larger than its core writes
+            (``state_max``) is refused before it is inflated whole.
+
     Raises:
-        StateError: The file is missing, empty, not gzip, truncated or corrupt.
+        StateError: The file is missing, empty, not gzip, truncated, corrupt or too large.
     """
     path = Path(path)
     try:  # a FIFO would block, a device never end, a loop never resolve
         blob = read_regular_file(path, "a save state file", MAX_STATE_FILE_SIZE)
     except FileSystemError as exc:
         raise StateError(f"{exc} It is not a save state.") from None
-    return StateFile(decompress_state(blob, source=str(path)), state_record(blob))
+    return StateFile(decompress_state(blob, source=str(path), system=system), state_record(blob))
 
 
 @dataclass(frozen=True)

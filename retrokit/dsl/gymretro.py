@@ -26,6 +26,7 @@ import json
 import math
 import os
 import re
+import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -35,7 +36,7 @@ from retrokit.dsl.check import RESERVED
 from retrokit.dsl.document import document_from_dict
 from retrokit.dsl.source import SourceText, located, read_source
 from retrokit.dsl.spec import ScenarioSpec
-from retrokit.errors import ScenarioCompileError, ScenarioError, did_you_mean
+from retrokit.errors import ScenarioCompileError, ScenarioError, SkippedDataWarning, did_you_mean, listed
 
 TOP_KEYS = ("reward", "rewards", "done", "actions", "crop", "crops", "scripts")
 REWARD_KEYS = ("variables", "time", "script")
@@ -108,6 +109,7 @@ class _Converter:
         self.data = data
         self.source = source
         self.fields = fields
+        self.skipped: list[str] = []  # keys neither retrokit nor stable-retro knows, by path
 
     def error(self, path: Sequence[str], message: str, cls: type[ScenarioError] = ScenarioError) -> ScenarioError:
         if self.source is None:
@@ -119,8 +121,10 @@ class _Converter:
         if not isinstance(obj, Mapping):
             raise self.error(path, "expected an object ({...})")
         for key in obj:
-            if key not in allowed:
-                raise self.error([*path, key], f"unknown key {key!r}." + did_you_mean(key, allowed) + f" Known keys: {', '.join(allowed)}")
+            if key not in allowed:  # stable-retro's reader ignores it: skipped, and named in one warning
+                key = str(key)[:60]  # a key of a megabyte names itself in 60 characters
+                hint = did_you_mean(key, allowed).strip()
+                self.skipped.append(".".join([*path, key]) + (f" ({hint[0].lower()}{hint[1:]})" if hint else ""))
         if "script" in obj:
             raise self.error(
                 [*path, "script"],
@@ -157,6 +161,13 @@ class _Converter:
             out["actions"] = data["actions"]
         if "crop" in data:
             out["crop"] = list(data["crop"])
+        if self.skipped:
+            where = self.source.name if self.source is not None else "scenario.json"
+            warnings.warn(
+                f"{where}: skipped {len(self.skipped)} key(s) no scenario.json has, as stable-retro skips them: "
+                f"{listed(self.skipped, width=120)}.",
+                SkippedDataWarning, stacklevel=2,
+            )
         return out
 
     def check_numbers(self, spec: Mapping, path: list[str]) -> None:

@@ -33,8 +33,12 @@ class StableRetroCompat:
         return meanings[0] if len(meanings) == 1 else meanings
 
     def get_ram(self) -> np.ndarray:
-        """A copy of the system RAM (``uint8``), in the core's byte order, as stable-retro's ``get_ram``."""
-        return self.emulator.ram.copy()  # type: ignore[attr-defined]
+        """A copy of the RAM (``uint8``) as stable-retro's ``get_ram`` gives it: the same bytes, order and length.
+
+        See :meth:`retrokit.host.emulator.Emulator.retro_ram` (on the NES, 10,240 bytes: the 2 KiB of
+        internal RAM, then the cartridge RAM at 0x6000).
+        """
+        return self.emulator.retro_ram()  # type: ignore[attr-defined]
 
     def load_state(self, state: str | os.PathLike[str]) -> None:
         """Start the next episodes at another state: a name of this game's states, or a ``.state`` path.

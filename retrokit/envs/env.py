@@ -51,7 +51,7 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
             weights: each reset draws one (seeded by ``reset(seed=...)``).
         scenario: A scenario name of the game, a path to a ``.yaml`` or
             Gym Retro ``.json`` scenario, or ``None`` for the game's default.
-        obs_type: ``"rgb"`` (the screen) or ``"ram"`` (the system RAM).
+        obs_type: ``"rgb"`` (the screen) or ``"ram"`` (the RAM as stable-retro's RAM observations show it).
         action_type: ``"all"``, ``"filtered"``, ``"discrete"`` or ``"multi_discrete"``.
         frameskip: Frames emulated per step.
         sticky_prob: Probability that a step's first frame keeps the previous buttons.
@@ -151,7 +151,7 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         if known_screen is not None:  # checked before any core is loaded
             self.preprocessing = preprocessing(observation, known_screen, obs_type=obs_type, scenario_crop=self._crop)
         self.emulator = Emulator(self.game.system, setup.rom, options=options, ports=max(players, 2))
-        self.reader = FieldReader(self.game.fields, self.emulator.space)
+        self.reader = self.game.reader(self.emulator.space)
         rate = self.emulator.system.frame_rate(self.emulator.av_info()["fps"])  # the core says NTSC or PAL
         self.metadata = {"render_modes": render_modes(), "render_fps": rate / frameskip}
         self.actions = ActionMap(self.emulator.system, action_type, getattr(self.scenario, "actions", None), players)
@@ -301,7 +301,7 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         if self.preprocessing is not None:
             return self.preprocessing.space()
         if self.obs_type == "ram":
-            return spaces.Box(0, 255, (len(self.emulator.ram),), np.uint8)
+            return spaces.Box(0, 255, (self.emulator.space.ram_size,), np.uint8)
         height, width = self._screen_shape
         if self._crop is not None:
             x, y, w, h = self._crop
@@ -408,9 +408,7 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         if self.preprocessing is not None:
             return self.emulator.observe(self._buffers.take())
         if self.obs_type == "ram":
-            out = self._buffers.take()
-            out[:] = self.emulator.ram
-            return out
+            return self.emulator.retro_ram(self._buffers.take())
         if self.emulator.screen_shape() == self._screen_shape and self._crop is None:
             return self.emulator.screen(self._buffers.take())
         frame = self.emulator.screen()

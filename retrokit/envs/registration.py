@@ -38,6 +38,7 @@ from retrokit.errors import RetrokitError
 
 NAMESPACE = "retrokit"
 VERSION = "v0"
+_CACHE_LIMIT = 64 << 20  # bytes of the ids' cache read: far above the wheel's thousand games' ids
 
 
 def game_id(game: str) -> str:
@@ -80,21 +81,22 @@ def known_ids() -> tuple[list[str], list[tuple[str, str]]]:
     Any change there, and the folders are read again.
     """
     from retrokit import paths
+    from retrokit.errors import FileSystemError
 
     key = _fingerprint(paths.game_search_dirs())
-    cache = paths.data_dir() / "cache" / "gymnasium-ids.json"
-    try:
-        kept = json.loads(cache.read_bytes())
+    try:  # never through a link, never more than a cap: a link to /dev/zero would never end
+        cache = paths.records_dir("cache") / "gymnasium-ids.json"
+        kept = json.loads(paths.read_regular_file(cache, "the Gymnasium ids' cache", _CACHE_LIMIT, follow=False))
         if kept["key"] == key:
             return kept["games"], [(game, state) for game, state in kept["levels"]]
-    except (OSError, ValueError, KeyError, TypeError):  # none yet, or unreadable: made again
+    except (FileSystemError, ValueError, KeyError, TypeError):  # none yet, or unreadable: made again
         pass
     from retrokit.data.games import list_games
     from retrokit.data.sonic_levels import levels
-    from retrokit.errors import FileSystemError
 
     games, found = [game.name for game in list_games()], levels()
     try:
+        cache = paths.records_dir("cache") / "gymnasium-ids.json"
         paths.atomic_write(cache, json.dumps({"key": key, "games": games, "levels": found}).encode(), overwrite=True)
     except FileSystemError:  # a read-only data folder: the ids are the same, only slower next time
         pass

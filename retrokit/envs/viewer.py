@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import functools
 import importlib.util
+import os
 import sys
 
 import numpy as np
@@ -51,8 +52,18 @@ def require_human() -> None:
         )
 
 
+#: SDL's hint (read from the environment when SDL starts) not to catch SIGINT and SIGTERM. Caught, each becomes
+#: a quit event in SDL's queue, which ends nothing: ``timeout``, ``kill`` and process managers could not stop a
+#: program showing a window. Left alone, SIGTERM ends it as it ends any Python program (SIGINT stays Python's).
+SDL_SIGNAL_HINT = "SDL_NO_SIGNAL_HANDLERS"
+
+
 class Viewer:
     """Shows RGB frames in a window, scaled up twice, at most ``fps`` a second.
+
+    SIGTERM ends the program as it ends any Python program (SDL is told not to
+    turn it into a quit event), and the window's close button ends it as Ctrl-C
+    does: the window closes and :meth:`show` raises ``KeyboardInterrupt``.
 
     Raises:
         MissingExtraError: pygame is not installed.
@@ -61,31 +72,46 @@ class Viewer:
 
     def __init__(self, title: str, fps: float, scale: int = 2) -> None:
         require_human()
+        os.environ.setdefault(SDL_SIGNAL_HINT, "1")  # before SDL starts: a user's own "0" is kept
         import pygame
 
         self._pygame = pygame
+        self.title, self.fps, self.scale = title, fps, scale
+        self._screen = None
+        self._open_display()
+        self._clock = pygame.time.Clock()
+
+    def _open_display(self) -> None:
+        pygame = self._pygame
         try:
             pygame.display.init()
         except pygame.error as exc:
             raise EnvError(f"Expected a display for render_mode='human', found none ({exc}). Use render_mode='rgb_array'.") from None
-        self.title, self.fps, self.scale = title, fps, scale
-        self._screen = None
-        self._clock = pygame.time.Clock()
 
     def show(self, frame: np.ndarray) -> None:
-        """Draw one frame and keep the window responsive."""
+        """Draw one frame and keep the window responsive.
+
+        Raises:
+            KeyboardInterrupt: The window's close button was pressed (the window is closed; showing
+                another frame opens it again).
+        """
         pygame = self._pygame
         height, width = frame.shape[:2]
         size = (width * self.scale, height * self.scale)
         if self._screen is None or self._screen.get_size() != size:
+            self._open_display()  # again, after the close button closed it
             self._screen = pygame.display.set_mode(size)
             pygame.display.set_caption(self.title)
         surface = pygame.surfarray.make_surface(np.ascontiguousarray(frame.swapaxes(0, 1)))
         self._screen.blit(pygame.transform.scale(surface, size), (0, 0))
-        pygame.event.pump()
+        # Every event is taken (nobody else reads them here), so none piles up; a quit is the close button.
+        if any(event.type == pygame.QUIT for event in pygame.event.get()):
+            self.close()
+            raise KeyboardInterrupt(f"the {self.title} window was closed")
         pygame.display.flip()
         self._clock.tick(self.fps)
 
     def close(self) -> None:
         """Close the window."""
+        self._screen = None
         self._pygame.display.quit()

@@ -14,10 +14,18 @@ child is run the same way, here:
   without them; no ``preexec_fn``, which may deadlock a child forked from a
   threaded process (the studio, a vector env).
 - **Request.** One JSON object on the child's stdin, which it reads before it loads anything.
-- **Answer.** Lines on its stdout, read with deadlines (:meth:`Child.lines`);
-  past one, its whole process group is killed (it leads a session of its own).
-  Leaving the ``with`` block early (an error, Ctrl-C) kills it too.
-- **Log.** Its stderr goes to a file, so a chatty core cannot fill a pipe; its last line says why it failed.
+- **Answer.** Lines on a pipe of its own, on another file descriptor than
+  stdout and stderr (:func:`answer_channel`), read with deadlines
+  (:meth:`Child.lines`); past one, its whole process group is killed (it
+  leads a session of its own). Leaving the ``with`` block early (an error,
+  Ctrl-C) kills it too. What a core prints (a state's bytes may be in it:
+  mednafen names a state's unknown variables on stdout) never reaches the
+  answer, so no file a child loads can write its verdict.
+- **Log.** Its stdout and stderr share another pipe, read as bytes while it
+  runs; only their last :data:`_LOG_TAIL` bytes are kept, so a chatty core
+  can neither fill a pipe nor this process's memory, and output never
+  counts as an answer for a deadline. Their last line says why it failed,
+  with undecodable bytes replaced.
 - **Start.** A child that cannot start (no memory, no processes left) is one
   :class:`~retrokit.errors.ChildStartError` line, never a raw ``OSError``.
 """
@@ -32,16 +40,27 @@ import selectors
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Self
+from typing import Any, BinaryIO, Self
 
 from retrokit.errors import ChildStartError
 
-_LOG_TAIL = 1 << 16  # the bytes of a child's log read for its last words
+_LOG_TAIL = 1 << 16  # the bytes of a child's log kept for its last words
+ANSWER_FD = "answer_fd"
+"""The request's key naming the file descriptor the child answers on (:func:`answer_channel`)."""
+
+
+def answer_channel(request: Mapping[str, Any]) -> BinaryIO:
+    """In a child: the pipe its parent reads answers from, named by the request; not inherited by its own children.
+
+    Write whole lines (``json.dumps(...) + "\\n"``, encoded) to it; it is unbuffered.
+    """
+    fd = int(request[ANSWER_FD])
+    os.set_inheritable(fd, False)
+    return open(fd, "wb", buffering=0)  # the child's one channel, open until it exits
 
 
 def lowered(kind: int, cap: int) -> tuple[int, int]:
@@ -112,15 +131,22 @@ class Child:
     def __init__(self, module: str, request: Mapping[str, Any], *, memory: int) -> None:
         self.module = module
         self.hung = False
-        self._log = tempfile.TemporaryFile()  # noqa: SIM115 (closed by close(), as the child ends)
+        self._tail = b""
+        try:
+            self._answers, answer_end = os.pipe()
+        except OSError as exc:
+            raise self._start_failed(exc) from None
         try:
             self._proc = subprocess.Popen(
-                [sys.executable, "-m", module], stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self._log,
-                bufsize=0, env=child_env(), start_new_session=True,
+                [sys.executable, "-P", "-m", module], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                stderr=subprocess.STDOUT, bufsize=0, env=child_env(), start_new_session=True, pass_fds=(answer_end,),
             )  # fmt: skip
         except (OSError, subprocess.SubprocessError) as exc:
-            self._log.close()
+            os.close(self._answers)
             raise self._start_failed(exc) from None
+        finally:
+            os.close(answer_end)  # the child's end: its exit closes the pipe
+        request = {**request, ANSWER_FD: answer_end}
         try:
             self._limit(memory)
         except OSError as exc:
@@ -151,42 +177,73 @@ class Child:
         return error
 
     def lines(self, *, first: float, each: float | None = None) -> Iterator[bytes]:
-        """The lines the child prints, as they come, until it ends; past a deadline it is killed (:attr:`hung`).
+        """The lines the child answers (:func:`answer_channel`), as they come, until it ends; past a deadline it is
+        killed (:attr:`hung`). Its stdout and stderr are read meanwhile, into its log.
 
         Args:
-            first: Seconds it may take to print anything, its start included
+            first: Seconds it may take to answer anything, its start included
                 (with ``each`` ``None``: to finish).
-            each: Seconds it may then take between two outputs.
+            each: Seconds it may then take between two answers.
         """
         # Raw reads, split here: a buffered reader could hold a line that select() then waits for.
-        fd = self._proc.stdout.fileno()  # type: ignore[union-attr]
+        output = self._proc.stdout.fileno()  # type: ignore[union-attr]
         pending = b""
         deadline = time.monotonic() + first
         with selectors.DefaultSelector() as selector:
-            selector.register(fd, selectors.EVENT_READ)
-            while True:
-                if not selector.select(timeout=max(0.0, deadline - time.monotonic())):
+            selector.register(self._answers, selectors.EVENT_READ)
+            selector.register(output, selectors.EVENT_READ)
+            while selector.get_map():  # until both close: it must not block on a full log pipe as it exits
+                ready = selector.select(timeout=max(0.0, deadline - time.monotonic()))
+                if not ready:
                     self._expire()
                     return
-                chunk = os.read(fd, 1 << 16)
-                if not chunk:
-                    break
-                if each is not None:
-                    deadline = time.monotonic() + each
-                *done, pending = (pending + chunk).split(b"\n")
-                yield from done
-        try:  # its stdout closed: it must end within the same deadline
+                for key, _ in ready:
+                    if key.fd == output:
+                        if not self._keep_output(output):
+                            selector.unregister(output)
+                        continue
+                    chunk = os.read(self._answers, 1 << 16)
+                    if not chunk:
+                        selector.unregister(self._answers)
+                        continue
+                    if each is not None:
+                        deadline = time.monotonic() + each
+                    *done, pending = (pending + chunk).split(b"\n")
+                    yield from done
+        try:  # its pipes closed: it must end within the same deadline
             self._proc.wait(timeout=max(0.0, deadline - time.monotonic()))
         except subprocess.TimeoutExpired:
             self._expire()
 
+    def _keep_output(self, fd: int) -> bool:
+        """Read what the child printed into the log's bounded tail; return whether more may come."""
+        chunk = os.read(fd, 1 << 16)
+        self._tail = (self._tail + chunk)[-_LOG_TAIL:]
+        return bool(chunk)
+
+    def _drain(self, fd: int) -> bool:
+        """Read all the (non-blocking) log holds now; return whether more may come."""
+        try:
+            while self._keep_output(fd):
+                pass
+        except BlockingIOError:
+            return True
+        return False
+
     def end(self) -> ChildEnd:
         """Wait for the child to end; return how it did."""
-        self._proc.stdout.close()  # type: ignore[union-attr]
+        output = self._proc.stdout.fileno()  # type: ignore[union-attr]
+        os.set_blocking(output, False)
+        with selectors.DefaultSelector() as selector:  # its log is read while it ends: a full pipe would block it
+            selector.register(output, selectors.EVENT_READ)
+            while self._proc.poll() is None:
+                if selector.select(timeout=0.1) and not self._drain(output):
+                    break
         status = self._proc.wait()
-        size = self._log.seek(0, os.SEEK_END)
-        self._log.seek(max(0, size - _LOG_TAIL))
-        text = self._log.read().decode("utf-8", errors="replace")
+        with contextlib.suppress(ProcessLookupError, PermissionError):  # what it left running holds its log open
+            os.killpg(self._proc.pid, signal.SIGKILL)
+        self._drain(output)
+        text = self._tail.decode("utf-8", errors="replace")
         return ChildEnd(status, self.hung, (text.strip().splitlines() or ["no message"])[-1])
 
     def _expire(self) -> None:
@@ -205,7 +262,9 @@ class Child:
         for stream in (self._proc.stdin, self._proc.stdout):
             if stream is not None:
                 stream.close()
-        self._log.close()
+        if self._answers >= 0:
+            os.close(self._answers)
+            self._answers = -1
 
     def __enter__(self) -> Self:
         return self

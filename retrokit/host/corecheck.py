@@ -37,7 +37,7 @@ from retrokit.errors import ChildStartError, CoreError, RetrokitError
 from retrokit.host.child import Child
 from retrokit.host.cores import built_cores_dir, core_filename
 from retrokit.host.elf import check_core_file
-from retrokit.paths import atomic_write, data_dir
+from retrokit.paths import atomic_write, data_dir, read_regular_file, records_dir
 from retrokit.wheel import wheel_files, wheel_version
 
 PROBE_FRAMES = 60
@@ -150,7 +150,7 @@ def vet_core(core: str | os.PathLike[str], system: str, rom: str | os.PathLike[s
         if not verdict.safe:
             raise CoreError(
                 f"{path} is not a core retrokit can load: {verdict.reason}. Use the stable-retro wheel's core "
-                f"(remove this one from RETROKIT_CORES), or rebuild it; the verdict is kept in {_verdict_file(digest)} "
+                f"(remove this one from RETROKIT_CORES), or rebuild it; the verdict is kept in {data_dir() / CORE_PROBES / digest} "
                 "(delete that file to probe the core again)."
             )
     _vetted.add(key)
@@ -192,14 +192,18 @@ def probe_core(core: Path, system: str, rom: str | os.PathLike[str], *, timeout:
     return ProbeVerdict(False, f"the probe failed (exit {end.status}: {end.last_words})", lasting=False)
 
 
+CORE_PROBES = "core-probes"
+"""The data folder's folder of core verdicts (:func:`retrokit.paths.records_dir`: never a link)."""
+
+
 def _verdict_file(digest: str) -> Path:
-    return data_dir() / "core-probes" / digest
+    return records_dir(CORE_PROBES) / digest  # never through a link: a planted verdict would vouch
 
 
 def _remembered(digest: str) -> ProbeVerdict | None:
     try:
-        text = _verdict_file(digest).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError):
+        text = read_regular_file(_verdict_file(digest), "a core's verdict", 4096, follow=False).decode("utf-8")
+    except (RetrokitError, UnicodeDecodeError):
         return None
     return ProbeVerdict(True) if text == _SAFE else ProbeVerdict(False, text)
 

@@ -1,9 +1,11 @@
-"""Console addresses, RAM fields, and reading them all after each step.
+"""Console addresses, RAM fields, stable-retro's RAM, and reading them all after each step.
 
 An :class:`AddressSpace` maps console addresses onto the core's memory buffers
 (the system RAM, or the regions of the core's memory map), undoing the byte
-swap of systems such as the Genesis. A :class:`FieldReader` compiles a game's
-fields once into a plan the native host executes in a single call.
+swap of systems such as the Genesis. It also knows the RAM as stable-retro
+shows it (``get_ram()``, RAM observations): its blocks (:class:`RamBlock`),
+one rule for every system. A :class:`FieldReader` compiles a game's fields
+once into a plan the native host executes in a single call.
 """
 
 from __future__ import annotations
@@ -39,21 +41,86 @@ class Region:
         return relative ^ (self.swap - 1) if _LITTLE_HOST else relative
 
 
+@dataclass(frozen=True)
+class RamBlock:
+    """One block of the RAM stable-retro shows: ``length`` bytes from console address ``start``, as the core keeps them.
+
+    Attributes:
+        start: The console address of its first byte.
+        length: Its size in bytes.
+        region: The index of the :class:`Region` whose buffer holds it (from its start), or ``None`` where
+            the core put no memory behind the descriptor: stable-retro shows zeros there.
+    """
+
+    start: int
+    length: int
+    region: int | None
+
+
+def stable_retro_blocks(descriptors: Sequence[tuple[int, int, int | None]]) -> list[RamBlock]:
+    """The blocks of stable-retro's RAM, from a core's writable memory descriptors, in their order.
+
+    stable-retro keeps one block per descriptor by its start address, so a later
+    descriptor at the same start replaces an earlier one, and lays them out in
+    ascending order of address (``Emulator::reconfigureAddressSpace`` and
+    ``RetroEnv.get_ram`` in its sources).
+
+    Args:
+        descriptors: ``(start, length, region index or None)`` of each descriptor that is not read-only.
+    """
+    by_start = {start: RamBlock(start, length, region) for start, length, region in descriptors}
+    return [by_start[start] for start in sorted(by_start)]
+
+
 class AddressSpace:
     """Console addresses over a core's memory.
 
     Args:
         regions: The mapped regions, searched in order.
+        ram_blocks: stable-retro's RAM (:func:`stable_retro_blocks`); by default each region, in address order.
     """
 
-    def __init__(self, regions: Sequence[Region]) -> None:
+    def __init__(self, regions: Sequence[Region], ram_blocks: Sequence[RamBlock] | None = None) -> None:
         self.regions = list(regions)
         self.buffers = [r.buffer for r in self.regions]
-        self._layout = self._describe(self.regions)
+        if ram_blocks is None:
+            ram_blocks = stable_retro_blocks([(r.start, r.length, i) for i, r in enumerate(self.regions)])
+        self.ram_blocks = tuple(ram_blocks)
+        #: The bytes of stable-retro's RAM: its blocks' lengths added up.
+        self.ram_size = sum(block.length for block in self.ram_blocks)
+        # Where each block goes in the RAM and comes from in its buffer: (at, end, region or None, from, to).
+        self._ram_plan: list[tuple[int, int, int | None, int, int]] = []
+        at = 0
+        for block in self.ram_blocks:
+            rel = 0 if block.region is None else block.start - self.regions[block.region].start
+            last = self._ram_plan[-1] if self._ram_plan else None
+            if last is not None and block.region is not None and last[2] == block.region and last[4] == rel:
+                # the block follows the last one in the same buffer (the NES's ten): one copy for both
+                self._ram_plan[-1] = (last[0], at + block.length, block.region, last[3], rel + block.length)
+            else:
+                self._ram_plan.append((at, at + block.length, block.region, rel, rel + block.length))
+            at += block.length
+        self._layout = self._describe(self.regions, self.ram_blocks)
 
     @staticmethod
-    def _describe(regions: Sequence[Region]) -> list[tuple[int, int, int]]:
-        return [(r.start, r.length, r.swap) for r in regions]
+    def _describe(regions: Sequence[Region], blocks: Sequence[RamBlock]) -> list[tuple[int, ...]]:
+        return [(r.start, r.length, r.swap) for r in regions] + [(b.start, b.length, -1) for b in blocks]
+
+    def copy_ram(self, out: np.ndarray) -> np.ndarray:
+        """Copy the RAM as stable-retro shows it into ``out`` (``uint8``, :attr:`ram_size` bytes) and return ``out``.
+
+        Each block's bytes come as the core keeps them (a Genesis's 16-bit words
+        host-order, as stable-retro's ``get_ram`` gives them), one after the other
+        in ascending order of address; a block the core put no memory behind is zeros.
+        """
+        view = memoryview(out).cast("B")
+        buffers = self.buffers
+        for at, end, region, start, stop in self._ram_plan:
+            if region is None:
+                out[at:end] = 0
+            else:
+                view[at:end] = buffers[region][start:stop]
+        return out
 
     def release(self) -> None:
         """Let go of every buffer onto the core's memory (before a reload frees it), until :meth:`rebind`.
@@ -86,10 +153,11 @@ class AddressSpace:
         Raises:
             CoreError: ``fresh`` lays its regions out otherwise (the core changed its map on a reload).
         """
-        if self._describe(fresh.regions) != self._layout:
+        found = self._describe(fresh.regions, fresh.ram_blocks)
+        if found != self._layout:
             raise CoreError(
                 f"Expected the core to map the same memory after reloading its game ({self._layout}); found "
-                f"{self._describe(fresh.regions)}. Report the core: its fields cannot be read across a reload."
+                f"{found}. Report the core: its fields cannot be read across a reload."
             )
         self.regions[:] = fresh.regions
         self.buffers[:] = fresh.buffers
@@ -100,22 +168,51 @@ class AddressSpace:
 
         The core's memory map is used where it gives one (skipping read-only
         regions, as Gym Retro does); otherwise the system RAM sits at the
-        system's RAM base.
+        system's RAM base. stable-retro's RAM follows the same rule: the map's
+        writable descriptors (one with no memory behind it too, as zeros), or
+        else the system RAM at the descriptor's ``ram.base``.
+
+        Descriptors that follow each other in console addresses and in memory
+        make one region (FCEUmm maps the NES's 2 KiB of RAM as two 1 KiB
+        descriptors over one array), so a field across them reads the bytes
+        that follow, as stable-retro reads it.
         """
-        regions = []
-        for desc in emulator.memory_maps():
-            if desc["flags"] & _CONST or desc["memory"] is None:
+        regions: list[Region] = []
+        descriptors: list[tuple[int, int, int | None]] = []
+        run: tuple[int, int] | None = None  # the last region's first descriptor and how many it holds, if it may grow
+        for index, desc in enumerate(emulator.memory_maps()):
+            if desc["flags"] & _CONST:
+                run = None
                 continue
             length = desc["length"]
             if desc["select"]:
                 by_select = ((~desc["select"] & ~desc["start"]) + 1) & desc["select"]
                 length = min(length, by_select) if length else by_select
-            regions.append(Region(desc["start"], length, desc["memory"], system.ram_swap))
+            memory = desc["memory"]
+            if memory is None:
+                descriptors.append((desc["start"], length, None))
+                run = None
+                continue
+            whole = length == len(memory)  # the region is all of the descriptor's memory: the next may follow it
+            last = regions[-1] if regions else None
+            if run is not None and whole and last is not None and desc["start"] == last.start + last.length:
+                first, count = run
+                span = emulator.memory_span(first, count + 1)  # None unless the memory follows too
+                if span is not None:
+                    regions[-1] = Region(last.start, last.length + length, span, system.ram_swap)
+                    descriptors.append((desc["start"], length, len(regions) - 1))
+                    run = (first, count + 1)
+                    continue
+            descriptors.append((desc["start"], length, len(regions)))
+            regions.append(Region(desc["start"], length, memory, system.ram_swap))
+            run = (index, 1) if whole else None
         if not regions:
             ram = emulator.memory(primitives.MEMORY_SYSTEM_RAM)
             if ram is not None:
                 regions.append(Region(system.ram_base, len(ram), ram, system.ram_swap))
-        return cls(regions)
+                if not descriptors:
+                    descriptors.append((system.ram_base, len(ram), 0))
+        return cls(regions, stable_retro_blocks(descriptors))
 
     def locate(self, address: int, width: int = 1) -> tuple[int, int]:
         """Return ``(buffer index, region-relative start)`` of ``width`` bytes at ``address``.

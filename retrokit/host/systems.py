@@ -17,6 +17,8 @@ import yaml
 from retrokit.errors import DataFileError, InvalidArgumentError, UnknownNameError, UnsupportedSystemError, did_you_mean
 
 _FILE = Path(__file__).with_name("systems.yaml")
+#: The state cap of a core whose descriptor names none: far above every such core's (Genesis Plus GX's is 1 MiB).
+DEFAULT_STATE_MAX = 16 * 2**20
 _T = TypeVar("_T")
 
 
@@ -80,12 +82,26 @@ class System:
             and loaded again before each state is loaded (then reset, if
             ``reset_before_state``), as a fresh core would take it, and before
             each hard reset.
+        reload_md5: With ``reload_before_state``, the ROMs (by MD5) whose state
+            loads need the reload; with ``reload_cartridges`` also empty, every
+            ROM's do. The others' state loads are a load, and their hard resets
+            restore what the first one (a reload) left: see :meth:`reloads_states`.
+        reload_cartridges: The cartridge classes (named in stella's states) whose
+            state loads need the reload too.
         start: The button that starts a game from its title screen.
         jump: The button JERK jumps with, unless a scenario names another.
         switches: Console switches (not pad buttons), which default action sets, the random
             agent, JERK and validate's smoke run leave alone.
+        extension_wins_over: Systems whose header this system's ROMs carry: a file with this system's
+            extension whose header names one of them is this system's (stable-retro goes by the extension).
+        state_max: The largest state the core writes, in bytes: a state inflating past it is refused.
+        movie_buttons: Buttons stable-retro's ``.bk2`` letters lack, recorded all the same: the button's
+            ``(frame letter, key-line name)``, as BizHawk's own input log of the console writes them.
         proven_by: What proves retrokit runs the system right, by kind (``"cartridge"``,
             ``"stable-retro"``, ``"ale-py"``): a game's name, or ``""``; empty if nothing does.
+        build_speedup: How many times faster this system's env steps on the core ``retrokit
+            build-core`` makes than on the wheel's, as measured (``None``: not measured).
+        build_measured: On what, when and how loaded a machine ``build_speedup`` was measured.
     """
 
     name: str
@@ -103,16 +119,25 @@ class System:
     state_length: str = "exact"
     reset_before_state: bool = False
     reload_before_state: bool = False
+    reload_md5: frozenset[str] = frozenset()
+    reload_cartridges: frozenset[str] = frozenset()
     detect: tuple[DetectRule, ...] = ()
     rom_format: str = ""
     missing_mappers: frozenset[int] = frozenset()
     start: str = "START"
     jump: str | None = None
     switches: tuple[str, ...] = ()
+    movie_buttons: dict[str, tuple[str, str]] = field(default_factory=dict)
+    extension_wins_over: tuple[str, ...] = ()
+    state_max: int = DEFAULT_STATE_MAX
     proven_by: dict[str, str] = field(default_factory=dict)
+    build_speedup: float | None = None
+    build_measured: str = ""
 
     def __post_init__(self) -> None:
-        for what, names in (("start", [self.start]), ("jump", [self.jump] if self.jump else []), ("switches", self.switches)):
+        named = (("start", [self.start]), ("jump", [self.jump] if self.jump else []), ("switches", self.switches),
+                 ("movie_buttons", list(self.movie_buttons)))  # fmt: skip
+        for what, names in named:
             for name in names:
                 if name not in self.button_names:
                     raise DataFileError(
@@ -162,6 +187,11 @@ class System:
         return bool(self.proven_by)
 
     @property
+    def present_mask(self) -> int:
+        """The RetroPad bits of the buttons the console has (``buttons`` entries that are not ``None``)."""
+        return self.mask(self.button_names)
+
+    @property
     def switch_mask(self) -> int:
         """The RetroPad bits of the console switches."""
         return self.mask(self.switches)
@@ -179,6 +209,19 @@ class System:
         for name in buttons:
             value |= 1 << self.button_bit(name)
         return value
+
+    def reloads_states(self, rom_md5: str, cartridge: str) -> bool:
+        """Whether loading a state into a console of this ROM must load the game again first.
+
+        Args:
+            rom_md5: The ROM's MD5, hex.
+            cartridge: The cartridge class the core's states name (``""`` when they name none).
+        """
+        if not self.reload_before_state:
+            return False
+        if not (self.reload_md5 or self.reload_cartridges):
+            return True
+        return rom_md5 in self.reload_md5 or cartridge in self.reload_cartridges
 
     def buttons_of(self, mask: int) -> list[str]:
         """Return the names of the buttons a bit mask presses."""
@@ -206,16 +249,35 @@ def _parse(name: str, entry: object) -> System:
             state_length=_one_of(entry.get("state_length", "exact"), ("exact", "parsed"), "state_length"),
             reset_before_state=_one_of(entry.get("reset_before_state", False), (False, True), "reset_before_state"),
             reload_before_state=_one_of(entry.get("reload_before_state", False), (False, True), "reload_before_state"),
+            reload_md5=frozenset(str(m).lower() for m in (entry.get("reload_only_for") or {}).get("md5", ())),
+            reload_cartridges=frozenset(str(c) for c in (entry.get("reload_only_for") or {}).get("cartridges", ())),
             detect=tuple(_detect_rule(rule) for rule in entry.get("detect") or ()),
             rom_format=_one_of(str((entry.get("rom") or {}).get("format", "")), ("", "ines"), "rom.format"),
             missing_mappers=frozenset(int(m) for m in (entry.get("rom") or {}).get("missing_mappers", ())),
             start=str(entry.get("start", "START")),
             jump=str(entry["jump"]) if entry.get("jump") else None,
             switches=tuple(str(b) for b in entry.get("switches", ())),
+            extension_wins_over=tuple(str(n) for n in entry.get("extension_wins_over", ())),
+            state_max=_positive(entry.get("state_max", DEFAULT_STATE_MAX), "state_max"),
+            movie_buttons={str(k): _letter_and_name(v) for k, v in (entry.get("movie_buttons") or {}).items()},
             proven_by={str(k): str(v or "") for k, v in (entry.get("proven_by") or {}).items()},
+            build_speedup=float(entry["build_core"]["speedup"]) if "build_core" in entry else None,
+            build_measured=str((entry.get("build_core") or {}).get("measured", "")),
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise DataFileError(f"{_FILE}: system {name!r} is malformed: {exc!r}.") from exc
+
+
+def _positive(value: object, key: str) -> int:
+    if type(value) is not int or value <= 0:
+        raise ValueError(f"{key} must be a positive number of bytes, not {value!r}")
+    return value
+
+
+def _letter_and_name(value: object) -> tuple[str, str]:
+    if not (isinstance(value, list) and len(value) == 2 and len(str(value[0])) == 1 and str(value[1])):
+        raise ValueError(f"a movie button is [one-character letter, key-line name], not {value!r}")
+    return str(value[0]), str(value[1])
 
 
 def _detect_rule(rule: dict) -> DetectRule:
@@ -251,7 +313,20 @@ def all_systems() -> dict[str, System]:
         # libyaml's loader where PyYAML has it: every process that makes an env reads this file, and the
         # pure-Python one takes a fifth of a second over it.
         data = yaml.load(f, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-    return {name: _parse(name, entry) for name, entry in data.items()}
+    systems = {name: _parse(name, entry) for name, entry in data.items()}
+    for system in systems.values():
+        for other in system.extension_wins_over:
+            if other not in systems:
+                raise DataFileError(
+                    f"{_FILE}: system {system.name!r}: expected extension_wins_over to name systems; found {other!r}."
+                    + did_you_mean(other, systems)
+                )
+    return systems
+
+
+def largest_state() -> int:
+    """The largest state any core writes (the largest ``state_max``): what a state read for no known system may be."""
+    return max(system.state_max for system in all_systems().values())
 
 
 def get_system(name: str | System) -> System:

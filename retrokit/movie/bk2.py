@@ -10,8 +10,9 @@ A ``.bk2`` file is a zip archive (members deflated) of three files:
     per player. In a group each button is its letter when pressed, else ``.``.
 ``Header.txt``
     ``Key Value`` lines: ``MovieVersion Retro``, ``Author ?``, ``emuVersion ?``,
-    ``Platform GEN``, ``GameName Airstriker-Genesis-v0``, ``SHA1 ?``, ``Core ?``,
-    ``rerecordCount 1``.
+    ``Platform GEN``, ``GameName Airstriker-Genesis-v0`` (the game's folder name in
+    stable-retro's data: ``-v0`` for its stable games, none for its experimental
+    and contrib ones), ``SHA1 ?``, ``Core ?``, ``rerecordCount 1``.
 ``Core.bin``
     The start state, uncompressed core serialization (only deflated by the zip).
 
@@ -19,7 +20,10 @@ Details stable-retro depends on, found by recording and reading real movies:
 its key line has no ``LogKey:`` prefix (a BizHawk-style ``LogKey:#Reset|Power|#``
 prefix makes its reader fail); buttons are listed in descending RetroPad id
 order; only buttons with a letter in :data:`LETTERS` are recorded (it drops the
-others, e.g. PC Engine's I to VI, silently); it cannot open a movie without
+others, e.g. PC Engine's I to VI and RUN, silently; retrokit records those as
+BizHawk's own input log of the console does, its descriptor's ``movie_buttons``,
+and stable-retro's reader, which goes by letter, skips letters it does not
+know); it cannot open a movie without
 ``Core.bin``, nor decode keys without ``Platform``. It maps frame characters to
 buttons by letter; retrokit maps them by column and checks the letter, so any
 movie retrokit accepts plays the same in both.
@@ -36,8 +40,9 @@ import zipfile
 import zlib
 from pathlib import Path
 
-from retrokit.data.states import MAX_STATE_SIZE
+from retrokit.data.games import stable_retro_name
 from retrokit.errors import MovieError, UnsupportedSystemError
+from retrokit.host.systems import get_system
 from retrokit.movie.model import Layout, Movie, layout, platform_of, system_of_platform
 from retrokit.paths import atomic_write, require_regular_file
 
@@ -77,8 +82,10 @@ def read_bk2(path: str | os.PathLike[str]) -> Movie:
                         f"{', '.join(map(repr, names)) or 'no files'}. Was it made by another program?"
                     )
             header_text = _text(path, archive, HEADER)
+            system, game, header = _parse_header(path, header_text)
             log_text = _text(path, archive, INPUT_LOG)
-            state = _member(path, archive, STATE, MAX_STATE_SIZE) if STATE in names else None
+            # no larger than the movie's core writes a state (systems.yaml's state_max)
+            state = _member(path, archive, STATE, get_system(system).state_max) if STATE in names else None
     except FileNotFoundError:
         raise MovieError(f"Expected a .bk2 movie at {path}; found no such file.") from None
     except IsADirectoryError:
@@ -96,7 +103,6 @@ def read_bk2(path: str | os.PathLike[str]) -> Movie:
             f"{path}: expected {STATE!r} to hold the movie's start state; found 0 bytes. A movie that starts at "
             f"power-on has no {STATE!r}: record it again, or copy the movie again if it was cut short."
         )
-    system, game, header = _parse_header(path, header_text)
     players, frames = _parse_log(path, log_text, layout(system))
     return Movie(game, system, players, state, frames, header)
 
@@ -254,8 +260,8 @@ def encode_bk2(movie: Movie) -> bytes:
 
 
 def _file_game_name(game: str) -> str:
-    """stable-retro names games ``<Name>-<System>-v0``; its player looks the movie's game up by that name."""
-    return game if game == "?" else f"{game}-v0"
+    """The name stable-retro's player looks the movie's game up by (:func:`retrokit.data.games.stable_retro_name`)."""
+    return game if game == "?" else stable_retro_name(game)
 
 
 def write_bk2(path: str | os.PathLike[str], movie: Movie, *, overwrite: bool = False) -> None:

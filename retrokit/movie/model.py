@@ -75,11 +75,13 @@ class Layout:
         system: The system's name.
         columns: ``(RetroPad id, letter, key-line name)`` per recorded button, in file order.
         allowed: The mask of the buttons a movie can hold.
+        stable_retro: The mask of those stable-retro reads (its letters; not a descriptor's ``movie_buttons``).
     """
 
     system: str
     columns: tuple[tuple[int, str, str], ...]
     allowed: int
+    stable_retro: int = 0
 
     def describe(self) -> str:
         """Return the buttons a movie of this system can hold, e.g. ``"Z, X, ..., B"``."""
@@ -110,10 +112,12 @@ class Layout:
 def layout(system: str) -> Layout:
     """Return the movie layout of a system (by name, case-insensitive)."""
     desc = get_system(system)
-    columns = [(bit, *LETTERS[name]) for bit, name in enumerate(desc.buttons) if name in LETTERS]
+    letters = {**LETTERS, **desc.movie_buttons}
+    columns = [(bit, *letters[name]) for bit, name in enumerate(desc.buttons) if name in letters]
     columns.sort(reverse=True)  # stable-retro lists buttons from the highest id down
     allowed = sum(1 << bit for bit, _, _ in columns)
-    return Layout(desc.name, tuple(columns), allowed)
+    theirs = sum(1 << bit for bit, name in enumerate(desc.buttons) if name in LETTERS)
+    return Layout(desc.name, tuple(columns), allowed, theirs)
 
 
 def platform_of(system: str) -> str:

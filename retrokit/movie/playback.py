@@ -22,6 +22,7 @@ from retrokit.errors import (
     MovieError,
     RomError,
     install_extra,
+    shell_word,
 )
 from retrokit.host.emulator import Emulator, VettedState
 from retrokit.movie.bk2 import read_bk2
@@ -293,8 +294,8 @@ def state_from_movie(game: Game, movie_path: str | os.PathLike[str], frame: int 
     movie = read_bk2(movie_path)
     if movie.game != game.name:
         raise MovieError(
-            f"Expected a movie of {game.name}; found one of {movie.game} in {movie_path}. "
-            f"Give its game instead: retrokit integrate {movie.game} NAME --movie {movie_path}"
+            f"Expected a movie of {game.name}; found one of {movie.game} in {str(movie_path)!r}. "
+            f"Give its game instead: retrokit integrate {movie.game} NAME --movie {shell_word(movie_path)}"
         )
     length = len(movie.frames)
     frame = length if frame is None else frame

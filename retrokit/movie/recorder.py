@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import sys
 import threading
-import time
 import weakref
 from collections.abc import Sequence
 from pathlib import Path
@@ -14,6 +14,7 @@ from typing import Self
 from retrokit.data.games import cached_rom_sha1, find_game
 from retrokit.data.states import StateRecord
 from retrokit.errors import FileConflictError, MovieError, RetrokitError
+from retrokit.host.systems import get_system
 from retrokit.movie.bk2 import encode_bk2, write_bk2
 from retrokit.movie.model import STATE_DIGEST, Movie, layout
 from retrokit.paths import atomic_write, ensure_folder
@@ -77,8 +78,38 @@ def state_header(game: str, state: bytes) -> dict[str, str]:
 
 #: How often, in seconds of wall-clock time, a recording movie is written out whole while it records.
 FLUSH_SECONDS = 1.0
-#: Frames between two looks at the clock (one look a frame would cost more than the check is worth).
-_CLOCK_EVERY = 64
+
+
+class _Flusher:
+    """The one thread of a process that writes every recording movie with new frames out, each :data:`FLUSH_SECONDS`.
+
+    A thread, not a check in :meth:`MovieRecorder.record`: a script that steps,
+    then thinks, sleeps or waits on a learner for longer, would otherwise keep its
+    last steps unwritten until its next one, and a kill then took them. The
+    files are held weakly (a dropped recorder's finalizer writes its movie), and
+    a forked child starts a thread of its own for its own recorders.
+    """
+
+    lock = threading.Lock()
+    files: weakref.WeakSet[_MovieFile] = weakref.WeakSet()
+    pid: int | None = None  # the process whose thread runs
+
+    @classmethod
+    def watch(cls, file: _MovieFile) -> None:
+        with cls.lock:
+            cls.files.add(file)
+            if cls.pid != os.getpid():
+                cls.pid = os.getpid()
+                threading.Thread(target=cls._run, name="retrokit-movie-flusher", daemon=True).start()
+
+    @classmethod
+    def _run(cls) -> None:
+        tick = threading.Event()
+        while not tick.wait(FLUSH_SECONDS):
+            with cls.lock:
+                files = list(cls.files)
+            for file in files:
+                file.flush_pending()
 
 
 class _MovieFile:
@@ -95,25 +126,46 @@ class _MovieFile:
         self.overwrite = overwrite
         self.written: int | None = None  # frames in the file; None: nothing written yet
         self.pid = os.getpid()  # a forked child must not write its parent's movie
+        self.closed = False
+        self.error: RetrokitError | OSError | None = None  # what the flusher thread met, for the recorder to raise
+        self._lock = threading.Lock()  # one writer at a time: an older snapshot never replaces a newer one
 
-    def write(self) -> None:
+    def write(self, *, last: bool = False) -> None:
         """Write the movie whole, as it is now, replacing what this recorder wrote before (atomically).
 
         The first write makes a new file or fails (unless asked to overwrite), even where an identical movie is:
         another process starting the same episode made that one, and it is not this recorder's to write on.
+
+        Args:
+            last: The recorder is closing: no write follows this one.
         """
-        if self.written is None and not self.overwrite:
-            atomic_write(self.path, encode_bk2(self.movie))
-        else:
-            write_bk2(self.path, self.movie, overwrite=True)
-        self.written = len(self.movie.frames)
+        with self._lock:
+            if self.closed:
+                return
+            # The frames so far: the recording thread appends on while this one encodes.
+            movie = dataclasses.replace(self.movie, frames=list(self.movie.frames))
+            if self.written is None and not self.overwrite:
+                atomic_write(self.path, encode_bk2(movie))
+            else:
+                write_bk2(self.path, movie, overwrite=True)
+            self.written = len(movie.frames)
+            self.closed = last
+
+    def flush_pending(self) -> None:
+        """The flusher thread's call: write the movie if it has frames the file lacks; keep an error for the recorder."""
+        if os.getpid() != self.pid or self.closed or len(self.movie.frames) == self.written or self.error:
+            return
+        try:
+            self.write()
+        except (RetrokitError, OSError) as exc:
+            self.error = exc
 
     def write_at_exit(self) -> None:
         """The finalizer: complete the movie of a script that exits, or drops its recorder, without close()."""
         if os.getpid() != self.pid:
             return
         try:
-            self.write()
+            self.write(last=True)
         except (RetrokitError, OSError) as exc:  # at exit there is no caller to raise to: say it once
             print(f"retrokit: the movie {self.path} could not be written at exit: {exc}", file=sys.stderr)
 
@@ -128,11 +180,12 @@ class MovieRecorder:
 
     Nothing recorded is lost to a process that ends badly: the movie (its
     header and start state) is written when the recorder is made; while it records,
-    the movie is written out whole (atomically, so the file is always a
-    playable movie) every :data:`FLUSH_SECONDS`, so a process killed with
-    SIGKILL leaves a movie of all but its last second; and a script that exits,
-    or drops the recorder, without :meth:`close` gets its movie written whole
-    by a finalizer.
+    a thread writes the movie out whole (atomically, so the file is always a
+    playable movie) every :data:`FLUSH_SECONDS` it has new frames, whatever the
+    script does meanwhile (steps, sleeps, waits on a learner), so a process
+    killed with SIGKILL leaves a movie of all but its last second; and a script
+    that exits, or drops the recorder, without :meth:`close` gets its movie
+    written whole by a finalizer.
 
     Args:
         path: The ``.bk2`` file to write.
@@ -167,11 +220,15 @@ class MovieRecorder:
         if start_state is not None:
             self.movie.header.update(state_header(self.movie.game, start_state))
         self._layout = layout(self.movie.system)
+        # RetroPad ids among the console's that no button sits on (the NES's 1, under action_type="all") reach
+        # no game; stable-retro's recording drops them, and so does this. Bits past the pad are refused.
+        system = get_system(self.movie.system)
+        self._kept = ~(((1 << len(system.buttons)) - 1) & ~system.present_mask)
         self._players = self.movie.players
         self._file = _MovieFile(path, self.movie, overwrite)
         self._file.write()  # now, whole and atomically: a recorder killed before its first flush leaves a movie that plays
         self._finalizer = weakref.finalize(self, self._file.write_at_exit)
-        self._next_flush = time.monotonic() + FLUSH_SECONDS
+        _Flusher.watch(self._file)
         self._closed = False
 
     @property
@@ -182,7 +239,8 @@ class MovieRecorder:
     def record(self, masks: Sequence[int]) -> None:
         """Append one frame: one RetroPad bit mask per port.
 
-        Masks beyond the movie's players must be 0 (e.g. an emulator's idle second port).
+        Masks beyond the movie's players must be 0 (e.g. an emulator's idle second port). Bits of
+        RetroPad ids the console has no button on are dropped, as stable-retro's recording drops them.
 
         Raises:
             MovieError: The recorder is closed, too few masks are given, a port beyond
@@ -191,7 +249,9 @@ class MovieRecorder:
         """
         if self._closed:
             raise MovieError(f"Expected an open recorder; found it closed after writing {self.path}. Make a new one.")
-        frame = tuple(int(m) for m in masks[: self._players])
+        self._raise_flush_error()
+        kept = self._kept
+        frame = tuple(int(m) & kept for m in masks[: self._players])
         frames = self.movie.frames
         if len(frame) < self._players or any(int(m) for m in masks[self._players :]):
             raise MovieError(
@@ -201,18 +261,24 @@ class MovieRecorder:
         if any(m < 0 or m & ~self._layout.allowed for m in frame):
             self._layout.check_frame(frame, self._players, f"{self.path} frame {len(frames)}")  # raises, naming it
         frames.append(frame)
-        if len(frames) % _CLOCK_EVERY == 0 and time.monotonic() >= self._next_flush:
-            self.flush()
 
     def flush(self) -> None:
-        """Write the movie recorded so far (a playable movie, replaced atomically by later writes and by close).
+        """Write the movie recorded so far now (a playable movie, replaced atomically by later writes and by close).
 
         Raises:
             FileConflictError: A different file appeared at the path meanwhile.
         """
+        self._raise_flush_error()
         if not self._closed and len(self.movie.frames) != self._file.written:
             self._file.write()
-        self._next_flush = time.monotonic() + FLUSH_SECONDS
+
+    def _raise_flush_error(self) -> None:
+        """Raise, in the recording thread, what the flusher thread met writing the movie (once)."""
+        error, self._file.error = self._file.error, None
+        if isinstance(error, RetrokitError):
+            raise error
+        if error is not None:
+            raise MovieError(f"Expected to write the movie {self.path} as it records; it failed: {error}.")
 
     def __len__(self) -> int:
         """How many frames have been recorded."""
@@ -230,7 +296,7 @@ class MovieRecorder:
             FileConflictError: A different file appeared at the path meanwhile.
         """
         if not self._closed:
-            self._file.write()
+            self._file.write(last=True)  # the whole movie: whatever the flusher thread met before is moot
             self._finalizer.detach()
             self._closed = True
         return self.path

@@ -28,6 +28,11 @@ PyObject *rk_py_serialize(EmulatorObject *self, PyObject *unused);
 PyObject *rk_py_unserialize(EmulatorObject *self, PyObject *args);
 PyObject *rk_py_reload(EmulatorObject *self, PyObject *unused);
 
+/* Emulator's views of its core's memory (host_memory.c). */
+PyObject *rk_py_memory(EmulatorObject *self, PyObject *arg);
+PyObject *rk_py_memory_maps(EmulatorObject *self, PyObject *unused);
+PyObject *rk_py_memory_span(EmulatorObject *self, PyObject *args);
+
 PyObject *rk_py_read_fields(PyObject *module, PyObject *const *args, Py_ssize_t nargs);
 PyObject *rk_py_pack_buttons(PyObject *module, PyObject *const *args, Py_ssize_t nargs);
 

@@ -1,8 +1,7 @@
 /*
  * The Emulator type of retrokit.native._host: loading, information, running,
- * and what it hands out: its screen as RGB, zero-copy views of its memory
- * (Memory objects keep their emulator alive), and audio; its states are
- * host_state.c's.
+ * and what it hands out: its screen as RGB and audio; its memory is
+ * host_memory.c's, its states host_state.c's.
  *
  * Arguments are checked before the core is touched, and every failure
  * raises; the GIL is released while frames run.
@@ -300,51 +299,6 @@ static PyObject *emulator_get_av_drawn(EmulatorObject *self, void *closure) {
     return PyLong_FromUnsignedLongLong(self->core.av_drawn);
 }
 
-typedef struct {
-    PyObject_HEAD
-    EmulatorObject *owner;
-    void *ptr;
-    Py_ssize_t size;
-} MemoryObject;
-
-static int memory_getbuffer(MemoryObject *self, Py_buffer *view, int flags) {
-    if (self->owner->closed && !self->owner->core.handle)
-        return rk_py_fail(CoreError, "the emulator behind this memory is closed");
-    if (PyBuffer_FillInfo(view, (PyObject *)self, self->ptr, self->size, 0, flags) < 0) return -1;
-    self->owner->exports++;
-    return 0;
-}
-
-static void memory_releasebuffer(MemoryObject *self, Py_buffer *view) { self->owner->exports--; }
-
-static void memory_dealloc(MemoryObject *self) {
-    Py_XDECREF(self->owner);
-    Py_TYPE(self)->tp_free((PyObject *)self);
-}
-
-static PyBufferProcs memory_as_buffer = {(getbufferproc)memory_getbuffer, (releasebufferproc)memory_releasebuffer};
-
-PyTypeObject MemoryType = {
-    PyVarObject_HEAD_INIT(NULL, 0).tp_name = "retrokit.native._host.Memory",
-    .tp_basicsize = sizeof(MemoryObject),
-    .tp_dealloc = (destructor)memory_dealloc,
-    .tp_as_buffer = &memory_as_buffer,
-    .tp_flags = Py_TPFLAGS_DEFAULT,
-    .tp_doc = "A region of a core's memory; it keeps its emulator alive.",
-};
-
-static PyObject *memory_view(EmulatorObject *self, void *ptr, size_t size) {
-    MemoryObject *m = PyObject_New(MemoryObject, &MemoryType);
-    if (!m) return NULL;
-    Py_INCREF(self);
-    m->owner = self;
-    m->ptr = ptr;
-    m->size = (Py_ssize_t)size;
-    PyObject *view = PyMemoryView_FromObject((PyObject *)m);
-    Py_DECREF(m);
-    return view;
-}
-
 static PyObject *emulator_screen_shape(EmulatorObject *self, PyObject *unused) {
     if (rk_py_enter(self, 1)) return NULL;
     rk_core *c = &self->core; /* before the first frame, the size the core announced; after a reload, the last */
@@ -371,39 +325,6 @@ static PyObject *emulator_screen(EmulatorObject *self, PyObject *out) {
     rk_py_leave(self);
     if (rc) PyErr_Format(CoreError, "the core uses pixel format %d, which retrokit cannot convert", c->pixel_format);
     return rk_py_release(&buf, rc ? NULL : Py_NewRef(Py_None));
-}
-
-static PyObject *emulator_memory(EmulatorObject *self, PyObject *arg) {
-    long kind = PyLong_AsLong(arg);
-    if (kind == -1 && PyErr_Occurred()) return NULL;
-    if (kind < 0 || kind > 255) return PyErr_Format(InvalidArgumentError, "memory kind must be 0..255, got %ld", kind);
-    if (rk_py_enter(self, 1)) return NULL;
-    rk_enter(&self->core);
-    void *ptr = self->core.api.get_memory_data((unsigned)kind);
-    size_t size = self->core.api.get_memory_size((unsigned)kind);
-    rk_leave();
-    rk_py_leave(self);
-    if (!ptr || !size) Py_RETURN_NONE;
-    return memory_view(self, ptr, size);
-}
-
-static PyObject *emulator_memory_maps(EmulatorObject *self, PyObject *unused) {
-    if (rk_py_enter(self, 1)) return NULL;
-    rk_py_leave(self);
-    PyObject *list = PyList_New(0);
-    for (int i = 0; list && i < self->core.n_maps; i++) {
-        rk_memmap *m = &self->core.maps[i];
-        /* If making the view fails, Py_BuildValue's N passes the error on. */
-        PyObject *view = m->ptr && m->len ? memory_view(self, (uint8_t *)m->ptr + m->offset, m->len)
-                                          : Py_NewRef(Py_None);
-        PyObject *d = Py_BuildValue("{s:K,s:n,s:n,s:n,s:n,s:s,s:N}", "flags", (unsigned long long)m->flags, "start",
-                                    (Py_ssize_t)m->start, "select", (Py_ssize_t)m->select, "disconnect",
-                                    (Py_ssize_t)m->disconnect, "length", (Py_ssize_t)m->len, "addrspace",
-                                    m->addrspace, "memory", view);
-        if (!d || PyList_Append(list, d) < 0) Py_CLEAR(list);
-        Py_XDECREF(d);
-    }
-    return list;
 }
 
 static PyObject *emulator_capture_audio(EmulatorObject *self, PyObject *arg) {
@@ -442,8 +363,10 @@ static PyMethodDef emulator_methods[] = {
     {"reset", (PyCFunction)emulator_reset, METH_NOARGS, "Hard-reset the console."},
     {"screen_shape", (PyCFunction)emulator_screen_shape, METH_NOARGS, "(height, width) of the last frame."},
     {"screen", (PyCFunction)emulator_screen, METH_O, "Write the last frame as RGB into a uint8 array."},
-    {"memory", (PyCFunction)emulator_memory, METH_O, "A writable zero-copy view of a core memory, or None."},
-    {"memory_maps", (PyCFunction)emulator_memory_maps, METH_NOARGS, "The core's memory descriptors, with views."},
+    {"memory", (PyCFunction)rk_py_memory, METH_O, "A writable zero-copy view of a core memory, or None."},
+    {"memory_span", (PyCFunction)rk_py_memory_span, METH_VARARGS,
+     "memory_span(first, count): one view over descriptors that follow each other in addresses and memory, or None."},
+    {"memory_maps", (PyCFunction)rk_py_memory_maps, METH_NOARGS, "The core's memory descriptors, with views."},
     {"capture_audio", (PyCFunction)emulator_capture_audio, METH_O, "Start or stop keeping audio samples."},
     {"take_audio", (PyCFunction)emulator_take_audio, METH_NOARGS, "Return and clear the captured int16 stereo samples."},
     {"serialize", (PyCFunction)rk_py_serialize, METH_NOARGS, "The core's state as bytes."},

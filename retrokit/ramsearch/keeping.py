@@ -92,8 +92,8 @@ class Keeping:
 
         It goes to ``<data>/games/<Game>/NAME.state`` (with its record), or next to a game.yaml of
         the user's own outside every games folder. With ``default``, ``states: default: NAME`` is
-        written into that folder's game.yaml, so ``make(game)`` starts from it; a game whose
-        game.yaml is elsewhere gets a copy of it there first (which then overrides it).
+        written into the game's game.yaml (:meth:`default_game_file`: a shipped game's is copied
+        into the data folder first), so ``make(game)`` starts from it.
 
         Returns:
             What was done: ``"made"``, ``"up to date"`` or ``"replaced"`` (see :func:`~retrokit.data.integrate.place_state`).
@@ -106,18 +106,15 @@ class Keeping:
         from retrokit.data.integrate import place_state, target_folder
 
         check_state_name(name)
-        folder = target_folder(self.game)
-        game_file = folder / "game.yaml"
-        if default and not game_file.exists():
-            self._check_own_game_yaml()
-        outcome = place_state(self.game, name, self.emulator.get_state(), folder, force=force)
+        game_file = self.default_game_file() if default else None  # a Gym Retro game refuses before any write
+        outcome = place_state(self.game, name, self.emulator.get_state(), target_folder(self.game), force=force)
         if outcome.status in ("differs", "damaged"):
             kind = "a different state" if outcome.status == "differs" else "a file the core cannot load"
             raise FileConflictError(
                 f"Expected no state {name!r} of {self.game.name} or the same one; found {kind} at {outcome.path}. "
                 "Pass --force (force=True) to replace it, or choose another name."
             )
-        if default:
+        if game_file is not None:
             self._write_default_state(game_file, name)
         return outcome
 
@@ -132,46 +129,49 @@ class Keeping:
             StateNotFoundError: The game has no state of that name.
             DataFileError: The game's data file is not a game.yaml.
         """
-        from retrokit.data.integrate import target_folder
-
         check_state_name(name)
         self.game.state_path(name)  # one of its states, or a StateNotFoundError with a did-you-mean
-        game_file = target_folder(self.game) / "game.yaml"
-        if not game_file.exists():
-            self._check_own_game_yaml()
+        game_file = self.default_game_file()
         self._write_default_state(game_file, name)
         return game_file
 
     def _write_default_state(self, game_file: Path, name: str) -> None:
+        gamefile.set_default_state(self._copied(game_file), name)
+
+    def _copied(self, game_file: Path) -> Path:
+        """``game_file``, once it exists: the copy-first rule (:meth:`default_game_file`), made under the folder's lock
+        (two writers making the copy at once: the second edits the first's copy)."""
         ensure_folder(game_file.parent, "to write the game's game.yaml into")
-        with locked(game_file):  # two writers making the copy at once: the second edits the first's copy
+        with locked(game_file):
             if not game_file.exists():
                 atomic_write(game_file, self.game.info.source.read_bytes())
-            gamefile.set_default_state(game_file, name)
-
-    def _check_own_game_yaml(self) -> None:
-        if self.game.info.source.name != "game.yaml":
-            raise DataFileError(
-                f"Expected {self.game.name} to have a game.yaml to write its default state into; its data file is "
-                f"{self.game.info.source}, in Gym Retro's format. Pass the state by name instead: make(game, state=NAME)."
-            )
+        return game_file
 
     # --- saving a find --------------------------------------------------------------------------
 
     def default_game_file(self) -> Path:
-        """The game.yaml ``save_field`` writes to by default: the game's own.
+        """The game.yaml this game's finds and default state are written into: the one rule of them all.
+
+        The game's own game.yaml where it is the user's (a folder in ``RETROKIT_GAMES``, the data
+        folder's ``games/``, a game.yaml outside every games folder); for a game retrokit ships (the
+        checkout's ``games/``, the installed package, stable-retro's wheel), its copy in
+        ``<data>/games/<Game>/game.yaml``, which overrides the shipped one once written (the writers
+        make it first). Nothing a user did not make is edited in place.
 
         Raises:
-            DataFileError: The game's data file is not a game.yaml (a Gym Retro folder), or is inside stable-retro.
+            DataFileError: The game's data file is not a game.yaml (Gym Retro's format).
         """
         source = self.game.info.source
-        installed = [p.resolve() for p in (wheel_dir(), Path(paths.__file__).parent) if p is not None]
-        if source.name != "game.yaml" or any(source.resolve().is_relative_to(p) for p in installed):
+        if source.name != "game.yaml":
             raise DataFileError(
-                f"Expected {self.game.name} to have its own game.yaml; its data file is {source}, inside an "
-                "installed package or in Gym Retro's format, which this tool does not edit. Copy the game's folder "
-                f"into a folder named in {paths.GAMES_ENV} and pass --game-file PATH (game_file=) to its game.yaml."
+                f"Expected {self.game.name} to have a game.yaml to write into; its data file is {source}, in Gym "
+                "Retro's format, which this tool does not edit. Pass --game-file PATH (game_file=) of a game.yaml of "
+                f"yours (a copy of the game's folder in a folder named in {paths.GAMES_ENV}), or a state by name "
+                "instead of a default (make(game, state=NAME))."
             )
+        shipped = [p.resolve() for p in (wheel_dir(), paths.repo_games_dir(), Path(paths.__file__).parent) if p]
+        if any(source.resolve().is_relative_to(p) for p in shipped):
+            return paths.user_games_dir() / self.game.name / "game.yaml"
         return source
 
     def save_field(
@@ -190,7 +190,7 @@ class Keeping:
             name: The field's name.
             address: Its console address.
             type_code: Its type code; a bit type (``|u1&0x04``) is written as ``type: "|u1", mask: 0x04``.
-            game_file: The game.yaml to write (by default :meth:`default_game_file`).
+            game_file: The game.yaml to write (by default :meth:`default_game_file`, copied first for a shipped game).
             force: Replace a field of the same name.
             value_range: The values it may hold, ``(lo, hi)``, written as ``range: [lo, hi]``.
 
@@ -206,7 +206,7 @@ class Keeping:
         self.layout.position(address, ftype.width)
         if value_range is not None:
             value_range = gamefile.check_range(value_range, ftype)
-        path = Path(game_file) if game_file is not None else self.default_game_file()
+        path = Path(game_file) if game_file is not None else self._copied(self.default_game_file())
         if game_file is not None:
             self._check_game_file(path)
         bit = isinstance(ftype, BitType)

@@ -37,7 +37,7 @@ from retrokit.data.games import Game, find_game
 from retrokit.data.roms import rom_sha1
 from retrokit.data.script import MAX_FRAMES, Step, parse_script, port_masks, script_frames
 from retrokit.data.states import StateRecord
-from retrokit.errors import InvalidArgumentError, MovieError, SessionError, StateError
+from retrokit.errors import DataFileError, InvalidArgumentError, MovieError, SessionError, StateError
 from retrokit.host.emulator import Emulator
 from retrokit.host.typecodes import parse_type
 from retrokit.paths import atomic_write
@@ -420,8 +420,19 @@ class RamSearch(Keeping):
         return self.snapshot("new search")
 
     def reload_game(self) -> None:
-        """Read the game's data files again, after its game.yaml was written (a field added or edited)."""
-        self.game = Game(self.game.name, self.game.folders).check()
+        """Read the game's data files again, after its game.yaml was written (a field added or edited).
+
+        A shipped game's first write made its copy in the data folder (:meth:`default_game_file`), which
+        then comes first.
+        """
+        folders = self.game.folders
+        try:
+            written = self.default_game_file().parent
+        except DataFileError:  # Gym Retro's format: nothing was written
+            written = folders[0]
+        if written not in folders and (written / "game.yaml").is_file():
+            folders = (written, *folders)
+        self.game = Game(self.game.name, folders).check()
 
     def filter(self, op: str, value: int | None = None, than: str | int | None = None) -> int:
         """Keep the candidates that pass a filter (see :mod:`retrokit.ramsearch.engine`); return how many are left."""

@@ -50,7 +50,7 @@ def field_reader(session: Session) -> FieldReader:
     entry = _readers.setdefault(session, _Reader())
     game = session.search.game
     if entry.game is not game or entry.reader is None or entry.reader.space is not session.search.emulator.space:
-        entry.game, entry.reader = game, FieldReader(game.fields, session.search.emulator.space)
+        entry.game, entry.reader = game, game.reader(session.search.emulator.space)
     if entry.remove is None:
         entry.remove = session.on_frame(_push)
     return entry.reader

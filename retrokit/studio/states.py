@@ -99,10 +99,7 @@ def _save(session: Session, name: str, default: bool, force: bool) -> dict[str, 
 
 
 def _set_default(session: Session, name: str) -> dict[str, Any]:
-    from retrokit.data.integrate import target_folder
-
-    game = session.search.game
-    check_inside(target_folder(game) / "game.yaml", roots(session), what="game.yaml")  # not a planted link
+    check_inside(session.search.default_game_file(), roots(session), what="game.yaml")  # not a planted link
     written = session.search.set_default_state(name)
     session.refresh_game()
     return {"game_file": str(written), **list_states(session)}

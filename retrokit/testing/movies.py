@@ -66,7 +66,6 @@ def replay(game: Game, movie_path: Path, scenario: str | None = None, rom: Path 
     """
     from retrokit.dsl.scenario import load_scenario
     from retrokit.host.emulator import Emulator
-    from retrokit.host.memory import FieldReader
     from retrokit.movie import read_bk2
     from retrokit.movie.playback import replay as frames_of
 
@@ -75,7 +74,7 @@ def replay(game: Game, movie_path: Path, scenario: str | None = None, rom: Path 
     compiled = load_scenario(path, list(game.fields), game_dir=path.parent)
     total, done_at = 0.0, None
     with Emulator(game.system, rom or game.require_rom(), ports=max(2, movie.players)) as emu:
-        reader = FieldReader(game.fields, emu.space)
+        reader = game.reader(emu.space)
         run = compiled.start()
         for frame in frames_of(movie, emu, source=f"{movie_path}: Core.bin"):  # its start state checked there
             if frame == 0:

@@ -39,9 +39,7 @@ if TYPE_CHECKING:
 
 __all__ = ["IDLE_FRAMES", "StateProbe", "check_states", "parse_states", "probe_states", "state_space"]
 
-IDLE_FRAMES = 60  # frames run after loading, so a state that breaks the core does so here
-INPUT_FRAMES = 300  # then, loaded again, frames of random input: some states crash only then
-CHILD_TIMEOUT = 30.0  # seconds a child may spend on one state
+IDLE_FRAMES = 60  # frames run after loading a state the probe vouches for already (others run the probe's)
 
 
 @dataclass
@@ -64,39 +62,21 @@ def probe_states(
 ) -> dict[str, StateProbe]:
     """Load each state in a child process with the game's ROM; return what each showed.
 
-    The child is the crash probe's (:func:`retrokit.data.probe.run_child`: a
-    memory cap, no core file, this retrokit). A child that dies or hangs marks
-    the state it was loading as failed, and a new child carries on with the
-    states after it: each state gets its own result, none is cached. A state
-    the crash probe's records already vouch for on this ROM
-    (:func:`~retrokit.data.probe.known_safe`: it ran 3,000 frames under input
-    there) is loaded and run idle as every other, but spared the run under input.
+    Each state goes through the crash probe (:func:`retrokit.data.probe.probe_files`),
+    the one rule by which any state loads: a state this machine vouches for
+    (shipped, or probed here before) is loaded and run ``frames`` idle frames;
+    any other is probed as ``make()`` would probe it, and its verdict kept, so
+    validate never passes a state that ``make()`` then refuses. A child that
+    dies or hangs fails the state it was on, and a new child carries on.
     """
     from retrokit.data.games import cached_rom_sha1
-    from retrokit.data.probe import known_safe, run_child
+    from retrokit.data.probe import probe_files
 
-    paths = {name: str(files[name] if files is not None else game.state_path(name)) for name in names}
+    paths = {name: files[name] if files is not None else game.state_path(name) for name in names}
     fields = [{"name": f.name, "address": f.address, "type": f.type, "mask": f.mask} for f in game.fields.values()]
-    probes: dict[str, StateProbe] = {}
     rom_sha1 = cached_rom_sha1(rom, game.system)
-    input_frames = {n: 0 if known_safe(paths[n], game.system.name, rom_sha1) else INPUT_FRAMES for n in names}
-    todo = list(names)
-    while todo:
-        done, current, failure = run_child(
-            game.system.name, rom, [(n, paths[n], input_frames[n]) for n in todo], frames=frames,
-            input_frames=INPUT_FRAMES,
-            fields=fields, timeout=CHILD_TIMEOUT,
-        )
-        probes.update({name: StateProbe(**vars(result)) for name, result in done.items()})
-        todo = [n for n in todo if n not in probes]
-        if current is not None and current in todo:  # the child died or hung on this one
-            probes[current] = StateProbe(current, paths[current], error=failure)
-            todo.remove(current)
-        elif todo:  # the child ended without starting the rest: report, do not loop
-            for name in todo:
-                probes[name] = StateProbe(name, paths[name], error=failure or "the state loader stopped early")
-            todo = []
-    return {name: probes[name] for name in names}
+    done = probe_files(game.system.name, rom, rom_sha1, paths, frames=frames, fields=fields)
+    return {name: StateProbe(**vars(done[name])) for name in names}
 
 
 def state_space(game: Game, data: bytes) -> AddressSpace | None:
@@ -187,7 +167,7 @@ def _check_loaded(
         if rom is None:
             report.add("state parses", PASS, probe.detail, state=name)
         else:
-            report.add("state loads", PASS, f"loaded and ran {IDLE_FRAMES} frames in a child process", state=name)
+            report.add("state loads", PASS, "loaded and ran in a child process (the crash probe)", state=name)
         foreign = _recorded_elsewhere(game, Path(probe.path))
         if foreign:
             report.add("state is the game's", FAIL, foreign, state=name)
@@ -285,7 +265,7 @@ def _check_movie_states(game: Game, report: GameReport, probes: Mapping[str, Sta
         if probe.error:
             report.add("movie start state", FAIL, probe.error, state=label)
         else:
-            report.add("movie start state", PASS, f"loaded and ran {IDLE_FRAMES} frames in a child process", state=label)
+            report.add("movie start state", PASS, "loaded and ran in a child process (the crash probe)", state=label)
             check_ranges(game, report, probe, label)
 
 

@@ -93,6 +93,9 @@ def _find(args: argparse.Namespace) -> int:
         print(f"Found {args.name}: {search.layout.format(found.address)} {found.type} ({finding.reason}).")
         if args.save:
             save_field_from(args, search, found.address, found.type)
+        else:
+            print(f"Save it with: retrokit ramsearch save {args.name} {search.layout.format(found.address)} "
+                  f"'{found.type}' --range LO HI   (or find again with --save)")  # fmt: skip
     return 0
 
 

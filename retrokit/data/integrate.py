@@ -211,7 +211,11 @@ def _script(game: Game, where: str, raw: Any) -> tuple[tuple[tuple[int, ...], in
         steps = parse_script(raw, lambda names: port_masks(game.system, ports, names))
     except RetrokitError as exc:
         raise DataFileError(f"{where}: {exc}") from None
-    return tuple((tuple(port_masks(game.system, ports, step.buttons)), step.frames) for step in steps)
+    masks: dict[int, tuple[int, ...]] = {}  # by step: a repeated step is one object, its masks one tuple
+    for step in steps:
+        if id(step) not in masks:
+            masks[id(step)] = tuple(port_masks(game.system, ports, step.buttons))
+    return tuple((masks[id(step)], step.frames) for step in steps)
 
 
 def _ports(game: Game) -> int:

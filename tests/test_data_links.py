@@ -4,7 +4,7 @@ Every path below the data folder comes from :func:`retrokit.paths.data_path`,
 which refuses a symlink at any level under it: a planted ``<data>/roms``,
 ``<data>/games`` or ``<data>/games/<Game>`` (pointing at someone else's
 folder) makes ``import``, ``integrate``, ``ramsearch save`` and ``savestate``
-and the emulator's saves fail with one line naming the link, and the folder
+and the emulator's saves and built cores fail with one line naming the link, and the folder
 it points at stays as it was. The data folder itself may be a link: the user
 chose it.
 """
@@ -34,6 +34,7 @@ CASES: dict[str, tuple[str, list[str]]] = {
     "savestate-game": ("games/Dasher-Genesis", ["ramsearch", "savestate", "Mine"]),
     "savestate-default": ("games/Dasher-Genesis", ["ramsearch", "savestate", "--default", "Mine"]),
     "emulator-saves": ("saves", ["ramsearch", "new", "Dasher-Genesis", "--state", "Zone1.Act1"]),
+    "emulator-cores": ("cores", ["ramsearch", "new", "Dasher-Genesis", "--state", "Zone1.Act1"]),
 }
 
 
@@ -80,7 +81,7 @@ def test_a_planted_link_is_refused_in_one_line_and_nothing_goes_through_it(runs,
 
 @pytest.mark.parametrize("level", ["games", "games/Dasher-Genesis", "games/Dasher-Genesis/game.yaml", "roms",
                                    "roms/Dasher-Genesis", "studio/drafts", "state-probes", "state-owners",
-                                   "core-probes", "cache", "system", "saves"])  # fmt: skip
+                                   "core-probes", "cache", "system", "saves", "cores"])  # fmt: skip
 def test_the_resolver_refuses_a_link_at_each_level(tmp_path: Path, monkeypatch, level: str) -> None:
     data, elsewhere = tmp_path / "data", tmp_path / "elsewhere"
     elsewhere.mkdir()
@@ -105,3 +106,19 @@ def test_the_data_folder_itself_may_be_a_link(tmp_path: Path, monkeypatch) -> No
     with pytest.raises(PlantedLinkError):
         paths.inside_data(tmp_path / "data" / "games" / "x.yaml")
     assert paths.inside_data(tmp_path / "elsewhere.yaml") == tmp_path / "elsewhere.yaml"  # not in the data folder
+
+
+def test_a_build_record_linked_elsewhere_vouches_for_nothing(tmp_path: Path) -> None:
+    """A core's build record vouches for its bytes: one that is a link (to a forged record) is not read."""
+    from retrokit.host.corecheck import built_vouchers
+    from retrokit.host.cores import read_build_record
+
+    (tmp_path / "cores").mkdir()
+    forged = tmp_path / "forged.json"
+    forged.write_text('{"core": "genesis_plus_gx", "library_sha256": "00", "stable_retro": "1"}')
+    (tmp_path / "cores" / "genesis_plus_gx.build.json").symlink_to(forged)
+    assert read_build_record("genesis_plus_gx", tmp_path) is None
+    assert built_vouchers(tmp_path) == {}
+    (tmp_path / "cores" / "genesis_plus_gx.build.json").unlink()
+    (tmp_path / "cores" / "genesis_plus_gx.build.json").write_bytes(forged.read_bytes())  # the same, as a file: read
+    assert len(built_vouchers(tmp_path)) == 1

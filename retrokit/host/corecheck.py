@@ -28,14 +28,13 @@ from __future__ import annotations
 
 import functools
 import hashlib
-import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
 
 from retrokit.errors import ChildStartError, CoreError
 from retrokit.host.child import Child
-from retrokit.host.cores import built_cores_dir, core_filename
+from retrokit.host.cores import built_cores_dir, core_filename, read_build_record
 from retrokit.host.elf import check_core_file
 from retrokit.host.verdicts import ProbeVerdict, keep_verdict, kept_verdict
 from retrokit.paths import data_dir
@@ -103,11 +102,10 @@ def built_vouchers(data: Path | None = None) -> dict[Path, Voucher]:
     """Return the cores ``retrokit build-core`` made, by path, with the SHA-256 each build record holds."""
     found = {}
     for record_path in sorted(built_cores_dir(data).glob("*.build.json")):
-        try:
-            record = json.loads(record_path.read_text(encoding="utf-8"))
-            core, digest = str(record["core"]), str(record["library_sha256"])
-        except (OSError, ValueError, TypeError, KeyError):
+        record = read_build_record(record_path.name.removesuffix(".build.json"), data) or {}
+        if "core" not in record or "library_sha256" not in record:
             continue  # no readable record vouches for nothing
+        core, digest = str(record["core"]), str(record["library_sha256"])
         fix = f"Build it again: retrokit build-core {core} --force"
         found[(built_cores_dir(data) / core_filename(core)).resolve()] = Voucher(digest, f"its build record {record_path}", fix)
     return found

@@ -81,7 +81,7 @@ def test_a_planted_link_is_refused_in_one_line_and_nothing_goes_through_it(runs,
 
 @pytest.mark.parametrize("level", ["games", "games/Dasher-Genesis", "games/Dasher-Genesis/game.yaml", "roms",
                                    "roms/Dasher-Genesis", "studio/drafts", "state-probes", "state-owners",
-                                   "core-probes", "cache", "system", "saves", "cores"])  # fmt: skip
+                                   "core-probes", "cache", "system", "saves", "cores", "sdist"])  # fmt: skip
 def test_the_resolver_refuses_a_link_at_each_level(tmp_path: Path, monkeypatch, level: str) -> None:
     data, elsewhere = tmp_path / "data", tmp_path / "elsewhere"
     elsewhere.mkdir()
@@ -122,3 +122,19 @@ def test_a_build_record_linked_elsewhere_vouches_for_nothing(tmp_path: Path) -> 
     (tmp_path / "cores" / "genesis_plus_gx.build.json").unlink()
     (tmp_path / "cores" / "genesis_plus_gx.build.json").write_bytes(forged.read_bytes())  # the same, as a file: read
     assert len(built_vouchers(tmp_path)) == 1
+
+
+def test_a_planted_sdist_is_not_what_a_core_is_built_from(tmp_path: Path) -> None:
+    """The kept sdist is what build-core compiles: a link at its folder or at the file is refused before any use."""
+    from retrokit.host.sdist import cached_sdist
+
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (elsewhere / "stable_retro-1.0.1.tar.gz").write_bytes(MARK)
+    kept = elsewhere / "stable_retro-1.0.1.tar.gz"
+    for data, link, target in ((tmp_path / "a", "sdist", elsewhere), (tmp_path / "b", f"sdist/{kept.name}", kept)):
+        (data / link).parent.mkdir(parents=True)
+        (data / link).symlink_to(target)
+        with pytest.raises(PlantedLinkError, match="found a symlink to"):
+            cached_sdist("1.0.1", data=data, index_url="http://127.0.0.1:9/")  # never reached
+    assert _snapshot(elsewhere) == {"stable_retro-1.0.1.tar.gz": MARK}

@@ -19,7 +19,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from retrokit.errors import PlantedLinkError, printable
+from retrokit.errors import InvalidArgumentError, PlantedLinkError, printable, shown
 
 DATA_ENV = "RETROKIT_DATA"
 
@@ -50,9 +50,15 @@ def data_path(*parts: str, data: Path | str | None = None) -> Path:
 
     Raises:
         PlantedLinkError: One level is a symlink (the message names it, where it points, and the fix).
+        InvalidArgumentError: ``parts`` would lead out of the data folder (an absolute path, ``..``).
     """
     path = Path(data) if data is not None else data_dir()
     names = Path(*parts).parts if parts else ()
+    if names and (Path(names[0]).is_absolute() or ".." in names):  # a name made of user input, checked or not
+        raise InvalidArgumentError(
+            f"Expected a path inside retrokit's data folder; got {shown(os.path.join(*parts))}, which leads out of it. "
+            "Use a plain name."
+        )
     for name in names:
         path = path / name
         if os.path.islink(path):

@@ -138,3 +138,11 @@ def test_a_planted_sdist_is_not_what_a_core_is_built_from(tmp_path: Path) -> Non
         with pytest.raises(PlantedLinkError, match="found a symlink to"):
             cached_sdist("1.0.1", data=data, index_url="http://127.0.0.1:9/")  # never reached
     assert _snapshot(elsewhere) == {"stable_retro-1.0.1.tar.gz": MARK}
+
+
+@pytest.mark.parametrize("parts", [("games", "/etc"), ("games", "..", ".."), ("/tmp",)], ids=["absolute", "up", "root"])
+def test_the_resolver_never_leads_out_of_the_data_folder(tmp_path: Path, parts: tuple[str, ...]) -> None:
+    from retrokit.errors import InvalidArgumentError
+
+    with pytest.raises(InvalidArgumentError, match="leads out of it"):
+        paths.data_path(*parts, data=tmp_path)

@@ -243,7 +243,7 @@ def test_validate_spares_only_states_this_machine_vouches_for_the_run_under_inpu
 
     def run_child(system, rom, todo, **kwargs):
         asked.update({name: input_frames for name, _, _, input_frames in todo})
-        return {}, None, "stopped"
+        return {}, None, probe.ProbeVerdict(False, "stopped")
 
     monkeypatch.setattr(probe, "run_child", run_child)
     states.probe_states(game, list(files), game.require_rom(), files=files)

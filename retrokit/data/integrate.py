@@ -392,12 +392,15 @@ def target_folder(game: Game, data_dir: Path | None = None) -> Path:
 
     A game whose only folder is outside every search folder (a game.yaml in the
     current directory) is the user's own: its states go next to its game.yaml.
+
+    Raises:
+        PlantedLinkError: ``<data>/games`` or the game's folder there is a symlink (:func:`retrokit.paths.data_path`).
     """
     searched = [d.resolve() for d in paths.game_search_dirs()]
     own = game.folders[0].resolve()
     if len(game.folders) == 1 and own.parent not in searched:
         return game.folders[0]
-    return paths.user_games_dir(data_dir) / game.name
+    return paths.data_path("games", game.name, data=data_dir)
 
 
 def games_with_state(name: str) -> list[str]:

@@ -19,6 +19,9 @@ from typing import Any
 import pytest
 from childproc import run_child
 
+ale_py = pytest.importorskip("ale_py")  # Breakout's and Pong's ROMs
+
+from retrokit.cli import main
 from retrokit.data.games import find_game
 from retrokit.data.states import compress_state, read_state_file
 from retrokit.movie import Movie, write_bk2
@@ -116,6 +119,7 @@ SAVE_AND_LOAD = """
 from pathlib import Path
 
 import retrokit
+from retrokit.cli import main
 from retrokit.data.games import find_game
 from retrokit.data.integrate import place_state
 from retrokit.data.states import compress_state, read_state_file
@@ -140,6 +144,8 @@ print("its own game plays it")
 """
 
 PAIRS = [(AIRSTRIKER, "Dasher-Genesis"), ("Dasher-Genesis", AIRSTRIKER)]
+PONG, BREAKOUT = "Pong-Atari2600", "Breakout-Atari2600"
+BREAKOUT_CASES = ["make", "playback", "integrate", "studio"]
 COMMANDS = ["playback", "integrate"]
 WRAPPINGS = ["the-wheels-file-copied", "recompressed-without-record"]
 
@@ -210,6 +216,29 @@ def cases(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         code = SAVE_AND_LOAD.format(saver=saver, loader=loader, folder=str(tmp / "saved"))
         case(f"saved-by-{saver}", "code", code, tmp)
 
+    # Pong's wheel state, inflated and compressed again (its file's digest is no wheel file's), into Breakout:
+    # two games retrokit does not ship, whose ROMs come from ale-py as a user's `import --from ale-py` brings them
+    roms = root / "breakout-roms"
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("RETROKIT_DATA", str(roms))
+        assert main(["import", str(Path(ale_py.__file__).parent / "roms" / "breakout.bin")]) == 0
+    pong = read_state_file(find_game(PONG).state_path()).data
+    for entry in BREAKOUT_CASES:
+        tmp = folder_of(f"pong-in-breakout-{entry}")
+        shutil.copytree(roms, tmp / "data")
+        if entry == "make":
+            (tmp / "Start.state").write_bytes(compress_state(pong, None))
+            what: Any = f"STATE = {str(tmp / 'Start.state')!r}\n" + MAKE_FOREIGN.replace("Dasher-Genesis", BREAKOUT)
+        elif entry == "studio":
+            game_copy = shutil.copytree(find_game(BREAKOUT).folders[0], tmp / BREAKOUT)
+            (game_copy / "Foreign.state").write_bytes(compress_state(pong, None))
+            what = f"GAME = {str(game_copy)!r}\n" + STUDIO_RESET
+        else:
+            write_bk2(tmp / "m.bk2", Movie(BREAKOUT, "Atari2600", 1, pong, [(0,)] * 30))
+            what = (["playback", str(tmp / "m.bk2"), str(tmp / "out")] if entry == "playback"
+                    else ["integrate", BREAKOUT, "Made", "--out", str(tmp / "made"), "--movie", str(tmp / "m.bk2")])  # fmt: skip
+        case(f"pong-in-breakout-{entry}", "code" if entry in ("make", "studio") else "cli", what, tmp)
+
     child = run_child(f"CASES = {runs!r}\n" + RUN_CASES, timeout=600)
     answers = {answer["case"]: answer for answer in map(json.loads, child.stdout.splitlines()) if answer}
     for name, facts in built.items():
@@ -266,3 +295,15 @@ def test_a_state_this_machine_saved_for_one_game_is_refused_for_another(cases, s
     stdout = printed(cases[f"saved-by-{saver}"]["answer"])
     assert f"found {saver}'s state (this machine saved it for {saver}" in stdout, stdout
     assert "its own game plays it" in stdout, stdout
+
+
+@pytest.mark.parametrize("entry", BREAKOUT_CASES)
+def test_a_rewrapped_state_of_any_wheel_game_is_known_by_its_owner(cases, entry):
+    """Pong's Start.state, compressed again, is Pong's wherever it enters Breakout (issue 42 item 4): every wheel game's
+    states are known by what they hold, not only those of games retrokit integrates."""
+    answer = cases[f"pong-in-breakout-{entry}"]["answer"]
+    said = refused(answer) if entry in ("playback", "integrate") else printed(answer)
+    assert f"expected a state of {BREAKOUT}; found {PONG}'s state (the stable-retro wheel ships it" in said, said
+    assert f"Load it with {PONG}" in said
+    made = cases[f"pong-in-breakout-{entry}"]["folder"] / "made"
+    assert not made.exists() or not list(made.iterdir())

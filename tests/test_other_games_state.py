@@ -18,6 +18,7 @@ from typing import Any
 
 import pytest
 from childproc import run_child
+from entrypoints import RUN_CASES, STUDIO_LOAD
 
 ale_py = pytest.importorskip("ale_py")  # Breakout's and Pong's ROMs
 
@@ -30,26 +31,6 @@ from retrokit.movie.model import STATE_DIGEST
 REPO = Path(__file__).resolve().parent.parent
 DASHER_STATE = REPO / "games" / "Dasher-Genesis" / "Zone1.Act1.state"
 AIRSTRIKER = "Airstriker-Genesis"
-
-#: Runs each case (a command line or a snippet) with RETROKIT_DATA of its own, printing one JSON line per case.
-RUN_CASES = """
-import contextlib, io, json, os, traceback
-from retrokit.cli import main
-for name, data, kind, what in CASES:
-    os.environ["RETROKIT_DATA"] = data
-    out, err = io.StringIO(), io.StringIO()
-    answer = {"case": name}
-    try:
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            if kind == "cli":
-                answer["status"] = main(what)
-            else:
-                exec(what, {})
-    except Exception:
-        answer["error"] = traceback.format_exc()
-    answer.update(stdout=out.getvalue(), stderr=err.getvalue())
-    print(json.dumps(answer), flush=True)
-"""
 
 def dasher_data() -> bytes:
     return read_state_file(DASHER_STATE).data
@@ -100,19 +81,6 @@ try:
     print('played')
 except StateError as exc:
     print('refused:', exc)
-"""
-
-STUDIO_RESET = """
-from retrokit.errors import StateError
-from retrokit.studio import play
-from retrokit.studio.session import Session
-session = Session(GAME)
-try:
-    session.call_blocking(play.reset, 'Foreign')
-    print('loaded')
-except StateError as exc:
-    print('refused:', exc)
-session.close()
 """
 
 SAVE_AND_LOAD = """
@@ -208,7 +176,7 @@ def cases(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         game_copy = shutil.copytree(find_game(host).folders[0], tmp / host)  # a copy of the game, its ROM found by hash
         owners = read_state_file(find_game(owner).state_path()).data
         (game_copy / "Foreign.state").write_bytes(compress_state(owners, None))
-        case(f"studio-{host}", "code", f"GAME = {str(game_copy)!r}\n" + STUDIO_RESET, tmp, game=game_copy)
+        case(f"studio-{host}", "code", f"GAME = {str(game_copy)!r}\nNAME = 'Foreign'\n" + STUDIO_LOAD, tmp, game=game_copy)
 
     for saver, loader in PAIRS:
         tmp = folder_of(f"saved-by-{saver}")
@@ -232,7 +200,7 @@ def cases(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         elif entry == "studio":
             game_copy = shutil.copytree(find_game(BREAKOUT).folders[0], tmp / BREAKOUT)
             (game_copy / "Foreign.state").write_bytes(compress_state(pong, None))
-            what = f"GAME = {str(game_copy)!r}\n" + STUDIO_RESET
+            what = f"GAME = {str(game_copy)!r}\nNAME = 'Foreign'\n" + STUDIO_LOAD
         else:
             write_bk2(tmp / "m.bk2", Movie(BREAKOUT, "Atari2600", 1, pong, [(0,)] * 30))
             what = (["playback", str(tmp / "m.bk2"), str(tmp / "out")] if entry == "playback"

@@ -1,0 +1,113 @@
+"""Every core that a state can crash has its layout checked (issue 42 item 1): PC Engine, Game Boy, NES.
+
+Each core's states (our cartridges') are fuzzed where its loader reads
+structure and small values (tests/statefuzz.py), and every fuzzed state runs on
+the raw core, one fork each, in one child: the fuzz must kill or hang each
+core, and :mod:`retrokit.host.statelayout` must refuse every state that did,
+before any probe. Then one of those states per core goes through every entry
+point (tests/entrypoints.py), all in one child: each refuses it with the
+layout's reason, and the child lives. And no legal state is refused: every
+state retrokit and the stable-retro wheel ship for these systems passes.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from childproc import REPO
+from entrypoints import ENTRY_POINTS, entry_cases, refusal, run_cases
+from statefuzz import FUZZES, run_raw
+
+from retrokit import paths
+from retrokit.data.states import read_state
+from retrokit.host.gblayout import gambatte_entries
+from retrokit.host.pcelayout import mednafen_sections
+from retrokit.host.statelayout import state_layout_problem
+
+COUNT = 40  # states a core: enough for each core's fuzz to kill it (the seed is fixed: the same states every run)
+SYSTEMS = list(FUZZES)
+#: What each core's check says of the state each entry point is given (the first the raw core died on).
+REASONS = {"PCEngine": "outside", "GameBoy": "entries do not parse", "Nes": "chunks do not fit"}
+
+
+@pytest.fixture(scope="module")
+def fuzzed(tmp_path_factory: pytest.TempPathFactory) -> dict[str, list[tuple[bytes, str | None]]]:
+    """Each core's fuzzed states, each with how the raw core ended on it (``None``: it lived), from one child."""
+    root = tmp_path_factory.mktemp("layout-fuzz")
+    states: dict[str, list[tuple[Path, bytes]]] = {}
+    for system, fuzz in FUZZES.items():
+        states[system] = []
+        for i, state in enumerate(fuzz.states(COUNT)):
+            path = root / f"{system}-{i:03d}.bin"
+            path.write_bytes(state)
+            states[system].append((path, state))
+    jobs = [(f.system, REPO / "games" / f.game / f.rom, [p for p, _ in states[s]]) for s, f in FUZZES.items()]
+    died = run_raw(jobs, root)
+    return {system: [(state, died.get(str(path))) for path, state in found] for system, found in states.items()}
+
+
+@pytest.mark.parametrize("system", SYSTEMS)
+def test_every_state_that_kills_the_raw_core_is_refused_by_its_layout(fuzzed, system: str) -> None:
+    deaths = [(state, how) for state, how in fuzzed[system] if how]
+    assert deaths, f"the fuzz of {system} no longer kills its raw core: it proves nothing"
+    missed = [how for state, how in deaths if not state_layout_problem(system, state)]
+    assert not missed, f"{len(missed)} of {len(deaths)} states that killed the raw {system} core passed: {missed}"
+    print(f"{system}: {len(deaths)} of {COUNT} fuzzed states killed the raw core ({sorted({h for _, h in deaths})})")
+
+
+@pytest.fixture(scope="module")
+def entries(fuzzed, tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[dict, Path]]:
+    """Each core's first killing state through every entry point, all in one child: ``{case: (answer, folder)}``."""
+    root = tmp_path_factory.mktemp("layout-entries")
+    cases, folders = [], {}
+    for system, fuzz in FUZZES.items():
+        state = next(state for state, how in fuzzed[system] if how)
+        folder = root / system
+        cases += entry_cases(system, fuzz.game, system, state, folder)
+        folders.update({f"{system}-{entry}": folder for entry in ENTRY_POINTS})
+    answers, child = run_cases(cases)
+    assert child.signal is None, child.describe()
+    return {name: (answer, folders[name]) for name, answer in answers.items()}
+
+
+@pytest.mark.parametrize("entry", ENTRY_POINTS)
+@pytest.mark.parametrize("system", SYSTEMS)
+def test_each_entry_point_refuses_a_state_that_kills_the_core(entries, system: str, entry: str) -> None:
+    answer, folder = entries[f"{system}-{entry}"]
+    said = refusal(entry, answer, folder)
+    assert REASONS[system] in said, said
+
+
+def _shipped(system: str) -> list[Path]:
+    ours = sorted((REPO / "games").glob(f"*-{system}/*.state"))
+    return ours + sorted(p for kind in paths.wheel_data_dirs() for p in kind.glob(f"*-{system}-v0/*.state"))
+
+
+@pytest.mark.parametrize("system", [*SYSTEMS, "GbColor"])
+def test_every_shipped_state_passes(system: str) -> None:
+    files = _shipped(system)
+    assert files, f"no shipped {system} state to check"
+    problems = {f"{f.parent.name}/{f.name}": state_layout_problem(system, read_state(f)) for f in files}
+    assert not {name: problem for name, problem in problems.items() if problem}
+
+
+def test_a_pce_dot_clock_past_its_three_widths_is_refused() -> None:
+    """It indexes the table of the frame's 3 widths: 3 reads past it (the core itself writes 0, 1 or 2)."""
+    good = read_state(REPO / "games" / "Skipper-PCEngine" / "Level1.state")
+    (at,) = [at for name, at, _ in (mednafen_sections(good) or {})[b"VCE"] if name == b"dot clock"]
+
+    def with_clock(clock: int) -> bytes:
+        return good[:at] + bytes([clock]) + good[at + 1 :]
+
+    assert state_layout_problem("PCEngine", with_clock(2)) == ""
+    assert "VCE dot clock is 3, outside 0 to 2" in state_layout_problem("PCEngine", with_clock(3))
+
+
+def test_a_gambatte_label_without_its_end_is_refused() -> None:
+    """Its loader copies a label up to its NUL into 8 bytes, never counting: one unended label overruns the heap."""
+    good = read_state(REPO / "games" / "Trekker-GameBoy" / "Level1.state")
+    at, _ = (gambatte_entries(good) or {})[b"c2mastr"]
+    state = bytearray(good)
+    state[at - 4] = ord("b")  # the NUL after "c2mastr": the label now runs on into its size
+    assert "label unended" in state_layout_problem("GameBoy", bytes(state))

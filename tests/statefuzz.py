@@ -21,6 +21,7 @@ from childproc import REPO, run_child
 from retrokit.data.states import read_state
 from retrokit.host.gblayout import gambatte_entries
 from retrokit.host.pcelayout import mednafen_sections
+from retrokit.host.sneslayout import HEADER, SPC_RAM
 
 
 def _pce(rng: random.Random, good: bytes) -> bytes:
@@ -68,6 +69,21 @@ def _fceumm(rng: random.Random, good: bytes) -> bytes:
     return bytes(state)
 
 
+def _snes9x(rng: random.Random, good: bytes) -> bytes:
+    at, spans = HEADER, {}
+    while at + 11 <= len(good) and good[at + 3 : at + 4] == b":":
+        length = int(good[at + 4 : at + 10])
+        spans[good[at : at + 3]] = (at + 11, length)
+        at += 11 + length
+    cpu, tim, snd = spans[b"CPU"], spans[b"TIM"], spans[b"SND"]
+    regions = [cpu, tim, (snd[0] + SPC_RAM, snd[1] - SPC_RAM)]  # the sound block past the SPC700's RAM
+    state = bytearray(good)
+    for _ in range(rng.randint(1, 3)):
+        start, length = rng.choice(regions)
+        state[start + rng.randrange(length)] = rng.choice([0x00, 0x7F, 0x80, 0xFF, rng.getrandbits(8)])
+    return bytes(state)
+
+
 @dataclass(frozen=True)
 class Fuzz:
     """One core's fuzz: the cartridge, the state it mutates, and how.
@@ -78,6 +94,8 @@ class Fuzz:
         state: The state file it mutates.
         rom: The ROM's file name.
         mutate: Makes a mutated copy of the state.
+        count: How many copies the tests fuzz: enough for the fixed seed to kill the raw core (a SNES state that
+            hangs it costs the whole alarm, so fewer there).
     """
 
     system: str
@@ -85,18 +103,20 @@ class Fuzz:
     state: str
     rom: str
     mutate: Callable[[random.Random, bytes], bytes]
+    count: int = 40
 
-    def states(self, count: int, seed: int = 42) -> list[bytes]:
-        """``count`` mutated copies of the state, the same for the same seed."""
+    def states(self, count: int | None = None, seed: int = 42) -> list[bytes]:
+        """``count`` (by default :attr:`count`) mutated copies of the state, the same for the same seed."""
         good = read_state(REPO / "games" / self.game / self.state)
         rng = random.Random(seed)
-        return [self.mutate(rng, good) for _ in range(count)]
+        return [self.mutate(rng, good) for _ in range(self.count if count is None else count)]
 
 
 FUZZES = {
     "PCEngine": Fuzz("PCEngine", "Skipper-PCEngine", "Level1.state", "rom.pce", _pce),
     "GameBoy": Fuzz("GameBoy", "Trekker-GameBoy", "Level1.state", "rom.gb", _gambatte),
     "Nes": Fuzz("Nes", "Hopper-Nes", "Level1-1.state", "rom.nes", _fceumm),
+    "Snes": Fuzz("Snes", "Skipper-Snes", "Level1.state", "rom.sfc", _snes9x, count=24),
 }
 
 RAW_RUN = """

@@ -1,4 +1,4 @@
-"""Every core that a state can crash has its layout checked (issue 42 item 1): PC Engine, Game Boy, NES.
+"""Every core that a state can crash has its layout checked (issue 42 item 1): PC Engine, Game Boy, NES, SNES.
 
 Each core's states (our cartridges') are fuzzed where its loader reads
 structure and small values (tests/statefuzz.py), and every fuzzed state runs on
@@ -23,12 +23,12 @@ from retrokit import paths
 from retrokit.data.states import read_state
 from retrokit.host.gblayout import gambatte_entries
 from retrokit.host.pcelayout import mednafen_sections
+from retrokit.host.sneslayout import SPC_RAM, snes9x_blocks
 from retrokit.host.statelayout import state_layout_problem
 
-COUNT = 40  # states a core: enough for each core's fuzz to kill it (the seed is fixed: the same states every run)
 SYSTEMS = list(FUZZES)
 #: What each core's check says of the state each entry point is given (the first the raw core died on).
-REASONS = {"PCEngine": "outside", "GameBoy": "entries do not parse", "Nes": "chunks do not fit"}
+REASONS = {"PCEngine": "outside", "GameBoy": "entries do not", "Nes": "chunks do not", "Snes": "what the core itself"}
 
 
 @pytest.fixture(scope="module")
@@ -38,7 +38,7 @@ def fuzzed(tmp_path_factory: pytest.TempPathFactory) -> dict[str, list[tuple[byt
     states: dict[str, list[tuple[Path, bytes]]] = {}
     for system, fuzz in FUZZES.items():
         states[system] = []
-        for i, state in enumerate(fuzz.states(COUNT)):
+        for i, state in enumerate(fuzz.states()):
             path = root / f"{system}-{i:03d}.bin"
             path.write_bytes(state)
             states[system].append((path, state))
@@ -53,7 +53,7 @@ def test_every_state_that_kills_the_raw_core_is_refused_by_its_layout(fuzzed, sy
     assert deaths, f"the fuzz of {system} no longer kills its raw core: it proves nothing"
     missed = [how for state, how in deaths if not state_layout_problem(system, state)]
     assert not missed, f"{len(missed)} of {len(deaths)} states that killed the raw {system} core passed: {missed}"
-    print(f"{system}: {len(deaths)} of {COUNT} fuzzed states killed the raw core ({sorted({h for _, h in deaths})})")
+    print(f"{system}: {len(deaths)} of {len(fuzzed[system])} fuzzed states killed the raw core ({sorted({h for _, h in deaths})})")
 
 
 @pytest.fixture(scope="module")
@@ -111,3 +111,13 @@ def test_a_gambatte_label_without_its_end_is_refused() -> None:
     state = bytearray(good)
     state[at - 4] = ord("b")  # the NUL after "c2mastr": the label now runs on into its size
     assert "label unended" in state_layout_problem("GameBoy", bytes(state))
+
+
+def test_a_snes_voice_past_its_brr_buffer_is_refused() -> None:
+    """A voice's position indexes its 24-entry BRR buffer: the core keeps it a multiple of 4 below 12."""
+    good = read_state(REPO / "games" / "Skipper-Snes" / "Level1.state")
+    block = snes9x_blocks(good)[b"SND"]
+    at = good.index(block) + SPC_RAM + 4 * 41 + 128 + 24 + 8  # voice 0's BRR position
+    assert state_layout_problem("Snes", good) == ""
+    wild = good[:at] + bytes([128]) + good[at + 1 :]
+    assert "SND voice 0 BRR position 128" in state_layout_problem("Snes", wild)

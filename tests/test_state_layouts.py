@@ -121,3 +121,28 @@ def test_a_snes_voice_past_its_brr_buffer_is_refused() -> None:
     assert state_layout_problem("Snes", good) == ""
     wild = good[:at] + bytes([128]) + good[at + 1 :]
     assert "SND voice 0 BRR position 128" in state_layout_problem("Snes", wild)
+
+
+@pytest.mark.parametrize("system", [*SYSTEMS, "GbColor"])
+def test_every_state_the_core_writes_in_play_passes(system: str) -> None:
+    """The core's own states, taken every 15 frames of 900 of random play from our cartridge's first state (a legal
+    state is never refused, wherever in a frame's work the core stands when it is saved)."""
+    import random
+
+    from retrokit.data.games import find_game
+    from retrokit.data.statecheck import load_state
+    from retrokit.host.emulator import Emulator
+
+    game = find_game(FUZZES[system].game if system in FUZZES else "Trekker-GbColor")
+    emulator = Emulator(system, game.require_rom())
+    try:
+        emulator.set_state(load_state(game, game.state_path()))
+        rng = random.Random(7)
+        refused = []
+        for step in range(60):
+            emulator.run([rng.getrandbits(12) for _ in range(emulator.ports)], 15)
+            if problem := state_layout_problem(system, bytes(emulator.get_state())):
+                refused.append((step, problem))
+    finally:
+        emulator.close()
+    assert not refused, refused

@@ -31,7 +31,16 @@ What the core does with some of those values:
 
 The PSG's volumes, waveform samples and counters are reduced by the core
 itself after a load, and every VRAM address is checked against the VRAM's
-size where it is used, so they need no check here.
+size where it is used, so they need no check here. Nor do the CPU's memory
+map registers (``MPR``): each is a byte, and the tables it indexes (the banks'
+memory and read and write handlers) have 256 entries, every one of them set.
+A map that is legal byte by byte can still send the emulated program astray
+(the fuzz found two that kill the raw core, with SIGBUS, after a few hundred
+frames): code run from the wrong bank writes what it likes to the hardware,
+as a ROM could, and the core trusts some of those writes (a PSG channel
+selector of 6 or 7 indexes past its 6 channels). That depends on no host
+memory layout, so the crash comes at the same frame in every process, and the
+probe, which plays the state in a child first, refuses it.
 """
 
 from __future__ import annotations

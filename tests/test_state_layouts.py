@@ -146,3 +146,19 @@ def test_every_state_the_core_writes_in_play_passes(system: str) -> None:
     finally:
         emulator.close()
     assert not refused, refused
+
+
+def test_a_memory_map_that_sends_the_pce_program_astray_is_left_to_the_probe(tmp_path: Path, monkeypatch) -> None:
+    """Each MPR byte is legal, the map as a whole is not (the raw core dies at the same frame every run): no layout
+    can tell, so the probe, playing it in a child first, refuses it."""
+    from retrokit.data.statecheck import vet_state
+    from retrokit.errors import StateError
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))  # no verdict of an earlier run
+    game = REPO / "games" / "Skipper-PCEngine"
+    good = read_state(game / "Level1.state")
+    (at,) = [at for name, at, _ in (mednafen_sections(good) or {})[b"CPU"] if name == b"MPR"]
+    astray = good[:at] + bytes([0x40, 0, 0, 0, 0, 0, 0, 0]) + good[at + 8 :]
+    assert state_layout_problem("PCEngine", astray) == ""
+    with pytest.raises(StateError, match="the PCEngine core can run; found one that it cannot"):
+        vet_state(astray, "PCEngine", game / "rom.pce")

@@ -162,3 +162,23 @@ def test_a_memory_map_that_sends_the_pce_program_astray_is_left_to_the_probe(tmp
     assert state_layout_problem("PCEngine", astray) == ""
     with pytest.raises(StateError, match="the PCEngine core can run; found one that it cannot"):
         vet_state(astray, "PCEngine", game / "rom.pce")
+
+
+def test_a_super_fx_plot_mode_or_pointer_past_its_memory_is_refused() -> None:
+    """Yoshi's Island's wheel state (the one Super FX state shipped): its plot mode picks the function the core
+    calls from a table, its pointers are offsets the core adds to its own bases; no ROM here runs one, so the rule
+    is shown on the layout alone."""
+    from retrokit.host.sneslayout import SFX_MODE, SFX_REGISTER_POINTERS
+
+    files = [p for kind in paths.wheel_data_dirs() for p in kind.glob("SuperMarioWorld2-Snes-v0/Start.state")]
+    if not files:
+        pytest.skip("the wheel's Yoshi's Island state is not installed")
+    good = read_state(files[0])
+    sfx = good.index(snes9x_blocks(good)[b"SFX"])
+
+    def with_word(offset: int, value: int) -> bytes:
+        return good[: sfx + offset] + value.to_bytes(4, "big") + good[sfx + offset + 4 :]
+
+    assert state_layout_problem("Snes", good) == ""
+    assert "SFX plot mode 7" in state_layout_problem("Snes", with_word(SFX_MODE, 7))
+    assert "SFX register pointers" in state_layout_problem("Snes", with_word(SFX_REGISTER_POINTERS[0], 0x7FFF0000))

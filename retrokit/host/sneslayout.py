@@ -28,6 +28,14 @@ would write:
   DSP's state, a count of bytes to skip that the core writes as 0 and reads
   on past the block by.
 
+A Super FX cartridge's state adds its chip's block (``SFX``), whose pointers
+the core rebuilds as a base it holds plus a 4-byte offset from the state: the
+current registers, the screen's columns, the RAM and ROM banks and the cache,
+each of which the core only ever points inside its registers, RAM, ROM or
+cache; and its plot mode, which picks the function the core then calls from a
+table of 10 (the core writes ``SCMR & 3``). A wild offset or mode is a wild
+pointer, or a call through one, as in Genesis Plus GX's bank map.
+
 The PPU, DMA and the memories are masked where they are used, so they need
 no check (fuzzing their blocks in Skipper-Snes's states killed no core).
 """
@@ -91,6 +99,45 @@ hidden envelope (2 bytes each), then its buffer position, BRR offset, key-on del
 ECHO_HISTORY = 8 * 2 * 2
 DSP_MISC = 49
 """The DSP's bytes after the echo history, before its last padding count."""
+
+
+# The Super FX's block (SFX, snapshot.cpp's SnapFX): where its fields are, and the pointers the core rebuilds from
+# 4-byte offsets (big-endian) added to a base it holds, unchecked.
+SFX_BANK_REGISTERS = {"vPrgBankReg": 76, "vRomBankReg": 80}
+SFX_MODE = 155
+"""``vMode``: the plot mode, which indexes the table of plot functions the core calls (it writes ``SCMR & 3``)."""
+SFX_REGISTER_POINTERS = (100, 104)
+"""``pvDreg``, ``pvSreg``: offsets into the 16 registers (4 bytes each)."""
+SFX_RAM_POINTERS = (163, *range(167, 167 + 32 * 4, 4), 439, *range(451, 451 + 4 * 4, 4))
+"""``pvScreenBase``, ``apvScreen[32]``, ``pvRamBank``, ``apvRamBank[4]``: offsets into the Super FX's RAM."""
+SFX_RAM_REACH = 0x3FC00 + 0xBC00
+"""The furthest into its RAM the core itself points: a screen base of ``SCBR << 10`` and a column past it."""
+SFX_ROM_POINTERS = {"vPrgBankReg": 447, "vRomBankReg": 443}
+"""``pvPrgBank``, ``pvRomBank``: offsets into the ROM (of 64 KiB banks, the upper half 2 MiB on) while their bank
+register names a ROM bank (below 0x70; banks 0x70 to 0x73 are its RAM, at no fixed offset from the ROM)."""
+SFX_ROM_REACH = 0x400000
+SFX_CACHE = (468, 0x100)
+"""``pvCache``: the cache's offset in the Super FX's registers, which the core only ever sets to 0x100."""
+SFX_SIZE = 996
+
+
+def _superfx_problem(sfx: bytes) -> str:
+    sfx = sfx[:SFX_SIZE].ljust(SFX_SIZE, b"\0")
+
+    def word(at: int) -> int:
+        return int.from_bytes(sfx[at : at + 4], "big")
+
+    if word(SFX_MODE) > 3:
+        return f"SFX plot mode {word(SFX_MODE)}"
+    if any(word(at) >= 16 * 4 or word(at) % 4 for at in SFX_REGISTER_POINTERS):
+        return f"SFX register pointers {[word(at) for at in SFX_REGISTER_POINTERS]}"
+    if wild := [hex(word(at)) for at in SFX_RAM_POINTERS if word(at) >= SFX_RAM_REACH]:
+        return f"SFX RAM pointer {wild[0]}"
+    for register, at in SFX_ROM_POINTERS.items():
+        if word(SFX_BANK_REGISTERS[register]) < 0x70 and word(at) >= SFX_ROM_REACH:
+            return f"SFX ROM pointer {word(at):#x}"
+    at, offset = SFX_CACHE
+    return f"SFX cache pointer {word(at):#x}" if word(at) != offset else ""
 
 
 def snes9x_blocks(state: bytes) -> dict[bytes, bytes]:
@@ -161,6 +208,8 @@ def snes9x_problem(state: bytes) -> str:
     wrong = _timing_problem(_fields(blocks[b"TIM"], TIM_FIELDS), _fields(blocks[b"CPU"], CPU_FIELDS))
     if not wrong and version >= 8:  # the sound block's layout since snes9x took bsnes's SPC700
         wrong = _sound_problem(blocks[b"SND"])
+    if not wrong and b"SFX" in blocks:
+        wrong = _superfx_problem(blocks[b"SFX"])
     if not wrong:
         return ""
     return (

@@ -335,7 +335,7 @@ def test_the_wheels_state_hashes_are_current() -> None:
     """The list that knows the wheel's states by what they hold (Airstriker's, Sonic's) matches the wheel installed."""
     games = REPO / "games"
     listed = (games / WHEEL_STATE_HASHES).read_text()
-    assert listed == wheel_state_hashes(games), (
+    assert listed == wheel_state_hashes(), (
         "games/WHEEL-STATES.sha256 is out of date: run python -m retrokit.data.shipped"
     )
     assert "stable/Airstriker-Genesis-v0/Level1.state" in listed

@@ -19,8 +19,11 @@ import pytest
 from retrokit.cli import main
 from retrokit.errors import PatchError
 from retrokit.host import build
+from retrokit.host.buildhint import build_hint
 from retrokit.host.cores import CORES_ENV, built_cores_dir, locate_core
 from retrokit.host.patching import apply_patch, parse_patch
+from retrokit.host.systems import get_system
+from retrokit.paths import wheel_cores_dir
 
 RECIPE = build.RECIPES["genesis_plus_gx"]
 PATCHED_FILE = "libretro/libretro.c"
@@ -35,8 +38,9 @@ def isolated(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> Path:
     return tmp_path / "data"
 
 
-def tools(tmp_path: Path, make: str | None = "ok", cc: bool = True) -> Path:
-    """A folder of fake build tools to be the whole PATH: ``cc`` and a ``make`` that succeeds or fails."""
+def tools(tmp_path: Path, make: str | None = "ok", cc: bool = True, core: str = "genesis_plus_gx") -> Path:
+    """A folder of fake build tools to be the whole PATH: ``cc`` and a ``make`` that succeeds (making ``core``'s
+    library) or fails."""
     folder = tmp_path / "bin"
     folder.mkdir(exist_ok=True)
     scripts = {}
@@ -44,7 +48,7 @@ def tools(tmp_path: Path, make: str | None = "ok", cc: bool = True) -> Path:
         scripts["cc"] = "#!/bin/sh\nexit 0\n"
     if make == "ok":  # lists one compile for the dry run, then "links" the library
         scripts["make"] = ('#!/bin/sh\nfor a in "$@"; do [ "$a" = -n ] && { echo "cc -c core/a.c"; exit 0; }; done\n'
-                           'echo "cc -c core/a.c"\necho fake-core > genesis_plus_gx_libretro.so\n')  # fmt: skip
+                           f'echo "cc -c core/a.c"\necho fake-core > {core}_libretro.so\n')  # fmt: skip
     elif make == "fails":
         scripts["make"] = '#!/bin/sh\necho "cc -c core/vdp.c"\necho "core/vdp.c:12: error: boom"\nexit 2\n'
     for name, text in scripts.items():
@@ -53,14 +57,14 @@ def tools(tmp_path: Path, make: str | None = "ok", cc: bool = True) -> Path:
     return folder
 
 
-def original_sources(end: str = "\n") -> dict[str, bytes]:
+def original_sources(end: str = "\n", recipe: build.Recipe = RECIPE) -> dict[str, bytes]:
     """The files the patch changes, in the sdist, each holding exactly the lines it expects (its hunks' old
     sides), with ``end`` line ends."""
     return {
-        f"{RECIPE.folder}/{patch.path}": "".join(
+        f"{recipe.folder}/{patch.path}": "".join(
             line.rstrip("\n") + end for hunk in patch.hunks for line in hunk.old
         ).encode()
-        for patch in parse_patch(build.patch_text(RECIPE))
+        for patch in parse_patch(build.patch_text(recipe))
     }
 
 
@@ -296,7 +300,24 @@ def test_a_build_is_installed_recorded_and_found_first(monkeypatch, tmp_path, ca
     assert run_cli(capsys, "--sdist", str(sdist))[2].startswith("Already built")  # nothing fetched or compiled again
     monkeypatch.setenv("PATH", path)
     assert main(["cores"]) == 0
-    assert f"genesis_plus_gx    built           {installed}" in capsys.readouterr().out
+    assert f"genesis_plus_gx    yes      built           {installed}" in capsys.readouterr().out
+    assert build_hint("Genesis") == ""  # built: the line that tells of it is never shown again
+
+
+def test_stella_is_built_installed_and_found_the_same_way(monkeypatch, tmp_path, capsys, isolated) -> None:
+    stella = build.RECIPES["stella"]
+    monkeypatch.setenv("PATH", str(tools(tmp_path, core="stella")))
+    sdist = fake_sdist(tmp_path, {**original_sources(recipe=stella), "cores/genesis/x.c": b"x"})
+    assert main(["build-core", "stella", "--sdist", str(sdist)]) == 0
+    err = capsys.readouterr().err
+    assert "Unpacking cores/atari2600/" in err and "Applying stella-av-enable.patch" in err
+    installed = built_cores_dir(isolated) / "stella_libretro.so"
+    assert (locate_core("stella").path, locate_core("stella").origin) == (installed, "built")
+    assert locate_core("genesis_plus_gx").origin == "wheel"  # one recipe builds one core
+    record = json.loads((built_cores_dir(isolated) / "stella.build.json").read_text())
+    assert record["patch"] == "stella-av-enable.patch"
+    assert main(["cores"]) == 0
+    assert f"Atari2600   stella             yes      built           {installed}" in capsys.readouterr().out
 
 
 def test_a_build_for_another_stable_retro_version_is_not_used(monkeypatch, tmp_path, capsys, isolated) -> None:
@@ -355,10 +376,21 @@ def test_malformed_patches_are_refused(tmp_path, text: str, message: str) -> Non
 # --- what find_core and retrokit cores make of the data folder ------------------------------------
 
 
-def test_without_a_build_the_wheel_core_is_listed(capsys) -> None:
+def test_without_a_build_the_wheel_core_is_listed_unpatched_with_the_measured_gain(isolated, capsys) -> None:
+    genesis = get_system("Genesis")
     assert main(["cores"]) == 0
     out = capsys.readouterr().out
-    assert "Genesis     genesis_plus_gx    wheel " in out and "retrokit build-core CORE" in out
+    assert "Genesis     genesis_plus_gx    no       wheel " in out and "retrokit build-core CORE" in out
+    assert f"Genesis envs step {genesis.build_speedup:.1f}x faster, measured on {genesis.build_measured}" in out
+    hint = build_hint("Genesis")
+    assert f"Genesis envs step {genesis.build_speedup:.1f}x faster" in hint and "build-core genesis_plus_gx" in hint
+    assert "\n" not in hint
+    assert build_hint("Nes") == "" and build_hint("Sms") == ""  # no recipe; a recipe but no figure measured
+
+
+def test_no_line_tells_of_the_build_when_the_user_chose_a_core(isolated, monkeypatch) -> None:
+    monkeypatch.setenv(CORES_ENV, str(wheel_cores_dir()))
+    assert locate_core("genesis_plus_gx").origin == CORES_ENV and build_hint("Genesis") == ""
 
 
 @pytest.mark.parametrize("record", [b"{not json", b"[1, 2]", b""], ids=["corrupt", "not-a-dict", "empty"])

@@ -81,8 +81,9 @@ def test_cores_prints_a_header_row_over_aligned_columns(capsys):
     status, out, _ = run(capsys, "cores")
     assert status == 0
     header, first = out.splitlines()[:2]
-    assert header.split() == ["SYSTEM", "CORE", "FOUND", "IN", "PATH"]
+    assert header.split() == ["SYSTEM", "CORE", "PATCHED", "FOUND", "IN", "PATH"]
     assert first.index(first.split()[1]) == header.index("CORE")  # the columns line up under their names
+    assert first.index(first.split()[2], header.index("CORE")) == header.index("PATCHED")
 
 
 def test_convert_names_its_positionals_as_its_text_does(capsys):

@@ -7,6 +7,9 @@ core does before every load. The reload frees the memory the core showed, so
 the views of it that the emulator's :class:`AddressSpace` holds (and every
 field reader reads through) are let go before and made again after, and the
 native host refuses to reload while any other view is alive.
+
+A game on joysticks keeps nothing outside its states (``reload_only_for``):
+its state loads and hard resets load no game, and play as a fresh console's.
 """
 
 from __future__ import annotations
@@ -33,22 +36,26 @@ def breakout_rom() -> Path:
     return Path(ale_py.__file__).parent / "roms" / "breakout.bin"
 
 
-@pytest.fixture(scope="module")
-def breakout_state(breakout_rom: Path) -> VettedState:
-    """stable-retro's shipped Breakout start, checked for ale-py's ROM (stable-retro's, by its SHA-1)."""
+def _shipped(game: str, rom: Path) -> VettedState:
+    """stable-retro's shipped start of ``game``, checked for ale-py's ROM (stable-retro's, by its SHA-1)."""
     from retrokit.data.statecheck import vet_state
     from retrokit.data.states import read_state
     from retrokit.paths import wheel_dir
 
-    path = wheel_dir() / "data" / "stable" / "Breakout-Atari2600-v0" / "Start.state"
-    return vet_state(read_state(path), "Atari2600", breakout_rom, source=str(path))
+    path = wheel_dir() / "data" / "stable" / f"{game}-Atari2600-v0" / "Start.state"
+    return vet_state(read_state(path), "Atari2600", rom, source=str(path))
 
 
-def _play(emulator: Emulator, state: VettedState) -> list[np.ndarray]:
-    """Load ``state``, then hold LEFT and RIGHT in turn (the paddle's charge moves); the screens seen."""
+@pytest.fixture(scope="module")
+def breakout_state(breakout_rom: Path) -> VettedState:
+    return _shipped("Breakout", breakout_rom)
+
+
+def _play(emulator: Emulator, state: VettedState, turn: tuple[int, int] = (LEFT, RIGHT)) -> list[np.ndarray]:
+    """Load ``state``, then hold one way and the other in turn (the paddle's charge moves); the screens seen."""
     emulator.set_state(state)
     screens = []
-    for mask in [LEFT] * 20 + [RIGHT] * 5 + [0] * 5:
+    for mask in [turn[0]] * 20 + [turn[1]] * 5 + [0] * 5:
         emulator.run([mask, 0], 4)
         screens.append(emulator.screen())
     return screens
@@ -72,13 +79,61 @@ def test_every_load_of_a_state_plays_alike_as_on_a_fresh_core(breakout_rom: Path
     assert len({s.tobytes() for s in first}) > 5  # the paddle moved: the game took the input
 
 
-def test_without_the_reload_the_paddle_charge_leaks_into_the_next_load(
-    breakout_rom: Path, breakout_state: VettedState
-) -> None:
+@pytest.mark.parametrize("game,rom,turn", [("Breakout", "breakout", "LEFT RIGHT"), ("Pong", "pong", "UP DOWN")])
+def test_without_the_reload_the_paddle_charge_leaks_into_the_next_load(game: str, rom: str, turn: str) -> None:
     # The descriptor fact is what makes loads alike: with it off, the console reset leaves the charge as it was.
+    # Pong is Video Olympics to stella, on paddles too, their axes swapped (UP and DOWN turn the player's).
+    path = Path(ale_py.__file__).parent / "roms" / f"{rom}.bin"
+    state = _shipped(game, path)
+    masks = tuple(get_system("Atari2600").mask([b]) for b in turn.split())
+    with Emulator("Atari2600", path) as emulator:
+        assert emulator.reloads_states
+        assert _same(_play(emulator, state, masks), _play(emulator, state, masks))
     system = dataclasses.replace(get_system("Atari2600"), reload_before_state=False)
-    with Emulator(system, breakout_rom) as emulator:
-        assert not _same(_play(emulator, breakout_state), _play(emulator, breakout_state))
+    with Emulator(system, path) as emulator:
+        assert not _same(_play(emulator, state, masks), _play(emulator, state, masks))
+
+
+def _random_play(emulator: Emulator, frames: int, seed: int) -> list[tuple[np.ndarray, np.ndarray]]:
+    """``frames`` frames of random joystick buttons (no console switch): the screen and RAM after each 4."""
+    buttons = emulator.system.mask(["BUTTON", "UP", "DOWN", "LEFT", "RIGHT"])
+    masks = np.random.default_rng(seed).integers(0, 256, size=frames) & buttons
+    seen = []
+    for i, mask in enumerate(masks):
+        emulator.run([int(mask), int(masks[-1 - i])], 1)
+        if i % 4 == 3:
+            seen.append((emulator.screen(), emulator.ram.copy()))
+    return seen
+
+
+def _alike(a: list[tuple[np.ndarray, np.ndarray]], b: list[tuple[np.ndarray, np.ndarray]]) -> bool:
+    return len(a) == len(b) and all(np.array_equal(x[0], y[0]) and np.array_equal(x[1], y[1]) for x, y in zip(a, b))
+
+
+def test_a_joystick_games_loads_and_hard_resets_load_no_game_and_play_as_a_fresh_consoles() -> None:
+    # Freeway: joysticks, a 2K cartridge. Each load and hard reset follows 400 frames of other random play.
+    rom = Path(ale_py.__file__).parent / "roms" / "freeway.bin"
+    state = _shipped("Freeway", rom)
+    with Emulator("Atari2600", rom) as fresh:
+        assert not fresh.reloads_states
+        fresh.set_state(state)
+        from_state = _random_play(fresh, 400, 1)
+    with Emulator("Atari2600", rom) as fresh:
+        fresh.reset()  # the first hard reset reloads, as every one did
+        from_power_on = _random_play(fresh, 400, 1)
+    with Emulator("Atari2600", rom) as emulator:
+        emulator.reset()
+        for _ in range(2):
+            _random_play(emulator, 400, 2)
+            view = emulator.space.buffers[0]
+            emulator.set_state(state)
+            assert emulator.space.buffers[0] is view  # no reload: the memory the core showed is the same
+            assert _alike(_random_play(emulator, 400, 1), from_state)
+            _random_play(emulator, 400, 3)
+            emulator.reset()
+            assert emulator.space.buffers[0] is view
+            assert _alike(_random_play(emulator, 400, 1), from_power_on)
+    assert len({screen.tobytes() for screen, _ in from_state}) > 5  # the game moved
 
 
 def _play_from_power_on(emulator: Emulator) -> list[np.ndarray]:
@@ -186,3 +241,30 @@ def test_an_env_plays_each_episode_alike(breakout_rom: Path, tmp_path: Path, mon
             episodes.append(seen)
     first, second = episodes
     assert all(np.array_equal(a[0], b[0]) and a[1] == b[1] for a, b in zip(first, second, strict=True))
+
+
+@pytest.mark.parametrize(
+    "state,expected",
+    [
+        pytest.param(b"\x0d\x00\x00\x0003090100state\x0b\x00\x00\x00CartridgeF8rest", "CartridgeF8", id="stella"),
+        pytest.param(b"", "", id="empty"),
+        pytest.param(b"\x0d\x00\x00\x0003090100state\xff\xff\xff\xffCartridge", "", id="a-length-past-the-end"),
+        pytest.param(b"\x0d\x00\x00\x0003090100state\x05\x00\x00\x00Other", "", id="not-a-cartridge"),
+        pytest.param(b"GENPLUS-GX" + bytes(100), "", id="a-genesis-state"),
+        pytest.param(b"\x0d\x00\x00\x0003090100state\x0b\x00\x00\x00Cartridge\xff\xfe", "", id="not-ascii"),
+    ],
+)
+def test_the_cartridge_class_is_read_from_a_stella_state_and_nothing_else(state: bytes, expected: str) -> None:
+    from retrokit.host.statelayout import cartridge_class
+
+    assert cartridge_class(state) == expected
+
+
+def test_the_reload_rule_names_roms_by_md5_and_cartridge() -> None:
+    atari = get_system("Atari2600")
+    breakout_md5 = "f34f08e5eb96e500e851a80be3277a56"  # stella's properties: PADDLES
+    assert atari.reloads_states(breakout_md5, "Cartridge2K") and atari.reloads_states("0" * 32, "CartridgeF8SC")
+    assert not atari.reloads_states("0" * 32, "CartridgeF8")
+    every = dataclasses.replace(atari, reload_md5=frozenset(), reload_cartridges=frozenset())
+    assert every.reloads_states("0" * 32, "")  # no list: every ROM reloads, as before
+    assert not get_system("Genesis").reloads_states(breakout_md5, "CartridgeF8SC")

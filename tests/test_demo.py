@@ -12,7 +12,10 @@ from retrokit.cli import main
 SMALL = ["demo", "--levels", "Zone2.Act2", "--timesteps", "300", "--workers", "1", "--no-progress"]
 
 
-def test_demo_evaluates_jerk_and_random_and_saves_the_report_plots_and_a_gif(tmp_path, capsys) -> None:
+def test_demo_evaluates_jerk_and_random_and_saves_the_report_plots_and_a_gif(tmp_path, capsys, monkeypatch) -> None:
+    from retrokit.host.buildhint import build_hint
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))  # no built core there: the wheel's runs
     out = tmp_path / "demo"
     assert main([*SMALL, "--out", str(out)]) == 0
     captured = capsys.readouterr()
@@ -21,6 +24,8 @@ def test_demo_evaluates_jerk_and_random_and_saves_the_report_plots_and_a_gif(tmp
         line = next(line for line in captured.err.splitlines() if line.startswith(f"{agent}: speed: "))
         # The Sonic protocol's time is named for the Sonic benchmark only (this is Dasher's).
         assert "env steps/s per level" in line and "the Sonic protocol" not in line
+    # Then, once, the line that says how much faster Genesis envs step on the core retrokit build-core makes.
+    assert captured.err.splitlines().count(build_hint("Genesis")) == 1 and "retrokit build-core" in build_hint("Genesis")
     table = printed[printed.index("level "):]
     assert "jerk" in table and "random" in table and "aggregate" in table and "Dasher-Genesis/Zone2.Act2" in table
     for agent in ("jerk", "random"):

@@ -311,7 +311,10 @@ def test_sonic_lists_the_papers_split(capsys) -> None:
     assert sum(line.startswith("train") for line in lines) == 47
 
 
-def test_a_benchmark_file_runs(tmp_path) -> None:
+def test_a_benchmark_file_runs_and_says_what_a_built_core_would_gain(tmp_path, monkeypatch, capsys) -> None:
+    from retrokit.host.buildhint import build_hint
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path / "data"))  # no built core there: the wheel's runs
     path = tmp_path / "mine.yaml"
     path.write_text("name: mine\nbudget: 200\nenv: {frameskip: 4, max_episode_steps: 100}\n"
                     "levels:\n  test: [Dasher-Genesis/Zone1.Act1]\n")
@@ -319,6 +322,8 @@ def test_a_benchmark_file_runs(tmp_path) -> None:
     assert main(["evaluate", "--benchmark", str(path), "--agent", "random", "--no-progress", "--out", str(out)]) == 0
     data = json.loads(summary(out))
     assert data["benchmark"] == "mine" and data["levels"]["Dasher-Genesis/Zone1.Act1"]["timesteps"] == 200
+    err = capsys.readouterr().err
+    assert err.splitlines().count(build_hint("Genesis")) == 1 and "retrokit build-core" in build_hint("Genesis")
 
 
 @pytest.mark.parametrize(

@@ -53,3 +53,17 @@ def test_the_readme_gives_the_measured_time_of_its_two_commands() -> None:
     after_tests = " ".join(text[tests:text.index("## The main job")].split())
     assert re.search(r"took [\d,]+ s \([\d.]+ minutes, [\d,]+ tests\) on the developers' 2-core \S+ VM with "
                      r"nothing else running \(\d{4}-\d\d-\d\d\)", after_tests), "the suite's measured time"
+
+
+def test_the_readme_and_evaluate_guide_say_how_much_faster_the_built_core_is_as_the_descriptor_measured_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from retrokit.host.buildhint import build_hint
+    from retrokit.host.systems import get_system
+
+    text = " ".join((REPO / "README.md").read_text()[:4000].split())  # its first lines, before "The main job"
+    assert text.index("## The main job") > text.index("retrokit build-core genesis_plus_gx")
+    assert f"Genesis envs step {get_system('Genesis').build_speedup:.1f}x faster" in text
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path))  # nothing built there: the line the commands print
+    monkeypatch.delenv("RETROKIT_CORES", raising=False)
+    assert build_hint("Genesis") in (REPO / "docs" / "evaluate.md").read_text().splitlines()

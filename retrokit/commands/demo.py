@@ -62,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
     from retrokit.benchmark.comparison import agent_folders, compare
     from retrokit.benchmark.definition import load_benchmark
     from retrokit.benchmark.evaluation import Evaluation, level_file_name
-    from retrokit.commands.evaluate import print_speed, print_table
+    from retrokit.commands.evaluate import print_build_hints, print_speed, print_table
 
     benchmark = load_benchmark("dasher")
     levels = benchmark.select(args.levels)
@@ -91,6 +91,7 @@ def run(args: argparse.Namespace) -> int:
         written.append(f"{out / 'jerk-best.gif'} (JERK's best episode, on {best})")
     print("wrote " + "\n      ".join(written))
     print_speed(made)  # as `retrokit evaluate` prints it: each agent's speed
+    print_build_hints(levels)  # and how much faster a built core would make it
     return 0
 
 

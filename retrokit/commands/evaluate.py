@@ -152,7 +152,17 @@ def run(args: argparse.Namespace) -> int:
                                     "scores.png, mean-learning-curve.png" if len(agents) == 1 else
                                     "report.md, scores.png, mean-learning-curve.png, and a run folder per agent"))
     print_speed(made)
+    print_build_hints(levels)
     return 0
+
+
+def print_build_hints(levels: list) -> None:  # retrokit.benchmark.definition.Level
+    """Say, on stderr, how much faster the levels' systems would run on a core ``retrokit build-core`` makes."""
+    from retrokit.data.games import find_game
+    from retrokit.host.buildhint import build_hints
+
+    for line in build_hints(find_game(level.game).system for level in levels):
+        print(line, file=sys.stderr)  # stdout is the results, the same on every machine
 
 
 def print_speed(made: list) -> None:  # retrokit.benchmark.evaluation.Evaluation

@@ -5,7 +5,8 @@ frame will be seen, so it draws every frame a frame-skipping env throws away.
 Its source, in stable-retro's sdist on the package index, already has the
 switch (``system_frame_gen(do_skip)``); a small patch kept in this package
 (``retrokit/native/patches/``) makes ``retro_run`` ask libretro's
-``GET_AUDIO_VIDEO_ENABLE`` and pass the answer on.
+``GET_AUDIO_VIDEO_ENABLE`` and pass the answer on. The same is done for
+stella, whose ``retro_run`` then skips converting the frames nobody sees.
 
 :func:`build_core` fetches the sdist of the installed stable-retro version
 with pip (:mod:`retrokit.host.sdist`), unpacks only the core's folder, applies the patch, runs the core's
@@ -79,6 +80,7 @@ RECIPES = {
     "genesis_plus_gx": Recipe(
         "genesis_plus_gx", "cores/genesis", "Makefile.libretro", "genesis_plus_gx-av-enable.patch", "+av-enable"
     ),
+    "stella": Recipe("stella", "cores/atari2600", "Makefile", "stella-av-enable.patch", "+av-enable"),
 }
 
 

@@ -8,6 +8,7 @@ core is touched, and maps console addresses for RAM access.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import logging
 import os
 import zlib
@@ -22,6 +23,7 @@ from retrokit.host import primitives
 from retrokit.host.corecheck import vet_core
 from retrokit.host.cores import find_core
 from retrokit.host.memory import AddressSpace
+from retrokit.host.statelayout import cartridge_class
 from retrokit.host.systems import System, get_system, system_for_extension
 from retrokit.paths import data_dir
 
@@ -168,12 +170,19 @@ class Emulator:
                     f"Expected one of {', '.join(map(repr, allowed))} for core option {key!r}, got {options[key]!r}."  # type: ignore[index]
                 )
         need_path = bool(self._emu.system_info()["need_fullpath"])
-        self._emu.load_game(str(rom), None if need_path else rom.read_bytes(), self.system.reload_before_state)
+        data = None if need_path and not self.system.reload_before_state else rom.read_bytes()
+        self._emu.load_game(str(rom), None if need_path else data, self.system.reload_before_state)
         self.rom = rom
         self.space = AddressSpace.for_emulator(self.system, self._emu)
         self._actions = np.zeros(ports, dtype=np.uint16)
         av = self._emu.av_info()
         self._largest = (av["max_height"], av["max_width"])  # the frame the core said it may draw, when it loaded
+        # Whether a state load must reload the game (what this ROM's console keeps outside its states would
+        # differ), and, where it need not, the console as the first hard reset (a reload) left it.
+        self._reload_states = self.system.reload_before_state and self.system.reloads_states(
+            hashlib.md5(data or b"", usedforsecurity=False).hexdigest(), cartridge_class(self._emu.serialize())
+        )
+        self._power_on: bytes | None = None
 
     @classmethod
     def for_rom(cls, rom: str | os.PathLike[str], **kwargs: object) -> Emulator:
@@ -297,10 +306,23 @@ class Emulator:
 
         On a system that reloads its game before a state (``reload_before_state``) the game is
         loaded again first, as before a state: what the core keeps outside its states starts afresh.
+        For a ROM whose state loads need no reload (:meth:`System.reloads_states`), only the first
+        hard reset reloads: the later ones load the state it left (the console's power-on RAM is
+        drawn from a generator no state holds, so a console reset alone would start another way).
         """
+        if self.system.reload_before_state and not self._reload_states and self._power_on is not None:
+            self._load(self._power_on)
+            return
         if self.system.reload_before_state:
             self._reload_game()
         self._emu.reset()
+        if self.system.reload_before_state and not self._reload_states:
+            self._power_on = self._emu.serialize()
+
+    @property
+    def reloads_states(self) -> bool:
+        """Whether each state load reloads the game first (``reload_before_state``, for this ROM)."""
+        return self._reload_states
 
     @property
     def handle(self) -> primitives.NativeEmulator:
@@ -353,8 +375,8 @@ class Emulator:
     def ram(self) -> np.ndarray:
         """The system RAM as a writable zero-copy ``uint8`` array, in the core's byte order.
 
-        On a system that reloads its game before a state (``reload_before_state``), the load
-        frees this memory, so :meth:`set_state` refuses while the array lives: copy what you keep.
+        Where a state load reloads the game (:attr:`reloads_states`), the load frees this
+        memory, so :meth:`set_state` refuses while the array lives: copy what you keep.
         """
         view = self._emu.memory(primitives.MEMORY_SYSTEM_RAM)
         if view is None:
@@ -397,8 +419,11 @@ class Emulator:
                 f"Expected a state for this emulator of {self.system.name}; found one checked for {state.system}. "
                 f"Load it into an emulator of {state.system}."
             )
-        if self.system.reload_before_state:
+        if self._reload_states:
             self._reload_game()
+        self._load(state)
+
+    def _load(self, state: bytes) -> None:
         if self.system.reset_before_state:
             self._emu.reset()
         self._emu.unserialize(state, self.system.state_length == "exact")

@@ -165,6 +165,22 @@ def _stella_problem(state: bytes) -> str:
     return ""
 
 
+def cartridge_class(state: bytes) -> str:
+    """The cartridge class a stella state names after its header (``"CartridgeF8SC"``); ``""`` for any other state."""
+    names = []
+    at = 0
+    for _ in range(2):  # the format's header, then the cartridge's class name: two length-prefixed strings
+        if at + 4 > len(state):
+            return ""
+        length = struct.unpack_from("<I", state, at)[0]
+        if length > 64 or at + 4 + length > len(state):
+            return ""
+        names.append(state[at + 4 : at + 4 + length])
+        at += 4 + length
+    name = names[1]
+    return name.decode("ascii") if name.startswith(b"Cartridge") and name.isascii() else ""
+
+
 def _genesis_plus_gx(check: Callable[[bytes], str]) -> Callable[[bytes], str]:
     """``check``, on a state in Genesis Plus GX 1.7.5's format only (the same size and signature in every mode; the
     system, from the ROM's extension, decides how the core reads the rest)."""

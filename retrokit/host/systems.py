@@ -80,12 +80,21 @@ class System:
             and loaded again before each state is loaded (then reset, if
             ``reset_before_state``), as a fresh core would take it, and before
             each hard reset.
+        reload_md5: With ``reload_before_state``, the ROMs (by MD5) whose state
+            loads need the reload; with ``reload_cartridges`` also empty, every
+            ROM's do. The others' state loads are a load, and their hard resets
+            restore what the first one (a reload) left: see :meth:`reloads_states`.
+        reload_cartridges: The cartridge classes (named in stella's states) whose
+            state loads need the reload too.
         start: The button that starts a game from its title screen.
         jump: The button JERK jumps with, unless a scenario names another.
         switches: Console switches (not pad buttons), which default action sets, the random
             agent, JERK and validate's smoke run leave alone.
         proven_by: What proves retrokit runs the system right, by kind (``"cartridge"``,
             ``"stable-retro"``, ``"ale-py"``): a game's name, or ``""``; empty if nothing does.
+        build_speedup: How many times faster this system's env steps on the core ``retrokit
+            build-core`` makes than on the wheel's, as measured (``None``: not measured).
+        build_measured: On what, when and how loaded a machine ``build_speedup`` was measured.
     """
 
     name: str
@@ -103,6 +112,8 @@ class System:
     state_length: str = "exact"
     reset_before_state: bool = False
     reload_before_state: bool = False
+    reload_md5: frozenset[str] = frozenset()
+    reload_cartridges: frozenset[str] = frozenset()
     detect: tuple[DetectRule, ...] = ()
     rom_format: str = ""
     missing_mappers: frozenset[int] = frozenset()
@@ -110,6 +121,8 @@ class System:
     jump: str | None = None
     switches: tuple[str, ...] = ()
     proven_by: dict[str, str] = field(default_factory=dict)
+    build_speedup: float | None = None
+    build_measured: str = ""
 
     def __post_init__(self) -> None:
         for what, names in (("start", [self.start]), ("jump", [self.jump] if self.jump else []), ("switches", self.switches)):
@@ -180,6 +193,19 @@ class System:
             value |= 1 << self.button_bit(name)
         return value
 
+    def reloads_states(self, rom_md5: str, cartridge: str) -> bool:
+        """Whether loading a state into a console of this ROM must load the game again first.
+
+        Args:
+            rom_md5: The ROM's MD5, hex.
+            cartridge: The cartridge class the core's states name (``""`` when they name none).
+        """
+        if not self.reload_before_state:
+            return False
+        if not (self.reload_md5 or self.reload_cartridges):
+            return True
+        return rom_md5 in self.reload_md5 or cartridge in self.reload_cartridges
+
     def buttons_of(self, mask: int) -> list[str]:
         """Return the names of the buttons a bit mask presses."""
         return [b for i, b in enumerate(self.buttons) if b is not None and mask >> i & 1]
@@ -206,6 +232,8 @@ def _parse(name: str, entry: object) -> System:
             state_length=_one_of(entry.get("state_length", "exact"), ("exact", "parsed"), "state_length"),
             reset_before_state=_one_of(entry.get("reset_before_state", False), (False, True), "reset_before_state"),
             reload_before_state=_one_of(entry.get("reload_before_state", False), (False, True), "reload_before_state"),
+            reload_md5=frozenset(str(m).lower() for m in (entry.get("reload_only_for") or {}).get("md5", ())),
+            reload_cartridges=frozenset(str(c) for c in (entry.get("reload_only_for") or {}).get("cartridges", ())),
             detect=tuple(_detect_rule(rule) for rule in entry.get("detect") or ()),
             rom_format=_one_of(str((entry.get("rom") or {}).get("format", "")), ("", "ines"), "rom.format"),
             missing_mappers=frozenset(int(m) for m in (entry.get("rom") or {}).get("missing_mappers", ())),
@@ -213,6 +241,8 @@ def _parse(name: str, entry: object) -> System:
             jump=str(entry["jump"]) if entry.get("jump") else None,
             switches=tuple(str(b) for b in entry.get("switches", ())),
             proven_by={str(k): str(v or "") for k, v in (entry.get("proven_by") or {}).items()},
+            build_speedup=float(entry["build_core"]["speedup"]) if "build_core" in entry else None,
+            build_measured=str((entry.get("build_core") or {}).get("measured", "")),
         )
     except (KeyError, TypeError, ValueError) as exc:
         raise DataFileError(f"{_FILE}: system {name!r} is malformed: {exc!r}.") from exc

@@ -6,7 +6,8 @@ Its source, in stable-retro's sdist on the package index, already has the
 switch (``system_frame_gen(do_skip)``); a small patch kept in this package
 (``retrokit/native/patches/``) makes ``retro_run`` ask libretro's
 ``GET_AUDIO_VIDEO_ENABLE`` and pass the answer on. The same is done for
-stella, whose ``retro_run`` then skips converting the frames nobody sees.
+stella, whose ``retro_run`` then skips converting the frames nobody sees,
+and gambatte, which then skips making and resampling the sound nobody hears.
 
 :func:`build_core` fetches the sdist of the installed stable-retro version
 with pip (:mod:`retrokit.host.sdist`), unpacks only the core's folder, applies the patch, runs the core's
@@ -81,6 +82,7 @@ RECIPES = {
         "genesis_plus_gx", "cores/genesis", "Makefile.libretro", "genesis_plus_gx-av-enable.patch", "+av-enable"
     ),
     "stella": Recipe("stella", "cores/atari2600", "Makefile", "stella-av-enable.patch", "+av-enable"),
+    "gambatte": Recipe("gambatte", "cores/gb", "Makefile.libretro", "gambatte-av-enable.patch", "+av-enable"),
 }
 
 

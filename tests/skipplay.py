@@ -6,9 +6,30 @@ tells it); the wheel's draws every frame. Both get the same buttons.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
+from retrokit.data.games import find_game
+from retrokit.data.statecheck import vet_state
+from retrokit.data.states import read_state
 from retrokit.host.emulator import Emulator
+from retrokit.paths import wheel_cores_dir
+
+
+def open_pair(game_name: str, state: str) -> tuple[Emulator, Emulator]:
+    """The wheel's core of ``game_name``'s system and the built one, each at its ``state``, the built one told
+    that only the last frame of a run is seen."""
+    game = find_game(game_name)
+    rom = game.require_rom()
+    path = game.state_path(state)
+    data = vet_state(read_state(path), game.system.name, rom, source=str(path))
+    wheel = Emulator(game.system.name, rom, core_path=wheel_cores_dir() / f"{game.system.core}_libretro.so")
+    built = Emulator(game.system.name, rom)  # finds the build in the data folder first
+    for emulator in (wheel, built):
+        emulator.set_state(data)
+    built.set_video_frames("last")
+    return wheel, built
 
 
 def play_alike(wheel: Emulator, built: Emulator, buttons: np.ndarray) -> set[bytes]:
@@ -30,3 +51,15 @@ def play_alike(wheel: Emulator, built: Emulator, buttons: np.ndarray) -> set[byt
     assert built.av_asked - asked == frames and built.av_drawn <= asked + frames // 4  # asked every frame, drew 1 in 4
     assert wheel.av_asked == 0  # the wheel's never asks
     return screens
+
+
+def check_alike(wheel: Emulator, built: Emulator, buttons: np.ndarray,
+                emulated: Callable[[bytes], bytes] = lambda state: state) -> None:
+    """:func:`play_alike`, then the whole states (as ``emulated`` keeps them) equal and the game moved; closes both."""
+    try:
+        screens = play_alike(wheel, built, buttons)
+        assert emulated(built.get_state()) == emulated(wheel.get_state())
+        assert len(screens) > 10  # the game moved
+    finally:
+        wheel.close()
+        built.close()

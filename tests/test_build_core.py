@@ -304,7 +304,7 @@ def test_a_build_is_installed_recorded_and_found_first(monkeypatch, tmp_path, ca
     assert build_hint("Genesis") == ""  # built: the line that tells of it is never shown again
 
 
-@pytest.mark.parametrize(("core", "system"), [("stella", "Atari2600"), ("gambatte", "GameBoy")])
+@pytest.mark.parametrize(("core", "system"), [("stella", "Atari2600"), ("gambatte", "GameBoy"), ("snes9x", "Snes")])
 def test_other_cores_are_built_installed_and_found_the_same_way(monkeypatch, tmp_path, capsys, isolated, core: str,
                                                                 system: str) -> None:
     recipe = build.RECIPES[core]

@@ -15,14 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from skipplay import play_alike
+from skipplay import check_alike, open_pair
 
-from retrokit.data.games import find_game
-from retrokit.data.statecheck import vet_state
-from retrokit.data.states import read_state
 from retrokit.host.cores import built_core
-from retrokit.host.emulator import Emulator
-from retrokit.paths import wheel_cores_dir
 
 pytestmark = pytest.mark.skipif(built_core("gambatte") is None, reason="the patched gambatte is not built "
                                 "(retrokit build-core gambatte)")
@@ -41,36 +36,15 @@ def _emulated(state: bytes) -> bytes:
     return state[: at + 3] + bytes(size) + state[at + 3 + size :]
 
 
-def _open(game_name: str, state: str) -> tuple[Emulator, Emulator]:
-    """The wheel's gambatte and the built one, each at ``state`` of ``game_name``."""
-    game = find_game(game_name)
-    rom = game.require_rom()
-    path = game.state_path(state)
-    data = vet_state(read_state(path), game.system.name, rom, source=str(path))
-    wheel = Emulator(game.system.name, rom, core_path=wheel_cores_dir() / "gambatte_libretro.so")
-    built = Emulator(game.system.name, rom)  # finds the build in the data folder first
-    for emulator in (wheel, built):
-        emulator.set_state(data)
-    built.set_video_frames("last")
-    return wheel, built
-
-
 @pytest.mark.parametrize("game", ["Trekker-GameBoy", "Trekker-GbColor"])
 @pytest.mark.parametrize("state", ["Level1", "Level2", "Level3"])
 def test_the_built_gambatte_plays_as_the_wheels_making_no_unheard_sound(game: str, state: str) -> None:
-    wheel, built = _open(game, state)
-    try:
-        buttons = np.random.default_rng(len(state) + len(game)).integers(0, 1 << 8, size=(FRAMES // 4, 1))
-        screens = play_alike(wheel, built, buttons)
-        assert _emulated(built.get_state()) == _emulated(wheel.get_state())
-        assert len(screens) > 10  # the game moved
-    finally:
-        wheel.close()
-        built.close()
+    buttons = np.random.default_rng(len(state) + len(game)).integers(0, 1 << 8, size=(FRAMES // 4, 1))
+    check_alike(*open_pair(game, state), buttons, _emulated)
 
 
 def test_with_audio_captured_the_sound_is_the_wheels() -> None:
-    wheel, built = _open("Trekker-GameBoy", "Level1")
+    wheel, built = open_pair("Trekker-GameBoy", "Level1")
     try:
         for emulator in (wheel, built):
             emulator.capture_audio(True)  # then the host tells the built core that the sound is heard

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from skipplay import play_alike
+from skipplay import check_alike
 
 from retrokit.host.cores import built_core
 from retrokit.host.emulator import Emulator
@@ -60,16 +60,9 @@ def _open(game: str) -> tuple[Emulator, Emulator]:
 
 @pytest.mark.parametrize("game", list(GAMES))
 def test_the_built_stella_plays_as_the_wheels_converting_only_the_seen_frames(game: str) -> None:
-    wheel, built = _open(game)
-    try:
-        switches = get_system("Atari2600").mask(["SELECT", "RESET"])
-        buttons = np.random.default_rng(0).integers(0, 1 << 8, size=(FRAMES // 4, 2)) & ~switches
-        screens = play_alike(wheel, built, buttons)
-        assert built.get_state() == wheel.get_state()
-        assert len(screens) > 10  # the game moved
-    finally:
-        wheel.close()
-        built.close()
+    switches = get_system("Atari2600").mask(["SELECT", "RESET"])
+    buttons = np.random.default_rng(0).integers(0, 1 << 8, size=(FRAMES // 4, 2)) & ~switches
+    check_alike(*_open(game), buttons)
 
 
 def test_with_audio_captured_the_sound_is_the_wheels() -> None:

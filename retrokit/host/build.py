@@ -7,8 +7,9 @@ switch (``system_frame_gen(do_skip)``); a small patch kept in this package
 (``retrokit/native/patches/``) makes ``retro_run`` ask libretro's
 ``GET_AUDIO_VIDEO_ENABLE`` and pass the answer on. The same is done for
 stella, whose ``retro_run`` then skips converting the frames nobody sees,
-gambatte, which then skips making and resampling the sound nobody hears, and
-snes9x, which then renders no frame nobody sees.
+gambatte, which then skips making and resampling the sound nobody hears,
+snes9x, which then renders no frame nobody sees, and fceumm, which then
+converts none.
 
 :func:`build_core` fetches the sdist of the installed stable-retro version
 with pip (:mod:`retrokit.host.sdist`), unpacks only the core's folder, applies the patch, runs the core's
@@ -89,6 +90,7 @@ RECIPES = {
     "stella": Recipe("stella", "cores/atari2600", "Makefile", "stella-av-enable.patch", "+av-enable"),
     "gambatte": Recipe("gambatte", "cores/gb", "Makefile.libretro", "gambatte-av-enable.patch", "+av-enable"),
     "snes9x": Recipe("snes9x", "cores/snes", "Makefile", "snes9x-av-enable.patch", "+av-enable", subdir="libretro"),
+    "fceumm": Recipe("fceumm", "cores/nes", "Makefile.libretro", "fceumm-av-enable.patch", "+av-enable"),
 }
 
 

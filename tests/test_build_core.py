@@ -304,7 +304,8 @@ def test_a_build_is_installed_recorded_and_found_first(monkeypatch, tmp_path, ca
     assert build_hint("Genesis") == ""  # built: the line that tells of it is never shown again
 
 
-@pytest.mark.parametrize(("core", "system"), [("stella", "Atari2600"), ("gambatte", "GameBoy"), ("snes9x", "Snes"), ("fceumm", "Nes")])
+@pytest.mark.parametrize(("core", "system"), [("stella", "Atari2600"), ("gambatte", "GameBoy"), ("snes9x", "Snes"), ("fceumm", "Nes"),
+                                             ("mednafen_pce_fast", "PCEngine")])
 def test_other_cores_are_built_installed_and_found_the_same_way(monkeypatch, tmp_path, capsys, isolated, core: str,
                                                                 system: str) -> None:
     recipe = build.RECIPES[core]
@@ -388,7 +389,7 @@ def test_without_a_build_the_wheel_core_is_listed_unpatched_with_the_measured_ga
     hint = build_hint("Genesis")
     assert f"Genesis envs step {genesis.build_speedup:.1f}x faster" in hint and "build-core genesis_plus_gx" in hint
     assert "\n" not in hint
-    assert build_hint("PCEngine") == "" and build_hint("Sms") == "" and build_hint("Snes") == ""  # no recipe; no figure
+    assert build_hint("PCEngine") == "" and build_hint("Sms") == "" and build_hint("Snes") == ""  # no figure measured
 
 
 def test_no_line_tells_of_the_build_when_the_user_chose_a_core(isolated, monkeypatch) -> None:

@@ -1,11 +1,11 @@
-"""The snes9x and the fceumm ``retrokit build-core`` makes, which skip the frames nobody sees, against the wheel's.
+"""The snes9x, fceumm and mednafen_pce_fast ``retrokit build-core`` makes, which skip unseen frames, against the wheel's.
 
-Each plays our cartridge of its system from a state of each of its levels (one of them for 2 players) on both cores, on
-the same random buttons of both pads (new ones every 4 frames) for 3,000 frames in runs of 4: the built
-core told that only each run's last frame is seen (as an RGB env at frame skip 4 tells it), the wheel's
-drawing every frame. After every run the RAM and the screen are equal, and at the end the whole state
-(tests/skipplay.py). Each core's cases skip when it is not built (``retrokit build-core <core>``).
-gambatte's own test is test_gambatte_skip.py (its states hold a field no two cores agree on).
+Each plays our cartridge of its system from a state of each of its levels (one for 2 players where the game
+has them) on both cores, on the same random buttons of both pads (new ones every 4 frames) for 3,000 frames
+in runs of 4: the built core told that only each run's last frame is seen (as an RGB env at frame skip 4
+tells it), the wheel's drawing every frame. After every run the RAM and the screen are equal, and at the end
+the whole state (tests/skipplay.py). Each core's cases skip when it is not built (``retrokit build-core
+<core>``). gambatte's own test is test_gambatte_skip.py (its states hold a field no two cores agree on).
 """
 
 from __future__ import annotations
@@ -21,6 +21,7 @@ FRAMES = 3000
 PLAYS = {
     "snes9x": ("Skipper-Snes", ["Level1", "Level2.2P", "Level3"]),
     "fceumm": ("Hopper-Nes", ["Level1-1", "Level2-1.2P", "Level3-1"]),
+    "mednafen_pce_fast": ("Skipper-PCEngine", ["Level1", "Level2", "Level3"]),
 }
 
 

@@ -18,9 +18,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "Needs a C compiler (cc, or $CC; stella needs a C++ one too), make, and network access to the package "
         "index. The patched genesis_plus_gx skips drawing the frames an env does not show, and their sound; the "
         "patched stella skips converting them; the patched gambatte skips making and resampling the sound nobody "
-        "hears; the patched snes9x renders no unseen frame and the patched fceumm converts none (retrokit docs cores).",
+        "hears; the patched snes9x and mednafen_pce_fast draw no unseen frame and the patched fceumm converts none "
+        "(retrokit docs cores).",
     )
-    parser.add_argument("core", metavar="CORE", help="the core to build: genesis_plus_gx, stella, gambatte, snes9x or fceumm")
+    parser.add_argument("core", metavar="CORE", help="the core to build: genesis_plus_gx, stella, gambatte, snes9x, fceumm or mednafen_pce_fast")
     parser.add_argument("--stable-retro", metavar="VERSION", dest="version",
                         help="build from this stable-retro version's source (default: the installed one; "
                         "retrokit uses a built core only while it matches the installed version)")

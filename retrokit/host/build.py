@@ -8,8 +8,8 @@ switch (``system_frame_gen(do_skip)``); a small patch kept in this package
 ``GET_AUDIO_VIDEO_ENABLE`` and pass the answer on. The same is done for
 stella, whose ``retro_run`` then skips converting the frames nobody sees,
 gambatte, which then skips making and resampling the sound nobody hears,
-snes9x, which then renders no frame nobody sees, and fceumm, which then
-converts none.
+snes9x and mednafen_pce_fast, which then draw no frame nobody sees, and
+fceumm, which then converts none.
 
 :func:`build_core` fetches the sdist of the installed stable-retro version
 with pip (:mod:`retrokit.host.sdist`), unpacks only the core's folder, applies the patch, runs the core's
@@ -91,6 +91,9 @@ RECIPES = {
     "gambatte": Recipe("gambatte", "cores/gb", "Makefile.libretro", "gambatte-av-enable.patch", "+av-enable"),
     "snes9x": Recipe("snes9x", "cores/snes", "Makefile", "snes9x-av-enable.patch", "+av-enable", subdir="libretro"),
     "fceumm": Recipe("fceumm", "cores/nes", "Makefile.libretro", "fceumm-av-enable.patch", "+av-enable"),
+    "mednafen_pce_fast": Recipe(
+        "mednafen_pce_fast", "cores/pce", "Makefile", "mednafen_pce_fast-av-enable.patch", "+av-enable"
+    ),
 }
 
 

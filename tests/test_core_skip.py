@@ -1,7 +1,7 @@
 """The snes9x, fceumm and mednafen_pce_fast ``retrokit build-core`` makes, which skip unseen frames, against the wheel's.
 
 Each plays our cartridge of its system from a state of each of its levels (one for 2 players where the game
-has them) on both cores, on the same random buttons of both pads (new ones every 4 frames) for 3,000 frames
+has them) on both cores, on the same random buttons of both pads (new ones every 4 frames) for 2,000 frames
 in runs of 4: the built core told that only each run's last frame is seen (as an RGB env at frame skip 4
 tells it), the wheel's drawing every frame. After every run the RAM and the screen are equal, and at the end
 the whole state (tests/skipplay.py). Each core's cases skip when it is not built (``retrokit build-core
@@ -16,7 +16,7 @@ from skipplay import check_alike, open_pair
 
 from retrokit.host.cores import built_core
 
-FRAMES = 3000
+FRAMES = 2000
 # core -> (our cartridge of its system, its states)
 PLAYS = {
     "snes9x": ("Skipper-Snes", ["Level1", "Level2.2P", "Level3"]),

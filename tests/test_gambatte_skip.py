@@ -2,7 +2,7 @@
 
 Both cores play Trekker (our Game Boy cartridge, as a Game Boy and as a Game
 Boy Color game) from each level's state, on the same random buttons (new ones
-every 4 frames) for 3,000 frames in runs of 4: the built core told that only
+every 4 frames) for 2,000 frames in runs of 4: the built core told that only
 each run's last frame is seen and no frame is heard (as an RGB env at frame
 skip 4 tells it), the wheel's drawing and sounding every frame. After every
 run the RAM and the screen are equal, and at the end the whole state. The
@@ -22,7 +22,7 @@ from retrokit.host.cores import built_core
 pytestmark = pytest.mark.skipif(built_core("gambatte") is None, reason="the patched gambatte is not built "
                                 "(retrokit build-core gambatte)")
 
-FRAMES = 3000
+FRAMES = 2000
 
 
 def _emulated(state: bytes) -> bytes:

@@ -38,7 +38,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     new.add_argument("--max-episode-steps", metavar="N", help="steps an episode lasts at most (default: 4500)")
     new.add_argument("--scenario", metavar="NAME", help="the game's scenario to play (default: its default one)")
     new.add_argument("--out", metavar="FILE", help="the file to write (default: GAME.yaml, lower case, here)")
-    add_force_option(new, "replace an existing file")
+    add_force_option(new, "replace an existing file", said_overwrite=False)
     new.set_defaults(run=_new)
     parser.set_defaults(run=run)
 

@@ -252,6 +252,14 @@ class RunFolderError(DataFileError):
     """An evaluation's run folder cannot be resumed: missing, damaged, or made with other settings."""
 
 
+class AgentConfigError(DataFileError):
+    """A learning agent's config (``--agent-config NAME|FILE``) is unreadable, or a key or value is wrong."""
+
+
+class PolicyFileError(DataFileError):
+    """A saved policy (``policy.json`` and its weights) is missing, damaged, too large or not of this agent."""
+
+
 class AgentError(RetrokitError, RuntimeError):
     """An agent raised, or gave an action its env cannot take, while it was evaluated."""
 

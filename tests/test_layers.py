@@ -14,7 +14,7 @@ PACKAGE = Path(__file__).resolve().parent.parent / "retrokit"
 # __init__ (retrokit.make, retrokit.sonic, ...: `import retrokit`); "base" is errors.py, paths.py, datafolder.py, lazy.py and wheel.py
 # (the stable-retro wheel's file list), which every layer uses; "native" is the C host's package.
 LAYERS = [
-    "__main__", "cli", "commands", "studio", "root", "retro", "benchmark", "testing", "ramsearch", "envs", "movie", "dsl", "data",
+    "__main__", "cli", "commands", "studio", "root", "retro", "learning", "benchmark", "testing", "ramsearch", "envs", "movie", "dsl", "data",
     "host", "native", "base",
 ]
 _TOP_MODULES = {

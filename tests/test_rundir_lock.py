@@ -33,13 +33,13 @@ def test_a_run_that_opened_the_lock_file_as_its_holder_removed_it_locks_the_new_
     real = rundir._lock_once
     raced = []
 
-    def opened_before_the_first_run_ended(path: Path) -> int:
+    def opened_before_the_first_run_ended(path: Path, what: str) -> int:
         if not raced:  # this run opened the old file; the first run then removed it and let go
             stale = os.open(path, os.O_RDWR)
             first.close()
             raced.append(stale)
             return stale  # its lock is free now, but on a file no longer at the path
-        return real(path)
+        return real(path, what)
 
     monkeypatch.setattr(rundir, "_lock_once", opened_before_the_first_run_ended)
     second = RunDir(out, SETTINGS, resume=True)

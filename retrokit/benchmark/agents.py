@@ -9,8 +9,10 @@ Gymnasium policy fits in a few lines (docs/evaluate.md has a Stable-Baselines3
 PPO). ``seed`` seeds the agent's own randomness; the env's first reset is
 already seeded by the runner.
 
-On the command line an agent is ``random``, ``jerk``, or ``MODULE:CALLABLE``
-where ``MODULE`` is an importable module or a ``.py`` file.
+On the command line an agent is ``random``, ``jerk``, a learning agent
+(``ppo``: :mod:`retrokit.learning`, which the runner also passes its setup as
+``agent(env, budget, seed, setup=...)``), or ``MODULE:CALLABLE`` where
+``MODULE`` is an importable module or a ``.py`` file.
 """
 
 from __future__ import annotations
@@ -33,6 +35,8 @@ if TYPE_CHECKING:  # only annotations use it: the agent check's child (_CHECK) n
 BUILTINS = {
     "random": "retrokit.benchmark.agents:random_agent",
     "jerk": "retrokit.benchmark.jerk:jerk",
+    # The learning agents (retrokit.learning): called with the level task's setup (config, start policy).
+    "ppo": "retrokit.learning.play:play",
 }
 
 

@@ -11,6 +11,12 @@ YAML file of the same shape::
     levels:
       train: [Game-System/State, ...]
       test: [Game-System/State, ...]
+    learning:                   # optional: what a learning agent (retrokit evaluate --agent ppo) plays
+      actions: [[LEFT], [RIGHT], [LEFT, DOWN], [RIGHT, DOWN], [DOWN], [DOWN, B], [B]]
+      x: p1_x                   # the field whose episode maximum's increase is the learner's reward
+
+The ``sonic`` benchmark's learning block is the Sonic preset's: its seven
+actions, and the contest reward's progress as the x.
 """
 
 from __future__ import annotations
@@ -25,7 +31,14 @@ from typing import Any
 import yaml
 
 from retrokit.data.yamlfile import load_yaml
-from retrokit.errors import BenchmarkFileError, RomNotFoundError, StateNotFoundError, UnknownNameError, did_you_mean
+from retrokit.errors import (
+    BenchmarkFileError,
+    RomNotFoundError,
+    StateNotFoundError,
+    UnknownNameError,
+    did_you_mean,
+    shown,
+)
 from retrokit.paths import read_regular_file
 
 # Every benchmark file beside this module is built in, by its name: each cartridge's (dasher.yaml, ...).
@@ -37,6 +50,57 @@ ENV_OPTIONS = (
     "scenario", "frameskip", "sticky_prob", "max_episode_steps", "scenario_every_frame", "obs_type", "action_type",
 )
 MAX_FILE_BYTES = 1 << 20  # a benchmark file is a few lines; refuse to parse anything huge
+LEARNING_KEYS = ("actions", "x")
+MAX_ACTIONS = 64  # a learner's choices: the paper's are 7; a pad's every combination is 4096
+MAX_BUTTONS = 16  # buttons of one combination: the most any system has
+
+
+@dataclass(frozen=True)
+class LearningTask:
+    """What a learning agent plays on a benchmark: its button combinations and the x its reward follows.
+
+    Attributes:
+        actions: The button combinations, one per discrete action (the Sonic preset's seven for ``sonic``).
+        x: The game's field that is the player's x: the learner's reward is the increase of the
+            episode's maximum x (:class:`~retrokit.envs.sonic.MaxProgress`); ``None``: the episode's reward
+            so far stands for it (the Sonic contest's reward is progress).
+    """
+
+    actions: tuple[tuple[str, ...], ...]
+    x: str | None = None
+
+    def as_dict(self) -> dict[str, Any]:
+        """The block as plain data (for ``run.json`` and ``policy.json``)."""
+        return {"actions": [list(combo) for combo in self.actions], "x": self.x}
+
+    @classmethod
+    def from_data(cls, data: Any) -> LearningTask:
+        """Read a ``learning:`` block.
+
+        Raises:
+            ValueError: It is not of that shape (the message says how, without the file's name).
+        """
+        if not isinstance(data, dict):
+            raise ValueError(f"'learning' must be a mapping of {' and '.join(LEARNING_KEYS)}, got {type(data).__name__}")  # noqa: TRY004 - bad data
+        for key in data:
+            if key not in LEARNING_KEYS:
+                hint = did_you_mean(str(key), LEARNING_KEYS).strip() or f"known: {', '.join(LEARNING_KEYS)}"
+                raise ValueError(f"'learning' has an unknown key {shown(key)} ({hint})")
+        actions = data.get("actions")
+        if not isinstance(actions, list) or not 1 <= len(actions) <= MAX_ACTIONS:
+            raise ValueError(f"'learning.actions' must be a list of 1 to {MAX_ACTIONS} button lists, got {shown(actions)}")
+        combos = []
+        for i, combo in enumerate(actions):
+            if not isinstance(combo, list) or len(combo) > MAX_BUTTONS or not all(isinstance(b, str) for b in combo):
+                raise ValueError(f"'learning.actions' item {i + 1} must be a list of button names such as [RIGHT, B], "
+                                 f"got {shown(combo)}")
+            combos.append(tuple(combo))
+        if len(set(map(frozenset, combos))) < len(combos):
+            raise ValueError("'learning.actions' lists a combination twice; each action must press other buttons")
+        x = data.get("x")
+        if x is not None and (not isinstance(x, str) or not x):
+            raise ValueError(f"'learning.x' must be the name of a field of the game, got {shown(x)}")
+        return cls(tuple(combos), x)
 
 
 @dataclass(frozen=True, order=True)
@@ -77,6 +141,7 @@ class Benchmark:
         budget: Timesteps per level.
         env: :class:`~retrokit.envs.env.RetroEnv` options (see :data:`ENV_OPTIONS`).
         description: One line.
+        learning: The actions and x of a learning agent (``learning:``), if the benchmark has them.
     """
 
     name: str
@@ -85,6 +150,7 @@ class Benchmark:
     budget: int
     env: Mapping[str, Any] = field(default_factory=dict)
     description: str = ""
+    learning: LearningTask | None = None
 
     def levels(self) -> tuple[Level, ...]:
         """Every level: the test levels, then the training ones."""
@@ -140,6 +206,8 @@ class Benchmark:
                         f"Expected the level {level.name} of the {self.name} benchmark to be a state of {game_name}, "
                         f"but it has none of that name." + did_you_mean(level.state, game.states)
                     )
+            if self.learning is not None:
+                self._check_learning(game)
             if game.rom_path() is None:
                 missing.append(game_name)
         if missing:
@@ -147,6 +215,32 @@ class Benchmark:
                 f"Expected the ROMs of the {self.name} benchmark's games, but {len(missing)} are not imported: "
                 f"{', '.join(missing)}. Import your copies with `retrokit import PATH...` (a folder or zip holding "
                 "them); `retrokit games --imported` lists what is there."
+            )
+
+    def _check_learning(self, game: Any) -> None:  # a retrokit.data.games.Game
+        """Check the ``learning:`` block against a game: its buttons and its x field must exist.
+
+        Raises:
+            UnknownNameError: A button is not one of the game's system's, or the x is not a field of the game.
+        """
+        from retrokit.host.systems import get_system
+
+        assert self.learning is not None
+        system = get_system(game.system)
+        names = [b for b in system.buttons if b]
+        for combo in self.learning.actions:
+            for button in combo:
+                if button not in names:
+                    raise UnknownNameError(
+                        f"Expected the buttons of the {self.name} benchmark's learning.actions to be {game.system} "
+                        f"buttons ({', '.join(names)}), got {button!r}; fix the benchmark's learning block."
+                        + did_you_mean(button, names)
+                    )
+        x = self.learning.x
+        if x is not None and x not in game.fields:
+            raise UnknownNameError(
+                f"Expected the {self.name} benchmark's learning.x to be a field of {game.name}, got {x!r}; "
+                f"`retrokit games {game.name}` lists its fields." + did_you_mean(x, game.fields)
             )
 
     def env_options(self) -> dict[str, Any]:
@@ -161,6 +255,7 @@ class Benchmark:
             "budget": self.budget,
             "env": dict(self.env),
             "levels": {"train": [lv.name for lv in self.train], "test": [lv.name for lv in self.test]},
+            **({"learning": self.learning.as_dict()} if self.learning is not None else {}),
         }
 
 
@@ -181,6 +276,7 @@ def sonic() -> Benchmark:
             "scenario_every_frame": True,
         },
         description="Gotta Learn Fast: 47 training and 11 test levels of Sonic 1, 2 and 3 & Knuckles, 1M timesteps each",
+        learning=LearningTask(preset.ACTIONS),
     )
 
 
@@ -237,7 +333,7 @@ def benchmark_from_data(data: Any, fail: Callable[[str], Exception], default_nam
     """
     if not isinstance(data, dict):
         raise fail(f"holds a {type(data).__name__}, not a mapping")
-    unknown = set(data) - {"name", "description", "budget", "env", "levels"}
+    unknown = set(data) - {"name", "description", "budget", "env", "levels", "learning"}
     if unknown:
         raise fail(f"has unknown keys {sorted(map(str, unknown))}")
     budget = data.get("budget")
@@ -259,6 +355,12 @@ def benchmark_from_data(data: Any, fail: Callable[[str], Exception], default_nam
             split[key] = tuple(dict.fromkeys(Level.parse(n) for n in names))
         except ValueError as exc:
             raise fail(f"'levels.{key}': {exc}") from None
+    learning = None
+    if data.get("learning") is not None:
+        try:
+            learning = LearningTask.from_data(data["learning"])
+        except ValueError as exc:
+            raise fail(str(exc)) from None
     return Benchmark(
         name=str(data.get("name") or default_name),
         train=split["train"],
@@ -266,4 +368,5 @@ def benchmark_from_data(data: Any, fail: Callable[[str], Exception], default_nam
         budget=budget,
         env=dict(env),
         description=str(data.get("description") or ""),
+        learning=learning,
     )

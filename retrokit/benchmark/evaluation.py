@@ -62,6 +62,8 @@ class Evaluation:
         progress: Show progress (bars on a terminal, else a line per level).
         paper_dir: Where the paper's ``test-scores.csv`` is (default: found by :mod:`.paper`).
         stall_timeout: Seconds a level may go without a timestep before it is stopped and fails.
+        setup: A built-in learning agent's setup (:class:`retrokit.learning.setup.LearnerSetup`): given to the
+            agent on each level, its observation options added to the level's env, its ``settings()`` recorded.
         failed: The levels that failed in this run, with why (filled by :func:`evaluate`).
         played: The levels finished in this run: their timesteps and play seconds (filled by :func:`evaluate`).
     """
@@ -80,6 +82,7 @@ class Evaluation:
     progress: bool = True
     paper_dir: Path | None = None
     stall_timeout: float = DEFAULT_STALL_SECONDS
+    setup: Any = None
     failed: dict[str, str] = field(default_factory=dict)
     played: dict[str, tuple[int, float]] = field(default_factory=dict)
 
@@ -105,6 +108,11 @@ class Evaluation:
             raise InvalidArgumentError(f"Expected a --stall-timeout of more than 0 seconds, got {self.stall_timeout}.")
         if self.ray_address is not None and self.backend != "ray":
             raise InvalidArgumentError(f"Expected --backend ray with --ray-address, got --backend {self.backend}.")
+        if self.gif and self.setup is not None:
+            raise InvalidArgumentError(
+                f"Expected no --gif with the learning agent {self.agent}: it sees gray frame stacks, not the screen "
+                "a GIF shows; drop --gif."
+            )
         self.benchmark.check_levels(self.levels)
         check_agent(self.agent)  # in a child: an agent module that exits at import must not end this process
 
@@ -116,6 +124,7 @@ class Evaluation:
             "seed": self.seed,
             "budget": self.budget or self.benchmark.budget,
             "levels": [level.name for level in self.levels],
+            **({"agent_setup": self.setup.settings()} if self.setup is not None else {}),
         }
 
     def speed(self) -> Speed | None:
@@ -155,7 +164,7 @@ def run_evaluation(evaluation: Evaluation) -> Summary:
     budget = settings["budget"]
     run = RunDir(ev.out, settings, resume=ev.resume)
     try:
-        tasks = [LevelTask(ev.benchmark, level, ev.agent, budget, ev.seed, ev.gif)
+        tasks = [LevelTask(ev.benchmark, level, ev.agent, budget, ev.seed, ev.gif, ev.setup)
                  for level in ev.levels if level.name not in run.finished]
         progress = LevelProgress([level.name for level in ev.levels], budget, set(run.finished), show=ev.progress)
         try:

@@ -20,9 +20,11 @@ import threading
 import traceback
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Any
 
 from retrokit.benchmark.definition import Benchmark, Level
 from retrokit.benchmark.monitor import BudgetSpent, Episode, Monitor
+from retrokit.envs.preprocessing import OBSERVATION_OPTIONS
 from retrokit.errors import AgentError, RetrokitError
 
 #: GIF frame time: a step is 4 frames at 60 frames a second.
@@ -41,6 +43,9 @@ class LevelTask:
     budget: int
     seed: int
     gif: bool = False
+    #: A built-in learning agent's setup (retrokit.learning.setup.LearnerSetup), passed to it as ``setup=``;
+    #: its ``observation`` (native preprocessing options only) is added to the level's env.
+    setup: Any = None
 
 
 @dataclass(frozen=True)
@@ -118,6 +123,8 @@ def run_level(task: LevelTask, emit: Callable[[Message], None]) -> None:
 
     name = task.level.name
     options = task.benchmark.env_options()
+    if task.setup is not None:  # what the learner sees; the rules (frame skip, sticky, episodes, scenario) stay
+        options.update({key: value for key, value in task.setup.observation.items() if key in OBSERVATION_OPTIONS})
     if task.gif:
         options["render_mode"] = "rgb_array"
     try:
@@ -149,7 +156,10 @@ def run_level(task: LevelTask, emit: Callable[[Message], None]) -> None:
     reporter.start()
     send(Started(name, os.getpid()))
     try:
-        agent(monitor, task.budget, task.level.seed(task.seed))
+        if task.setup is None:
+            agent(monitor, task.budget, task.level.seed(task.seed))
+        else:
+            agent(monitor, task.budget, task.level.seed(task.seed), setup=task.setup)
     except BudgetSpent:
         pass
     except AgentError as exc:

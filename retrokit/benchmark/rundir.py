@@ -90,17 +90,11 @@ class RunDir:
         self.failed: dict[str, str] = {}
         self.episodes: dict[str, list[Episode]] = {}
         self.replayed: list[str] = []  # finished levels of an older run that did not spend their budget
-        if resume and not os.path.lexists(self.path / RUN_FILE):
-            raise _nothing_to_resume(self.path)
-        if not resume:
-            self._refuse_earlier()
-            ensure_folder(self.path, "for the evaluation's results")
-        self._lock = _lock(self.path / LOCK_FILE)
+        self._lock = claim_folder(self.path, OUTPUTS, "evaluation", resume=resume)
         try:
             if resume:
                 self._load()
             else:
-                self._refuse_earlier()  # again, now that no other run can be writing
                 self._save()
                 atomic_write(self.path / EPISODES_FILE, b"", overwrite=True)
             self._log = open(self.path / EPISODES_FILE, "a", encoding="utf-8")  # noqa: SIM115 - open for the run
@@ -108,26 +102,12 @@ class RunDir:
             os.close(self._lock)
             raise
 
-    def _refuse_earlier(self) -> None:
-        there = [name for name in OUTPUTS if os.path.lexists(self.path / name)]
-        if there:
-            raise FileConflictError(
-                f"Expected a new or empty --out folder, but {self.path} already holds an evaluation "
-                f"({', '.join(there)}); continue it with --resume, or choose another --out."
-            )
-
     def _damaged(self, name: str, problem: str) -> RunFolderError:
         return _damaged(self.path, name, problem)
 
     def _load(self) -> None:
         saved = read_run_file(self.path)
-        settings = saved["settings"]
-        if settings != self.settings:
-            differ = sorted(k for k in {*settings, *self.settings} if settings.get(k) != self.settings.get(k))
-            raise RunFolderError(
-                f"Expected --resume with the settings {self.path} was started with, but {', '.join(map(str, differ))} "
-                "differ; use the same options, or a new --out."
-            )
+        check_same_settings(self.path, saved["settings"], self.settings)
         for level, data in saved["finished"].items():
             try:
                 entry = FinishedLevel.from_json(data)
@@ -219,17 +199,93 @@ class RunDir:
     def close(self) -> None:
         """Close the episode log and release the folder, removing its lock file."""
         self._log.close()
-        # Unlinked while still held: a run that opened the old file meanwhile sees it is no longer the path's
-        # file once it gets the lock, and takes the new one (see _lock), so two runs never both hold the folder.
+        unlock_folder(self.path / LOCK_FILE, self._lock)
+
+
+def unlock_folder(path: Path, fd: int) -> None:
+    """Release a run folder's lock that :func:`lock_folder` took on ``path`` (``fd``), removing the lock file.
+
+    It is unlinked while still held: a run that opened the old file meanwhile sees it is no longer the path's
+    file once it gets the lock, and takes the new one (see :func:`lock_folder`), so two runs never both hold the
+    folder.
+    """
+    try:
+        path.unlink()
+    except FileNotFoundError:
+        pass
+    os.close(fd)
+
+
+def claim_folder(path: Path, outputs: tuple[str, ...], kind: str, *, resume: bool) -> int:
+    """Take a run folder for a run of ``kind``: a new (or empty) one, or with ``resume`` one that holds such a run.
+
+    Args:
+        path: The folder.
+        outputs: The files a run of this kind writes; the first is its settings file, which a run to resume has.
+        kind: ``"evaluation"``, ``"training run"``: for the messages.
+        resume: Continue the run there.
+
+    Returns:
+        The lock's descriptor (see :func:`lock_folder`; :func:`unlock_folder` releases it).
+
+    Raises:
+        RunFolderError: With ``resume``, the folder holds no run; or another run holds its lock.
+        FileConflictError: Without ``resume``, the folder holds a run's outputs already.
+    """
+    what = f"{'an' if kind[0] in 'aeiou' else 'a'} {kind}"
+    run_file = path / outputs[0]
+    if resume and not run_file.exists() and not run_file.is_symlink():
+        raise RunFolderError(
+            f"Expected {path} to hold {what} to resume ({outputs[0]}), but it has none; drop --resume to start one."
+        )
+    if not resume:
+        refuse_earlier(path, outputs, what)
+        ensure_folder(path, f"for the {kind}'s results")
+    fd = lock_folder(path / LOCK_FILE, kind)
+    if not resume:
         try:
-            (self.path / LOCK_FILE).unlink()
-        except FileNotFoundError:
-            pass
-        os.close(self._lock)
+            refuse_earlier(path, outputs, what)  # again, now that no other run can be writing
+        except BaseException:
+            os.close(fd)
+            raise
+    return fd
 
 
-def _lock(path: Path) -> int:
-    """Take the folder's lock (released when the descriptor closes or the process dies); return the descriptor.
+def refuse_earlier(path: Path, outputs: tuple[str, ...], what: str) -> None:
+    """Refuse a new run in a folder that holds one of a run's ``outputs`` already.
+
+    Args:
+        path: The run folder.
+        outputs: The files a run of this kind writes.
+        what: The kind of run, for the message (``"an evaluation"``).
+
+    Raises:
+        FileConflictError: One of them is there.
+    """
+    there = [name for name in outputs if os.path.lexists(path / name)]
+    if there:
+        raise FileConflictError(
+            f"Expected a new or empty --out folder, but {path} already holds {what} "
+            f"({', '.join(there)}); continue it with --resume, or choose another --out."
+        )
+
+
+def check_same_settings(path: Path, saved: dict[str, Any], settings: dict[str, Any]) -> None:
+    """Refuse to resume the run in ``path``, started with ``saved``, with other ``settings``.
+
+    Raises:
+        RunFolderError: They differ; the message names the keys that do.
+    """
+    if saved != settings:
+        differ = sorted(k for k in {*saved, *settings} if saved.get(k) != settings.get(k))
+        raise RunFolderError(
+            f"Expected --resume with the settings {path} was started with, but {', '.join(map(str, differ))} "
+            "differ; use the same options, or a new --out."
+        )
+
+
+def lock_folder(path: Path, what: str = "evaluation") -> int:
+    """Take a run folder's lock (released when the descriptor closes or the process dies); return the descriptor.
 
     A run that ends removes the lock file while it still holds it; the lock
     taken is on the file that is at ``path`` once taken, not on one removed
@@ -239,7 +295,7 @@ def _lock(path: Path) -> int:
         RunFolderError: Another run holds it, or the lock file cannot be made.
     """
     for _ in range(100):
-        fd = _lock_once(path)
+        fd = _lock_once(path, what)
         try:
             held, there = os.fstat(fd), os.stat(path, follow_symlinks=False)
         except FileNotFoundError:
@@ -298,7 +354,7 @@ def read_run_file(folder: Path) -> dict[str, Any]:
     return saved
 
 
-def _lock_once(path: Path) -> int:
+def _lock_once(path: Path, what: str) -> int:
     """Open ``path`` and take its lock; return the descriptor."""
     try:
         fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC, 0o644)
@@ -316,7 +372,7 @@ def _lock_once(path: Path) -> int:
             holder = os.pread(fd, 32, 0).decode("ascii", "replace").strip()
             who = f"process {holder}" if holder.isdigit() else "a process that has not written its number yet"
             raise RunFolderError(
-                f"Expected no other evaluation running in the folder {str(path.parent)!r}; found one there ({who}). "
+                f"Expected no other {what} running in the folder {str(path.parent)!r}; found one there ({who}). "
                 "Wait for it to end, or use another --out."
             ) from None
     except (RetrokitError, OSError):

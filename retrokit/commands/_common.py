@@ -48,3 +48,11 @@ def add_evaluation_options(parser, workers_help: str) -> None:  # an argparse pa
     parser.add_argument("--timesteps", type=int, default=None, help="timesteps per level (default: the benchmark's)")
     parser.add_argument("--seed", type=int, default=0, help="the run's seed (default: 0)")
     parser.add_argument("--workers", type=int, default=min(2, os.cpu_count() or 1), help=workers_help)
+
+
+def add_learning_options(parser) -> None:  # an argparse parser
+    """Add what a learning agent takes in ``evaluate`` and ``train``: ``--agent-config`` and ``--init``."""
+    parser.add_argument("--agent-config", default=None, metavar="NAME|FILE",
+                        help="a learning agent's config: paper (the default), quick, or a YAML file (a changed copy)")
+    parser.add_argument("--init", default=None, metavar="PATH",
+                        help="start from a trained policy: a `retrokit train` folder or its policy.json")

@@ -14,13 +14,15 @@ import os
 import sys
 from pathlib import Path
 
-from retrokit.commands._common import add_evaluation_options
+from retrokit.commands._common import add_evaluation_options, add_learning_options
 
 AGENT_NOTE = """\
-An agent is random, jerk, or MODULE:CALLABLE (an importable module or a .py file), a callable
+An agent is random, jerk, ppo, or MODULE:CALLABLE (an importable module or a .py file), a callable
     agent(env: gymnasium.Env, budget: int, seed: int) -> None
 that loops over env.reset() and env.step(action) until step() raises BudgetSpent (the runner catches it).
-The Ray backend is an extra: pip install 'retrokit-rl[ray]'.
+ppo learns during each level's budget (the paper's PPO); with --init DIR it starts from a policy that
+`retrokit train` made (Joint PPO), and with --no-learn it only plays it (the zero-shot score). It needs
+the extra retrokit-rl[train]. The Ray backend is an extra: pip install 'retrokit-rl[ray]'.
 """
 
 EXAMPLES = [
@@ -31,6 +33,9 @@ EXAMPLES = [
     "retrokit evaluate --benchmark mine.yaml --agent random --stall-timeout 120 --out runs/mine",
     "retrokit evaluate --benchmark sonic --agent jerk --backend ray --ray-address auto --out runs/sonic",
     "retrokit evaluate --benchmark sonic --list            # the benchmark's levels",
+    "retrokit evaluate --agent ppo --agent-config quick --levels Zone1.Act2 --timesteps 120000 --out runs/ppo",
+    "retrokit evaluate --agent ppo --init runs/joint --out runs/joint-ppo      # Joint PPO: fine-tune a trained policy",
+    "retrokit evaluate --agent ppo --init runs/joint --no-learn --out runs/zero-shot",
 ]
 
 
@@ -51,7 +56,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--benchmark", default="dasher", help="sonic, dasher, or another cartridge's benchmark (hopper-nes, hopper-sms, hopper-gg, trekker, trekker-color, skipper-pce, skipper-snes: tools/cartridges.yaml), or a benchmark YAML file (default: dasher)")
     parser.add_argument("--agent", action="append", default=None, metavar="AGENT",
-                        help="random, jerk, or MODULE:CALLABLE; repeat it to compare agents (default: jerk)")
+                        help="random, jerk, ppo, or MODULE:CALLABLE; repeat it to compare agents (default: jerk)")
+    add_learning_options(parser)
+    parser.add_argument("--no-learn", action="store_true",
+                        help="play the --init policy without learning (its zero-shot score, the paper's Figure 4)")
     add_evaluation_options(parser, "processes (or Ray CPUs) sharing the levels (default: up to 2)")
     parser.add_argument("--stall-timeout", type=float, default=DEFAULT_STALL_SECONDS, metavar="SECONDS",
                         help="stop a level whose agent takes no timestep for this long, and fail it "
@@ -114,6 +122,8 @@ def run(args: argparse.Namespace) -> int:
     from retrokit.benchmark.definition import Benchmark, load_benchmark
     from retrokit.benchmark.evaluation import Evaluation, evaluate
     from retrokit.errors import InvalidArgumentError
+    from retrokit.learning.algorithms import is_learning_agent
+    from retrokit.learning.setup import prepare
 
     if args.resume and args.out is not None:
         _resumed(args)
@@ -131,10 +141,13 @@ def run(args: argparse.Namespace) -> int:
     made: list[Evaluation] = []
 
     def make(agent: str, out: Path) -> Evaluation:
+        # Each learning agent gets the learning options; given to no learning agent at all, they are refused.
+        setup = prepare(agent, benchmark, args.agent_config, args.init, learn=not args.no_learn) \
+            if is_learning_agent(agent) or not any(map(is_learning_agent, agents)) else None
         made.append(Evaluation(
             benchmark=benchmark, levels=levels, agent=agent, out=out, budget=args.timesteps, seed=seed,
             workers=args.workers, backend=args.backend, ray_address=args.ray_address, resume=args.resume,
-            gif=args.gif, progress=not args.no_progress, stall_timeout=args.stall_timeout,
+            gif=args.gif, progress=not args.no_progress, stall_timeout=args.stall_timeout, setup=setup,
         ))
         return made[-1]
 

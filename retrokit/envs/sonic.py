@@ -12,6 +12,7 @@ ones the stable-retro wheel ships.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 import gymnasium
@@ -28,7 +29,7 @@ from retrokit.data.sonic_levels import (  # noqa: F401 - named here too, where u
 )
 from retrokit.envs.env import RetroEnv
 from retrokit.envs.options import check_options
-from retrokit.errors import InvalidArgumentError, StateNotFoundError, did_you_mean
+from retrokit.errors import EnvError, InvalidArgumentError, StateNotFoundError, did_you_mean
 
 #: The baselines' 7 button combinations.
 ACTIONS = (("LEFT",), ("RIGHT",), ("LEFT", "DOWN"), ("RIGHT", "DOWN"), ("DOWN",), ("DOWN", "B"), ("B",))
@@ -48,6 +49,21 @@ RULES = {
 }
 
 
+def press_each(env: gymnasium.Env, combos: tuple[tuple[str, ...], ...]) -> list[np.ndarray]:
+    """The action array of each button combination, for an env (or a vector env's env) with ``action_type="all"``.
+
+    What :class:`Discretizer` sends; a vector env's learner maps its choices through the same arrays.
+
+    Raises:
+        InvalidArgumentError: The env's actions are not ``"all"``.
+        UnknownNameError: A button is not one of the system's.
+    """
+    base: RetroEnv = env.unwrapped  # type: ignore[assignment]
+    if base.actions.action_type != "all":
+        raise InvalidArgumentError(f"Expected an env with action_type='all', got {base.actions.action_type!r}.")
+    return [base.actions.press(combo) for combo in combos]  # type: ignore[misc]
+
+
 class Discretizer(gymnasium.ActionWrapper):
     """Turns a Discrete choice into one of a list of button combinations.
 
@@ -58,10 +74,7 @@ class Discretizer(gymnasium.ActionWrapper):
 
     def __init__(self, env: gymnasium.Env, combos: tuple[tuple[str, ...], ...]) -> None:
         super().__init__(env)
-        base: RetroEnv = env.unwrapped  # type: ignore[assignment]
-        if base.actions.action_type != "all":
-            raise InvalidArgumentError(f"Expected an env with action_type='all', got {base.actions.action_type!r}.")
-        self._arrays = [base.actions.press(combo) for combo in combos]
+        self._arrays = press_each(env, combos)
         self.combos = combos
         self.action_space = spaces.Discrete(len(combos))
 
@@ -69,27 +82,72 @@ class Discretizer(gymnasium.ActionWrapper):
         return self._arrays[int(action)]
 
 
+class MaxProgress:
+    """One episode's max-x reward: a step earns how far it takes the episode's best progress, never less than 0.
+
+    The baselines' reward preprocessing. Progress is the x of a RAM field (a
+    benchmark's ``learning.x``) or, without one, the episode's reward so far
+    (the Sonic contest's reward is progress along the level): going back
+    costs nothing, and earns nothing again when the agent covers the same
+    ground a second time.
+    """
+
+    def __init__(self) -> None:
+        self.best = self.current = 0.0
+
+    def start(self, progress: float = 0.0) -> None:
+        """Begin an episode at ``progress`` (its x at the start, or 0 for the reward so far)."""
+        self.best = self.current = float(progress)
+
+    def advance(self, progress: float) -> float:
+        """The step's reward: how far ``progress`` (now) passes the best so far."""
+        gain = max(0.0, float(progress) - self.best)
+        self.best, self.current = max(self.best, float(progress)), float(progress)
+        return gain
+
+
 class AllowBacktracking(gymnasium.Wrapper):
-    """Rewards only new progress: the step's gain past the best x so far.
+    """Rewards only new progress: the step's gain past the best x so far (:class:`MaxProgress`).
 
     The baselines' preprocessing: with the contest reward (progress), going
     back and forth no longer costs reward, so agents may backtrack freely.
+
+    Args:
+        env: The env.
+        x: A field of the game (in ``info``) that is the player's x; ``None``: the episode's reward so far.
     """
 
-    def __init__(self, env: gymnasium.Env) -> None:
+    def __init__(self, env: gymnasium.Env, x: str | None = None) -> None:
         super().__init__(env)
-        self._current = self._best = 0.0
+        self.x = x
+        self._progress = MaxProgress()
 
     def reset(self, **kwargs: Any):
-        self._current = self._best = 0.0
-        return self.env.reset(**kwargs)
+        obs, info = self.env.reset(**kwargs)
+        self._progress.start(progress_of(info, self.x))
+        return obs, info
 
     def step(self, action: Any):
         obs, reward, terminated, truncated, info = self.env.step(action)
-        self._current += reward
-        reward = max(0.0, self._current - self._best)
-        self._best = max(self._best, self._current)
-        return obs, reward, terminated, truncated, info
+        now = self._progress.current + float(reward) if self.x is None else progress_of(info, self.x)
+        return obs, self._progress.advance(now), terminated, truncated, info
+
+
+def progress_of(info: Mapping[str, Any], x: str | None) -> float:
+    """The field ``x`` of a step's ``info`` (0.0 without ``x``: progress is then the reward so far).
+
+    Raises:
+        EnvError: ``info`` has no field ``x`` (the env's ``info_keys`` leave it out).
+    """
+    if x is None:
+        return 0.0
+    try:
+        return float(info[x])
+    except KeyError:
+        raise EnvError(
+            f"Expected the field {x!r} (the x of the max-x reward) in the step's info, but it has "
+            f"{', '.join(sorted(map(str, info))) or 'none'}; keep it in info_keys."
+        ) from None
 
 
 def make(

@@ -1,0 +1,84 @@
+"""The learning algorithms retrokit builds in, and how each declares its config's keys.
+
+Each algorithm is a module named in :data:`ALGORITHMS` that defines, without
+importing its library at module level:
+
+- ``LIBRARY``: the library it trains with (``"stable-baselines3"``), for messages and ``policy.json``;
+- ``KEYS``: its config's keys, a mapping of name to :class:`Key` (the loader checks every config against it);
+- ``observation_options(config)``: the native preprocessing options (``grayscale``, ``resize``, ...) the runner
+  adds to a level's env for it;
+- ``require()``: raise :class:`~retrokit.errors.MissingExtraError` if its library is not installed;
+- ``play(env, budget, seed, setup)``: play (and learn on) one level's env for ``retrokit evaluate``;
+- ``train(run)``: train one policy on a benchmark's training levels for ``retrokit train``
+  (:class:`~retrokit.learning.trainrun.TrainRun`).
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from dataclasses import dataclass
+from types import ModuleType
+from typing import Any
+
+from retrokit.errors import UnknownNameError, did_you_mean
+
+#: Every learning agent, by its ``--agent`` name: the module that implements it.
+ALGORITHMS = {
+    "ppo": "retrokit.learning.ppo",
+}
+
+
+@dataclass(frozen=True)
+class Key:
+    """One key of an agent's config: its type, its range, and what it means.
+
+    Attributes:
+        kind: ``int``, ``float`` (an int is taken too), ``bool`` or ``str``.
+        help: What the key sets, for messages and docs.
+        low: The smallest value allowed (numbers).
+        high: The largest value allowed (numbers).
+        choices: The values allowed (strings).
+    """
+
+    kind: type
+    help: str
+    low: float | None = None
+    high: float | None = None
+    choices: tuple[str, ...] | None = None
+
+    def problem(self, value: Any) -> str | None:
+        """Why ``value`` does not fit this key, or ``None`` if it does."""
+        kind = self.kind
+        fits = (
+            isinstance(value, bool) if kind is bool
+            else isinstance(value, int | float) and not isinstance(value, bool) if kind is float
+            else isinstance(value, kind) and not isinstance(value, bool)
+        )  # fmt: skip
+        if not fits:
+            return f"must be {'a whole number' if kind is int else 'a number' if kind is float else kind.__name__}"
+        low = -math.inf if self.low is None else self.low
+        high = math.inf if self.high is None else self.high
+        if kind in (int, float) and not low <= value <= high:  # NaN too: no comparison holds
+            return f"must be from {low:g} to {high:g}"
+        if self.choices is not None and value not in self.choices:
+            return f"must be one of {', '.join(self.choices)}"
+        return None
+
+
+def is_learning_agent(name: str) -> bool:
+    """Whether ``--agent name`` is a built-in learning agent."""
+    return name in ALGORITHMS
+
+
+def algorithm(name: str) -> ModuleType:
+    """The module of the learning agent ``name``.
+
+    Raises:
+        UnknownNameError: ``name`` is not a learning agent.
+    """
+    if name not in ALGORITHMS:
+        raise UnknownNameError(
+            f"Expected a learning agent ({', '.join(ALGORITHMS)}), got {name!r}." + did_you_mean(name, ALGORITHMS)
+        )
+    return importlib.import_module(ALGORITHMS[name])

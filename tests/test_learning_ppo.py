@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 import yaml
 from incli import retrokit_in_process
+from learningruns import evaluate, evaluate_three_ways
 
 pytest.importorskip(
     "stable_baselines3",
@@ -75,21 +76,12 @@ def test_train_writes_the_policy_the_curve_and_a_checkpoint(trained) -> None:
 
 
 def _evaluate(folder: Path, out: str, *args: str) -> subprocess.CompletedProcess:
-    agent = () if "--agent" in args else ("--agent", "ppo")
-    return retrokit_in_process(folder, "evaluate", *agent, "--levels", "Zone1.Act2", "--timesteps", "80",
-                               "--workers", "1", "--no-progress", "--out", str(folder / out), *args)
+    return evaluate(folder, "ppo", 80, out, *args)
 
 
 def test_evaluate_learns_from_scratch_and_from_the_trained_policy(folder, tiny, trained) -> None:
-    for out, args in (("scratch", ()), ("from-folder", ("--init", str(trained))),
-                      ("zero-shot", ("--init", str(trained / "policy.json"), "--no-learn"))):
-        done = _evaluate(folder, out, "--agent-config", str(tiny), *args)
-        assert done.returncode == 0, done.stderr
-        run = json.loads((folder / out / "run.json").read_text())
-        assert run["finished"]["Dasher-Genesis/Zone1.Act2"]["timesteps"] == 80
-        setup = run["settings"]["agent_setup"]
-        assert setup["config"]["values"]["horizon"] == 32 and setup["learn"] == (out != "zero-shot")
-        assert (setup["init"] is None) == (out == "scratch")
+    for out, setup in evaluate_three_ways(folder, "ppo", 80, tiny, trained).items():
+        assert setup["config"]["values"]["horizon"] == 32
         assert setup["paper_agent"] == {"scratch": "PPO", "from-folder": "Joint PPO", "zero-shot": None}[out]
         if setup["init"]:
             assert setup["init"]["weights_sha256"] == read_policy(trained).sha256

@@ -37,6 +37,7 @@ BUILTINS = {
     "jerk": "retrokit.benchmark.jerk:jerk",
     # The learning agents (retrokit.learning): called with the level task's setup (config, start policy).
     "ppo": "retrokit.learning.play:play",
+    "rainbow": "retrokit.learning.play:play",
 }
 
 

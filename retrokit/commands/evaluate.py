@@ -17,11 +17,12 @@ from pathlib import Path
 from retrokit.commands._common import add_evaluation_options, add_learning_options
 
 AGENT_NOTE = """\
-An agent is random, jerk, ppo, or MODULE:CALLABLE (an importable module or a .py file), a callable
+An agent is random, jerk, ppo, rainbow, or MODULE:CALLABLE (an importable module or a .py file), a callable
     agent(env: gymnasium.Env, budget: int, seed: int) -> None
 that loops over env.reset() and env.step(action) until step() raises BudgetSpent (the runner catches it).
-ppo learns during each level's budget (the paper's PPO); with --init DIR it starts from a policy that
-`retrokit train` made (Joint PPO), and with --no-learn it only plays it (the zero-shot score). It needs
+ppo and rainbow learn during each level's budget (the paper's PPO and Rainbow); with --init DIR they start
+from a policy that `retrokit train` made (Joint PPO, Joint Rainbow), and with --no-learn only play it (the
+zero-shot score). They need
 the extra retrokit-rl[train]. The Ray backend is an extra: pip install 'retrokit-rl[ray]'.
 """
 
@@ -36,6 +37,7 @@ EXAMPLES = [
     "retrokit evaluate --agent ppo --agent-config quick --levels Zone1.Act2 --timesteps 120000 --out runs/ppo",
     "retrokit evaluate --agent ppo --init runs/joint --out runs/joint-ppo      # Joint PPO: fine-tune a trained policy",
     "retrokit evaluate --agent ppo --init runs/joint --no-learn --out runs/zero-shot",
+    "retrokit evaluate --agent rainbow --agent-config quick --levels Zone1.Act2 --timesteps 120000 --out runs/rainbow",
 ]
 
 
@@ -56,7 +58,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     parser.add_argument("--benchmark", default="dasher", help="sonic, dasher, or another cartridge's benchmark (hopper-nes, hopper-sms, hopper-gg, trekker, trekker-color, skipper-pce, skipper-snes: tools/cartridges.yaml), or a benchmark YAML file (default: dasher)")
     parser.add_argument("--agent", action="append", default=None, metavar="AGENT",
-                        help="random, jerk, ppo, or MODULE:CALLABLE; repeat it to compare agents (default: jerk)")
+                        help="random, jerk, ppo, rainbow, or MODULE:CALLABLE; repeat it to compare agents (default: jerk)")
     add_learning_options(parser)
     parser.add_argument("--no-learn", action="store_true",
                         help="play the --init policy without learning (its zero-shot score, the paper's Figure 4)")

@@ -17,6 +17,7 @@ from retrokit.commands._common import add_learning_options
 EXAMPLES = [
     "retrokit train --benchmark dasher --agent ppo --agent-config quick --timesteps 200000 --out runs/joint",
     "retrokit train --benchmark dasher --agent ppo --timesteps 200000 --out runs/joint --resume   # after a kill",
+    "retrokit train --benchmark dasher --agent rainbow --agent-config quick --timesteps 200000 --out runs/joint-rainbow",
     "retrokit train --benchmark sonic --agent ppo --timesteps 50000000 --checkpoint-every 1800 --out runs/sonic",
 ]
 
@@ -34,7 +35,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--agent ppo --init DIR` fine-tunes the policy on the test levels. Needs the extra retrokit-rl[train].",
     )
     parser.add_argument("--benchmark", default="dasher", help="sonic, dasher, another cartridge's, or a YAML file (default: dasher)")
-    parser.add_argument("--agent", default="ppo", help="the learning agent (default: ppo)")
+    parser.add_argument("--agent", default="ppo", help="the learning agent: ppo or rainbow (default: ppo)")
     add_learning_options(parser)
     parser.add_argument("--timesteps", type=int, required=True, help="timesteps to train for, over all levels")
     parser.add_argument("--levels", default="train", help="train (the default), test, all, or LEVEL,...")

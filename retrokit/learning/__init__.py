@@ -10,7 +10,8 @@ A layer above :mod:`retrokit.benchmark` and :mod:`retrokit.envs`:
 - :mod:`.setup` prepares a learning agent for ``retrokit evaluate`` (config, ``--init``, zero-shot);
 - :mod:`.play` is the agent ``retrokit evaluate --agent ppo`` calls on each level;
 - :mod:`.trainrun` is ``retrokit train``'s run folder: settings, lock, checkpoints, the learning curve;
-- :mod:`.ppo` is PPO over Stable-Baselines3.
+- :mod:`.ppo` is PPO over Stable-Baselines3;
+- :mod:`.rainbow` is Rainbow over Tianshou.
 
 The libraries are the extra ``retrokit-rl[train]`` (stable-baselines3, torch); nothing here imports them until
 an agent plays or trains.

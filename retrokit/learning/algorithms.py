@@ -5,6 +5,8 @@ importing its library at module level:
 
 - ``LIBRARY``: the library it trains with (``"stable-baselines3"``), for messages and ``policy.json``;
 - ``KEYS``: its config's keys, a mapping of name to :class:`Key` (the loader checks every config against it);
+- optionally ``check_values(values)``: the problem of keys taken together (``v_min`` above ``v_max``), as a
+  sentence, or ``None``;
 - ``observation_options(config)``: the native preprocessing options (``grayscale``, ``resize``, ...) the runner
   adds to a level's env for it;
 - ``require()``: raise :class:`~retrokit.errors.MissingExtraError` if its library is not installed;
@@ -21,11 +23,12 @@ from dataclasses import dataclass
 from types import ModuleType
 from typing import Any
 
-from retrokit.errors import UnknownNameError, did_you_mean
+from retrokit.errors import MissingExtraError, UnknownNameError, did_you_mean, install_extra
 
 #: Every learning agent, by its ``--agent`` name: the module that implements it.
 ALGORITHMS = {
     "ppo": "retrokit.learning.ppo",
+    "rainbow": "retrokit.learning.rainbow",
 }
 
 
@@ -64,6 +67,24 @@ class Key:
         if self.choices is not None and value not in self.choices:
             return f"must be one of {', '.join(self.choices)}"
         return None
+
+
+def require_libraries(agent: str, modules: dict[str, str]) -> None:
+    """Raise :class:`~retrokit.errors.MissingExtraError` unless each module (import name: shown name) imports.
+
+    The extra ``train`` has every learning agent's libraries; the message says to install torch's CPU build first.
+    """
+    import importlib
+
+    try:
+        for module in modules:
+            importlib.import_module(module)
+    except ImportError as exc:
+        raise MissingExtraError(
+            f"Expected {' and '.join(modules.values())} for --agent {agent}, but importing them failed ({exc}). "
+            "Install torch's CPU build with `pip install torch --index-url https://download.pytorch.org/whl/cpu`, "
+            f"then `{install_extra('train')}`."
+        ) from None
 
 
 def is_learning_agent(name: str) -> bool:

@@ -124,4 +124,7 @@ def check_config(agent: str, data: Any, keys: Mapping[str, Any], path: Path | st
             raise AgentConfigError(
                 f"Expected {key} in {where} to be {spec.help}: it {problem}; got {shown(data[key])}."
             )
+    problem = getattr(algorithm(agent), "check_values", lambda _: None)(data)
+    if problem is not None:
+        raise AgentConfigError(f"Expected {where} to fit together, but {problem}.")
     return {key: data[key] for key in keys}

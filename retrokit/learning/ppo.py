@@ -22,8 +22,8 @@ from collections.abc import Mapping
 from functools import partial
 from typing import TYPE_CHECKING, Any
 
-from retrokit.errors import MissingExtraError, PolicyFileError, install_extra
-from retrokit.learning.algorithms import Key
+from retrokit.errors import PolicyFileError
+from retrokit.learning.algorithms import Key, require_libraries
 from retrokit.learning.task import image_options
 
 if TYPE_CHECKING:
@@ -63,15 +63,7 @@ def observation_options(config: Mapping[str, Any]) -> dict[str, Any]:
 
 def require() -> None:
     """Raise :class:`~retrokit.errors.MissingExtraError` unless Stable-Baselines3 and torch are installed."""
-    try:
-        import stable_baselines3  # noqa: F401
-        import torch  # noqa: F401
-    except ImportError as exc:
-        raise MissingExtraError(
-            f"Expected Stable-Baselines3 and torch for --agent ppo, but importing them failed ({exc}). Install "
-            "torch's CPU build with `pip install torch --index-url https://download.pytorch.org/whl/cpu`, then "
-            f"`{install_extra('train')}`."
-        ) from None
+    require_libraries("ppo", {"stable_baselines3": "Stable-Baselines3", "torch": "torch"})
 
 
 def library() -> str:
@@ -129,7 +121,14 @@ def load_tensors(data: bytes, what: str) -> dict[str, Any]:
 
 
 def load_weights(model: Any, data: bytes, what: str) -> None:
-    """Load a network's weights into ``model``: the same names and shapes only.
+    """Load a network's weights into ``model``: the same names and shapes only (see :func:`load_into`)."""
+    load_into(model.policy, data, what)
+
+
+def load_into(network: Any, data: bytes, what: str) -> dict[str, Any]:  # a torch.nn.Module
+    """Load saved weights into a torch ``network``: the same names and shapes only; return them.
+
+    Every torch-based agent's weights load through here (PPO's policy, Rainbow's network).
 
     Raises:
         PolicyFileError: They are not tensors, or their names or shapes are not this network's.
@@ -137,7 +136,7 @@ def load_weights(model: Any, data: bytes, what: str) -> None:
     import torch
 
     state = load_tensors(data, what)
-    ours = model.policy.state_dict()
+    ours = network.state_dict()
     if set(state) != set(ours) or any(
         not isinstance(state[key], torch.Tensor) or state[key].shape != ours[key].shape for key in ours
     ):
@@ -145,7 +144,8 @@ def load_weights(model: Any, data: bytes, what: str) -> None:
             f"Expected {what} to be the weights of this config's network ({len(ours)} tensors), but their names "
             "or shapes differ; it was saved from another network."
         )
-    model.policy.load_state_dict(state)
+    network.load_state_dict(state)
+    return state
 
 
 def observation_spec(venv: Any, config: Mapping[str, Any]) -> dict[str, Any]:

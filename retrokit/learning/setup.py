@@ -18,7 +18,7 @@ from typing import Any
 from retrokit.benchmark.definition import Benchmark, LearningTask
 from retrokit.benchmark.paper import paper_name
 from retrokit.errors import InvalidArgumentError, PolicyFileError
-from retrokit.learning.algorithms import algorithm, is_learning_agent
+from retrokit.learning.algorithms import ALGORITHMS, algorithm, is_learning_agent
 from retrokit.learning.config import AgentConfig, load_config
 from retrokit.learning.policy import SavedPolicy, read_policy
 from retrokit.learning.task import learning_task
@@ -99,8 +99,8 @@ def prepare(
             given.append("--no-learn")
         if given:
             raise InvalidArgumentError(
-                f"Expected {' and '.join(given)} with a learning agent (ppo), got them with --agent {agent}; "
-                "drop them, or use --agent ppo."
+                f"Expected {' and '.join(given)} with a learning agent ({', '.join(ALGORITHMS)}), got them with "
+                f"--agent {agent}; drop them, or use --agent ppo."
             )
         return None
     if not learn and init is None:

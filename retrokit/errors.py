@@ -202,6 +202,11 @@ class FileSystemError(RetrokitError, OSError):
     """A file or folder cannot be read or written: a file where a folder should be, no permission, a full disk."""
 
 
+class PlantedLinkError(FileSystemError):
+    """A folder or file below the data folder is a symlink, which retrokit never makes there: it would send writes
+    elsewhere, and let files nobody wrote there pass for retrokit's own."""
+
+
 class MovieError(RetrokitError, ValueError):
     """A .bk2 movie is malformed or does not fit the game it is played on."""
 

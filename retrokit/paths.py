@@ -12,9 +12,8 @@ Game folders are searched, in order, in:
    ``data/contrib`` folders.
 
 The per-user data folder holds imported ROMs (``<data>/roms/<Game>/rom.<ext>``)
-and the user's game folders (``<data>/games/<Game>/``).
-It is ``RETROKIT_DATA`` if set, else ``$XDG_DATA_HOME/retrokit``, else
-``~/.local/share/retrokit``.
+and the user's game folders (``<data>/games/<Game>/``): :mod:`retrokit.datafolder`
+(whose names this module re-exports) finds it, and is the one way to a path in it.
 
 The stable-retro wheel is located without importing its Python code.
 """
@@ -34,10 +33,19 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import BinaryIO
 
+from retrokit.datafolder import (  # noqa: F401 (re-exported: the data folder's names, as callers know them)
+    DATA_ENV,
+    data_dir,
+    data_path,
+    imported_rom_path,
+    inside_data,
+    records_dir,
+    roms_dir,
+    user_games_dir,
+)
 from retrokit.errors import FileConflictError, FileSystemError, UnknownNameError, did_you_mean, shown
 
 GAMES_ENV = "RETROKIT_GAMES"
-DATA_ENV = "RETROKIT_DATA"
 WHEEL_DATA_KINDS = ("stable", "experimental", "contrib")
 
 
@@ -133,11 +141,6 @@ def env_games_dirs() -> list[Path]:
     return [Path(part).expanduser() for part in value.split(os.pathsep) if part.strip()]
 
 
-def user_games_dir(data: Path | str | None = None) -> Path:
-    """Return the folder of the user's game folders: ``<data>/games`` (it may not exist yet)."""
-    return (Path(data) if data is not None else data_dir()) / "games"
-
-
 def game_search_dirs() -> list[Path]:
     """Return the existing folders that hold game folders, in search order."""
     candidates = [*env_games_dirs(), user_games_dir()]
@@ -152,46 +155,6 @@ def game_search_dirs() -> list[Path]:
             seen.add(path)
             result.append(path)
     return result
-
-
-def data_dir() -> Path:
-    """Return the per-user data folder (it may not exist yet)."""
-    override = os.environ.get(DATA_ENV)
-    if override:
-        return Path(override).expanduser()
-    xdg = os.environ.get("XDG_DATA_HOME")
-    if xdg and Path(xdg).is_absolute():  # the XDG spec says to ignore relative paths
-        return Path(xdg) / "retrokit"
-    return Path.home() / ".local" / "share" / "retrokit"
-
-
-def records_dir(kind: str) -> Path:
-    """``<data>/<kind>``: a folder of retrokit's own records (``state-probes``, ``state-owners``, ``core-probes``).
-
-    Records vouch for files (a verdict lets a state load unprobed), so the folder
-    must not be a symlink, which would send writes elsewhere and let files nobody
-    wrote here vouch; read its files with ``follow=False`` (:func:`read_regular_file`).
-
-    Raises:
-        FileSystemError: It is a symlink.
-    """
-    folder = data_dir() / kind
-    if os.path.islink(folder):
-        raise FileSystemError(
-            f"Expected {str(folder)!r} to be retrokit's own folder of {kind}; found a symlink, whose files vouch for "
-            "nothing. Remove the link: retrokit makes the folder again."
-        )
-    return folder
-
-
-def roms_dir(data: Path | str | None = None) -> Path:
-    """Return the folder of imported ROMs: ``<data>/roms``."""
-    return (Path(data) if data is not None else data_dir()) / "roms"
-
-
-def imported_rom_path(game: str, ext: str, data: Path | str | None = None) -> Path:
-    """Return where the imported ROM of ``game`` lives: ``<data>/roms/<game>/rom.<ext>``."""
-    return roms_dir(data) / game / f"rom.{ext.lstrip('.')}"
 
 
 def _umask() -> int:

@@ -304,20 +304,24 @@ def test_a_build_is_installed_recorded_and_found_first(monkeypatch, tmp_path, ca
     assert build_hint("Genesis") == ""  # built: the line that tells of it is never shown again
 
 
-def test_stella_is_built_installed_and_found_the_same_way(monkeypatch, tmp_path, capsys, isolated) -> None:
-    stella = build.RECIPES["stella"]
-    monkeypatch.setenv("PATH", str(tools(tmp_path, core="stella")))
-    sdist = fake_sdist(tmp_path, {**original_sources(recipe=stella), "cores/genesis/x.c": b"x"})
-    assert main(["build-core", "stella", "--sdist", str(sdist)]) == 0
+@pytest.mark.parametrize(("core", "system"), [("stella", "Atari2600"), ("gambatte", "GameBoy"), ("snes9x", "Snes"), ("fceumm", "Nes"),
+                                             ("mednafen_pce_fast", "PCEngine")])
+def test_other_cores_are_built_installed_and_found_the_same_way(monkeypatch, tmp_path, capsys, isolated, core: str,
+                                                                system: str) -> None:
+    recipe = build.RECIPES[core]
+    monkeypatch.setenv("PATH", str(tools(tmp_path, core=core)))
+    sdist = fake_sdist(tmp_path, {**original_sources(recipe=recipe), "cores/genesis/x.c": b"x"})
+    assert main(["build-core", core, "--sdist", str(sdist)]) == 0
     err = capsys.readouterr().err
-    assert "Unpacking cores/atari2600/" in err and "Applying stella-av-enable.patch" in err
-    installed = built_cores_dir(isolated) / "stella_libretro.so"
-    assert (locate_core("stella").path, locate_core("stella").origin) == (installed, "built")
+    assert f"Unpacking {recipe.folder}/" in err and f"Applying {core}-av-enable.patch" in err
+    installed = built_cores_dir(isolated) / f"{core}_libretro.so"
+    assert (locate_core(core).path, locate_core(core).origin) == (installed, "built")
     assert locate_core("genesis_plus_gx").origin == "wheel"  # one recipe builds one core
-    record = json.loads((built_cores_dir(isolated) / "stella.build.json").read_text())
-    assert record["patch"] == "stella-av-enable.patch"
+    record = json.loads((built_cores_dir(isolated) / f"{core}.build.json").read_text())
+    assert record["patch"] == f"{core}-av-enable.patch"
     assert main(["cores"]) == 0
-    assert f"Atari2600   stella             yes      built           {installed}" in capsys.readouterr().out
+    row = next(line for line in capsys.readouterr().out.splitlines() if line.startswith(f"{system} "))
+    assert row.split()[1:5] == [core, "yes", "built", str(installed)]
 
 
 def test_a_build_for_another_stable_retro_version_is_not_used(monkeypatch, tmp_path, capsys, isolated) -> None:
@@ -385,7 +389,7 @@ def test_without_a_build_the_wheel_core_is_listed_unpatched_with_the_measured_ga
     hint = build_hint("Genesis")
     assert f"Genesis envs step {genesis.build_speedup:.1f}x faster" in hint and "build-core genesis_plus_gx" in hint
     assert "\n" not in hint
-    assert build_hint("Nes") == "" and build_hint("Sms") == ""  # no recipe; a recipe but no figure measured
+    assert build_hint("PCEngine") == "" and build_hint("Sms") == "" and build_hint("Snes") == ""  # no figure measured
 
 
 def test_no_line_tells_of_the_build_when_the_user_chose_a_core(isolated, monkeypatch) -> None:

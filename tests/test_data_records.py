@@ -16,7 +16,7 @@ import pytest
 
 from retrokit.data import probe
 from retrokit.data.games import find_game
-from retrokit.data.states import read_state
+from retrokit.data.states import compress_state, read_state
 from retrokit.errors import StateError
 
 DASHER = Path(__file__).resolve().parent.parent / "games" / "Dasher-Genesis"
@@ -84,3 +84,32 @@ def test_the_gymnasium_ids_cache_is_not_read_through_a_link(tmp_path: Path, monk
     assert "Dasher-Genesis" in games
     cache = tmp_path / "cache" / "gymnasium-ids.json"
     assert not cache.is_symlink() and b"Dasher-Genesis" in cache.read_bytes()  # the link replaced, not written through
+
+
+def test_a_hang_is_not_kept_as_the_states_verdict(tmp_path: Path, monkeypatch) -> None:
+    """A child that misses its deadline may only have been starved of a CPU: the state is reported as hanging
+    this time, and no verdict is kept, so the next load probes it again (as the core probe does).
+
+    A deadline of a millisecond stands in for a loaded machine: no core runs the probe's frames that fast.
+    """
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path))
+    game = find_game("Dasher-Genesis")
+    (tmp_path / "Unknown.state").write_bytes(compress_state(_unknown_state()))
+    results = probe.probe_files("Genesis", game.require_rom(), game.sha1s[0], {"Unknown": tmp_path / "Unknown.state"},
+                                timeout=0.001)  # fmt: skip
+    assert not results["Unknown"].loaded and "hangs the core" in results["Unknown"].error
+    assert probe._cached(probe.probe_key(_unknown_state(), "Genesis", game.sha1s[0])) is None
+    assert not (tmp_path / "state-probes").exists()
+
+
+def test_only_lasting_verdicts_are_kept(tmp_path: Path, monkeypatch) -> None:
+    """The one rule both probes keep verdicts by: a hang (:attr:`ChildEnd.lasting`) is not kept, a crash is."""
+    from retrokit.host.child import ChildEnd
+    from retrokit.host.verdicts import ProbeVerdict, keep_verdict, kept_verdict
+
+    monkeypatch.setenv("RETROKIT_DATA", str(tmp_path))
+    hung, crashed = ChildEnd(-9, True, "no message"), ChildEnd(-11, False, "no message")
+    keep_verdict("state-probes", "hung", ProbeVerdict(False, "it hangs", lasting=hung.lasting))
+    keep_verdict("state-probes", "crashed", ProbeVerdict(False, "SIGSEGV", lasting=crashed.lasting))
+    assert kept_verdict("state-probes", "hung", "a verdict") is None
+    assert kept_verdict("state-probes", "crashed", "a verdict") == ProbeVerdict(False, "SIGSEGV")

@@ -311,7 +311,7 @@ CASES = [
     pytest.param(
         'rewad: x\n',
         ScenarioError,
-        "{tmp}/s.yaml:1:1: unknown key 'rewad' in a scenario. Did you mean 'reward'? Known keys: name, description, include, tables, define, reward, rewards, done, dones, actions, crop, jump\n"
+        "{tmp}/s.yaml:1:1: unknown key 'rewad' in a scenario. Did you mean 'reward'? Known keys: name, description, include, tables, define, reward, rewards, done, dones, actions, crop, jump, reset_ram\n"
         '    rewad: x\n'
         '    ^^^^^',
         id='unknown_top_key',

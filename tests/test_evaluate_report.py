@@ -57,7 +57,8 @@ def from_episodes(agent: str, wanted: dict[str, tuple[float, float]], init: str 
     episodes = {level: [Episode(1, 4500, 2 * score - final, 4500, 1.0), Episode(2, 4500, final, 950_000, 2.0)]
                 for level, (score, final) in wanted.items()}
     settings = {"benchmark": {"name": "sonic"}, "agent": agent, "seed": 0, "budget": BUDGET, "levels": list(wanted),
-                **({"init": init} if init is not None else {})}
+                # a learning agent's run names its paper row in its setup, "Joint ..." when it starts from a policy
+                **({"agent_setup": {"paper_agent": paper_name(agent, init)}} if init is not None else {})}
     return summarize(settings, {level: FinishedLevel(BUDGET, 2) for level in wanted}, episodes)
 
 

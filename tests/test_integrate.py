@@ -93,7 +93,7 @@ def write_recipe(folder: Path, recipe: str) -> None:
         ("  Zone1.Act1: {press: [START], until: {game_mode: 1}, frames: 60}\n", "found both. Keep one"),
         ("  Zone1.Act1: {press: [START], frames: 0}\n", "expected frames to be a number of frames from 1"),
         ("  Zone1.Act1: {set: {zone: 0}, untill: {game_mode: 1}}\n", "Did you mean 'until'"),
-        ("  Zone1.Act1: {script: '_*20 STRAT*2', frames: 60}\n", r"script's step 2 \('STRAT\*2', column 6\).*'START'"),
+        ("  Zone1.Act1: {script: '_*20 STRAT*2', frames: 60}\n", r"script at line 1, column 6: .*Did you mean 'START'\?\n_\*20 STRAT\*2\n     \^"),
         ("  Zone1.Act1: {script: '_*20 START*2', frames: 20}\n", "expected frames .20, counted from power-on. to cover"),
         ("  Zone1.Act1: {script: [START], frames: 60}\n", "Expected a script of at most"),
     ],

@@ -11,14 +11,14 @@ import pytest
 
 PACKAGE = Path(__file__).resolve().parent.parent / "retrokit"
 # Each layer may import itself and the layers after it, never one before it. "root" is the package's own
-# __init__ (retrokit.make, retrokit.sonic, ...: `import retrokit`); "base" is errors.py, paths.py, lazy.py and wheel.py
+# __init__ (retrokit.make, retrokit.sonic, ...: `import retrokit`); "base" is errors.py, paths.py, datafolder.py, lazy.py and wheel.py
 # (the stable-retro wheel's file list), which every layer uses; "native" is the C host's package.
 LAYERS = [
     "__main__", "cli", "commands", "studio", "root", "retro", "learning", "benchmark", "testing", "ramsearch", "envs", "movie", "dsl", "data",
     "host", "native", "base",
 ]
 _TOP_MODULES = {
-    "__init__": "root", "__main__": "__main__", "cli": "cli", "errors": "base", "paths": "base", "lazy": "base",
+    "__init__": "root", "__main__": "__main__", "cli": "cli", "errors": "base", "paths": "base", "datafolder": "base", "lazy": "base",
     "wheel": "base",
 }
 

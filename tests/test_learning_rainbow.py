@@ -107,6 +107,14 @@ def test_network_replay_and_updates_are_the_papers(tianshou) -> None:
     assert sorted((m.in_features, m.out_features) for m in noisy) == sorted(
         [(3136, 512), (512, 7 * 51), (3136, 512), (512, 51)])
     assert {m.sigma for m in noisy} == {0.5}
+    # the noisy layers are computed factorized, and stay noisy while acting (eval mode): the library's formula
+    layer, x = noisy[0], torch.randn(3, 3136)
+    with torch.no_grad():
+        expected = x @ (layer.mu_W + layer.sigma_W * layer.eps_q.ger(layer.eps_p)).T + layer.mu_bias + layer.sigma_bias * layer.eps_q
+        for mode in (True, False):
+            learner.network.train(mode)
+            assert torch.allclose(layer(x), expected, atol=1e-4)
+        assert not torch.allclose(expected, x @ layer.mu_W.T + layer.mu_bias, atol=1e-4)
     support = learner.policy.support
     assert len(support) == 51 and support[0] == -200 and support[-1] == 200
     algorithm = learner.algorithm

@@ -18,7 +18,11 @@ from typing import Any
 
 import pytest
 from childproc import run_child
+from entrypoints import RUN_CASES, STUDIO_LOAD
 
+ale_py = pytest.importorskip("ale_py")  # Breakout's and Pong's ROMs
+
+from retrokit.cli import main
 from retrokit.data.games import find_game
 from retrokit.data.states import compress_state, read_state_file
 from retrokit.movie import Movie, write_bk2
@@ -27,26 +31,6 @@ from retrokit.movie.model import STATE_DIGEST
 REPO = Path(__file__).resolve().parent.parent
 DASHER_STATE = REPO / "games" / "Dasher-Genesis" / "Zone1.Act1.state"
 AIRSTRIKER = "Airstriker-Genesis"
-
-#: Runs each case (a command line or a snippet) with RETROKIT_DATA of its own, printing one JSON line per case.
-RUN_CASES = """
-import contextlib, io, json, os, traceback
-from retrokit.cli import main
-for name, data, kind, what in CASES:
-    os.environ["RETROKIT_DATA"] = data
-    out, err = io.StringIO(), io.StringIO()
-    answer = {"case": name}
-    try:
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            if kind == "cli":
-                answer["status"] = main(what)
-            else:
-                exec(what, {})
-    except Exception:
-        answer["error"] = traceback.format_exc()
-    answer.update(stdout=out.getvalue(), stderr=err.getvalue())
-    print(json.dumps(answer), flush=True)
-"""
 
 def dasher_data() -> bytes:
     return read_state_file(DASHER_STATE).data
@@ -99,23 +83,11 @@ except StateError as exc:
     print('refused:', exc)
 """
 
-STUDIO_RESET = """
-from retrokit.errors import StateError
-from retrokit.studio import play
-from retrokit.studio.session import Session
-session = Session(GAME)
-try:
-    session.call_blocking(play.reset, 'Foreign')
-    print('loaded')
-except StateError as exc:
-    print('refused:', exc)
-session.close()
-"""
-
 SAVE_AND_LOAD = """
 from pathlib import Path
 
 import retrokit
+from retrokit.cli import main
 from retrokit.data.games import find_game
 from retrokit.data.integrate import place_state
 from retrokit.data.states import compress_state, read_state_file
@@ -140,6 +112,8 @@ print("its own game plays it")
 """
 
 PAIRS = [(AIRSTRIKER, "Dasher-Genesis"), ("Dasher-Genesis", AIRSTRIKER)]
+PONG, BREAKOUT = "Pong-Atari2600", "Breakout-Atari2600"
+BREAKOUT_CASES = ["make", "playback", "integrate", "studio"]
 COMMANDS = ["playback", "integrate"]
 WRAPPINGS = ["the-wheels-file-copied", "recompressed-without-record"]
 
@@ -202,13 +176,36 @@ def cases(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Any]:
         game_copy = shutil.copytree(find_game(host).folders[0], tmp / host)  # a copy of the game, its ROM found by hash
         owners = read_state_file(find_game(owner).state_path()).data
         (game_copy / "Foreign.state").write_bytes(compress_state(owners, None))
-        case(f"studio-{host}", "code", f"GAME = {str(game_copy)!r}\n" + STUDIO_RESET, tmp, game=game_copy)
+        case(f"studio-{host}", "code", f"GAME = {str(game_copy)!r}\nNAME = 'Foreign'\n" + STUDIO_LOAD, tmp, game=game_copy)
 
     for saver, loader in PAIRS:
         tmp = folder_of(f"saved-by-{saver}")
         (tmp / "saved").mkdir()
         code = SAVE_AND_LOAD.format(saver=saver, loader=loader, folder=str(tmp / "saved"))
         case(f"saved-by-{saver}", "code", code, tmp)
+
+    # Pong's wheel state, inflated and compressed again (its file's digest is no wheel file's), into Breakout:
+    # two games retrokit does not ship, whose ROMs come from ale-py as a user's `import --from ale-py` brings them
+    roms = root / "breakout-roms"
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("RETROKIT_DATA", str(roms))
+        assert main(["import", str(Path(ale_py.__file__).parent / "roms" / "breakout.bin")]) == 0
+    pong = read_state_file(find_game(PONG).state_path()).data
+    for entry in BREAKOUT_CASES:
+        tmp = folder_of(f"pong-in-breakout-{entry}")
+        shutil.copytree(roms, tmp / "data")
+        if entry == "make":
+            (tmp / "Start.state").write_bytes(compress_state(pong, None))
+            what: Any = f"STATE = {str(tmp / 'Start.state')!r}\n" + MAKE_FOREIGN.replace("Dasher-Genesis", BREAKOUT)
+        elif entry == "studio":
+            game_copy = shutil.copytree(find_game(BREAKOUT).folders[0], tmp / BREAKOUT)
+            (game_copy / "Foreign.state").write_bytes(compress_state(pong, None))
+            what = f"GAME = {str(game_copy)!r}\nNAME = 'Foreign'\n" + STUDIO_LOAD
+        else:
+            write_bk2(tmp / "m.bk2", Movie(BREAKOUT, "Atari2600", 1, pong, [(0,)] * 30))
+            what = (["playback", str(tmp / "m.bk2"), str(tmp / "out")] if entry == "playback"
+                    else ["integrate", BREAKOUT, "Made", "--out", str(tmp / "made"), "--movie", str(tmp / "m.bk2")])  # fmt: skip
+        case(f"pong-in-breakout-{entry}", "code" if entry in ("make", "studio") else "cli", what, tmp)
 
     child = run_child(f"CASES = {runs!r}\n" + RUN_CASES, timeout=600)
     answers = {answer["case"]: answer for answer in map(json.loads, child.stdout.splitlines()) if answer}
@@ -266,3 +263,15 @@ def test_a_state_this_machine_saved_for_one_game_is_refused_for_another(cases, s
     stdout = printed(cases[f"saved-by-{saver}"]["answer"])
     assert f"found {saver}'s state (this machine saved it for {saver}" in stdout, stdout
     assert "its own game plays it" in stdout, stdout
+
+
+@pytest.mark.parametrize("entry", BREAKOUT_CASES)
+def test_a_rewrapped_state_of_any_wheel_game_is_known_by_its_owner(cases, entry):
+    """Pong's Start.state, compressed again, is Pong's wherever it enters Breakout (issue 42 item 4): every wheel game's
+    states are known by what they hold, not only those of games retrokit integrates."""
+    answer = cases[f"pong-in-breakout-{entry}"]["answer"]
+    said = refused(answer) if entry in ("playback", "integrate") else printed(answer)
+    assert f"expected a state of {BREAKOUT}; found {PONG}'s state (the stable-retro wheel ships it" in said, said
+    assert f"Load it with {PONG}" in said
+    made = cases[f"pong-in-breakout-{entry}"]["folder"] / "made"
+    assert not made.exists() or not list(made.iterdir())

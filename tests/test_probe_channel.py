@@ -217,7 +217,8 @@ def test_a_child_that_failed_before_any_state_leaves_no_verdict(tmp_path: Path, 
     state = bytearray(read_state(SKIPPER / "Level1.state"))
     state[100] ^= 0xFF  # nothing ships or vouches for it
     (tmp_path / "Unknown.state").write_bytes(compress_state(bytes(state)))
-    monkeypatch.setattr(probe, "run_child", lambda *a, **k: ({}, None, "the state loader exited with status 1: x"))
+    failure = probe.ProbeVerdict(False, "the state loader exited with status 1: x")
+    monkeypatch.setattr(probe, "run_child", lambda *a, **k: ({}, None, failure))
     results = probe.probe_files("PCEngine", SKIPPER / "rom.pce", "0" * 40, {"Unknown": tmp_path / "Unknown.state"})
     assert results["Unknown"].error == "the state loader exited with status 1: x" and not results["Unknown"].loaded
     assert not (tmp_path / "data" / "state-probes").exists()

@@ -113,7 +113,7 @@ def test_undo_redo_round_trip_on_the_command_line(session, capsys):
         assert status == 0, err
         counts.append(out.split("-> ")[1].split()[0])
     assert counts[2] == counts[0] and counts[4] == counts[0] and counts[5] == counts[1]
-    assert counts[3] == f"{2_097_072:,}"
+    assert counts[3] == f"{2_490_276:,}"
     status, _, err = run(capsys, "redo")
     assert status == 2 and "redo" in err
 
@@ -136,7 +136,7 @@ def test_undo_redo_round_trip_on_the_command_line(session, capsys):
         (("run", "--movie", "missing.bk2"), "missing.bk2"),
         (("poke", "0xFF002B", "300"), "from 0 to 255"),
         (("show", "--session", "missing.session"), "found no file"),
-        (("show", "--limit", "0"), "Expected at most 100,000 candidates to list; found 2,097,072"),
+        (("show", "--limit", "0"), "Expected at most 100,000 candidates to list; found 2,490,276"),
         (("show", "--json", "--limit", "1000000000"), "Filter them first"),
         (("new", "Dasher-Genesis"), "--force"),
         (("new", "Airstriker-Genesis"), "another game, Dasher-Genesis"),
@@ -335,7 +335,7 @@ def test_the_shell_runs_subcommands_line_by_line(tmp_path, monkeypatch):
         "filter decreased",
         "filter equl 2",
         "filter equal 2 --than 'unclosed",
-        "show --limit 2",
+        "show --limit 3",
         "quit",
         "filter changed",
     ]

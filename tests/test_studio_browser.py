@@ -144,7 +144,7 @@ def test_find_the_lives_with_the_search_and_add_the_field(page, studio):
     page.pause()
     page.reset("Zone1.Act1")
     page.click("search-new")
-    page.said("New search: 2,097,072 candidates.")
+    page.said("New search: 2,490,276 candidates.")
 
     def filter_(op: str, value: str = "") -> str:
         Select(page.el("search-op")).select_by_value(op)
@@ -153,7 +153,7 @@ def test_find_the_lives_with_the_search_and_add_the_field(page, studio):
         page.click("search-apply")
         return page.said(f"{op}")
 
-    assert filter_("equal", "3").startswith("equal 3: 2,097,072 -> ")
+    assert filter_("equal", "3").startswith("equal 3: 2,490,276 -> ")
     page.advance(150, Keys.ARROW_RIGHT)  # into the first pit: a life lost
     assert "decreased --than previous" in filter_("decreased")
     page.advance(130)  # the respawn: the lives stay put
@@ -185,13 +185,47 @@ def test_find_the_lives_with_the_search_and_add_the_field(page, studio):
     page.tab("search")
     page.click("search-undo")
     assert page.said("Undid decreased --than previous: ").endswith(" candidates.")
-    assert page.text("search-count") != "12 candidates"
+    assert page.text("search-count") != "15 candidates"
     page.click("search-redo")
-    page.said("Redid decreased --than previous: 12 candidates.")
+    page.said("Redid decreased --than previous: 15 candidates.")
     page.type("poke-value", "9")
     page.click("poke")
     page.said("Poked 0xFF002B (|u1): it now reads 9.")
     until("9 lives in Watch", lambda: page.field("lives") == "9")
+
+
+def test_find_a_field_with_one_button(page, studio):
+    """Issue 44: Find plays what changes the lives and what keeps them, in turn, until one value is left, and adds it."""
+    page.tab("search")
+    page.pause()
+    page.reset("Zone1.Act1")
+    page.click("search-new")
+    page.said("New search: 2,490,276 candidates.")
+    before = studio.server.request("GET", "/api/status")[1]["frame"]  # the server's: the canvas may lag behind
+    page.type("find-changes", "RIGHT*200")  # into the pit: a life lost
+    Select(page.el("find-kind")).select_by_value("decreases")
+    page.type("find-keeps", "_*130")  # the respawn
+    page.type("find-name", "lives_found")
+    page.el("find-save").click()
+    page.type("field-lo", "0")
+    page.type("field-hi", "9")
+    page.click("find")
+    said = page.said("Found lives_found: 0xFF002B |u1 (one value is left, read 36 ways). Wrote field lives_found "
+                     "(0xFF002B, |u1, range [0, 9]) into ")  # fmt: skip
+    assert said.endswith(f"{studio.game / 'game.yaml'}.")
+    fields = yaml.safe_load((studio.game / "game.yaml").read_text())["fields"]
+    assert fields["lives_found"] == {"address": 0xFF002B, "type": "|u1", "range": [0, 9]}
+    rows = page.driver.find_elements(By.CSS_SELECTOR, "#search-rows tr")
+    assert rows[0].get_attribute("data-address") == "0xFF002B" and rows[0].get_attribute("data-type") == "|u1"
+    assert rows[0].find_elements(By.TAG_NAME, "td")[4].text.split() == ["3", "2", "2", "1", "1", "0"]
+    # three rounds played, the last one's keeps cut short by the find: the screen is where the game now is
+    until("the screen after the find", lambda: page.frame() == before + 3 * 200 + 2 * 130)
+    assert page.el("field-address").get_attribute("value") == "0xFF002B"  # "add as field" is filled too
+    # a mistake is refused before anything plays, with the script's caret
+    page.type("find-changes", "(RIGHT*2")
+    page.click("find")
+    until("the script's error", lambda: "In the script at line 1, column 8: Expected" in page.message())
+    assert studio.server.request("GET", "/api/status")[1]["frame"] == before + 860  # nothing played
 
 
 def test_save_a_state(page, studio):

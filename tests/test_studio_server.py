@@ -98,7 +98,7 @@ def test_info_lists_the_systems_buttons_and_the_default_keys(client):
     assert keys["ArrowRight"] == "RIGHT" and keys["Enter"] == "START"
     assert set(keys.values()) == set(info["buttons"])  # every button has a key
     assert info["gamepad"]["12"] == "UP" and info["gamepad"]["9"] == "START"
-    assert info["ram"] == {"start": 0xFF0000, "length": 256}
+    assert info["ram"] == {"start": 0xFF0000, "length": 256, "digits": 6}
     assert (info["width"], info["height"]) == (320, 224) and 59 < info["frame_rate"] < 61
     assert "Zone1.Act1" in info["states"] and info["speeds"] == [0.25, 8.0]
 

@@ -44,7 +44,7 @@ def studio() -> TestClient:
 def refused(answer) -> str:
     assert answer.status_code == 403, answer.text
     body = answer.json()
-    assert body["kind"] == "AccessDeniedError" and "\n" not in body["error"] and "reward: 0" not in answer.text
+    assert body["kind"] in ("AccessDeniedError", "PlantedLinkError") and "\n" not in body["error"] and "reward: 0" not in answer.text
     return body["error"]
 
 
@@ -94,3 +94,18 @@ def test_a_made_game_yaml_linked_outside_gets_no_default_state(world, monkeypatc
     with studio() as client:
         refused(client.post("/api/states/default", json={"name": "Zone1.Act2"}))
     assert (world["outside"] / "game.yaml").read_bytes() == before
+
+
+@pytest.mark.parametrize("level", ["games", "games/Dasher-Genesis"])
+def test_a_made_game_folder_linked_outside_gets_no_field(world, monkeypatch, level):
+    """Add field on a shipped game writes its game.yaml copy in the data folder: a planted link at the data folder's
+    games/ or at the game's folder there is refused in one line (:func:`retrokit.paths.data_path`), nothing written."""
+    monkeypatch.delenv(paths.GAMES_ENV)
+    link = world["data"] / level
+    link.parent.mkdir(parents=True, exist_ok=True)
+    link.symlink_to(world["outside"], target_is_directory=True)
+    with studio() as client:
+        error = refused(client.post("/api/search/field", json={"name": "planted", "address": 0xFF0100, "type": "|u1"}))
+    assert f"'{link}'" in error and "found a symlink" in error
+    assert sorted(p.name for p in world["outside"].rglob("*")) == ["secret.yaml"]
+    assert (world["outside"] / "secret.yaml").read_text() == SECRET

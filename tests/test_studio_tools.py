@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import re
 
+import pytest
 import studioclient
 from studioclient import LIVES, P1_X, PORT, TOKEN, fields, ok, refused, step
 
@@ -77,7 +78,47 @@ def test_a_search_takes_at_most_64_snapshots(client):
         ok(client.post("/api/search/snapshot"))
     full = refused(client.post("/api/search/snapshot"))
     assert "at most 64 snapshots" in full["error"] and full["kind"] == "RamSearchError"
+    no_room = refused(client.post("/api/search/find", json={"changes": "RIGHT", "keeps": "_"}))
+    assert "Expected room for two snapshots a round; this search has 64 of its 64" in no_room["error"]
     assert len(ok(client.post("/api/search/new"))["snapshots"]) == 1
+
+
+def test_find_plays_scripts_with_repeats_and_finds_the_lives(client, game):
+    """The studio's scripts are the one script language: repeats, as ramsearch and state recipes take them."""
+    ok(client.post("/api/search/new"))
+    frame = ok(client.get("/api/status"))["frame"]
+    found = ok(client.post("/api/search/find", json={
+        "changes": "(RIGHT*100)*2", "keeps": "(_*65)*2", "kind": "decreases", "name": "lives_again", "save": True}))
+    assert found["found"] and (found["rows"][0]["address"], found["rows"][0]["type"]) == (LIVES, "|u1")
+    assert found["steps"][0].startswith("script (RIGHT*100)*2 (200 frames); decreased --than previous: ")
+    assert found["field"]["name"] == "lives_again" and "lives_again:" in game.read_text()
+    assert ok(client.get("/api/status"))["frame"] == frame + found["frames"] == frame + 3 * 200 + 2 * 130
+
+
+@pytest.mark.parametrize(
+    ("body", "message"),
+    [
+        ({"keeps": "_*5"}, "Expected 'changes' in the request's JSON object"),
+        ({"changes": ["RIGHT"], "keeps": "_*5"}, "Expected 'changes' to be a string"),
+        ({"changes": "RIGHT*5", "keeps": "_*5", "kind": "becomes"}, "Expected a number with 'becomes'"),
+        ({"changes": "RIGHT*5", "keeps": "_*5", "kind": "decrease"}, "Did you mean 'decreases'?"),
+        ({"changes": "RIGHT*5", "keeps": "_*5", "kind": "becomes", "value": "x"}, "the number it becomes"),
+        ({"changes": "RIGHT*5", "keeps": "((A*9999)*99999)*99999"}, "at most 1,000,000 frames"),
+        ({"changes": "RIGHT*30000", "keeps": "_*6001"}, "at most 36,000 frames together in the studio; got 36,001"),
+        ({"changes": "(RIGHT*2", "keeps": "_*5"}, "In the script at line 1, column 8: Expected"),
+        ({"changes": "RIHGT", "keeps": "_*5"}, "Did you mean 'RIGHT'?"),
+        ({"changes": "RIGHT*5", "keeps": "_*5", "save": True}, "Expected 'name' in the request's JSON object"),
+        ({"changes": "RIGHT*5", "keeps": "_*5", "save": True, "name": "2lives"}, "field name"),
+    ],
+    ids=["no-changes", "changes-not-text", "becomes-no-number", "kind-typo", "number-not-a-number", "hostile-script",
+         "over-the-studio-budget", "script-syntax", "button-typo", "save-without-name", "bad-name"],
+)  # fmt: skip
+def test_find_refuses_a_bad_request_before_the_game_moves(client, body, message):
+    ok(client.post("/api/search/new"))
+    frame = ok(client.get("/api/status"))["frame"]
+    answer = client.post("/api/search/find", json=body)
+    assert answer.status_code == 400 and message in answer.json()["error"], answer.text
+    assert ok(client.get("/api/status"))["frame"] == frame and len(ok(client.get("/api/search"))["snapshots"]) == 1
 
 
 def test_the_longest_listing_stays_in_bounded_memory(game):

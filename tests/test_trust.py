@@ -243,7 +243,7 @@ def test_validate_spares_only_states_this_machine_vouches_for_the_run_under_inpu
 
     def run_child(system, rom, todo, **kwargs):
         asked.update({name: input_frames for name, _, _, input_frames in todo})
-        return {}, None, "stopped"
+        return {}, None, probe.ProbeVerdict(False, "stopped")
 
     monkeypatch.setattr(probe, "run_child", run_child)
     states.probe_states(game, list(files), game.require_rom(), files=files)
@@ -335,7 +335,7 @@ def test_the_wheels_state_hashes_are_current() -> None:
     """The list that knows the wheel's states by what they hold (Airstriker's, Sonic's) matches the wheel installed."""
     games = REPO / "games"
     listed = (games / WHEEL_STATE_HASHES).read_text()
-    assert listed == wheel_state_hashes(games), (
+    assert listed == wheel_state_hashes(), (
         "games/WHEEL-STATES.sha256 is out of date: run python -m retrokit.data.shipped"
     )
     assert "stable/Airstriker-Genesis-v0/Level1.state" in listed

@@ -34,11 +34,11 @@ def test_a_million_envs_are_refused_at_once_without_building_any() -> None:
         """
         import time, retrokit
         from retrokit.errors import InvalidArgumentError
-        start = time.monotonic()
+        start = time.process_time()  # its own CPU: the waits of a loaded machine do not count
         try:
             retrokit.make_vec("Airstriker-Genesis", 10**6)
         except InvalidArgumentError as exc:
-            print("refused", round(time.monotonic() - start, 3), exc)
+            print("refused", round(time.process_time() - start, 3), exc)
         """,
         timeout=60,
     )

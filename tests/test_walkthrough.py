@@ -17,7 +17,10 @@ import json
 from pathlib import Path
 
 import pytest
-from walkthrough import GALAXIAN, RUNNER, SHOWN_DATA, Step, Walkthrough
+import yaml
+from walkthrough import GALAXIAN, NES, RUNNER, SHOWN_DATA, Step, Walkthrough
+
+from retrokit.data.games import find_game
 
 
 @pytest.fixture
@@ -33,7 +36,7 @@ def folders(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> tuple[Path, Path
     return work, data
 
 
-def run_as_written(text: Walkthrough, work: Path, data: Path, capsys) -> list[Step]:
+def as_written(text: Walkthrough, work: Path, data: Path, capsys) -> list[Step]:
     """Run the walkthrough; check every command printed what the text shows, and every file shown is as written."""
     steps = list(text.run(work, data, capsys))
     wrong = [
@@ -42,6 +45,16 @@ def run_as_written(text: Walkthrough, work: Path, data: Path, capsys) -> list[St
         if not s.matches()
     ]
     assert not wrong, "\n\n".join(wrong)
+    shown = text.written()
+    assert len(shown) == 1
+    for path, content in shown:
+        assert Path(path.replace(SHOWN_DATA, str(data))).read_text(encoding="utf-8").strip() == content.strip()
+    return steps
+
+
+def run_as_written(text: Walkthrough, work: Path, data: Path, capsys) -> list[Step]:
+    """:func:`as_written`, and what the Genesis and Atari walkthroughs have in common (issue 21's loop by hand)."""
+    steps = as_written(text, work, data, capsys)
     commands = [s.command.split()[1] for s in steps]
     for command in ("import", "new", "ramsearch", "validate", "evaluate"):
         assert command in commands
@@ -51,10 +64,6 @@ def run_as_written(text: Walkthrough, work: Path, data: Path, capsys) -> list[St
     assert sum("--range" in line for line in lines if line.startswith("retrokit ramsearch save ")) == 2
     assert [c for c in lines if c.startswith("retrokit evaluate") and c.count("--agent") == 2]
     assert (work / "runs" / "report.md").is_file()
-    shown = text.written()
-    assert len(shown) == 1
-    for path, content in shown:
-        assert Path(path.replace(SHOWN_DATA, str(data))).read_text(encoding="utf-8").strip() == content.strip()
     return steps
 
 
@@ -93,6 +102,27 @@ def test_galaxian_atari2600_runs_as_written(folders, capsys) -> None:
     }
     assert {e["steps"] for e in episodes["jerk"]} == {80} and max(e["reward"] for e in episodes["jerk"]) == 30
     assert [(e["steps"], e["reward"]) for e in episodes["random"]] == [(200, 410), (200, 310)]
+
+
+def test_nes_in_under_25_commands_runs_as_written(folders, capsys) -> None:
+    """Issue 44: a new NES game from a bare ROM to evaluate, the fields found by `ramsearch find`, the benchmark written."""
+    work, data = folders
+    lines = [s.command for s in as_written(NES, work, data, capsys)]
+    assert len(lines) < 25 and f"commands: {len(lines)}." in NES.section()[1]  # the count the text gives
+    assert lines[:2] == ["retrokit import jumper.nes", "retrokit new jumper.nes --name Jumper-Nes"]
+    finds = [line for line in lines if line.startswith("retrokit ramsearch find ")]
+    assert len(finds) == 2 and all("--save --range" in line for line in finds)
+    assert not [line for line in lines if line.startswith(("retrokit ramsearch filter", "retrokit ramsearch save "))]
+    assert "retrokit benchmark new Jumper-Nes --budget 500 --max-episode-steps 300" in lines
+    assert lines[-1].startswith("retrokit evaluate --benchmark jumper-nes.yaml --agent jerk --agent random")
+    assert NES.by_hand() == ["# file: ~/.local/share/retrokit/games/Jumper-Nes/scenario.yaml"]  # all else: commands
+    # the fields found are the cartridge's own, which its game.yaml names (the walk never reads it)
+    hopper = find_game("Hopper-Nes").fields
+    found = yaml.safe_load((data / "games" / "Jumper-Nes" / "game.yaml").read_text())["fields"]
+    assert (found["lives"]["address"], found["x"]["address"]) == (hopper["p1_lives"].address, hopper["p1_x"].address)
+    assert (found["lives"]["type"], found["x"]["type"]) == (hopper["p1_lives"].type, hopper["p1_x"].type)
+    episodes = [json.loads(line) for line in (work / "runs" / "jerk" / "episodes.jsonl").read_text().splitlines()]
+    assert episodes and all(e["level"] == "Jumper-Nes/Level1" for e in episodes)
 
 
 def test_each_walkthrough_ends_where_the_next_section_starts() -> None:

@@ -1,8 +1,8 @@
 """Running a walkthrough of the docs (a section of commands and their output) as written.
 
-docs/integrate.md has two: "Your own game, from a ROM" (a header-patched
-Dasher on the Genesis) and "An Atari 2600 game, from ale-py's ROMs"
-(Galaxian). A walkthrough's blocks run in order in one working folder, with a
+docs/integrate.md has three: "Your own game, from a ROM" (a header-patched
+Dasher on the Genesis), "An Atari 2600 game, from ale-py's ROMs"
+(Galaxian) and "An NES game, in under 25 commands" (a title-patched Hopper). A walkthrough's blocks run in order in one working folder, with a
 fresh data folder shown in the text as ``~/.local/share/retrokit``:
 
 - a ``python`` block is executed (it makes or copies the ROM);
@@ -139,3 +139,4 @@ def commands(console: str) -> Iterator[tuple[int, str, str]]:
 INTEGRATE = REPO / "docs" / "integrate.md"
 RUNNER = Walkthrough(INTEGRATE, "## Your own game, from a ROM")
 GALAXIAN = Walkthrough(INTEGRATE, "## An Atari 2600 game, from ale-py's ROMs")
+NES = Walkthrough(INTEGRATE, "## An NES game, in under 25 commands")

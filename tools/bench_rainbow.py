@@ -120,17 +120,20 @@ def main() -> None:
     parser.add_argument("--rllib", action="store_true", help="also RLlib's DQN with the Rainbow settings")
     args = parser.parse_args()
     torch.manual_seed(0)
-    print(f"{os.cpu_count()} CPUs, load {os.getloadavg()[0]:.1f}, torch threads {torch.get_num_threads()}")
+    print(f"{os.cpu_count()} CPUs, load {os.getloadavg()[0]:.1f}, torch threads {torch.get_num_threads()}", flush=True)
     base = bench_env(args.steps)
-    rows = [("env (random actions)", base),
-            ("tianshou acting", bench_tianshou(args.steps, learn=False)),
-            ("tianshou learning", bench_tianshou(args.steps, learn=True))]
+
+    def show(name: str, value: float) -> None:  # as each phase ends: a long RLlib phase keeps what came before
+        print(f"{name:24s} {value:8.1f} steps/s  {value / base:6.3f} x the env", flush=True)
+
+    show("env (random actions)", base)
+    show("tianshou acting", bench_tianshou(args.steps, learn=False))
+    show("tianshou learning", bench_tianshou(args.steps, learn=True))
     if args.rllib:
         os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
         sampling, learning = bench_rllib(args.steps)
-        rows += [("rllib acting", sampling), ("rllib learning", learning)]
-    for name, value in rows:
-        print(f"{name:24s} {value:8.1f} steps/s  {value / base:6.3f} x the env")
+        show("rllib acting", sampling)
+        show("rllib learning", learning)
     print(f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB, load {os.getloadavg()[0]:.1f}")
 
 

@@ -3,7 +3,7 @@
 
 Takes two real snapshots of Dasher's 64 KiB of work RAM (its first act, then
 60 frames of running right), and times single filters on a fresh search,
-where every position of all 32 types is still a candidate: the worst case. A
+where every position of all 38 types is still a candidate: the worst case. A
 filter's time includes decoding both snapshots as every type, as the first
 filter of a `retrokit ramsearch filter` process does. The baseline, measured
 in the same run, is one numpy comparison of two int64 arrays of 64 Ki values

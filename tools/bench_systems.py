@@ -3,7 +3,9 @@
 For each cartridge of tools/cartridges.yaml (and Airstriker-Genesis, the wheel's free ROM), in one run:
 retrokit's env (``retrokit.make``, RGB observations, frame skip 1 and 4) and stable-retro's env on an
 integration of the same game (tests/stable_retro_game.py writes it), the same random button sets held
-for 6 steps. It prints steps/s and retrokit's ratio to stable-retro's; docs/systems.md quotes the figures.
+for 6 steps. It prints steps/s and retrokit's ratio to stable-retro's, and the machine's load average before
+and after (the rates are the load's; the ratios, from the same run, carry over); docs/systems.md quotes the figures.
+The env runs whichever core retrokit finds: one ``retrokit build-core`` made, if there is one (it says which).
 
     python tools/bench_systems.py [--steps 3000] [--games Dasher-Genesis,...]
 """
@@ -11,6 +13,7 @@ for 6 steps. It prints steps/s and retrokit's ratio to stable-retro's; docs/syst
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import tempfile
 import time
@@ -26,6 +29,13 @@ from stable_retro_game import pressed, wandering, write_integration
 
 import retrokit
 from retrokit.data.games import find_game
+from retrokit.host.cores import locate_core
+
+
+def load() -> str:
+    """The machine's load average, which the rates depend on."""
+    one, five, fifteen = os.getloadavg()
+    return f"load average {one:.2f}, {five:.2f}, {fifteen:.2f} ({os.cpu_count()} CPUs)"
 
 
 def rate(env, steps: int, buttons: list, source, frameskip: int) -> float:
@@ -50,6 +60,7 @@ def main() -> None:
     args = parser.parse_args()
     root = Path(tempfile.mkdtemp(prefix="bench-systems-"))
     stable_retro.data.Integrations.add_custom_path(str(root))
+    print(load())
     print(f"{'game':<24} {'system':<10} {'screen':>8}  {'ours fs1':>9} {'theirs':>8} {'ratio':>6}  {'ours fs4':>9} {'theirs':>8} {'ratio':>6}")
     for name in args.games.split(","):
         game = find_game(name)
@@ -71,8 +82,10 @@ def main() -> None:
             theirs.close()
             row.append((mine, other))
         (a1, b1), (a4, b4) = row
+        found = locate_core(game.system.core)
         print(f"{name:<24} {game.system.name:<10} {f'{width}x{height}':>8}  {a1:>9,.0f} {b1:>8,.0f} {a1 / b1:>5.2f}x"
-              f"  {a4:>9,.0f} {b4:>8,.0f} {a4 / b4:>5.2f}x")
+              f"  {a4:>9,.0f} {b4:>8,.0f} {a4 / b4:>5.2f}x  ({found.origin} {game.system.core})")
+    print(load())
 
 
 if __name__ == "__main__":

@@ -171,6 +171,15 @@ def mean_curve(episodes: dict[str, list[Episode]], budget: int, points: int = CU
     return {"timesteps": steps, "score": scores}
 
 
+def paper_agent(settings: dict[str, Any]) -> str | None:
+    """The paper's row a run's agent stands beside: a built-in learning agent's setup names it (PPO from scratch,
+    Joint PPO from a trained policy, none when it plays zero-shot); any other agent goes by its name."""
+    setup = settings.get("agent_setup")
+    if isinstance(setup, dict):
+        return setup.get("paper_agent")
+    return paper_name(settings["agent"])
+
+
 def summarize(settings: dict[str, Any], finished: dict[str, FinishedLevel],
               episodes: dict[str, list[Episode]]) -> Summary:
     """The summary of the finished levels, in the order the run names them."""
@@ -184,6 +193,5 @@ def summarize(settings: dict[str, Any], finished: dict[str, FinishedLevel],
         benchmark=settings["benchmark"]["name"], agent=settings["agent"], seed=settings["seed"],
         budget=settings["budget"], complete=len(levels) == len(settings["levels"]), levels=levels,
         aggregate=aggregate(levels), notes=notes, final_aggregate=final_aggregate(levels),
-        # "init": the trained policy a learning agent starts from, when the run's settings name one.
-        paper_agent=paper_name(settings["agent"], settings.get("init")), curve=curve,
+        paper_agent=paper_agent(settings), curve=curve,
     )

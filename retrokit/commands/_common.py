@@ -31,13 +31,15 @@ def add_data_dir_option(parser) -> None:  # an argparse parser
     )
 
 
-def add_force_option(parser, help: str) -> None:  # an argparse parser
+def add_force_option(parser, help: str, *, said_overwrite: bool = True) -> None:  # an argparse parser
     """Add ``--force``, the one word of every command for "replace what is there" (into ``args.force``).
 
-    ``--overwrite``, the word some commands used before, still works as a hidden alias, so scripts keep running.
+    ``--overwrite``, the word the older commands (``said_overwrite``) used before, still works on them as a hidden
+    alias, so scripts keep running; a command born after the change has no old scripts to keep, so no alias.
     """
     parser.add_argument("--force", action="store_true", help=help)
-    parser.add_argument("--overwrite", dest="force", action="store_true", help=argparse.SUPPRESS)
+    if said_overwrite:
+        parser.add_argument("--overwrite", dest="force", action="store_true", help=argparse.SUPPRESS)
 
 
 def add_evaluation_options(parser, workers_help: str) -> None:  # an argparse parser

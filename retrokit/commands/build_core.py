@@ -17,9 +17,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "wheel's (the data folder is $RETROKIT_DATA, else $XDG_DATA_HOME/retrokit, else ~/.local/share/retrokit). "
         "Needs a C compiler (cc, or $CC; stella needs a C++ one too), make, and network access to the package "
         "index. The patched genesis_plus_gx skips drawing the frames an env does not show, and their sound; the "
-        "patched stella skips converting them (retrokit docs cores).",
+        "patched stella skips converting them; the patched gambatte skips making and resampling the sound nobody "
+        "hears; the patched snes9x and mednafen_pce_fast draw no unseen frame and the patched fceumm converts none "
+        "(retrokit docs cores).",
     )
-    parser.add_argument("core", metavar="CORE", help="the core to build: genesis_plus_gx or stella")
+    parser.add_argument("core", metavar="CORE", help="the core to build: genesis_plus_gx, stella, gambatte, snes9x, fceumm or mednafen_pce_fast")
     parser.add_argument("--stable-retro", metavar="VERSION", dest="version",
                         help="build from this stable-retro version's source (default: the installed one; "
                         "retrokit uses a built core only while it matches the installed version)")
@@ -82,4 +84,5 @@ EXAMPLES = [
     "retrokit build-core genesis_plus_gx --sdist stable_retro-1.0.1.tar.gz   # from a downloaded sdist, offline",
     "retrokit build-core genesis_plus_gx --index-url https://pypi.example.org/simple --force",
     "retrokit build-core stella                          # the Atari 2600's core, which skips converting unseen frames",
+    "retrokit build-core gambatte                        # the Game Boy's core, which skips the sound nobody hears",
 ]

@@ -13,6 +13,9 @@ thing and writes it back. See ``docs/ramsearch.md``::
     retrokit ramsearch poke ADDRESS VALUE [--type TYPE] [--session FILE]
     retrokit ramsearch screenshot FILE.png [--session FILE]
     retrokit ramsearch save NAME ADDRESS TYPE [--range LO HI] [--game-file PATH] [--session FILE]
+    retrokit ramsearch find NAME --changes SCRIPT --keeps SCRIPT [--kind increases|decreases|changes|becomes N]
+                            [--save [--range LO HI] [--game-file PATH] [--force]] [--rounds N] [--session FILE]
+    retrokit ramsearch suggest --at FRAME [--at FRAME ...] (--script SCRIPT | --movie FILE.bk2) [--window N] [--limit N]
     retrokit ramsearch savestate NAME [--default] [--force] [--session FILE]
     retrokit ramsearch movie FILE.bk2 [--force] [--session FILE]
     retrokit ramsearch shell [--session FILE]       # the others typed at a prompt, one a line
@@ -25,16 +28,19 @@ from __future__ import annotations
 
 import argparse
 import json
-from typing import TYPE_CHECKING
 
 from retrokit.commands._common import add_force_option
+from retrokit.commands._ramsearch_common import (
+    SESSION_HELP,
+    VALUES_SHOWN,
+    number,
+    open_search,
+    print_groups,
+    save_field_from,
+    session_path,
+)
+from retrokit.commands._ramsearch_loops import register_loops
 from retrokit.errors import InvalidArgumentError
-
-if TYPE_CHECKING:
-    from retrokit.ramsearch import Candidate, RamSearch
-
-_SESSION_HELP = "the session file (default: ramsearch.session in the current folder)"
-_VALUES_SHOWN = 8  # snapshots whose values `show` prints; older ones are elided
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
@@ -47,13 +53,14 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="find a game's variables in RAM (snapshots, filters, undo) and save them into its game.yaml",
         description="A RAM search in the spirit of BizHawk's RAM Search and Gym Retro's integration tool. Start "
         "with 'new', move the game with 'run', narrow the candidates with 'filter', look with 'show', and write "
-        "a find into the game's game.yaml with 'save'. The search is kept in a session file between commands.",
+        "a find into the game's game.yaml with 'save'; or let 'find' play and filter until one value is left, and "
+        "'suggest' rank the bytes that change at an event. The search is kept in a session file between commands.",
     )
     commands = parser.add_subparsers(title="subcommands", metavar="SUBCOMMAND")
 
     def sub(name: str, help_text: str, run) -> argparse.ArgumentParser:
         p = commands.add_parser(name, help=help_text, description=help_text[0].upper() + help_text[1:] + ".")
-        p.add_argument("--session", metavar="FILE", default=None, help=_SESSION_HELP)
+        p.add_argument("--session", metavar="FILE", default=None, help=SESSION_HELP)
         p.set_defaults(run=run)
         return p
 
@@ -61,7 +68,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p.add_argument("game", metavar="GAME", help="the game, e.g. Dasher-Genesis")
     p.add_argument("--state", help="the save state to start from (default: the game's default state)")
     p.add_argument(
-        "--types", metavar="CODES", help="comma-separated type codes to search (default: every type Gym Retro infers)"
+        "--types", metavar="CODES",
+        help="comma-separated type codes to search, or bits (default: every type Gym Retro infers, and the "
+        "3-byte ones: <u3 >u3 <i3 >i3 <d3 >d3)",
     )
     p.add_argument("--force", action="store_true", help="replace an existing session file")
 
@@ -120,6 +129,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "--range", nargs=2, metavar=("LO", "HI"), help="the values the field may hold, written as range: [LO, HI]"
     )
 
+    register_loops(sub)
+
     p = sub("savestate", "save the game's state now as a state of the game, in the data folder", _savestate)
     p.add_argument("name", metavar="NAME", help="the state's name, e.g. Level1")
     p.add_argument("--default", action="store_true", help="make it the state make(game) starts from")
@@ -132,8 +143,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 SUBCOMMANDS = (
-    "new", "run", "filter", "show", "history", "undo", "redo", "poke", "screenshot", "save", "savestate", "movie",
-    "shell",
+    "new", "run", "filter", "show", "history", "undo", "redo", "poke", "screenshot", "save", "find", "suggest",
+    "savestate", "movie", "shell",
 )  # fmt: skip
 
 
@@ -144,32 +155,6 @@ def run(args: argparse.Namespace) -> int:
     )
 
 
-# --- helpers --------------------------------------------------------------------------------------
-
-
-def _number(text: str | None, what: str) -> int | None:
-    if text is None:
-        return None
-    try:
-        return int(text, 0)
-    except ValueError:
-        raise InvalidArgumentError(
-            f"Expected {what} as a whole number (decimal, or hex as 0xFF002B), got {text!r}."
-        ) from None
-
-
-def _session(args: argparse.Namespace) -> str:
-    from retrokit.ramsearch import DEFAULT_SESSION
-
-    return args.session or DEFAULT_SESSION
-
-
-def _open(args: argparse.Namespace) -> RamSearch:
-    from retrokit.ramsearch import RamSearch
-
-    return RamSearch.load(_session(args))
-
-
 # --- subcommands ----------------------------------------------------------------------------------
 
 
@@ -178,7 +163,7 @@ def _new(args: argparse.Namespace) -> int:
     from retrokit.ramsearch import RamSearch
     from retrokit.ramsearch.session import check_new_session
 
-    path = _session(args)
+    path = session_path(args)
     game = find_game(args.game)
     check_new_session(path, game.name, force=args.force)
     with RamSearch(game, args.state, types=args.types) as search:
@@ -191,7 +176,7 @@ def _new(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    frames, until = _number(args.frames, "--frames"), _number(args.until, "--until")
+    frames, until = number(args.frames, "--frames"), number(args.until, "--until")
     if args.movie is None and until is not None:
         raise InvalidArgumentError("Expected --until with --movie FILE.bk2; got --until alone.")
     if args.movie is not None and (args.press or frames is not None or args.state or args.script is not None):
@@ -203,14 +188,14 @@ def _run(args: argparse.Namespace) -> int:
             "Expected either --script or --press/--frames, not both: a script holds its own buttons, e.g. RIGHT*30."
         )
     snapshot = not args.no_snapshot
-    with _open(args) as search:
+    with open_search(args) as search:
         if args.movie is not None:
             index = search.play(args.movie, until, snapshot=snapshot)
         elif args.script is not None:
             index = search.run_script(args.script, state=args.state, snapshot=snapshot)
         else:
             index = search.run(args.press, 1 if frames is None else frames, state=args.state, snapshot=snapshot)
-        search.save(_session(args))
+        search.save(session_path(args))
         if index is None:
             frames_played = sum(count for count, _ in search.inputs)
             print(f"Moved on, no snapshot taken ({frames_played} frames played since the start state).")
@@ -226,36 +211,21 @@ def _filter(args: argparse.Namespace) -> int:
             than = int(than, 16)
         except ValueError:
             pass  # the engine names what --than takes, and the closest one
-    with _open(args) as search:
+    with open_search(args) as search:
         before = search.count
-        after = search.filter(args.op, _number(args.value, "VALUE"), than)
-        search.save(_session(args))
+        after = search.filter(args.op, number(args.value, "VALUE"), than)
+        search.save(session_path(args))
         print(f"{search.history[-1]}: {before:,} -> {after:,} candidates.")
     return 0
-
-
-def _rows(search: RamSearch, groups: list[list[Candidate]]) -> list[list[str]]:
-    """One row per group of candidates that read the same bytes the same way (the narrowest type first)."""
-    first = max(0, len(search.labels) - _VALUES_SHOWN)
-    rows = []
-    for group in groups:
-        head = group[0]
-        shown = ("... " if first else "") + " ".join(str(v) for v in head.values[first:])
-        others = [
-            c.type if c.address == head.address else f"{c.type}@{search.layout.format(c.address)}" for c in group[1:]
-        ]
-        also = f"  (also {' '.join(others)})" if others else ""
-        rows.append([search.layout.format(head.address), head.type, head.scale or "-", str(head.changes), shown + also])
-    return rows
 
 
 def _show(args: argparse.Namespace) -> int:
     from retrokit.ramsearch.candidates import check_listable, list_groups
 
-    limit = _number(args.limit, "--limit")
+    limit = number(args.limit, "--limit")
     if limit is None or limit < 0:
         raise InvalidArgumentError(f"Expected --limit of 0 (all) or more, got {args.limit!r}.")
-    with _open(args) as search:
+    with open_search(args) as search:
         if args.json:
             check_listable(search.count, limit)
             candidates = search.candidates(limit or None)
@@ -274,18 +244,14 @@ def _show(args: argparse.Namespace) -> int:
         )
         if not shown:
             return 0
-        first = max(0, len(search.labels) - _VALUES_SHOWN)
-        header = ["address", "type", "scale", "changes", f"values at snapshots {first}-{len(search.labels) - 1}"]
-        rows = [header, *_rows(search, shown)]
-        widths = [max(len(r[i]) for r in rows) for i in range(4)]
-        for row in rows:
-            print("  ".join(cell.ljust(width) for cell, width in zip(row[:4], widths)) + "  " + row[4])
+        print_groups(search, shown)
+        first = max(0, len(search.labels) - VALUES_SHOWN)
         print("snapshots: " + "; ".join(f"{i} {label}" for i, label in enumerate(search.labels) if i >= first))
     return 0
 
 
 def _history(args: argparse.Namespace) -> int:
-    with _open(args) as search:
+    with open_search(args) as search:
         print(f"{len(search.labels)} snapshot{'s' * (len(search.labels) != 1)} (--than N compares with snapshot N):")
         for index, label in enumerate(search.labels):
             print(f"  {index}  {label}")
@@ -306,25 +272,25 @@ def _redo(args: argparse.Namespace) -> int:
 
 
 def _step_history(args: argparse.Namespace, *, redo: bool) -> int:
-    with _open(args) as search:
+    with open_search(args) as search:
         before = search.count
         label = search.redo() if redo else search.undo()
-        search.save(_session(args))
+        search.save(session_path(args))
         print(f"{'Redid' if redo else 'Undid'} {label}: {before:,} -> {search.count:,} candidates.")
     return 0
 
 
 def _poke(args: argparse.Namespace) -> int:
-    address, value = _number(args.address, "ADDRESS"), _number(args.value, "VALUE")
-    with _open(args) as search:
+    address, value = number(args.address, "ADDRESS"), number(args.value, "VALUE")
+    with open_search(args) as search:
         search.poke(address, value, args.type)
-        search.save(_session(args))
+        search.save(session_path(args))
         print(f"Wrote {value} as {args.type} at {search.layout.format(address)}; the next run starts from it.")
     return 0
 
 
 def _screenshot(args: argparse.Namespace) -> int:
-    with _open(args) as search:
+    with open_search(args) as search:
         path = search.screenshot(args.file, overwrite=args.force)
         height, width = search.emulator.screen_shape()
         print(f"Saved the screen ({width}x{height}) to {path}.")
@@ -370,19 +336,13 @@ def _shell(args: argparse.Namespace) -> int:
 
 
 def _save(args: argparse.Namespace) -> int:
-    address = _number(args.address, "ADDRESS")
-    value_range = None if args.range is None else tuple(_number(v, "--range") for v in args.range)
-    with _open(args) as search:
-        path = search.save_field(
-            args.name, address, args.type, game_file=args.game_file, force=args.force, value_range=value_range
-        )
-        extra = "" if value_range is None else f", range [{value_range[0]}, {value_range[1]}]"
-        print(f"Wrote field {args.name} ({search.layout.format(address)}, {args.type}{extra}) into {path}.")
+    with open_search(args) as search:
+        save_field_from(args, search, number(args.address, "ADDRESS"), args.type)
     return 0
 
 
 def _savestate(args: argparse.Namespace) -> int:
-    with _open(args) as search:
+    with open_search(args) as search:
         outcome = search.save_state(args.name, default=args.default, force=args.force)
         done = {"made": "Saved", "replaced": "Replaced", "up to date": "Kept (already the same state)"}[outcome.status]
         print(f"{done} state {args.name} of {search.game.name}: {outcome.path}.")
@@ -392,7 +352,7 @@ def _savestate(args: argparse.Namespace) -> int:
 
 
 def _movie(args: argparse.Namespace) -> int:
-    with _open(args) as search:
+    with open_search(args) as search:
         path = search.write_movie(args.file, overwrite=args.force)
         frames = sum(count for count, _ in search.inputs)
         print(f"Wrote {frames} frames played since the start state to {path}.")
@@ -421,6 +381,10 @@ EXAMPLES = [
     "retrokit ramsearch screenshot poked.png",
     "retrokit ramsearch save lives 0xFF002B '|u1'",
     "retrokit ramsearch save lives 0xFF002B '|u1' --range 0 9",
+    "retrokit ramsearch find lives --changes 'RIGHT*200' --keeps '_*130' --kind decreases --save --range 0 9",
+    "retrokit ramsearch find score --changes '(RIGHT*10 A*2)*5' --keeps '_*30' --kind increases",
+    "retrokit ramsearch suggest --script 'RIGHT*400' --at 133 --at 331   # bytes changing as the player dies",
+    "retrokit ramsearch suggest --movie level1.bk2 --at 1520 --window 0",
     "retrokit ramsearch savestate Level1 --default",
     "retrokit ramsearch movie level1.bk2",
     "retrokit ramsearch shell --session dasher.session",

@@ -18,7 +18,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "Prints one table per game and a summary; exits with status 1 if any check failed.",
     )
     parser.add_argument("games", nargs="*", metavar="GAME",
-                        help="game names or game folders (default: the game.yaml folder in the current directory)")
+                        help="game names or game folders (default: the game.yaml folder in the current directory), "
+                        "or benchmark files (FILE.yaml: its shape, levels and ROMs, and every level's env starting)")
     parser.add_argument("--all", action="store_true",
                         help="every game retrokit ships or you made: each game `retrokit games` lists whose first "
                         "folder is not the stable-retro wheel's (the repository's games/, RETROKIT_GAMES' folders "
@@ -61,6 +62,13 @@ def run(args: argparse.Namespace) -> int:
                 "Example: retrokit validate Dasher-Genesis"
             )
         targets = ["."]
+    from retrokit.benchmark.making import is_benchmark_file
+
+    benchmarks = [t for t in targets if is_benchmark_file(t)]
+    targets = [t for t in targets if t not in benchmarks]
+    checked = [_check_benchmark_file(path) for path in benchmarks]
+    if not targets:
+        return 0 if all(checked) else 1
     reports: list[GameReport] = []
     # A bar redraws in place, which only a terminal shows: in a pipe or a log, one line per stage instead.
     bars = is_terminal()
@@ -89,7 +97,26 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         write_json(args.json, reports)
         print(f"wrote every result to {args.json}")
-    return 0 if all(r.passed for r in reports) else 1
+    return 0 if all(r.passed for r in reports) and all(checked) else 1
+
+
+def _check_benchmark_file(path: str) -> bool:
+    """Check a benchmark file; print what was found, in a line per problem; return whether it passed."""
+    from retrokit.benchmark.definition import read_benchmark
+    from retrokit.benchmark.making import check_benchmark
+    from retrokit.errors import RetrokitError
+
+    try:
+        problems = check_benchmark(path)
+    except RetrokitError as exc:
+        print(f"{path}: FAIL: {exc}")
+        return False
+    bench = read_benchmark(path)
+    print(f"{path}: the {bench.name} benchmark, {len(bench.train)} level(s) to train and {len(bench.test)} to test, "
+          f"{bench.budget:,} timesteps a level: " + ("every level starts: ok" if not problems else "FAIL"))  # fmt: skip
+    for problem in problems:
+        print(f"  FAIL: {problem}")
+    return not problems
 
 
 def own_games() -> list[str]:
@@ -106,4 +133,5 @@ EXAMPLES = [
     "retrokit validate Dasher-Genesis                    # one game, by name",
     "retrokit validate games/MyGame-Genesis --json report.json",
     "retrokit validate --all --quiet                     # every game not from the wheel, failures only",
+    "retrokit validate hopper-nes.yaml                   # a benchmark file: its levels start",
 ]

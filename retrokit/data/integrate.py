@@ -211,7 +211,11 @@ def _script(game: Game, where: str, raw: Any) -> tuple[tuple[tuple[int, ...], in
         steps = parse_script(raw, lambda names: port_masks(game.system, ports, names))
     except RetrokitError as exc:
         raise DataFileError(f"{where}: {exc}") from None
-    return tuple((tuple(port_masks(game.system, ports, step.buttons)), step.frames) for step in steps)
+    masks: dict[int, tuple[int, ...]] = {}  # by step: a repeated step is one object, its masks one tuple
+    for step in steps:
+        if id(step) not in masks:
+            masks[id(step)] = tuple(port_masks(game.system, ports, step.buttons))
+    return tuple((masks[id(step)], step.frames) for step in steps)
 
 
 def _ports(game: Game) -> int:
@@ -388,12 +392,15 @@ def target_folder(game: Game, data_dir: Path | None = None) -> Path:
 
     A game whose only folder is outside every search folder (a game.yaml in the
     current directory) is the user's own: its states go next to its game.yaml.
+
+    Raises:
+        PlantedLinkError: ``<data>/games`` or the game's folder there is a symlink (:func:`retrokit.paths.data_path`).
     """
     searched = [d.resolve() for d in paths.game_search_dirs()]
     own = game.folders[0].resolve()
     if len(game.folders) == 1 and own.parent not in searched:
         return game.folders[0]
-    return paths.user_games_dir(data_dir) / game.name
+    return paths.data_path("games", game.name, data=data_dir)
 
 
 def games_with_state(name: str) -> list[str]:

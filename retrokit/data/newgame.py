@@ -175,7 +175,7 @@ def new_game(
             f"Expected a ROM no game knows; found that {str(rom)!r} (SHA-1 {sha1}) is the ROM of "
             f"{', '.join(g.name for g in owners)}. Import it with: retrokit import {shell_word(rom)}"
         )
-    folder = paths.user_games_dir(data_dir) / name
+    folder = paths.data_path("games", name, data=data_dir)  # never through a planted link
     if folder.exists():
         raise FileConflictError(
             f"Expected no folder at {folder} for the new game; found one. Move it away, or pick another name."

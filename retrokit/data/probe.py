@@ -47,7 +47,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from retrokit import paths
 from retrokit.data.shipped import is_shipped_blob
 from retrokit.data.states import MAX_STATE_FILE_SIZE, decompress_state
 from retrokit.errors import RetrokitError, StateError
@@ -55,6 +54,7 @@ from retrokit.host.child import Child
 from retrokit.host.emulator import VettedState, claim_mint
 from retrokit.host.statelayout import state_layout_problem
 from retrokit.host.systems import System, get_system
+from retrokit.host.verdicts import ProbeVerdict, keep_verdict, kept_verdict
 
 _mint = claim_mint()
 
@@ -69,7 +69,6 @@ CHILD_STARTUP = 120.0
 """Seconds a child may take to start (importing retrokit, loading the core) on a busy machine."""
 CHILD_MEMORY = 512 << 20
 """Bytes of address space a child may map: a state that makes the core allocate wildly fails there."""
-_SAFE = "safe"
 
 
 # --- The child's results -------------------------------------------------------------------------
@@ -103,8 +102,9 @@ class ChildResult:
 def run_child(
     system: str, rom: str | os.PathLike[str], states: Sequence[tuple[str, str, int, int]], *,
     fields: Sequence[Mapping[str, Any]] = (), timeout: float | None = None,
-) -> tuple[dict[str, ChildResult], str | None, str]:
-    """Run one child over ``states``; return the results it finished, the state to blame if it failed, and why.
+) -> tuple[dict[str, ChildResult], str | None, ProbeVerdict | None]:
+    """Run one child over ``states``; return the results it finished, the state to blame if it failed, and the
+    failure's verdict (``None`` if the child ended well; a hang's is not lasting: :attr:`ChildEnd.lasting`).
 
     The child (run as every risky child is: :mod:`retrokit.host.child`) answers
     on a pipe of its own, a line before and after each state; a state that
@@ -148,8 +148,9 @@ def run_child(
     elif end.status != 0:
         failure = f"the state loader exited with status {end.status}: {end.last_words}"
     else:
-        return results, None, ""
-    return {}, current if current is not None else next(reversed(results), None), failure
+        return results, None, None
+    blamed = current if current is not None else next(reversed(results), None)
+    return {}, blamed, ProbeVerdict(False, failure, lasting=end.lasting)
 
 
 def probe_files(
@@ -202,10 +203,12 @@ def probe_files(
         done, blamed, failure = run_child(system, rom, [plans[n] for n in todo], fields=fields, timeout=timeout)
         results.update(done)
         if blamed is None and failure:  # the child failed before any state: it says nothing of them, keep nothing
-            results.update({n: ChildResult(n, plans[n][1], error=failure) for n in todo})
+            results.update({n: ChildResult(n, plans[n][1], error=failure.reason) for n in todo})
             keys = {n: key for n, key in keys.items() if n not in todo}
-        elif blamed is not None:
-            results[blamed] = ChildResult(blamed, plans[blamed][1], error=failure)
+        elif blamed is not None and failure:
+            results[blamed] = ChildResult(blamed, plans[blamed][1], error=failure.reason)
+            if not failure.lasting:  # a hang on a loaded machine: probed again next time
+                keys.pop(blamed, None)
         todo = [n for n in todo if n not in results]
     for name, key in keys.items():
         result = results[name]
@@ -214,19 +217,6 @@ def probe_files(
 
 
 # --- One state's verdict -------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class ProbeVerdict:
-    """What probing a state found.
-
-    Attributes:
-        safe: The state loaded and ran its frames in the child.
-        reason: Why it is not safe (empty when it is): the signal, a hang, or retrokit's error.
-    """
-
-    safe: bool
-    reason: str = ""
 
 
 PROBE_VERSION = 2
@@ -267,7 +257,7 @@ def probe_state(
         tmp.flush()
         results, _, failure = run_child(system, rom, [("state", tmp.name, frames, input_frames)], timeout=timeout)
     if failure:  # how the child ended comes first: a dead or hung child vouches for nothing it answered
-        return ProbeVerdict(False, failure)
+        return failure
     result = results.get("state")
     if result is None:
         return ProbeVerdict(False, "the probe stopped before it loaded the state")
@@ -275,24 +265,15 @@ def probe_state(
 
 
 PROBES = "state-probes"
-"""The data folder's folder of verdicts (:func:`retrokit.paths.records_dir`: never a link)."""
+"""The data folder's folder of verdicts (:mod:`retrokit.host.verdicts`: never through a link)."""
 
 
 def _cached(key: str) -> ProbeVerdict | None:
-    try:
-        text = paths.read_regular_file(paths.records_dir(PROBES) / key, "a probe's verdict", 4096, follow=False)
-        text = text.decode("utf-8")
-    except (RetrokitError, UnicodeDecodeError):  # none, unreadable, or through a link: only a probe can tell
-        return None
-    return ProbeVerdict(True) if text == _SAFE else ProbeVerdict(False, text)
+    return kept_verdict(PROBES, key, "a probe's verdict")
 
 
 def _remember(key: str, verdict: ProbeVerdict) -> None:
-    try:
-        text = (_SAFE if verdict.safe else verdict.reason).encode()
-        paths.atomic_write(paths.records_dir(PROBES) / key, text, overwrite=True)
-    except RetrokitError:
-        pass  # an unwritable data folder (or a link planted in it) only means probing again next time
+    keep_verdict(PROBES, key, verdict)  # a hang's verdict is not lasting: not kept
 
 
 def remember(state: VettedState, rom_sha1: str) -> None:

@@ -12,10 +12,10 @@ Which game a shipped state is for is known too (:mod:`retrokit.data.statecheck`
 refuses it for another game): a file of the wheel by the folder ``RECORD``
 lists it in, and the state inside, however it is wrapped again (its record
 stripped, a movie's ``Core.bin``), by :data:`WHEEL_STATE_HASHES`, which
-lists the digest of the state in each of the wheel's ``.state`` files of the
-games retrokit knows (those ``games/`` integrates too, and those whose ROM the
-wheel ships, as Airstriker's). Only its lines whose file the installed wheel
-holds, by its ``RECORD`` digest, are used.
+lists the digest of the state in each of the wheel's ``.state`` files, every
+game's (Pong's ``Start.state`` inflated and compressed again is still known as
+Pong's). Only its lines whose file the installed wheel holds, by its
+``RECORD`` digest, are used.
 """
 
 from __future__ import annotations
@@ -60,37 +60,15 @@ def wheel_state_files() -> dict[str, tuple[str, ...]]:
     return found
 
 
-def wheel_known_games(games: Path) -> list[Path]:
-    """The wheel's game folders whose states :data:`WHEEL_STATE_HASHES` lists: the games ``games`` integrates too,
-    and those whose ROM the wheel ships."""
-    from retrokit.errors import RetrokitError
-    from retrokit.host.systems import system_for_extension
-
-    def ships_rom(folder: Path) -> bool:
-        for file in folder.glob("rom.*"):
-            try:
-                system_for_extension(file.suffix)
-                return True
-            except RetrokitError:  # rom.sha, rom.delta: no ROM
-                continue
-        return False
-
-    ours = {p.name for p in games.iterdir() if p.is_dir()}
-    return [
-        folder
-        for kind in paths.wheel_data_dirs()
-        for folder in sorted(kind.iterdir())
-        if folder.is_dir() and (folder.name.removesuffix("-v0") in ours or ships_rom(folder))
-    ]
-
-
-def wheel_state_hashes(games: Path) -> str:
-    """The text of :data:`WHEEL_STATE_HASHES` for the installed wheel (the states' digests, once inflated)."""
+def wheel_state_hashes() -> str:
+    """The text of :data:`WHEEL_STATE_HASHES` for the installed wheel: the digest of the state inside each of its
+    ``.state`` files, every game's (about 1,800 files, 1.2 GB once inflated: seconds, so it is done once, here, when
+    retrokit is packaged, and never when a state is loaded)."""
     from retrokit.data.states import read_state_file
     from retrokit.errors import RetrokitError
 
     lines = []
-    for folder in wheel_known_games(games):
+    for folder in (folder for kind in paths.wheel_data_dirs() for folder in sorted(kind.iterdir()) if folder.is_dir()):
         for path in sorted(folder.glob("*.state")):
             try:
                 data = read_state_file(path).data
@@ -119,5 +97,5 @@ def state_hashes(games: Path) -> str:
 if __name__ == "__main__":  # python -m retrokit.data.shipped: rewrite games/*STATES.sha256 after adding a state
     root = Path(__file__).resolve().parents[2] / "games"
     paths.atomic_write(root / STATE_HASHES, state_hashes(root).encode(), overwrite=True)
-    paths.atomic_write(root / WHEEL_STATE_HASHES, wheel_state_hashes(root).encode(), overwrite=True)
+    paths.atomic_write(root / WHEEL_STATE_HASHES, wheel_state_hashes().encode(), overwrite=True)
     sys.exit(0)

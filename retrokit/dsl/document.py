@@ -37,7 +37,7 @@ from retrokit.errors import RetrokitError, ScenarioError, did_you_mean, shown
 
 TOP_KEYS = (
     "name", "description", "include", "tables", "define", "reward", "rewards", "done", "dones", "actions", "crop",
-    "jump",
+    "jump", "reset_ram",
 )
 INCLUDE_KEYS = ("description", "include", "tables", "define")
 TABLE_KEYS = ("by", "default", "values", "description")
@@ -284,6 +284,8 @@ class DocumentLoader:
             if not isinstance(jump, str) or not jump:
                 raise reader.error(entries["jump"][1], "jump is one button name, the one JERK jumps with, such as A")
             spec.jump = jump
+        if "reset_ram" in entries:
+            spec.reset_ram = self._reset_ram(reader, entries["reset_ram"][1])
         if "crop" in entries:
             crop = reader.plain(entries["crop"][1])
             if not (isinstance(crop, list) and len(crop) == 4 and all(isinstance(c, int) and not isinstance(c, bool) and c >= 0 for c in crop)):
@@ -301,6 +303,26 @@ class DocumentLoader:
         if not isinstance(node, yaml.SequenceNode) or not node.value:
             raise reader.error(node, f"{what} must be a non-empty list")
         return list(node.value)
+
+    @staticmethod
+    def _reset_ram(reader: _Reader, node: yaml.Node) -> dict[int, tuple[str, int, int]]:
+        from retrokit.dsl.resetram import MAX_WRITES, draw_of
+
+        entries = reader.mapping(node, "reset_ram")
+        if not entries or len(entries) > MAX_WRITES:
+            raise reader.error(node, f"reset_ram maps 1 to {MAX_WRITES} console addresses to what to write there")
+        writes = {}
+        for key_text, (key, value) in entries.items():
+            address = reader.plain(key)
+            if not isinstance(address, int) or isinstance(address, bool) or address < 0:
+                raise reader.error(key, f"a reset_ram key is a console address, such as 0x0017; got {key_text!r}")
+            if address in writes:
+                raise reader.error(key, f"reset_ram gives address 0x{address:X} twice")
+            try:
+                writes[address] = draw_of(reader.plain(value))
+            except RetrokitError as exc:
+                raise reader.error(value, str(exc)) from None
+        return writes
 
     @staticmethod
     def _actions(reader: _Reader, node: yaml.Node) -> list:

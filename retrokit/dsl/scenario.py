@@ -39,6 +39,7 @@ class Scenario:
         crop: ``(x, y, width, height)`` of the screen to keep, or ``None``.
         fields: The fields the scenario reads.
         jump: The button JERK jumps with in this game, or ``None`` for the system's.
+        reset_ram: What an env writes into RAM at each reset: by address, ``(type, lowest, highest)``.
     """
 
     def __init__(self, spec: ScenarioSpec, fields: Sequence[str]) -> None:
@@ -48,6 +49,7 @@ class Scenario:
         self.actions = spec.actions
         self.jump = spec.jump
         self.crop = spec.crop
+        self.reset_ram = dict(spec.reset_ram)
         self.fields = self._program.fields
 
     @property

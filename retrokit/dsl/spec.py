@@ -54,6 +54,8 @@ class ScenarioSpec:
         actions: Gym Retro-style button combinations, if given.
         jump: The button JERK jumps with, if given (else the system's).
         crop: ``(x, y, width, height)`` of the screen to keep, if given.
+        reset_ram: What to write into RAM at each reset, drawn from the env's seeded generator: by console
+            address, ``(type code, lowest, highest)`` (see :mod:`retrokit.envs.resetram`).
     """
 
     name: str
@@ -66,3 +68,4 @@ class ScenarioSpec:
     actions: list | None = None
     jump: str | None = None
     crop: tuple[int, int, int, int] | None = None
+    reset_ram: dict[int, tuple[str, int, int]] = field(default_factory=dict)

@@ -20,6 +20,7 @@ from gymnasium import spaces
 
 from retrokit.data.games import Game, find_game
 from retrokit.data.resolve import Resolved, StartState, State, resolve, resolve_state
+from retrokit.dsl.resetram import apply_writes, check_writes
 from retrokit.envs.actions import ActionMap
 from retrokit.envs.buffers import BufferPool
 from retrokit.envs.compat import StableRetroCompat
@@ -179,6 +180,13 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         self._info_array = np.zeros(len(self._info_index or ()), dtype=np.int64)
         #: The info's fields after a step, as int64s (a vector env copies them into its batch).
         self.info_values = memoryview(self.reader.values if self._info_index is None else self._info_array)
+        self._reset_ram = getattr(self.scenario, "reset_ram", None) or {}
+        check_writes(self._reset_ram, self.emulator.space)
+        if self._reset_ram and record is not None:  # a movie replays from its state, without the writes
+            raise InvalidArgumentError(
+                "Expected record= without a scenario that writes reset_ram: a movie starts from the state, and "
+                "replayed would miss what reset_ram wrote. Record with another scenario."
+            )
         self.record_dir = Path(record) if record is not None else None
         if self.record_dir is not None:
             stem = f"{self.game.name}-{self.state_name or 'power-on'}"
@@ -318,6 +326,7 @@ class RetroEnv(StableRetroCompat, PicklesAsArguments, gymnasium.Env):
         self.emulator.forget_action()
         self.emulator.set_sticky(self.sticky_prob, int(self.np_random.integers(0, 2**63)))
         noops = int(self.np_random.integers(1, self.noop_max + 1)) if self.noop_max else 0
+        apply_writes(self._reset_ram, self.emulator.space, self.np_random)  # after the other draws: see resetram
         frames = noops * self.frameskip + self.reset_frame
         if frames:
             self.emulator.run(self._noop, frames)  # one call: only its last frame is drawn

@@ -6,7 +6,10 @@ Its source, in stable-retro's sdist on the package index, already has the
 switch (``system_frame_gen(do_skip)``); a small patch kept in this package
 (``retrokit/native/patches/``) makes ``retro_run`` ask libretro's
 ``GET_AUDIO_VIDEO_ENABLE`` and pass the answer on. The same is done for
-stella, whose ``retro_run`` then skips converting the frames nobody sees.
+stella, whose ``retro_run`` then skips converting the frames nobody sees,
+gambatte, which then skips making and resampling the sound nobody hears,
+snes9x and mednafen_pce_fast, which then draw no frame nobody sees, and
+fceumm, which then converts none.
 
 :func:`build_core` fetches the sdist of the installed stable-retro version
 with pip (:mod:`retrokit.host.sdist`), unpacks only the core's folder, applies the patch, runs the core's
@@ -67,6 +70,9 @@ class Recipe:
         patch: The patch file in ``retrokit/native/patches``.
         version_tag: Appended to the core's reported library version, so a
             built core says what it is.
+        subdir: Where in ``folder`` make runs and the library appears, as
+            stable-retro's build has it (snes9x's ``libretro``); the patch
+            applies to ``folder``.
     """
 
     core: str
@@ -74,6 +80,7 @@ class Recipe:
     makefile: str
     patch: str
     version_tag: str
+    subdir: str = ""
 
 
 RECIPES = {
@@ -81,6 +88,12 @@ RECIPES = {
         "genesis_plus_gx", "cores/genesis", "Makefile.libretro", "genesis_plus_gx-av-enable.patch", "+av-enable"
     ),
     "stella": Recipe("stella", "cores/atari2600", "Makefile", "stella-av-enable.patch", "+av-enable"),
+    "gambatte": Recipe("gambatte", "cores/gb", "Makefile.libretro", "gambatte-av-enable.patch", "+av-enable"),
+    "snes9x": Recipe("snes9x", "cores/snes", "Makefile", "snes9x-av-enable.patch", "+av-enable", subdir="libretro"),
+    "fceumm": Recipe("fceumm", "cores/nes", "Makefile.libretro", "fceumm-av-enable.patch", "+av-enable"),
+    "mednafen_pce_fast": Recipe(
+        "mednafen_pce_fast", "cores/pce", "Makefile", "mednafen_pce_fast-av-enable.patch", "+av-enable"
+    ),
 }
 
 
@@ -189,13 +202,14 @@ def make_core(
     args = ["make", "-f", recipe.makefile, f"-j{jobs or os.cpu_count() or 1}", f"CC={cc}", "fpic=-fPIC",
             f"GIT_VERSION={recipe.version_tag}"]  # fmt: skip
     env = {**os.environ, **WHEEL_MAKE_ENV}
+    where = source / recipe.subdir
     try:  # the dry run lists the commands, so progress has a total
-        dry = subprocess.run([*args, "-n"], cwd=source, env=env, capture_output=True, text=True, check=False).stdout
+        dry = subprocess.run([*args, "-n"], cwd=where, env=env, capture_output=True, text=True, check=False).stdout
         total = sum(" -c " in line for line in dry.splitlines()) + 1
         log_path = source / "build.log"
         done = 0
         with open(log_path, "w", encoding="utf-8") as log:
-            proc = subprocess.Popen(args, cwd=source, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+            proc = subprocess.Popen(args, cwd=where, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
             assert proc.stdout is not None
             for line in proc.stdout:
                 log.write(line)
@@ -208,7 +222,7 @@ def make_core(
             f"Expected to run make in {source}; it failed: {exc}. Install make and a C compiler "
             f"(Debian/Ubuntu: apt install build-essential), then run the command again."
         ) from None
-    library = source / core_filename(recipe.core)
+    library = where / core_filename(recipe.core)
     if proc.returncode != 0 or not library.is_file():
         lines = log_path.read_text(encoding="utf-8", errors="replace").splitlines()
         first = next((line for line in lines if "error" in line.lower()), lines[-1] if lines else "no output")

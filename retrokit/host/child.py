@@ -115,6 +115,16 @@ class ChildEnd:
         """The signal that killed it, by name, unless it exited (or was killed for a deadline)."""
         return signal_name(-self.status) if self.status < 0 and not self.hung else None
 
+    @property
+    def lasting(self) -> bool:
+        """Whether how it ended speaks of what it ran, so a verdict drawn from it may be kept.
+
+        A child that missed its deadline may only have been starved of a CPU on a
+        loaded machine (two cores shared by many processes), not stuck: such a
+        verdict holds for this moment, and the next run probes again.
+        """
+        return not self.hung
+
 
 class Child:
     """``python -m MODULE`` in a child process, with limits, given ``request``; use it in a ``with`` block.

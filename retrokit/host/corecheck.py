@@ -28,16 +28,16 @@ from __future__ import annotations
 
 import functools
 import hashlib
-import json
 import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from retrokit.errors import ChildStartError, CoreError, RetrokitError
+from retrokit.errors import ChildStartError, CoreError
 from retrokit.host.child import Child
-from retrokit.host.cores import built_cores_dir, core_filename
+from retrokit.host.cores import built_cores_dir, core_filename, read_build_record
 from retrokit.host.elf import check_core_file
-from retrokit.paths import atomic_write, data_dir, read_regular_file, records_dir
+from retrokit.host.verdicts import ProbeVerdict, keep_verdict, kept_verdict
+from retrokit.paths import data_dir
 from retrokit.wheel import wheel_files, wheel_version
 
 PROBE_FRAMES = 60
@@ -48,7 +48,6 @@ PROBE_ADDRESS_SPACE = 3 * 2**30
 """The probe's address-space cap: far above what Python, numpy and a core map, far below a runaway."""
 REFUSED = 3
 """The child's exit status when retrokit refused the core with its own error."""
-_SAFE = "safe"
 
 _StatKey = tuple[str, int, int, int]
 _digests: dict[_StatKey, str] = {}  # SHA-256 by (path, size, mtime, inode): each file hashed once per process
@@ -103,11 +102,10 @@ def built_vouchers(data: Path | None = None) -> dict[Path, Voucher]:
     """Return the cores ``retrokit build-core`` made, by path, with the SHA-256 each build record holds."""
     found = {}
     for record_path in sorted(built_cores_dir(data).glob("*.build.json")):
-        try:
-            record = json.loads(record_path.read_text(encoding="utf-8"))
-            core, digest = str(record["core"]), str(record["library_sha256"])
-        except (OSError, ValueError, TypeError, KeyError):
+        record = read_build_record(record_path.name.removesuffix(".build.json"), data) or {}
+        if "core" not in record or "library_sha256" not in record:
             continue  # no readable record vouches for nothing
+        core, digest = str(record["core"]), str(record["library_sha256"])
         fix = f"Build it again: retrokit build-core {core} --force"
         found[(built_cores_dir(data) / core_filename(core)).resolve()] = Voucher(digest, f"its build record {record_path}", fix)
     return found
@@ -142,11 +140,10 @@ def vet_core(core: str | os.PathLike[str], system: str, rom: str | os.PathLike[s
             f"{voucher.sha256[:16]}.... {voucher.fix}."
         )
     if voucher is None and digest not in {v.sha256 for v in vouchers.values()}:
-        verdict = _remembered(digest)
+        verdict = kept_verdict(CORE_PROBES, digest, "a core's verdict")
         if verdict is None:
             verdict = probe_core(path, system, rom)
-            if verdict.lasting:
-                _remember(digest, verdict)
+            keep_verdict(CORE_PROBES, digest, verdict)
         if not verdict.safe:
             raise CoreError(
                 f"{path} is not a core retrokit can load: {verdict.reason}. Use the stable-retro wheel's core "
@@ -154,23 +151,6 @@ def vet_core(core: str | os.PathLike[str], system: str, rom: str | os.PathLike[s
                 "(delete that file to probe the core again)."
             )
     _vetted.add(key)
-
-
-@dataclass(frozen=True)
-class ProbeVerdict:
-    """What probing a core found.
-
-    Attributes:
-        safe: The child loaded it and ran its frames, or refused it with retrokit's own error
-            (which this process will meet the same way, safely).
-        reason: Why it is not safe: the signal, a hang, or the child's last words.
-        lasting: Whether the verdict says something about the core itself (kept), or about this moment (a hang
-            on a loaded machine, a child that could not start: probed again next time).
-    """
-
-    safe: bool
-    reason: str = ""
-    lasting: bool = True
 
 
 def probe_core(core: Path, system: str, rom: str | os.PathLike[str], *, timeout: float = PROBE_TIMEOUT) -> ProbeVerdict:
@@ -184,7 +164,7 @@ def probe_core(core: Path, system: str, rom: str | os.PathLike[str], *, timeout:
     except ChildStartError as exc:  # a child that failed before it ran (no memory, no processes)
         return ProbeVerdict(False, f"the probe could not start: {exc.reason}", lasting=False)
     if end.hung:
-        return ProbeVerdict(False, f"it still ran {timeout:.0f} s after loading (it hangs)", lasting=False)
+        return ProbeVerdict(False, f"it still ran {timeout:.0f} s after loading (it hangs)", lasting=end.lasting)
     if end.status in (0, REFUSED):
         return ProbeVerdict(True)
     if end.signal is not None:
@@ -193,26 +173,7 @@ def probe_core(core: Path, system: str, rom: str | os.PathLike[str], *, timeout:
 
 
 CORE_PROBES = "core-probes"
-"""The data folder's folder of core verdicts (:func:`retrokit.paths.records_dir`: never a link)."""
-
-
-def _verdict_file(digest: str) -> Path:
-    return records_dir(CORE_PROBES) / digest  # never through a link: a planted verdict would vouch
-
-
-def _remembered(digest: str) -> ProbeVerdict | None:
-    try:
-        text = read_regular_file(_verdict_file(digest), "a core's verdict", 4096, follow=False).decode("utf-8")
-    except (RetrokitError, UnicodeDecodeError):
-        return None
-    return ProbeVerdict(True) if text == _SAFE else ProbeVerdict(False, text)
-
-
-def _remember(digest: str, verdict: ProbeVerdict) -> None:
-    try:
-        atomic_write(_verdict_file(digest), (_SAFE if verdict.safe else verdict.reason).encode(), overwrite=True)
-    except RetrokitError:
-        pass  # a read-only data folder: the core is probed again next time, which is only slower
+"""The data folder's folder of core verdicts (:mod:`retrokit.host.verdicts`: never through a link)."""
 
 
 def mark_probing(core: Path) -> None:

@@ -20,8 +20,8 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
-from retrokit.errors import CoreNotFoundError
-from retrokit.paths import data_dir, wheel_cores_dir
+from retrokit.errors import CoreNotFoundError, FileSystemError
+from retrokit.paths import data_path, read_regular_file, wheel_cores_dir
 
 CORES_ENV = "RETROKIT_CORES"
 _DEBIAN_DIRS = ("/usr/lib/x86_64-linux-gnu/libretro", "/usr/lib/aarch64-linux-gnu/libretro", "/usr/lib/libretro")
@@ -58,8 +58,12 @@ def stable_retro_version() -> str | None:
 
 
 def built_cores_dir(data: Path | str | None = None) -> Path:
-    """Return where ``retrokit build-core`` installs cores: ``<data>/cores``."""
-    return (Path(data) if data is not None else data_dir()) / "cores"
+    """Return where ``retrokit build-core`` installs cores: ``<data>/cores``, never a link (its records vouch).
+
+    Raises:
+        PlantedLinkError: It is a symlink (:func:`retrokit.paths.data_path`).
+    """
+    return data_path("cores", data=data)
 
 
 def build_record_path(core: str, data: Path | str | None = None) -> Path:
@@ -69,9 +73,10 @@ def build_record_path(core: str, data: Path | str | None = None) -> Path:
 
 def read_build_record(core: str, data: Path | str | None = None) -> dict[str, str] | None:
     """Return what ``retrokit build-core`` recorded about a built core, or ``None`` if nothing readable."""
-    try:
-        record = json.loads(build_record_path(core, data).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    try:  # a record vouches for a core's bytes: never read through a link, nor more than a record holds
+        text = read_regular_file(build_record_path(core, data), "a core's build record", 1 << 16, follow=False)
+        record = json.loads(text.decode("utf-8"))
+    except (FileSystemError, ValueError):
         return None
     return record if isinstance(record, dict) else None
 

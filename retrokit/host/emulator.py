@@ -25,7 +25,7 @@ from retrokit.host.cores import find_core
 from retrokit.host.memory import AddressSpace
 from retrokit.host.statelayout import cartridge_class
 from retrokit.host.systems import System, get_system, system_for_extension
-from retrokit.paths import data_dir
+from retrokit.paths import data_path
 
 logger = logging.getLogger("retrokit.core")
 _LOG_LEVELS = (logging.DEBUG, logging.INFO, logging.WARNING, logging.ERROR)
@@ -153,8 +153,7 @@ class Emulator:
         core = Path(core_path) if core_path is not None else find_core(self.system.core)
         vet_core(core, self.system.name, rom)  # a damaged library would make the loader kill the process
         merged = {**self.system.options, **(options or {})}
-        folder = data_dir()
-        system_dir, save_dir = folder / "system", folder / "saves"
+        system_dir, save_dir = data_path("system"), data_path("saves")  # the core writes there: never through a link
         self._emu = primitives.NativeEmulator(str(core), str(system_dir), str(save_dir), merged, _log_core, ports)
         declared = self._emu.options()
         for key in options or {}:

@@ -25,7 +25,7 @@ from pathlib import Path
 from urllib.parse import urlsplit
 
 from retrokit.errors import BuildToolError, CoreBuildError, InvalidArgumentError, SourceFetchError, SourceNotFoundError
-from retrokit.paths import data_dir, ensure_folder, locked
+from retrokit.paths import data_path, ensure_folder, locked
 
 Progress = Callable[[str, int, int], None]  # (what, done, total): total 0 when unknown
 
@@ -267,10 +267,10 @@ def cached_sdist(
 
     Raises:
         SourceFetchError, SourceNotFoundError, BuildToolError, CoreBuildError: As :func:`fetch_sdist`.
-        FileSystemError: The data folder cannot be written.
+        FileSystemError: The data folder cannot be written, or a link is planted in it (PlantedLinkError).
     """
-    folder = ensure_folder((data if data is not None else data_dir()) / SDIST_FOLDER, "to keep stable-retro's sdist in")
-    target = folder / f"stable_retro-{version}.tar.gz"
+    folder = ensure_folder(data_path(SDIST_FOLDER, data=data), "to keep stable-retro's sdist in")
+    target = data_path(SDIST_FOLDER, f"stable_retro-{version}.tar.gz", data=data)  # what builds run: never a link
     if target.is_file():
         return target
     with locked(target):

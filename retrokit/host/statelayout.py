@@ -49,12 +49,24 @@ state begins with its class name (a 4-byte length, then the name), which the
 core checks before reading on; so every place the name occurs is checked, and a
 name planted earlier in the state cannot hide the one the core reads (but the
 copy of the name in the state's header, which the core only compares).
+
+The PC Engine, Game Boy, NES and SNES cores have checks of their own, one
+module each beside this one, for their formats differ: mednafen's named
+sections (timestamps, the dot clock, indexes), gambatte's labelled entries
+read by a loader that has no end, FCEUmm's chunks whose sizes it seeks by as
+signed numbers, and snes9x's blocks of timings, clocks and sound-chip
+positions. :data:`_CHECKS` is the one table every state load goes through.
 """
 
 from __future__ import annotations
 
 import struct
 from collections.abc import Callable
+
+from retrokit.host.gblayout import gambatte_problem
+from retrokit.host.neslayout import fceumm_problem
+from retrokit.host.pcelayout import pce_problem
+from retrokit.host.sneslayout import snes9x_problem
 
 GENESIS_STATE_SIZE = 1036288
 """Bytes of a Genesis Plus GX 1.7.5 state (its ``STATE_SIZE``, 0xFD000)."""
@@ -198,6 +210,11 @@ _CHECKS: dict[str, Callable[[bytes], str]] = {
     "Sms": _genesis_plus_gx(_master_system_problem),
     "GameGear": _genesis_plus_gx(_master_system_problem),
     "Atari2600": _stella_problem,
+    "PCEngine": pce_problem,
+    "GameBoy": gambatte_problem,
+    "GbColor": gambatte_problem,
+    "Nes": fceumm_problem,
+    "Snes": snes9x_problem,
 }
 """The systems whose states are checked, by their core's layout."""
 
@@ -207,7 +224,14 @@ def state_layout_problem(system: str, state: bytes) -> str:
 
     Only what is known of a core's layout is checked: a Genesis, Master
     System or Game Gear state in Genesis Plus GX 1.7.5's format, an Atari 2600
-    state in stella's. Anything else is left to the probe.
+    state in stella's, a PC Engine state in mednafen's
+    (:mod:`retrokit.host.pcelayout`), a Game Boy or Game Boy Color state in
+    gambatte's (:mod:`retrokit.host.gblayout`), an NES state in FCEUmm's
+    (:mod:`retrokit.host.neslayout`), a SNES state in snes9x's
+    (:mod:`retrokit.host.sneslayout`). Anything else is left to the probe, as
+    is what no layout shows: a state whose values are each legal but send the
+    emulated program astray (a PC Engine state whose memory map puts the
+    stack in ROM) crashes, if it does, at the same frame in any process.
 
     Args:
         system: The system's name (``"Genesis"``).

@@ -28,10 +28,10 @@ _ORDERS = ("><", "<>", ">=", "<=", ">", "<", "|", "=")
 _CODE = re.compile(r"^(><|<>|>=|<=|>|<|\||=)([uidn])([1-8])$")
 _HOST_BIG = sys.byteorder == "big"
 
-# The codes Gym Retro integrations use, for did-you-mean suggestions.
+# The codes Gym Retro integrations use, and the 3-byte ones a RAM search finds, for did-you-mean suggestions.
 COMMON_CODES = (
-    "|u1", "|i1", "|d1", "|n1", ">u2", "<u2", ">i2", "<i2", ">d2", "<d2", ">u4", "<u4", ">i4", "<i4",
-    ">d4", "<d4", ">n4", "<n4", ">d6", ">n6", ">d8", ">n8", "><u4", "<>u4",
+    "|u1", "|i1", "|d1", "|n1", ">u2", "<u2", ">i2", "<i2", ">d2", "<d2", ">u3", "<u3", ">i3", "<i3", ">d3", "<d3",
+    ">u4", "<u4", ">i4", "<i4", ">d4", "<d4", ">n4", "<n4", ">d6", ">n6", ">d8", ">n8", "><u4", "<>u4",
 )  # fmt: skip
 
 

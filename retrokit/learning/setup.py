@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from retrokit.benchmark.definition import Benchmark, LearningTask
+from retrokit.benchmark.paper import paper_name
 from retrokit.errors import InvalidArgumentError, PolicyFileError
 from retrokit.learning.algorithms import ALGORITHMS, algorithm, is_learning_agent
 from retrokit.learning.config import AgentConfig, load_config
@@ -49,10 +50,7 @@ class LearnerSetup:
     def paper_agent(self) -> str | None:
         """The paper's name for this play of the agent: ``PPO`` from scratch, ``Joint PPO`` from a trained policy
         (the reports set it beside that row); ``None`` for a zero-shot play, which the paper's tables lack."""
-        if not self.learn:
-            return None
-        name = self.agent.upper() if self.agent == "ppo" else self.agent.capitalize()
-        return name if self.init is None else f"Joint {name}"
+        return paper_name(self.agent, self.init) if self.learn else None
 
     def settings(self) -> dict[str, Any]:
         """What determines the agent's play, for ``run.json`` (``--resume`` requires the same)."""

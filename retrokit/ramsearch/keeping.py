@@ -160,6 +160,7 @@ class Keeping:
 
         Raises:
             DataFileError: The game's data file is not a game.yaml (Gym Retro's format).
+            PlantedLinkError: The file, or a folder on its way in the data folder, is a symlink.
         """
         source = self.game.info.source
         if source.name != "game.yaml":
@@ -171,8 +172,8 @@ class Keeping:
             )
         shipped = [p.resolve() for p in (wheel_dir(), paths.repo_games_dir(), Path(paths.__file__).parent) if p]
         if any(source.resolve().is_relative_to(p) for p in shipped):
-            return paths.user_games_dir() / self.game.name / "game.yaml"
-        return source
+            return paths.data_path("games", self.game.name, "game.yaml")
+        return paths.inside_data(source)  # a game folder of the data folder's is written there, never through a link
 
     def save_field(
         self,

@@ -35,7 +35,7 @@ import numpy as np
 from retrokit.data import statecheck
 from retrokit.data.games import Game, find_game
 from retrokit.data.roms import rom_sha1
-from retrokit.data.script import MAX_FRAMES, parse_script, port_masks
+from retrokit.data.script import MAX_FRAMES, Step, parse_script, port_masks, script_frames
 from retrokit.data.states import StateRecord
 from retrokit.errors import DataFileError, InvalidArgumentError, MovieError, SessionError, StateError
 from retrokit.host.emulator import Emulator
@@ -269,13 +269,48 @@ class RamSearch(Keeping):
         steps = parse_script(script, self.buttons)
         if state is not None:
             self.load_state(state)
-        for step in steps:
-            self.step(step.buttons, step.frames)
-        text = " ".join(step.describe() for step in steps)
-        frames = sum(step.frames for step in steps)
+        self.play_steps(steps)
+        text = " ".join(script.split())
         text = text if len(text) <= _LABEL_SCRIPT else text[: _LABEL_SCRIPT - 3] + "..."
-        label = f"{'state ' + state + ', ' if state else ''}script {text} ({frames} frames)"
+        label = f"{'state ' + state + ', ' if state else ''}script {text} ({script_frames(steps)} frames)"
         return self._snap(label, snapshot)
+
+    def play_steps(self, steps: Sequence[Step]) -> None:
+        """Play a parsed script's steps (each step's masks made once: a repeated step is one object)."""
+        masks: dict[int, list[int]] = {}
+        for step in steps:
+            held = masks.get(id(step))
+            if held is None:
+                held = masks[id(step)] = self.buttons(step.buttons)
+            self.emulator.run(held, step.frames)
+            self._played(held, step.frames)
+
+    def ram_frames(self, script: str | None = None, movie: str | os.PathLike[str] | None = None) -> Iterator[np.ndarray]:
+        """The RAM now, then after each frame of a script, or of a movie from its start, played a frame at a time.
+
+        The script or movie is checked now, before anything plays; it plays as the iterator is advanced.
+
+        Raises:
+            InvalidArgumentError: Neither or both are given, or the script is malformed.
+            MovieError: The movie is malformed or of another game.
+        """
+        if (script is None) == (movie is None):
+            raise InvalidArgumentError("Expected a script or a movie to play, one of them; got " +
+                                       ("both." if script is not None else "neither."))  # fmt: skip
+        if movie is not None:
+            return (self.layout.read(self.emulator.space) for _ in self.replaying(movie)[1])
+        steps = parse_script(script, self.buttons)
+
+        def play() -> Iterator[np.ndarray]:
+            yield self.layout.read(self.emulator.space)
+            for step in steps:
+                masks = self.buttons(step.buttons)
+                for _ in range(step.frames):
+                    self.emulator.run(masks, 1)
+                    self._played(masks, 1)
+                    yield self.layout.read(self.emulator.space)
+
+        return play()
 
     def _snap(self, label: str, snapshot: bool) -> int | None:
         return self.snapshot(label) if snapshot else None

@@ -50,7 +50,7 @@ VERSION = 2  # 2: scale masks, and the inputs played
 MAX_FILE = 1 << 26  # 64 MiB compressed: a session of a thousand snapshots of 64 KiB takes a few
 MAX_UNPACKED = 1 << 28  # 256 MiB: a bigger archive is not one this tool wrote for a console's RAM
 MAX_META = 1 << 22  # 4 MiB of JSON: labels and filter names of tens of thousands of snapshots
-MAX_CANDIDATES = 1 << 27  # 4 MiB of RAM as 32 types: their flags and scales take 256 MiB
+MAX_CANDIDATES = 1 << 27  # 4 MiB of RAM as 32 types (3.5 MiB as 38): their flags and scales take 256 MiB
 _START = "Start a new search with: retrokit ramsearch new GAME"
 
 

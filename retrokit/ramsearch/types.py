@@ -3,7 +3,10 @@
 A RAM search looks at each byte position as each of the types Gym Retro
 infers (its ``Search`` class's defaults): unsigned and signed integers of 1, 2
 and 4 bytes in every byte order, BCD (``d``, two digits a byte) of 1 to 8
-bytes and low-nibble BCD (``n``, one digit a byte) of 2 to 8 bytes. The
+bytes and low-nibble BCD (``n``, one digit a byte) of 2 to 8 bytes; and the
+3-byte integers and BCD in either order (``<d3``, ``>u3``, ...), which Gym
+Retro's search leaves out although its reader has them: NES games keep
+six-digit scores and 24-bit positions in three bytes. The
 host-relative orders (``=``, ``>=``, ``<=``) are left out: on any one host
 each is one of the fixed orders listed.
 
@@ -36,6 +39,7 @@ from retrokit.host.typecodes import BCD, LOW_BCD, SIGNED, UNSIGNED, FieldType, p
 SEARCH_TYPES: tuple[str, ...] = (
     "|u1", "|i1", "|d1", "|n1",
     ">u2", "<u2", ">i2", "<i2", ">d2", "<d2", ">n2", "<n2",
+    ">u3", "<u3", ">i3", "<i3", ">d3", "<d3",
     ">u4", "<u4", "><u4", "<>u4", ">i4", "<i4", "><i4", "<>i4",
     ">d4", "<d4", "><d4", "<>d4", ">n4", "<n4", "><n4", "<>n4",
     ">d6", ">n6", ">d8", ">n8",

@@ -54,6 +54,7 @@ SCREEN_MAGIC = b"RKS1"
 #: The HTTP status of each kind of error; any other RetrokitError is a 400.
 _STATUS: tuple[tuple[type[errors.RetrokitError], int], ...] = (
     (errors.AccessDeniedError, 403),
+    (errors.PlantedLinkError, 403),
     (errors.UnknownNameError, 404),
     (errors.FileConflictError, 409),
     (errors.RequestTooLargeError, 413),

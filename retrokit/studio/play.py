@@ -63,10 +63,11 @@ def pad_map(system: System) -> dict[str, str]:
 
 def ram_region(layout: RamLayout, system: System) -> dict[str, int]:
     """Where the RAM view and click-to-find start: the system RAM's region (at the descriptor's base; a Game Boy's
-    core maps HRAM and VRAM too), its first :data:`RAM_SHOWN` bytes."""
+    core maps HRAM and VRAM too), its first :data:`RAM_SHOWN` bytes; and the hex digits the page writes an address
+    with, the CLI's and game.yaml's (``0x0300`` on a NES, ``0xFF0000`` on a Genesis), not one width for all."""
     regions = sorted(layout.regions, key=lambda region: region[0] != system.ram_base)  # that region first
     start, size = regions[0] if regions else (system.ram_base, 0)
-    return {"start": start, "length": min(RAM_SHOWN, size)}
+    return {"start": start, "length": min(RAM_SHOWN, size), "digits": layout.digits}
 
 
 def info(session: Session) -> dict[str, Any]:

@@ -62,7 +62,7 @@ def _name(value: object, game: Any) -> str:
 
 def draft_path(game: str, name: str) -> Path:
     """The draft of a game's scenario in the data folder."""
-    return paths.data_dir() / "studio" / "drafts" / game / f"{name}.yaml"
+    return paths.data_path("studio", "drafts", game, f"{name}.yaml")  # never through a planted link
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,9 @@ Routes (under ``/api``):
 - ``GET /search/candidates?limit=N``: groups of candidates, with values per snapshot and live.
 - ``POST /search/poke`` ``{"address", "value", "type"?}``.
 - ``POST /search/field`` ``{"name", "address", "type", "range"?, "force"?}``: add a field to game.yaml.
+- ``POST /search/find`` ``{"name", "changes", "keeps", "kind"?, "value"?, "save"?, "range"?, "force"?}``: play
+  both scripts in turn, filtering after each, until one value is left (:func:`~retrokit.ramsearch.find.find_field`,
+  as ``ramsearch find``); with ``save``, add it as a field. The game waits while the scripts play.
 
 This module also holds the number helpers the other tool modules share:
 :func:`integer_of` and :func:`address_of` (JSON numbers, or hex text as the game files write addresses).
@@ -33,9 +36,12 @@ from starlette.requests import Request
 from starlette.responses import JSONResponse
 from starlette.routing import Route
 
+from retrokit.data.script import parse_script, script_frames
 from retrokit.errors import InvalidArgumentError, RamSearchError, shown
 from retrokit.ramsearch.candidates import Candidate, list_groups
 from retrokit.ramsearch.filters import OPS, THAN_FORMS
+from retrokit.ramsearch.find import MAX_ROUNDS, find_field
+from retrokit.ramsearch.gamefile import check_field_name
 from retrokit.studio.security import check_inside, expect, game_roots, json_body, session_of
 
 if TYPE_CHECKING:
@@ -47,6 +53,9 @@ MAX_ROWS = 100
 MAX_SNAPSHOTS = 64
 """The most snapshots one search of the studio takes: with 100 rows listed, a listing then peaks under 200 MB
 (at 256 snapshots it took 750 MB for 500 rows). A new search starts again from one."""
+MAX_FIND_FRAMES = 36_000
+"""The most frames one round of a find plays in the studio (both scripts: ten minutes of play at 60 a second):
+the game, and every request to it, waits while they run."""
 PUSH_PERIOD = 0.05
 """Seconds between two pushes of a tool's live values: 20 a second, whatever the game's speed."""
 
@@ -210,6 +219,45 @@ def save_field(session: Session, name: object, address: object, type_code: objec
             "range": list(spec.range) if spec.range else None, "path": str(path)}
 
 
+def _find(session: Session, body: dict[str, Any]) -> dict[str, Any]:
+    """Run :func:`find_field` from the game now; say what it left, and add the field found if asked."""
+    search = session.search
+    changes, keeps = expect(body, "changes", str), expect(body, "keeps", str)
+    kind, value = expect(body, "kind", str, "changes"), body.get("value")
+    value = None if value is None else integer_of(value, "the number it becomes")
+    save, force, value_range = expect(body, "save", bool, False), expect(body, "force", bool, False), body.get("range")
+    name = expect(body, "name", str) if save else None
+    if save:
+        check_field_name(name)  # before anything plays: a find is not played twice for a typo
+    rounds = min(MAX_ROUNDS, (MAX_SNAPSHOTS - len(search.labels)) // 2)
+    if rounds < 1:
+        raise RamSearchError(
+            f"Expected room for two snapshots a round; this search has {len(search.labels)} of its {MAX_SNAPSHOTS}. "
+            "Start a new search (POST /api/search/new) from the game now."
+        )
+    per_round = sum(script_frames(parse_script(script, search.buttons)) for script in (changes, keeps))
+    if per_round > MAX_FIND_FRAMES:
+        raise InvalidArgumentError(
+            f"Expected scripts of at most {MAX_FIND_FRAMES:,} frames together in the studio; got {per_round:,}. "
+            "Play longer ones with `retrokit ramsearch find`."
+        )
+    finding = find_field(search, changes, keeps, kind, value, rounds=rounds)
+    session.frame += finding.frames  # the game moved on by them, all at once: the page sees where it is now
+    session.send_screen()
+    session.publish(session.status())
+    answer = {"found": finding.found, "reason": finding.reason, "left": finding.count, "steps": finding.steps,
+              "frames": finding.frames, "rows": [_row(session, g) for g in finding.groups], **_status(session)}  # fmt: skip
+    if finding.found and save:
+        found = finding.candidate
+        answer["field"] = save_field(session, name, found.address, found.type, value_range, force)
+    return answer
+
+
+async def find(request: Request) -> JSONResponse:
+    body = await json_body(request)
+    return JSONResponse(await session_of(request).call(_find, body))
+
+
 async def status(request: Request) -> JSONResponse:
     return JSONResponse(await session_of(request).call(_status))
 
@@ -281,4 +329,5 @@ routes = [
     Route("/search/candidates", candidates, methods=["GET"]),
     Route("/search/poke", poke, methods=["POST"]),
     Route("/search/field", add_field, methods=["POST"]),
+    Route("/search/find", find, methods=["POST"]),
 ]

@@ -41,8 +41,17 @@ export function byId(id) {
   return node;
 }
 
-/** A console address as the CLI writes it: 0xFF002B. */
-export function hex(address, digits = 6) {
+// The hex digits of this console's addresses, as the CLI and game.yaml write them (/api/info's ram.digits: 4 on a
+// NES, 6 on a Genesis), set once the page knows its game.
+let addressDigits = 6;
+
+/** Write addresses of a console whose highest mapped address takes ``digits`` hex digits. */
+export function setAddressDigits(digits) {
+  addressDigits = digits;
+}
+
+/** A console address as the CLI writes it: 0xFF002B on a Genesis, 0x0300 on a NES. */
+export function hex(address, digits = addressDigits) {
   return "0x" + Number(address).toString(16).toUpperCase().padStart(digits, "0");
 }
 

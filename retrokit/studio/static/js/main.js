@@ -3,7 +3,7 @@
 // and leaves the others working.
 
 import { get } from "./api.js";
-import { byId } from "./dom.js";
+import { byId, setAddressDigits } from "./dom.js";
 import * as play from "./play.js";
 import * as socket from "./socket.js";
 import { say } from "./status.js";
@@ -41,6 +41,7 @@ async function boot() {
   }
   document.title = `${info.game} · retrokit studio`;
   byId("game-name").textContent = `${info.game} (${info.system})`;
+  setAddressDigits(info.ram.digits);
   play.init(info);
   // The panels start at once, not one after the other: each waits for its own answers from the server, and in
   // turn they kept the page from being ready for the sum of those waits.

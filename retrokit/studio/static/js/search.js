@@ -134,6 +134,36 @@ async function addField() {
   return `Wrote field ${answer.name} (${answer.hex}, ${answer.type}${range}) into ${answer.path}.`;
 }
 
+/** Find a field in one go (POST /search/find, as `retrokit ramsearch find`): play what changes it and what keeps
+ * it, in turn, filtering after each, until one value is left; it fills "add as field", or is added if asked. */
+async function find() {
+  const name = byId("find-name").value.trim();
+  const kind = byId("find-kind").value;
+  const body = { name, changes: byId("find-changes").value, keeps: byId("find-keeps").value, kind };
+  if (kind === "becomes") body.value = parseNumber(byId("find-value").value, "number it becomes");
+  if (byId("find-save").checked) {
+    const lo = parseNumber(byId("field-lo").value, "range's low end");
+    const hi = parseNumber(byId("field-hi").value, "range's high end");
+    if ((lo === null) !== (hi === null)) throw new Error("Expected both ends of the range, or neither.");
+    Object.assign(body, { save: true, force: byId("field-force").checked }, lo === null ? {} : { range: [lo, hi] });
+  }
+  const answer = await post("search/find", body);
+  showStatus(answer);
+  await list();
+  if (!answer.found) {
+    throw new Error(`Expected one value left; ${answer.reason} (${answer.left.toLocaleString("en")} candidates).`);
+  }
+  const found = answer.rows[0];
+  Object.assign(byId("field-name"), { value: name });
+  Object.assign(byId("field-address"), { value: found.hex });
+  Object.assign(byId("field-type"), { value: found.type });
+  const said = `Found ${name || "it"}: ${found.hex} ${found.type} (${answer.reason}).`;
+  if (!answer.field) return said;
+  refreshWatch();
+  const range = answer.field.range ? `, range [${answer.field.range.join(", ")}]` : "";
+  return `${said} Wrote field ${answer.field.name} (${answer.field.hex}, ${answer.field.type}${range}) into ${answer.field.path}.`;
+}
+
 async function poke() {
   const value = parseNumber(byId("poke-value").value, "value");
   if (value === null) throw new Error("Expected a value to poke.");
@@ -170,6 +200,17 @@ export async function init(info) {
     el("div", { class: "scroll" }, el("table", { id: "search-table" },
       el("thead", {}, el("tr", {}, ["address", "type", "scale", "changes", "values at snapshots", "now"].map((h) => el("th", {}, h)))),
       el("tbody", { id: "search-rows" }))),
+    el("h3", {}, "Find a field"),
+    el("form", { id: "find-form", class: "row", title: "Plays both scripts in turn from the game now, filtering after each, until one value is left" },
+      el("label", {}, "play ", el("input", { id: "find-changes", size: 14, placeholder: "RIGHT*200", "aria-label": "a script that changes the field" })),
+      el("label", {}, "which ", el("select", { id: "find-kind" },
+        ["decreases", "increases", "changes", "becomes"].map((kind) => el("option", { value: kind }, kind)))),
+      el("input", { id: "find-value", size: 5, placeholder: "N", hidden: true, "aria-label": "the number it becomes" }),
+      el("label", {}, " it; then ", el("input", { id: "find-keeps", size: 10, placeholder: "_*130", "aria-label": "a script that keeps the field" })),
+      el("label", {}, " keeps it; name ", el("input", { id: "find-name", size: 10, placeholder: "lives" })),
+      el("label", { title: "Add it to game.yaml, with the range and replace boxes below" },
+        el("input", { type: "checkbox", id: "find-save" }), " add as field"),
+      el("button", { type: "submit", id: "find" }, "Find")),
     el("h3", {}, "Add as field (game.yaml)"),
     el("form", { id: "field-form", class: "row" },
       el("label", {}, "name ", el("input", { id: "field-name", size: 12, placeholder: "lives" })),
@@ -210,6 +251,8 @@ export async function init(info) {
     }, (line) => line));
   }
   attemptOnSubmit(byId("field-form"), addField, (line) => line);
+  attemptOnSubmit(byId("find-form"), find, (line) => line);
+  byId("find-kind").addEventListener("change", () => { byId("find-value").hidden = byId("find-kind").value !== "becomes"; });
   attemptOnSubmit(byId("poke-form"), poke, (line) => line);
 
   // Live values of the listed rows; a changed value flashes.

@@ -24,7 +24,7 @@ EXAMPLES = [
 
 def register(subparsers: argparse._SubParsersAction) -> None:
     """Add the ``train`` command."""
-    from retrokit.learning.trainrun import DEFAULT_CHECKPOINT_SECONDS
+    from retrokit.learning import DEFAULT_CHECKPOINT_SECONDS
 
     parser = subparsers.add_parser(
         "train",

@@ -22,3 +22,7 @@ from __future__ import annotations
 from retrokit.lazy import lazy_names
 
 __getattr__ = lazy_names(__name__)  # its submodules, on first use: retrokit.learning.<module>
+
+#: Seconds between ``retrokit train``'s checkpoints, its ``--checkpoint-every`` default: kept here, where the
+#: command's parser reads it without importing the training stack (``retrokit --help`` stays light).
+DEFAULT_CHECKPOINT_SECONDS = 600.0

@@ -35,6 +35,7 @@ from retrokit.benchmark.definition import Benchmark, Level
 from retrokit.benchmark.monitor import Episode
 from retrokit.benchmark.rundir import LOCK_FILE, check_same_settings, claim_folder, unlock_folder
 from retrokit.errors import FileSystemError, RunFolderError
+from retrokit.learning import DEFAULT_CHECKPOINT_SECONDS
 from retrokit.learning.config import AgentConfig
 from retrokit.learning.policy import MAX_WEIGHTS_BYTES, SavedPolicy, write_policy
 from retrokit.learning.task import learning_task
@@ -48,7 +49,6 @@ OUTPUTS = (RUN_FILE, CURVE_FILE, CURVE_PLOT, "policy.json", CHECKPOINT_DIR)
 CURVE_COLUMNS = ("timesteps", "level", "episode", "steps", "reward", "wall")
 MAX_RUN_FILE_BYTES = 1 << 20
 MAX_CURVE_BYTES = 32 << 20  # about 50 bytes an episode: 600,000 episodes, and read back whole in far under 500 MB
-DEFAULT_CHECKPOINT_SECONDS = 600.0
 
 
 @dataclass(frozen=True)

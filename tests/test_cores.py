@@ -38,6 +38,18 @@ def test_two_copies_of_one_core_are_independent(tmp_path) -> None:
     b.close()
 
 
+def test_an_empty_override_leaves_a_declared_option_unanswered(tmp_path) -> None:
+    """A descriptor's null option: the core is told nothing, as by stable-retro's frontend (the PC Engine's turbo
+    delay; that the core then keeps its own fallback shows in tests/test_pcecart.py)."""
+    core = next(p for p in CORES if p.name.startswith("mednafen_pce_fast"))
+    emu = _host.Emulator(str(core), str(tmp_path), str(tmp_path), {"pce_Turbo_Delay": ""})
+    try:
+        _, value, allowed = emu.options()["pce_Turbo_Delay"]
+        assert value == "" and "Fast" in allowed
+    finally:
+        emu.close()
+
+
 @pytest.mark.parametrize("options", [{"\udc80": "x"}, {"key": "\udc80"}], ids=["key", "value"])
 def test_an_option_utf8_cannot_hold_raises_instead_of_crashing(tmp_path, options: dict[str, str]) -> None:
     with pytest.raises(UnicodeEncodeError):

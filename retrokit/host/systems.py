@@ -60,7 +60,8 @@ class System:
         ram_swap: The word size of the RAM buffer's byte swap (1: none).
         buttons: The console's name for each RetroPad id, ``None`` where unused.
         types: The type codes integrations of this system usually use.
-        options: Core option defaults for this system.
+        options: Core option defaults for this system; ``""`` (``null`` in the descriptor) leaves
+            the option unanswered, so the core keeps the value it falls back to.
         actions: Gym Retro's default groups of button combinations.
         screen: ``(height, width)`` of observations, or ``None`` for the first frame's.
         frame_rates: The console's frames per second, by video standard (``"ntsc"``,
@@ -241,7 +242,7 @@ def _parse(name: str, entry: object) -> System:
             ram_swap=int(ram.get("swap", 1)),
             buttons=tuple(entry["buttons"]),
             types=tuple(entry.get("types", ())),
-            options={str(k): str(v) for k, v in (entry.get("options") or {}).items()},
+            options={str(k): "" if v is None else str(v) for k, v in (entry.get("options") or {}).items()},
             actions=tuple(tuple(tuple(combo) for combo in group) for group in entry.get("actions", ())),
             screen=tuple(entry["screen"]) if "screen" in entry else None,
             aliases=tuple(entry.get("aliases", ())),

@@ -26,7 +26,7 @@ enum { RK_VIDEO_ALL, RK_VIDEO_LAST, RK_VIDEO_NONE };
 typedef struct {
     char *key;
     char *desc;
-    char *value;   /* current value, always a valid string */
+    char *value;   /* current value, always a valid string; "" when left unanswered */
     char **allowed;
     int n_allowed;
 } rk_option;

@@ -94,6 +94,10 @@ static void add_option(rk_core *core, const char *key, const char *desc, const c
     const char *value = default_value ? default_value : (n > 0 ? values[0] : "");
     const char *wanted = find_override(core, key);
     if (wanted && option_allows(o, wanted)) value = wanted;
+    /* An empty override leaves the option unanswered (get_variable says so), as a frontend
+     * that answers no option does: some cores fall back to a value none of their own
+     * declares (mednafen_pce_fast's turbo delay stays 0 under stable-retro). */
+    else if (wanted && !*wanted) value = "";
     o->value = strdup(value);
 }
 
@@ -184,11 +188,11 @@ static bool get_variable(rk_core *core, struct rk_retro_variable *var) {
     rk_option *o = var->key ? find_option(core, var->key) : NULL;
     if (o) {
         var->value = o->value;
-        return true;
+        return option_allows(o, o->value); /* false when left unanswered (add_option) */
     }
     const char *wanted = var->key ? find_override(core, var->key) : NULL;
     var->value = wanted ? wanted : "";
-    return wanted != NULL;
+    return wanted != NULL && *wanted;
 }
 
 static void set_memory_maps(rk_core *core, const struct rk_retro_memory_map *map) {

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import resource
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -22,9 +23,9 @@ from retrokit.host.child import Child
 MODULE = "house_child"
 CHILD = """
 import json, os, resource, subprocess, sys, time
-from retrokit.host.child import answer_channel
+from retrokit.host.child import answer_channel, read_request
 
-request = json.load(sys.stdin)
+request = read_request()
 answer = answer_channel(request)
 if request["do"] == "limits":
     limits = {"as": resource.getrlimit(resource.RLIMIT_AS), "core": resource.getrlimit(resource.RLIMIT_CORE)}
@@ -33,6 +34,10 @@ elif request["do"] == "hang":  # a grandchild in its group, then silence
     sleeper = subprocess.Popen(["sleep", "600"])
     answer.write(b"%d\\n" % sleeper.pid)
     time.sleep(600)
+elif request["do"] == "spin":  # a core looping on a state, the GIL held between its steps
+    answer.write(b"%d\\n" % os.getpid())
+    while True:
+        pass
 elif request["do"] == "fail":
     print("first words\\nlast words", file=sys.stderr)
     sys.exit(5)
@@ -156,3 +161,38 @@ def test_a_child_whose_answers_were_not_all_read_still_ends(child_module: Path) 
         end = child.end()  # not one answer read: the child writes megabytes of log first
         rescue.cancel()
     assert (end.status, end.hung, end.last_words) == (0, False, "last \ufffd words")
+
+
+def test_a_child_ends_when_its_parent_is_killed(child_module: Path) -> None:
+    """A parent killed while its child spins (SIGKILL: no ``with`` block ends it) leaves no child spinning on.
+
+    The child leads a session of its own, so the kill reaches only the parent; the child's watch of its parent
+    ends it within a second or so (it once spun for 76 minutes under a killed test).
+    """
+    parent = subprocess.Popen(
+        [sys.executable, "-c", f"""
+import sys
+from retrokit.host.child import Child
+with Child({MODULE!r}, {{"do": "spin"}}, memory=1 << 30) as child:
+    print(next(child.lines(first=120)).decode().strip(), flush=True)
+    import time; time.sleep(600)
+"""], stdout=subprocess.PIPE, text=True)
+    try:
+        pid = int(parent.stdout.readline())
+        assert alive(pid)
+    finally:
+        parent.kill()
+        parent.wait()
+    deadline = time.monotonic() + 60  # a generous bound for a loaded machine: the watch looks twice a second
+    while alive(pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not alive(pid), f"the child {pid} spins on after its parent was killed"
+
+
+def alive(pid: int) -> bool:
+    """Whether ``pid`` runs (a zombie its new parent has not reaped yet counts as ended)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (FileNotFoundError, ProcessLookupError):
+        return False
+    return state not in ("Z", "X")

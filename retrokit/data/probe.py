@@ -377,12 +377,12 @@ def _child_main() -> int:
     import random
 
     from retrokit.data.states import read_state, state_format
-    from retrokit.host.child import answer_channel
+    from retrokit.host.child import answer_channel, read_request
     from retrokit.host.emulator import Emulator
     from retrokit.host.fields import FieldSpec
     from retrokit.host.memory import FieldReader
 
-    request = json.load(sys.stdin)  # its limits are set by now (retrokit.host.child)
+    request = read_request()  # its limits are set by now (retrokit.host.child)
     answer = answer_channel(request)
     emu = Emulator(request["system"], request["rom"])
     specs = [FieldSpec(f["name"], f["address"], f["type"], f["mask"]) for f in request["fields"]]

@@ -11,18 +11,18 @@ emulator, and the emulator vets its core through corecheck.
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
 from retrokit.errors import RetrokitError
+from retrokit.host.child import read_request
 from retrokit.host.corecheck import PROBE_FRAMES, REFUSED, mark_probing
 from retrokit.host.emulator import Emulator
 
 
 def main() -> int:
     """Open the emulator with the request's core, run the frames; exit 0, or REFUSED on retrokit's error."""
-    request = json.load(sys.stdin)
+    request = read_request()  # ends it if the process that asked is killed
     system, rom, core = str(request["system"]), str(request["rom"]), str(request["core"])
     mark_probing(Path(core))  # this process is the probe: it loads the core unvetted
     try:

@@ -8,9 +8,19 @@ import subprocess
 from pathlib import Path
 from typing import Any
 
+import yaml
 from incli import retrokit_in_process
 
+from retrokit.learning.config import load_config
+
 LEVEL = "Zone1.Act2"
+
+
+def tiny_config(folder: Path, agent: str, changes: dict[str, Any]) -> Path:
+    """``agent``'s shipped ``quick`` config with a tiny budget's ``changes``, written as ``folder/tiny.yaml``."""
+    path = folder / "tiny.yaml"
+    path.write_text(yaml.safe_dump({**load_config(agent, "quick").values, **changes}))
+    return path
 
 
 def evaluate(folder: Path, agent: str, timesteps: int, out: str, *args: str) -> subprocess.CompletedProcess:

@@ -16,9 +16,8 @@ import time
 from pathlib import Path
 
 import pytest
-import yaml
 from incli import retrokit_in_process
-from learningruns import evaluate, evaluate_three_ways
+from learningruns import evaluate, evaluate_three_ways, tiny_config
 
 pytest.importorskip(
     "stable_baselines3",
@@ -28,7 +27,6 @@ pytest.importorskip(
 
 from retrokit.benchmark.definition import load_benchmark
 from retrokit.benchmark.level import LevelDone, LevelTask, run_level
-from retrokit.learning.config import load_config
 from retrokit.learning.policy import read_policy
 from retrokit.learning.setup import prepare
 
@@ -43,9 +41,7 @@ def folder(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="module")
 def tiny(folder) -> Path:
-    path = folder / "tiny.yaml"
-    path.write_text(yaml.safe_dump({**load_config("ppo", "quick").values, **TINY}))
-    return path
+    return tiny_config(folder, "ppo", TINY)
 
 
 @pytest.fixture(scope="module")

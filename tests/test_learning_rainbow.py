@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 import yaml
 from incli import retrokit_in_process
-from learningruns import evaluate_three_ways
+from learningruns import evaluate_three_ways, tiny_config
 
 from retrokit.errors import AgentConfigError
 from retrokit.learning.config import CONFIG_DIR, load_config
@@ -148,9 +148,7 @@ def folder(tmp_path_factory) -> Path:
 
 @pytest.fixture(scope="module")
 def tiny(tianshou, folder) -> Path:
-    path = folder / "tiny.yaml"
-    path.write_text(yaml.safe_dump({**load_config("rainbow", "quick").values, **TINY}))
-    return path
+    return tiny_config(folder, "rainbow", TINY)
 
 
 @pytest.fixture(scope="module")

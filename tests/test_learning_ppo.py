@@ -81,12 +81,18 @@ def test_evaluate_learns_from_scratch_and_from_the_trained_policy(folder, tiny, 
         assert setup["paper_agent"] == {"scratch": "PPO", "from-folder": "Joint PPO", "zero-shot": None}[out]
         if setup["init"]:
             assert setup["init"]["weights_sha256"] == read_policy(trained).sha256
-    # --resume refuses another config or start policy
+    # --resume refuses another config, or the same start policy played without learning (an option left out is
+    # no change: it is taken from the run folder, below)
     other = folder / "tiny-other.yaml"
     other.write_text(tiny.read_text().replace("entropy: 0.01", "entropy: 0.02"))
-    for args in (("--agent-config", str(other), "--init", str(trained)), ("--agent-config", str(tiny))):
+    for args in (("--agent-config", str(other), "--init", str(trained)),
+                 ("--agent-config", str(tiny), "--init", str(trained / "policy.json"), "--no-learn")):
         done = _evaluate(folder, "from-folder", *args, "--resume")
         assert done.returncode == 2 and "agent_setup differ" in done.stderr, done.stderr
+    # `--out DIR --resume` alone takes the config, the start policy and --no-learn from the run folder
+    for out in ("scratch", "from-folder", "zero-shot"):
+        done = retrokit_in_process(folder, "evaluate", "--out", str(folder / out), "--resume", "--no-progress")
+        assert done.returncode == 0, done.stderr
 
 
 def test_zero_shot_never_updates_the_policy(folder, tiny, trained, monkeypatch) -> None:

@@ -116,6 +116,15 @@ def _resumed(args: argparse.Namespace) -> None:
     for option, key in (("timesteps", "budget"), ("seed", "seed")):
         if getattr(args, option) is None and isinstance(settings.get(key), int):
             setattr(args, option, settings[key])
+    setup = settings.get("agent_setup")
+    if isinstance(setup, dict):  # a learning agent's run: its config, its start policy, whether it learned
+        config, init = setup.get("config"), setup.get("init")
+        if args.agent_config is None and isinstance(config, dict) and isinstance(config.get("name"), str):
+            args.agent_config = config["name"]  # a shipped config's name or the user's file, read (and checked) again
+        if args.init is None and isinstance(init, dict) and isinstance(init.get("policy"), str):
+            args.init = init["policy"]
+        if setup.get("learn") is False:
+            args.no_learn = True
 
 
 def run(args: argparse.Namespace) -> int:

@@ -69,6 +69,17 @@ class Key:
         return None
 
 
+#: The keys of what every learning agent's learner sees (:mod:`.task`): its reward's scale and its frames. Each
+#: algorithm's table holds them, from here, so PPO and Rainbow cannot drift apart on them.
+VIEW_KEYS: dict[str, Key] = {
+    "reward_scale": Key(float, "what the learner's reward (the max-x reward) is multiplied by", 1e-9, 1e6),
+    "frame_size": Key(int, "the side of the square frames the network sees, in pixels", 36, 256),
+    "frame_stack": Key(int, "the frames stacked in an observation", 1, 16),
+    "grayscale": Key(bool, "whether the frames are gray (else RGB)"),
+    "network": Key(str, "the network", choices=("nature_cnn",)),
+}
+
+
 def require_libraries(agent: str, modules: dict[str, str]) -> None:
     """Raise :class:`~retrokit.errors.MissingExtraError` unless each module (import name: shown name) imports.
 

@@ -23,7 +23,7 @@ from functools import partial
 from typing import TYPE_CHECKING, Any
 
 from retrokit.errors import PolicyFileError
-from retrokit.learning.algorithms import Key, require_libraries
+from retrokit.learning.algorithms import VIEW_KEYS, Key, require_libraries
 from retrokit.learning.task import image_options
 
 if TYPE_CHECKING:
@@ -47,11 +47,7 @@ KEYS: dict[str, Key] = {
     "value_coef": Key(float, "the value loss's coefficient (vf_coef)", 0.0, 100.0),
     "max_grad_norm": Key(float, "the gradients' clipping norm", 0.0, 1e6),
     "learning_rate": Key(float, "Adam's step size", 1e-9, 1.0),
-    "reward_scale": Key(float, "what the learner's reward (the max-x reward) is multiplied by", 1e-9, 1e6),
-    "frame_size": Key(int, "the side of the square frames the network sees, in pixels", 36, 256),
-    "frame_stack": Key(int, "the frames stacked in an observation", 1, 16),
-    "grayscale": Key(bool, "whether the frames are gray (else RGB)"),
-    "network": Key(str, "the network", choices=("nature_cnn",)),
+    **VIEW_KEYS,
     "train_envs_per_level": Key(int, "the envs of each training level that retrokit train runs", 1, 64),
 }
 

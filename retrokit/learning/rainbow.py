@@ -34,7 +34,7 @@ import gymnasium
 import numpy as np
 
 from retrokit.errors import InvalidArgumentError
-from retrokit.learning.algorithms import Key, require_libraries
+from retrokit.learning.algorithms import VIEW_KEYS, Key, require_libraries
 from retrokit.learning.task import TaskView, image_options
 
 if TYPE_CHECKING:
@@ -68,11 +68,7 @@ KEYS: dict[str, Key] = {
     "target_update": Key(int, "the agent steps between copies of the target network", 1, 1 << 40),
     "learning_starts": Key(int, "the transitions in the replay before the first update", 1, 1 << 40),
     "update_every": Key(int, "the agent steps of an env between updates", 1, 1 << 20),
-    "reward_scale": Key(float, "what the learner's reward (the max-x reward) is multiplied by", 1e-9, 1e6),
-    "frame_size": Key(int, "the side of the square frames the network sees, in pixels", 36, 256),
-    "frame_stack": Key(int, "the frames stacked in an observation", 1, 16),
-    "grayscale": Key(bool, "whether the frames are gray (else RGB)"),
-    "network": Key(str, "the network", choices=("nature_cnn",)),
+    **VIEW_KEYS,
     "train_envs": Key(int, "the envs retrokit train steps, each drawing a training level per episode", 1, 256),
 }
 

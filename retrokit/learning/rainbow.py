@@ -141,15 +141,8 @@ def build(config: Mapping[str, Any], shape: tuple[int, ...], actions: int) -> Le
     from tianshou.algorithm.modelfree.c51 import C51Policy
     from tianshou.algorithm.modelfree.rainbow import RainbowDQN
     from tianshou.algorithm.optim import AdamOptimizerFactory
-    from tianshou.env.atari.atari_network import RainbowNet, ScaledObsInputActionReprNet
 
-    channels, height, width = shape
-    network = ScaledObsInputActionReprNet(RainbowNet(
-        c=channels, h=height, w=width, action_shape=[actions], num_atoms=config["atoms"],
-        noisy_std=config["noisy_sigma0"], is_dueling=config["dueling"], is_noisy=config["noisy"],
-    ))  # fmt: skip
-    if config["noisy"]:
-        _act_noisily(network)
+    network = build_network(config, shape, actions)
     policy = C51Policy(model=network, action_space=gymnasium.spaces.Discrete(actions), num_atoms=config["atoms"],
                        v_min=config["v_min"], v_max=config["v_max"])
     algorithm = RainbowDQN(
@@ -159,6 +152,24 @@ def build(config: Mapping[str, Any], shape: tuple[int, ...], actions: int) -> Le
         target_update_freq=max(1, round(config["target_update"] / config["update_every"])),
     )  # fmt: skip
     return Learner(network, policy, algorithm)
+
+
+def build_network(config: Mapping[str, Any], shape: tuple[int, ...], actions: int) -> Any:  # a torch.nn.Module
+    """Hessel et al.'s network of ``config`` (Tianshou's ``RainbowNet``, its input scaled from bytes), noisy when acting.
+
+    The one network of every Rainbow: the local one's, and the layers of the RLlib module
+    (:mod:`retrokit.learning.rllib_rainbow`), so that a policy trained on either loads in the other.
+    """
+    from tianshou.env.atari.atari_network import RainbowNet, ScaledObsInputActionReprNet
+
+    channels, height, width = shape
+    network = ScaledObsInputActionReprNet(RainbowNet(
+        c=channels, h=height, w=width, action_shape=[actions], num_atoms=config["atoms"],
+        noisy_std=config["noisy_sigma0"], is_dueling=config["dueling"], is_noisy=config["noisy"],
+    ))  # fmt: skip
+    if config["noisy"]:
+        _act_noisily(network)
+    return network
 
 
 def _act_noisily(network: Any) -> None:  # a torch.nn.Module
@@ -188,7 +199,7 @@ def _noisy_forward(layer: Any, x: Any) -> Any:  # a NoisyLinear, a tensor -> a t
     return functional.linear(x, layer.mu_W, layer.mu_bias) + noise * layer.eps_q
 
 
-def _draw_noise(network: Any) -> None:  # a torch.nn.Module
+def draw_noise(network: Any) -> None:  # a torch.nn.Module
     """Draw new noise for every noisy layer of ``network``."""
     from tianshou.utils.net.discrete import NoisyLinear
 
@@ -205,6 +216,25 @@ def replay_bytes(config: Mapping[str, Any], size: int) -> int:
     return size * (frame * (1 if stacked else config["frame_stack"]) + TRANSITION_EXTRA_BYTES)
 
 
+def check_replay_fits(transitions: int, needed: int, where: str = "") -> None:
+    """Refuse a replay of ``transitions`` that takes ``needed`` bytes if the memory available is less.
+
+    It fills as the agent plays: refused now, not killed by the system hours later.
+
+    Raises:
+        InvalidArgumentError: It would not fit; ``where`` says where it lives, if not in this process.
+    """
+    from retrokit.envs.memory import available_memory
+
+    room = available_memory()
+    if room is not None and needed > room:
+        raise InvalidArgumentError(
+            f"Expected Rainbow's replay of {transitions:,} transitions{where} to fit in memory: it takes "
+            f"{needed / 2**30:,.1f} GiB, and {max(room, 0) / 2**30:,.1f} GiB are available; use a config with a "
+            "smaller replay (quick.yaml keeps 100,000), or a machine with more memory."
+        )
+
+
 def replay(config: Mapping[str, Any], envs: int, size: int | None = None) -> Any:  # a tianshou buffer
     """The prioritized replay: each gray frame stored once, as bytes, the stacks rebuilt when sampled.
 
@@ -214,17 +244,9 @@ def replay(config: Mapping[str, Any], envs: int, size: int | None = None) -> Any
     """
     from tianshou.data import PrioritizedVectorReplayBuffer
 
-    from retrokit.envs.memory import available_memory
-
     stacked = config["grayscale"] and config["frame_stack"] > 1
     total = max(envs, size or config["replay"])
-    needed, room = replay_bytes(config, total), available_memory()
-    if room is not None and needed > room:
-        raise InvalidArgumentError(
-            f"Expected Rainbow's replay of {total:,} transitions to fit in memory: it takes {needed / 2**30:,.1f} "
-            f"GiB, and {max(room, 0) / 2**30:,.1f} GiB are available; use a config with a smaller replay "
-            "(quick.yaml keeps 100,000), or a machine with more memory."
-        )
+    check_replay_fits(total, replay_bytes(config, total))
     return PrioritizedVectorReplayBuffer(
         total, buffer_num=envs, ignore_obs_next=True, save_only_last_obs=stacked,
         stack_num=config["frame_stack"] if stacked else 1, alpha=config["priority_alpha"],
@@ -266,7 +288,7 @@ def run_steps(learner: Learner, collector: Any, buffer: Any, config: Mapping[str
         collector.collect(n_step=config["update_every"] * envs)
         steps += config["update_every"] * envs
         if not learn and config["noisy"]:
-            _draw_noise(learner.network)  # zero-shot: new noise as often as updates would draw it
+            draw_noise(learner.network)  # zero-shot: new noise as often as updates would draw it
         if learn and len(buffer) >= config["learning_starts"]:
             with policy_within_training_step(learner.policy), torch_train_mode(learner.policy):
                 for _ in range(envs):

@@ -46,6 +46,16 @@ def test_every_key_of_a_rainbow_config_is_mapped() -> None:
     assert list(rr.MAPPING) == list(rainbow.KEYS)
 
 
+def test_the_docs_map_every_key() -> None:
+    """docs/learning.md's "Rainbow on Ray" table names every key of the config."""
+    from pathlib import Path
+
+    text = (Path(__file__).parent.parent / "docs" / "learning.md").read_text()
+    section = text.split("## Rainbow on Ray")[1].split("\n## ")[0]
+    table = [line for line in section.splitlines() if line.startswith("| `")]
+    assert [key for key in rainbow.KEYS if not any(f"`{key}`" in line.split(" | ")[0] for line in table)] == []
+
+
 def test_paper_config_is_rllibs_dqn_as_the_local_rainbow(roomy) -> None:
     from ray.rllib.algorithms.dqn.dqn import calculate_rr_weights
 
@@ -96,13 +106,53 @@ def test_a_replay_that_does_not_fit_is_refused(monkeypatch) -> None:
 
 
 @pytest.mark.parametrize(("config", "runners", "envs", "error", "message"), [
-    ("ppo", 1, 1, AgentConfigError, "Expected a rainbow config"),
+    ("ppo", 1, 1, AgentConfigError, "Expected only keys of a rainbow config"),
     ("rainbow", -1, 1, InvalidArgumentError, "got -1 and 1"),
     ("rainbow", 2, 0, InvalidArgumentError, "got 2 and 0"),
 ], ids=["ppo-config", "negative-runners", "no-envs"])
 def test_wrong_arguments_are_one_line(roomy, config, runners, envs, error, message) -> None:
     with pytest.raises(error) as caught:
         rr.algorithm_config(load_config(config).values, ENV, runners, envs, 0)
+    assert message in str(caught.value) and "\n" not in str(caught.value)
+
+
+@pytest.mark.parametrize("change", [{}, {"noisy": False}, {"dueling": False}, {"noisy": False, "dueling": False}],
+                         ids=["rainbow", "plain-heads", "one-stream", "plain-one-stream"])
+def test_the_module_is_the_local_network(change) -> None:
+    """Built alone (no Ray), the module's network is the local Rainbow's, key for key, and gives its
+    distributions, whatever the heads; its logits are the ones RLlib's loss takes."""
+    import gymnasium
+    import torch
+    from ray.rllib.core.columns import Columns
+
+    from retrokit.learning.rllib_rainbow_module import CONFIG, RainbowModule
+
+    config = {**tiny(), **change}
+    space = gymnasium.spaces.Box(0, 255, (4, 36, 36), np.uint8)
+    module = RainbowModule(observation_space=space, action_space=gymnasium.spaces.Discrete(7), inference_only=False,
+                           model_config={CONFIG: config})
+    local = rainbow.build(config, space.shape, 7)
+    weights = io.BytesIO()
+    torch.save(module.network.state_dict(), weights)
+    rainbow.load_weights(local, weights.getvalue(), "the module's weights")
+    obs = np.random.default_rng(5).integers(0, 256, (3, *space.shape), dtype=np.uint8)
+    with torch.no_grad():
+        out = module.compute_q_values({Columns.OBS: torch.as_tensor(obs)})
+        ours = local.network(obs)[0].numpy()
+    np.testing.assert_allclose(out["qf_probs"].numpy(), ours, rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(torch.softmax(out["qf_logits"], -1).numpy(), ours, rtol=1e-5, atol=1e-6)
+    atoms = np.linspace(config["v_min"], config["v_max"], config["atoms"])
+    np.testing.assert_allclose(out["qf_preds"].numpy(), (ours * atoms).sum(-1), rtol=1e-4, atol=1e-5)
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    ({"v_min": 300.0}, "v_min (300) must be below v_max (200)"),
+    ({"atoms": 1}, "atoms in the rainbow config"),
+    ({"replay": 1e30}, "replay in the rainbow config"),
+], ids=["empty-support", "one-atom", "huge-replay"])
+def test_a_wrong_value_is_refused_as_the_loader_refuses_it(roomy, change, message) -> None:
+    with pytest.raises(AgentConfigError) as caught:
+        rr.algorithm_config({**load_config("rainbow").values, **change}, ENV, 1, 1, 0)
     assert message in str(caught.value) and "\n" not in str(caught.value)
 
 

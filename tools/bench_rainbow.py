@@ -7,11 +7,14 @@ stacked) and prints its steps per second and its ratio to the bare env's (random
 - ``tianshou acting``: Tianshou's Rainbow choosing every action (Hessel et al.'s network), no updates;
 - ``tianshou learning``: the same with an update of 32 transitions every 4 steps (the paper's ratio);
 - with ``--rllib``: RLlib's DQN with the Rainbow settings (51 atoms, noisy, dueling, double Q, 3-step,
-  prioritized replay), its env runner in this process, before and after learning starts.
+  prioritized replay), its env runner in this process, before and after learning starts;
+- with ``--ray``: retrokit's RLlib Rainbow (:mod:`retrokit.learning.rllib_rainbow`, ``train --backend ray``'s:
+  the local Rainbow's network in RLlib's DQN) on a local 2-CPU Ray, one env runner (a Ray actor), before and
+  after learning starts.
 
 The rates follow the machine and its load; the ratios carry over better. docs/learning.md has a run's figures.
 
-    python tools/bench_rainbow.py --steps 1000 [--rllib]
+    python tools/bench_rainbow.py --steps 1000 [--rllib] [--ray]
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ from __future__ import annotations
 import argparse
 import os
 import resource
+import sys
 import time
 
 import numpy as np
@@ -101,7 +105,11 @@ def bench_rllib(steps: int) -> tuple[float, float]:
         .reporting(min_sample_timesteps_per_iteration=steps // 4)
         .debugging(seed=0)
     )  # fmt: skip
-    algo = config.build_algo()
+    return rllib_rates(config.build_algo(), steps)
+
+
+def rllib_rates(algo, steps: int) -> tuple[float, float]:
+    """Train ``algo`` (learning from ``steps`` on) for twice ``steps``: (steps/s before learning, after); stop it."""
     try:
         marks = [(time.perf_counter(), 0)]
         while marks[-1][1] < 2 * steps:
@@ -114,17 +122,39 @@ def bench_rllib(steps: int) -> tuple[float, float]:
             rate(marks[-1][1] - learning[1], marks[-1][0] - learning[0]))
 
 
+def bench_ray(steps: int) -> tuple[float, float]:
+    """retrokit's RLlib Rainbow (rllib_rainbow) on a local 2-CPU Ray, one env runner: (before learning, after)."""
+    import ray
+    from ray import cloudpickle
+    from ray.tune.registry import register_env
+
+    from retrokit.learning import rllib_rainbow
+
+    config = {**load_config("rainbow").values, "learning_starts": steps, "replay": 4 * steps}
+    ray.init(address="local", num_cpus=2, include_dashboard=False, log_to_driver=False, logging_level="ERROR")
+    try:
+        cloudpickle.register_pickle_by_value(sys.modules[__name__])  # the env runner cannot import this script
+        register_env("dasher-rainbow-ray", lambda _: dasher_env())
+        dqn = rllib_rainbow.algorithm_config(config, "dasher-rainbow-ray", 1, 1, 0)
+        return rllib_rates(dqn.reporting(min_sample_timesteps_per_iteration=steps // 4).build_algo(), steps)
+    finally:
+        ray.shutdown()
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=1000, help="steps a phase (default: 1000)")
     parser.add_argument("--rllib", action="store_true", help="also RLlib's DQN with the Rainbow settings")
+    parser.add_argument("--ray", action="store_true",
+                        help="also retrokit's RLlib Rainbow (train --backend ray's) on a local 2-CPU Ray")
     args = parser.parse_args()
     torch.manual_seed(0)
-    print(f"{os.cpu_count()} CPUs, load {os.getloadavg()[0]:.1f}, torch threads {torch.get_num_threads()}", flush=True)
+    print(f"{os.cpu_count()} CPUs, /proc/loadavg {loadavg()}, torch threads {torch.get_num_threads()}", flush=True)
     base = bench_env(args.steps)
 
     def show(name: str, value: float) -> None:  # as each phase ends: a long RLlib phase keeps what came before
-        print(f"{name:24s} {value:8.1f} steps/s  {value / base:6.3f} x the env", flush=True)
+        print(f"{name:24s} {value:8.1f} steps/s  {value / base:6.3f} x the env  (load {os.getloadavg()[0]:.1f})",
+              flush=True)
 
     show("env (random actions)", base)
     show("tianshou acting", bench_tianshou(args.steps, learn=False))
@@ -134,7 +164,21 @@ def main() -> None:
         sampling, learning = bench_rllib(args.steps)
         show("rllib acting", sampling)
         show("rllib learning", learning)
-    print(f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB, load {os.getloadavg()[0]:.1f}")
+    if args.ray:
+        os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
+        sampling, learning = bench_ray(args.steps)
+        show("ray rainbow acting", sampling)
+        show("ray rainbow learning", learning)
+    print(f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB, /proc/loadavg {loadavg()}")
+
+
+def loadavg() -> str:
+    """The machine's load, as /proc/loadavg gives it (the rates follow it)."""
+    try:
+        with open("/proc/loadavg") as file:
+            return file.read().strip()
+    except OSError:
+        return f"{os.getloadavg()[0]:.1f}"
 
 
 if __name__ == "__main__":

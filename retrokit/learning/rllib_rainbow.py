@@ -27,7 +27,8 @@ import math
 from collections.abc import Mapping
 from typing import Any
 
-from retrokit.errors import AgentConfigError, InvalidArgumentError
+from retrokit.errors import InvalidArgumentError
+from retrokit.learning.config import check_config
 from retrokit.learning.rainbow import KEYS, check_replay_fits
 
 #: Where each key of a Rainbow config goes in RLlib's DQN: a ``DQNConfig`` field (``training(...)``), the
@@ -46,7 +47,7 @@ MAPPING: dict[str, str] = {
     "replay": "replay_buffer_config.capacity (timesteps, a PrioritizedEpisodeReplayBuffer)",
     "priority_alpha": "replay_buffer_config.alpha",
     "priority_beta": "replay_buffer_config.beta (fixed)",
-    "minibatch": "train_batch_size_per_learner",
+    "minibatch": "train_batch_size_per_learner (with N learners an update takes N minibatches, N times rarer)",
     "target_update": "target_network_update_freq (env steps over all envs), tau 1",
     "learning_starts": "num_steps_sampled_before_learning_starts",
     "update_every": "rollout_fragment_length and training_intensity: one update per update_every steps",
@@ -86,7 +87,7 @@ def algorithm_config(config: Mapping[str, Any], env: str, runners: int, envs_per
         A ``DQNConfig``; ``.build_algo()`` makes the algorithm (after ``ray.init``).
 
     Raises:
-        AgentConfigError: ``config`` is not a Rainbow config (its keys are another's).
+        AgentConfigError: ``config`` is not a Rainbow config: a key unknown or missing, a value out of range.
         InvalidArgumentError: Fewer than 0 runners or 1 env a runner, or the replay does not fit in memory.
     """
     from ray.rllib.algorithms.dqn import DQNConfig
@@ -94,13 +95,7 @@ def algorithm_config(config: Mapping[str, Any], env: str, runners: int, envs_per
 
     from retrokit.learning.rllib_rainbow_module import CONFIG, RainbowLearner, RainbowModule
 
-    values = dict(config)
-    if set(values) != set(KEYS):
-        wrong = sorted(set(values) ^ set(KEYS))
-        raise AgentConfigError(
-            f"Expected a rainbow config for RLlib's Rainbow, but its keys differ from one's in {', '.join(wrong[:6])}; "
-            "load it with --agent rainbow --agent-config NAME|FILE."
-        )
+    values = check_config("rainbow", dict(config), KEYS, "given to RLlib's Rainbow")  # the loader's checks, again
     if runners < 0 or envs_per_runner < 1:
         raise InvalidArgumentError(
             f"Expected 0 or more env runners and 1 or more envs a runner, got {runners} and {envs_per_runner}."

@@ -42,6 +42,15 @@ def roomy(monkeypatch):
     monkeypatch.setattr(retrokit.envs.memory, "available_memory", lambda: None)
 
 
+def test_importing_it_imports_neither_ray_nor_torch() -> None:
+    """retrokit's CLI imports the learning modules without the train extra: RLlib only inside the functions."""
+    import subprocess
+
+    code = "import sys, retrokit.learning.rllib_rainbow; print([m for m in ('ray', 'torch') if m in sys.modules])"
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120, check=True)
+    assert done.stdout.strip() == "[]"
+
+
 def test_every_key_of_a_rainbow_config_is_mapped() -> None:
     assert list(rr.MAPPING) == list(rainbow.KEYS)
 

@@ -15,8 +15,10 @@ What differs from the local Rainbow (docs/learning.md, "Rainbow on Ray"):
 - the replay is RLlib's prioritized episode replay in the driver: each observation is kept as the env gives
   it, the stacked frames (4 x 7,056 bytes a step), where Tianshou keeps each frame once. It is refused early
   when it does not fit in the memory available (:func:`replay_bytes`);
-- RLlib's n-step returns stop at an episode's end and its priorities are the loss of each transition, as
-  Tianshou's; the PER's beta stays fixed (RLlib passes the config's beta at every sample), as locally.
+- RLlib never starts a sampled transition in the last ``n_step - 1`` steps of an episode (it draws again),
+  where Tianshou takes a shorter return there: those steps' rewards are learned only inside earlier
+  transitions' returns. Its priorities are each transition's loss and its beta stays fixed (RLlib passes the
+  config's beta at every sample), as locally.
 
 RLlib is imported inside the functions only: importing this module needs neither Ray nor torch.
 """

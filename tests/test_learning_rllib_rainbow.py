@@ -114,14 +114,17 @@ def test_a_replay_that_does_not_fit_is_refused(monkeypatch) -> None:
     rr.algorithm_config(load_config("rainbow", "quick").values, ENV, 2, 1, 0)  # 100,000: 2.7 GiB fits
 
 
-@pytest.mark.parametrize(("config", "runners", "envs", "error", "message"), [
-    ("ppo", 1, 1, AgentConfigError, "Expected only keys of a rainbow config"),
-    ("rainbow", -1, 1, InvalidArgumentError, "got -1 and 1"),
-    ("rainbow", 2, 0, InvalidArgumentError, "got 2 and 0"),
-], ids=["ppo-config", "negative-runners", "no-envs"])
-def test_wrong_arguments_are_one_line(roomy, config, runners, envs, error, message) -> None:
+@pytest.mark.parametrize(("config", "runners", "envs", "seed", "error", "message"), [
+    ("ppo", 1, 1, 0, AgentConfigError, "Expected only keys of a rainbow config"),
+    ("rainbow", -1, 1, 0, InvalidArgumentError, "got -1, 1, 0"),
+    ("rainbow", 2, 0, 0, InvalidArgumentError, "got 2, 0, 0"),
+    ("rainbow", "2", 1, 0, InvalidArgumentError, "got '2', 1, 0"),
+    ("rainbow", 2, True, 0, InvalidArgumentError, "got 2, True, 0"),
+    ("rainbow", 2, 1, -5, InvalidArgumentError, "got 2, 1, -5"),
+], ids=["ppo-config", "negative-runners", "no-envs", "runners-text", "envs-bool", "negative-seed"])
+def test_wrong_arguments_are_one_line(roomy, config, runners, envs, seed, error, message) -> None:
     with pytest.raises(error) as caught:
-        rr.algorithm_config(load_config(config).values, ENV, runners, envs, 0)
+        rr.algorithm_config(load_config(config).values, ENV, runners, envs, seed)
     assert message in str(caught.value) and "\n" not in str(caught.value)
 
 

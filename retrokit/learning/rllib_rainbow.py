@@ -90,7 +90,8 @@ def algorithm_config(config: Mapping[str, Any], env: str, runners: int, envs_per
 
     Raises:
         AgentConfigError: ``config`` is not a Rainbow config: a key unknown or missing, a value out of range.
-        InvalidArgumentError: Fewer than 0 runners or 1 env a runner, or the replay does not fit in memory.
+        InvalidArgumentError: Fewer than 0 runners or 1 env a runner, a negative seed, or the replay does not fit
+            in memory.
     """
     from ray.rllib.algorithms.dqn import DQNConfig
     from ray.rllib.core.rl_module.rl_module import RLModuleSpec
@@ -98,9 +99,12 @@ def algorithm_config(config: Mapping[str, Any], env: str, runners: int, envs_per
     from retrokit.learning.rllib_rainbow_module import CONFIG, RainbowLearner, RainbowModule
 
     values = check_config("rainbow", dict(config), KEYS, "given to RLlib's Rainbow")  # the loader's checks, again
-    if runners < 0 or envs_per_runner < 1:
+    counts = (runners, envs_per_runner, seed)
+    if not all(isinstance(n, int) and not isinstance(n, bool) for n in counts) or runners < 0 or envs_per_runner < 1 \
+            or seed < 0:
         raise InvalidArgumentError(
-            f"Expected 0 or more env runners and 1 or more envs a runner, got {runners} and {envs_per_runner}."
+            "Expected 0 or more env runners, 1 or more envs a runner and a seed of 0 or more, whole numbers, got "
+            f"{', '.join(repr(n) for n in counts)}."
         )
     check_replay_fits(values["replay"], replay_bytes(values, values["replay"]), " (RLlib's, in the Ray driver)")
     fragment = values["update_every"] * math.ceil(values["n_step"] / values["update_every"])

@@ -29,7 +29,7 @@ from retrokit.learning.config import load_config
 pytestmark = pytest.mark.timeout(600)
 TINY = {"frame_size": 36, "minibatch": 8, "learning_starts": 64, "target_update": 32, "replay": 1000}
 ENV = "retrokit-test-dasher-rainbow"
-STEPS = 300  # three iterations of 100 steps: learning starts in the first, the target is copied in each
+STEPS = 200  # two iterations of 100 steps: learning starts in the first, the target is copied in each
 
 
 def tiny() -> dict:
@@ -324,7 +324,7 @@ def test_state_round_trip_restores_the_learner(trained, local_ray, observation) 
     weights, state = rr.weights_of(algorithm), rr.state_of(algorithm)
     saved = torch.load(io.BytesIO(state), weights_only=True)
     assert saved["state"] and saved["param_groups"][0]["eps"] == 0.00015
-    fresh = rr.algorithm_config(local_ray, ENV, 0, 1, 1).build_algo()
+    fresh = rr.algorithm_config(local_ray, ENV, 0, 1, 1).reporting(min_sample_timesteps_per_iteration=100).build_algo()
     try:
         assert not np.allclose(rllib_distributions(fresh, observation), rllib_distributions(algorithm, observation))
         rr.restore(fresh, weights, state)
@@ -342,6 +342,10 @@ def test_state_round_trip_restores_the_learner(trained, local_ray, observation) 
             acting = fresh.env_runner.module.compute_q_values({Columns.OBS: torch.as_tensor(observation)})
         np.testing.assert_allclose(acting["qf_probs"].numpy(), rllib_distributions(algorithm, observation),
                                    rtol=1e-6, atol=1e-7)
+        # A resumed run refills its replay, then its Adam goes on from the saved steps: 10 updates from step 64.
+        fresh.train()
+        steps = {int(moments["step"]) for moments in load_tensors(rr.state_of(fresh), "s")["state"].values()}
+        assert steps == {int(moments["step"]) + 10 for moments in saved["state"].values()}
         rr.restore(fresh, weights, None)  # --init: the weights alone
 
         other = rainbow.build({**local_ray, "atoms": 11}, observation.shape[1:], 7)

@@ -32,8 +32,6 @@ from ray.rllib.utils.schedules.scheduler import Scheduler
 
 from retrokit.learning import rainbow
 
-#: The module's attribute holding the network; its state dict's keys start with this and a dot.
-NETWORK = "network"
 #: The model config's key of the Rainbow config's values.
 CONFIG = "rainbow"
 

@@ -63,6 +63,8 @@ class Training:
         timesteps: Timesteps to train for, over all levels.
         seed: The run's seed.
         init: A policy to start from, if any.
+        backend: ``local`` (this machine's processes) or ``ray`` (RLlib's env runners on a Ray cluster).
+        env_runners: With ``ray``, the env runners (a multiple of the levels; see :mod:`.raytrain`).
     """
 
     benchmark: Benchmark
@@ -72,6 +74,8 @@ class Training:
     timesteps: int
     seed: int = 0
     init: SavedPolicy | None = None
+    backend: str = "local"
+    env_runners: int | None = None
 
     def settings(self) -> dict[str, Any]:
         """What determines the run, for ``run.json``; ``--resume`` requires the same."""
@@ -83,6 +87,9 @@ class Training:
             "timesteps": self.timesteps,
             "seed": self.seed,
             "init": None if self.init is None else {"policy": str(self.init.path.resolve()), "weights_sha256": self.init.sha256},
+            # the library that trains differs with the backend (RLlib's PPO is not SB3's): a resume keeps it
+            "backend": self.backend,
+            "env_runners": self.env_runners,
         }
 
 
@@ -335,21 +342,42 @@ def state_bytes(save: Any, value: Any) -> bytes:
 
 
 def train(training: Training, out: Path, *, resume: bool = False, progress: bool = True,
-          checkpoint_seconds: float = DEFAULT_CHECKPOINT_SECONDS) -> TrainRun:
+          checkpoint_seconds: float = DEFAULT_CHECKPOINT_SECONDS, ray_address: str | None = None) -> TrainRun:
     """Run ``training`` into ``out`` (see the module's doc); return the finished run (closed).
 
+    Args:
+        training: What to train, and on which backend.
+        out: The run folder.
+        resume: Continue the run in ``out``.
+        progress: Show progress.
+        checkpoint_seconds: Seconds between checkpoints.
+        ray_address: With the ``ray`` backend, a cluster's address (``None``: a new local Ray).
+
     Raises:
-        RetrokitError: A level, ROM or the library is missing, or the folder cannot be used (see :class:`TrainRun`).
+        RetrokitError: A level, ROM or the library is missing, the Ray cluster cannot be reached, or the folder
+            cannot be used (see :class:`TrainRun`).
         KeyboardInterrupt: Interrupted; the last checkpoint stays, for ``--resume``.
     """
     from retrokit.learning.algorithms import algorithm
 
     module = algorithm(training.agent)
     training.benchmark.check_levels(list(training.levels))
-    module.require()
+    if training.backend == "ray":
+        from retrokit.benchmark.ray_backend import check_address
+        from retrokit.learning import raytrain
+
+        raytrain.check(training)
+        raytrain.require(training.agent)
+        if ray_address:
+            check_address(ray_address)  # before the folder is claimed: a typo leaves nothing behind
+    else:
+        module.require()
     run = TrainRun(out, training, resume=resume, progress=progress, checkpoint_seconds=checkpoint_seconds)
     try:
-        module.train(run)
+        if training.backend == "ray":
+            raytrain.train(run, ray_address)
+        else:
+            module.train(run)
         run.finish()
     finally:
         run.close()

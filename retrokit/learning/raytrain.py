@@ -1,0 +1,177 @@
+"""``retrokit train --backend ray``: a learning agent trained jointly by RLlib, its env runners over a Ray cluster.
+
+The driver (this process) connects to Ray the way ``evaluate --backend ray``
+does (:func:`retrokit.benchmark.ray_backend.connected`: the address tried
+first, a clear error if nothing answers), registers the env, builds RLlib's
+algorithm and learns in this process, while ``--env-runners`` env runners (one
+CPU each, wherever the cluster has one) play: runner ``i`` (RLlib's
+``worker_index``, from 1) plays training level ``(i - 1) mod L`` with the
+config's ``train_envs_per_level`` envs, so every level is played by as many
+runners, and every update is over all of them (the paper's joint training).
+
+A runner's env is the level's env (:func:`retrokit.envs.env.make` with the
+benchmark's rules and the config's native preprocessing) as the learner sees it
+(:class:`~retrokit.learning.task.TaskEnv`). Each finished episode is sent, with
+its level, benchmark reward and steps, to a small actor on this node
+(:class:`EpisodeLog`), which the driver empties into the run's ``curve.csv``
+after each update. A runner lost with its node is started again by RLlib
+(``restart_failed_env_runners``) on the nodes left; the update waits for enough
+timesteps from the runners alive, so the run still ends with all its timesteps.
+
+Checkpoints, ``--resume`` and ``policy.json`` are :class:`~retrokit.learning.trainrun.TrainRun`'s, as for the
+local backend: the weights and optimizer state are torch ``state_dict`` s that the agent's module
+(:data:`AGENTS`) reads from and loads into the algorithm; RLlib's own checkpoints (pickles) are never written.
+"""
+
+from __future__ import annotations
+
+import importlib
+import uuid
+from functools import partial
+from types import ModuleType
+from typing import TYPE_CHECKING, Any
+
+from retrokit.errors import InvalidArgumentError, install_extra
+from retrokit.learning.algorithms import algorithm, require_libraries
+
+if TYPE_CHECKING:
+    from retrokit.learning.trainrun import Training, TrainRun
+
+#: The agents RLlib trains, by ``--agent``: the module of each, which gives ``algorithm_config(config, env,
+#: runners, envs_per_runner, seed)``, ``weights_of(algorithm)``, ``state_of(algorithm)`` and
+#: ``restore(algorithm, weights, state)`` (see :mod:`.rllib_ppo`).
+AGENTS = {
+    "ppo": "retrokit.learning.rllib_ppo",
+}
+#: Seconds RLlib waits before starting a failed env runner again (its default, 60, would idle the run that long).
+RESTART_DELAY_SECONDS = 2.0
+
+
+def check(training: Training) -> None:
+    """Refuse, before anything starts, an agent RLlib does not train here, or env runners that leave levels out.
+
+    Raises:
+        InvalidArgumentError: The agent has no RLlib module, or ``env_runners`` is not a multiple of the levels.
+    """
+    if training.agent not in AGENTS:
+        raise InvalidArgumentError(
+            f"Expected an agent that trains on Ray ({', '.join(AGENTS)}) with --backend ray, got --agent "
+            f"{training.agent}, which trains locally only for now; drop --backend ray."
+        )
+    levels, runners = len(training.levels), training.env_runners
+    if runners is None or runners < 1 or runners % levels:
+        raise InvalidArgumentError(
+            f"Expected --env-runners to be a multiple of the {levels} level(s) trained on, so each level has as many "
+            f"runners, got {runners}; use {levels} (the default) or {2 * levels}."
+        )
+
+
+def require(agent: str) -> None:
+    """Raise :class:`~retrokit.errors.MissingExtraError` unless RLlib and the agent's own libraries are there."""
+    try:
+        require_libraries(agent, {"ray.rllib": "RLlib", "torch": "torch"})
+    except ImportError as exc:
+        raise type(exc)(f"{exc} RLlib is `{install_extra('ray')}` with `pip install 'ray[rllib]'`.") from None
+    algorithm(agent).require()
+
+
+def rllib_module(agent: str) -> ModuleType:
+    """The RLlib module of ``agent`` (see :data:`AGENTS`)."""
+    return importlib.import_module(AGENTS[agent])
+
+
+def library() -> str:
+    """The library and its version, for ``policy.json``."""
+    import ray
+
+    return f"ray[rllib] {ray.__version__}"
+
+
+class EpisodeLog:
+    """A Ray actor on the driver's node that collects the runners' finished episodes until the driver takes them."""
+
+    def __init__(self) -> None:
+        self.episodes: list[tuple[str, float, int]] = []
+
+    def add(self, level: str, reward: float, steps: int) -> None:
+        self.episodes.append((level, reward, steps))
+
+    def take(self) -> list[tuple[str, float, int]]:
+        taken, self.episodes = self.episodes, []
+        return taken
+
+
+def make_env(spec: dict[str, Any], context: Any) -> Any:  # RLlib's EnvContext -> a gymnasium.Env
+    """The env of an env runner: its level's, as the learner sees it, reporting each episode to the log.
+
+    ``spec`` is plain data (it travels to every node inside the registered creator).
+    """
+    import ray
+
+    from retrokit.envs.env import make
+    from retrokit.learning.task import TaskEnv
+
+    index = (context.worker_index - 1) % len(spec["levels"])
+    game, state = spec["levels"][index]
+    name = f"{game}/{state}"
+    log = ray.get_actor(spec["log"])
+
+    def ended(_env: Any, reward: float, steps: int) -> None:
+        ray.get(log.add.remote(name, reward, steps))  # waited for: a sample's episodes are all logged when it ends
+
+    env = make(game, state, spec["scenario"], **spec["options"])
+    return TaskEnv(env, spec["task"], spec["reward_scale"], ended)
+
+
+def train(run: TrainRun, address: str | None) -> None:
+    """Train the run's agent on Ray (see the module's doc); the run's checkpoints and curve as the local backend's."""
+    from ray.rllib.core import DEFAULT_MODULE_ID
+    from ray.rllib.utils.metrics import ENV_RUNNER_RESULTS, NUM_ENV_STEPS_SAMPLED_LIFETIME
+    from ray.tune.registry import register_env
+
+    from retrokit.benchmark.ray_backend import connected, on_this_node
+
+    training = run.training
+    agent = rllib_module(training.agent)
+    config = training.config.values
+    runners = training.env_runners
+    options = {**training.benchmark.env_options(), **algorithm(training.agent).observation_options(config)}
+    scenario = options.pop("scenario", None)
+    with connected(address, runners) as ray:
+        name = f"retrokit-{uuid.uuid4().hex}"
+        log = ray.remote(EpisodeLog).options(name=name, **on_this_node(ray)).remote()
+        spec = {"levels": [(level.game, level.state) for level in training.levels], "options": options,
+                "scenario": scenario, "task": run.task, "reward_scale": config["reward_scale"], "log": name}
+        register_env(name, partial(make_env, spec))
+        settings = agent.algorithm_config(config, name, runners, config.get("train_envs_per_level", 1), training.seed)
+        settings.fault_tolerance(restart_failed_env_runners=True,
+                                 delay_between_env_runner_restarts_s=RESTART_DELAY_SECONDS)
+        algo = settings.build_algo()
+        try:
+            start = run.timesteps
+            saved = run.resume_state()
+            if saved is not None:
+                agent.restore(algo, *saved)
+            elif training.init is not None:
+                agent.restore(algo, training.init.read_weights(), None)
+            space = next(iter(algo.learner_group.foreach_learner(
+                lambda learner: learner.module[DEFAULT_MODULE_ID].observation_space))).get()
+            spec_ = {"shape": list(space.shape), "dtype": str(space.dtype),
+                     "options": algorithm(training.agent).observation_options(config)}
+            made_by = library()
+
+            def save(timesteps: int) -> None:
+                run.save(timesteps, agent.weights_of(algo), agent.state_of(algo), spec_, made_by)
+
+            timesteps = start
+            while timesteps < training.timesteps:
+                result = algo.train()
+                timesteps = start + int(result[ENV_RUNNER_RESULTS][NUM_ENV_STEPS_SAMPLED_LIFETIME])
+                for level, reward, steps in ray.get(log.take.remote()):
+                    run.episode(level, reward, steps, timesteps)
+                if run.updated(timesteps) and timesteps < training.timesteps:
+                    save(timesteps)
+            save(timesteps)
+        finally:
+            algo.stop()
+            ray.kill(log)

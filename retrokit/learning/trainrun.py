@@ -367,9 +367,9 @@ def train(training: Training, out: Path, *, resume: bool = False, progress: bool
         from retrokit.learning import raytrain
 
         raytrain.check(training)
-        raytrain.require(training.agent)
         if ray_address:
-            check_address(ray_address)  # before the folder is claimed: a typo leaves nothing behind
+            check_address(ray_address)  # before the folder is claimed (a typo leaves nothing), and RLlib imported
+        raytrain.require(training.agent)
     else:
         module.require()
     run = TrainRun(out, training, resume=resume, progress=progress, checkpoint_seconds=checkpoint_seconds)

@@ -19,7 +19,7 @@ EXAMPLES = [
     "retrokit train --benchmark dasher --agent ppo --timesteps 200000 --out runs/joint --resume   # after a kill",
     "retrokit train --benchmark dasher --agent rainbow --agent-config quick --timesteps 200000 --out runs/joint-rainbow",
     "retrokit train --benchmark sonic --agent ppo --timesteps 50000000 --checkpoint-every 1800 --out runs/sonic",
-    "retrokit train --benchmark sonic --agent ppo --backend ray --ray-address auto --env-runners 94 --timesteps 100000000 --out runs/sonic-ray",
+    "retrokit train --benchmark sonic --agent ppo --backend ray --ray-address auto --env-runners 47 --timesteps 100000000 --out runs/sonic-ray",
 ]
 
 

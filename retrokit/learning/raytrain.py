@@ -31,8 +31,8 @@ from functools import partial
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
-from retrokit.errors import InvalidArgumentError, install_extra
-from retrokit.learning.algorithms import algorithm, require_libraries
+from retrokit.errors import InvalidArgumentError, MissingExtraError
+from retrokit.learning.algorithms import algorithm
 
 if TYPE_CHECKING:
     from retrokit.learning.trainrun import Training, TrainRun
@@ -67,12 +67,15 @@ def check(training: Training) -> None:
 
 
 def require(agent: str) -> None:
-    """Raise :class:`~retrokit.errors.MissingExtraError` unless RLlib and the agent's own libraries are there."""
-    try:
-        require_libraries(agent, {"ray.rllib": "RLlib", "torch": "torch"})
-    except ImportError as exc:
-        raise type(exc)(f"{exc} RLlib is `{install_extra('ray')}` with `pip install 'ray[rllib]'`.") from None
+    """Raise :class:`~retrokit.errors.MissingExtraError` unless the agent's libraries and RLlib are installed."""
     algorithm(agent).require()
+    try:
+        import ray.rllib  # noqa: F401 - the check
+    except ImportError as exc:
+        raise MissingExtraError(
+            f"Expected RLlib for --agent {agent} --backend ray, but importing it failed ({exc}); run "
+            "`pip install 'ray[rllib]'`, on every node of the cluster too."
+        ) from None
 
 
 def rllib_module(agent: str) -> ModuleType:
@@ -146,6 +149,9 @@ def train(run: TrainRun, address: str | None) -> None:
         settings = agent.algorithm_config(config, name, runners, config.get("train_envs_per_level", 1), training.seed)
         settings.fault_tolerance(restart_failed_env_runners=True,
                                  delay_between_env_runner_restarts_s=RESTART_DELAY_SECONDS)
+        # No time limit on a sample (RLlib's is 60 s, past which it drops what was played): a fragment of the
+        # paper's horizon, 8,192 steps, takes minutes on a CPU. A runner lost with its node answers with an error.
+        settings.env_runners(sample_timeout_s=None)
         algo = settings.build_algo()
         try:
             start = run.timesteps

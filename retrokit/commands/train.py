@@ -1,7 +1,8 @@
 """``retrokit train``: one policy trained on a benchmark's training levels at once (the paper's Joint PPO).
 
-Every training level runs in the native vector env and every update is over
-all of them; checkpoints go into ``--out`` as it trains, ``--resume`` continues
+Every training level runs in the native vector env (or, with ``--backend ray``,
+in RLlib's env runners over a Ray cluster) and every update is over all of
+them; checkpoints go into ``--out`` as it trains, ``--resume`` continues
 a killed run, and the policy it saves is what ``retrokit evaluate --agent ppo
 --init DIR`` fine-tunes on the test levels. See docs/evaluate.md.
 """

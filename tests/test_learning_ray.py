@@ -130,6 +130,7 @@ with torch.no_grad():
     logits = module.forward_inference(batch)["action_dist_inputs"].numpy()
     values = module.compute_values(batch).numpy()
 np.savez(folder / "outputs.npz", obs=obs, logits=logits, values=values)
+results["too_many"] = train("too-many", "--env-runners", "4")  # 2 CPUs: RLlib would wait without end
 results["killed_run"] = train("killed")
 results["other_backend"] = run("--out", str(folder / "killed"), "--resume")
 results["resumed"] = train("killed", "--resume")
@@ -242,6 +243,13 @@ def test_resume_on_ray_continues_and_another_backend_is_refused(folder, cluster)
     assert timesteps == sorted(timesteps) and timesteps[-1] > cluster["killed"]  # went on from the checkpoint
 
 
+def test_more_runners_than_the_cluster_has_cpus_is_refused(folder, cluster) -> None:
+    refused = cluster["too_many"]
+    assert refused["code"] == 2 and "Expected a CPU for each of the 4 env runners" in refused["stderr"]
+    assert "it has 2; add nodes, or use --env-runners 2." in refused["stderr"]
+    assert not (folder / "too-many").exists()
+
+
 def test_no_ray_process_is_left_behind(cluster) -> None:
     assert len(cluster["processes"]) >= 4  # the GCS, raylets, env runners: what the run had started
     left = []
@@ -260,9 +268,10 @@ def test_no_ray_process_is_left_behind(cluster) -> None:
     (("--backend", "ray", "--ray-address", "nowhere"), "Expected --ray-address as HOST:PORT"),
     (("--backend", "ray", "--env-runners", "3"), "Expected --env-runners to be a multiple of the 2 level(s)"),
     (("--backend", "ray", "--env-runners", "0"), "Expected --env-runners to be a multiple"),
+    (("--backend", "ray", "--env-runners", str(10**12)), "up to 4096, got 1000000000000"),
     (("--backend", "ray", "--agent", "rainbow", "--agent-config", "quick"), "trains locally only for now"),
     (("--ray-address", "127.0.0.1:1"), "Expected --ray-address and --env-runners with --backend ray only"),
-], ids=["unreachable", "malformed", "runners-not-a-multiple", "no-runners", "rainbow", "address-without-ray"])
+], ids=["unreachable", "malformed", "runners-not-a-multiple", "no-runners", "runners-huge", "rainbow", "address-without-ray"])
 def test_bad_ray_options_are_one_line(folder, common, args, message) -> None:
     """Refused before the folder is claimed, and before Ray or RLlib is imported."""
     base = [a for a in common if a not in ("--agent-config", str(folder / "tiny.yaml"))]

@@ -27,11 +27,13 @@ from __future__ import annotations
 
 import importlib
 import uuid
+from collections.abc import Iterator
+from contextlib import contextmanager
 from functools import partial
 from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
-from retrokit.errors import InvalidArgumentError, MissingExtraError
+from retrokit.errors import BackendUnavailableError, InvalidArgumentError, MissingExtraError
 from retrokit.learning.algorithms import algorithm
 
 if TYPE_CHECKING:
@@ -43,6 +45,8 @@ if TYPE_CHECKING:
 AGENTS = {
     "ppo": "retrokit.learning.rllib_ppo",
 }
+#: The most env runners a run asks for: the paper's 188 workers as 4 runners a level need 188; more is a typo.
+MAX_ENV_RUNNERS = 4096
 #: Seconds RLlib waits before starting a failed env runner again (its default, 60, would idle the run that long).
 RESTART_DELAY_SECONDS = 2.0
 
@@ -59,11 +63,36 @@ def check(training: Training) -> None:
             f"{training.agent}, which trains locally only for now; drop --backend ray."
         )
     levels, runners = len(training.levels), training.env_runners
-    if runners is None or runners < 1 or runners % levels:
+    if runners is None or not 1 <= runners <= MAX_ENV_RUNNERS or runners % levels:
         raise InvalidArgumentError(
-            f"Expected --env-runners to be a multiple of the {levels} level(s) trained on, so each level has as many "
-            f"runners, got {runners}; use {levels} (the default) or {2 * levels}."
+            f"Expected --env-runners to be a multiple of the {levels} level(s) trained on (so each level has as many "
+            f"runners) up to {MAX_ENV_RUNNERS}, got {runners}; use {levels} (the default) or {2 * levels}."
         )
+
+
+@contextmanager
+def cluster(training: Training, address: str | None) -> Iterator[Any]:
+    """Ray, connected (:func:`~retrokit.benchmark.ray_backend.connected`) and checked to have a CPU for each runner.
+
+    A local Ray is started with as many CPUs as runners. On a cluster with fewer, RLlib would wait for the runners
+    it cannot place without end: refused instead, before the run folder is claimed.
+
+    Raises:
+        BackendUnavailableError: Ray cannot be reached, or the cluster has fewer CPUs than env runners.
+    """
+    from retrokit.benchmark.ray_backend import connected
+
+    runners = training.env_runners or 1
+    with connected(address, runners) as ray:
+        cpus = ray.cluster_resources().get("CPU", 0)
+        if cpus < runners:
+            fits = int(cpus) // len(training.levels) * len(training.levels)
+            where = address or "this process joined"
+            raise BackendUnavailableError(
+                f"Expected a CPU for each of the {runners} env runners on the Ray cluster at {where}, but it has "
+                f"{cpus:g}; add nodes, or use --env-runners {fits or len(training.levels)}."
+            )
+        yield ray
 
 
 def require(agent: str) -> None:

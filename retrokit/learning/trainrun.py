@@ -19,6 +19,7 @@ the evaluation's) for its lifetime.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import hashlib
 import io
@@ -372,13 +373,15 @@ def train(training: Training, out: Path, *, resume: bool = False, progress: bool
         raytrain.require(training.agent)
     else:
         module.require()
-    run = TrainRun(out, training, resume=resume, progress=progress, checkpoint_seconds=checkpoint_seconds)
-    try:
-        if training.backend == "ray":
-            raytrain.train(run, ray_address)
-        else:
-            module.train(run)
-        run.finish()
-    finally:
-        run.close()
+    # on Ray, connected (and the cluster's CPUs checked) before the folder is claimed
+    with raytrain.cluster(training, ray_address) if training.backend == "ray" else contextlib.nullcontext():
+        run = TrainRun(out, training, resume=resume, progress=progress, checkpoint_seconds=checkpoint_seconds)
+        try:
+            if training.backend == "ray":
+                raytrain.train(run, ray_address)
+            else:
+                module.train(run)
+            run.finish()
+        finally:
+            run.close()
     return run

@@ -49,7 +49,7 @@ import ray
 from ray.cluster_utils import Cluster
 import numpy as np, torch
 from retrokit.cli import main
-from retrokit.learning import rllib_ppo, trainrun
+from retrokit.learning import raytrain, rllib_ppo, trainrun
 from ray.rllib.core import DEFAULT_MODULE_ID
 
 folder, common = Path(sys.argv[1]), json.loads(sys.argv[2])
@@ -131,6 +131,16 @@ with torch.no_grad():
     values = module.compute_values(batch).numpy()
 np.savez(folder / "outputs.npz", obs=obs, logits=logits, values=values)
 results["too_many"] = train("too-many", "--env-runners", "4")  # 2 CPUs: RLlib would wait without end
+
+
+def no_rom_here(spec, context):
+    """A runner's env on a node without the game's ROM (pickled by value: this script is the runners' __main__)."""
+    raise FileNotFoundError("no ROM on this node")
+
+
+making, raytrain.make_env = raytrain.make_env, no_rom_here
+results["runners_fail"] = train("runners-fail")
+raytrain.make_env = making
 results["killed_run"] = train("killed")
 results["other_backend"] = run("--out", str(folder / "killed"), "--resume")
 results["resumed"] = train("killed", "--resume")
@@ -248,6 +258,13 @@ def test_more_runners_than_the_cluster_has_cpus_is_refused(folder, cluster) -> N
     assert refused["code"] == 2 and "Expected a CPU for each of the 4 env runners" in refused["stderr"]
     assert "it has 2; add nodes, or use --env-runners 2." in refused["stderr"]
     assert not (folder / "too-many").exists()
+
+
+def test_runners_that_cannot_make_their_env_are_one_line(folder, cluster) -> None:
+    failed = cluster["runners_fail"]
+    assert failed["code"] == 2 and "Expected RLlib's 2 env runners to start on the Ray cluster" in failed["stderr"]
+    assert "every node needs retrokit, RLlib and the benchmark's ROMs" in failed["stderr"]
+    assert len(failed["stderr"].strip().splitlines()) == 1
 
 
 def test_no_ray_process_is_left_behind(cluster) -> None:

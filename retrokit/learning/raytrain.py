@@ -68,6 +68,19 @@ def check(training: Training) -> None:
             f"Expected --env-runners to be a multiple of the {levels} level(s) trained on (so each level has as many "
             f"runners) up to {MAX_ENV_RUNNERS}, got {runners}; use {levels} (the default) or {2 * levels}."
         )
+    # The env every runner makes, made here once: a bad option is this process's one-line error, not the death of
+    # every runner, which RLlib reports as an IndexError of its own.
+    from retrokit.envs.env import make
+
+    options, scenario = env_options(training)
+    make(training.levels[0].game, training.levels[0].state, scenario, **options).close()
+
+
+def env_options(training: Training) -> tuple[dict[str, Any], Any]:
+    """The options of every runner's env (the benchmark's rules, the config's native preprocessing), and its scenario."""
+    options = {**training.benchmark.env_options(),
+               **algorithm(training.agent).observation_options(training.config.values)}
+    return options, options.pop("scenario", None)
 
 
 @contextmanager
@@ -167,8 +180,7 @@ def train(run: TrainRun, address: str | None) -> None:
     agent = rllib_module(training.agent)
     config = training.config.values
     runners = training.env_runners
-    options = {**training.benchmark.env_options(), **algorithm(training.agent).observation_options(config)}
-    scenario = options.pop("scenario", None)
+    options, scenario = env_options(training)
     with connected(address, runners) as ray:
         name = f"retrokit-{uuid.uuid4().hex}"
         log = ray.remote(EpisodeLog).options(name=name, **on_this_node(ray)).remote()
@@ -181,7 +193,14 @@ def train(run: TrainRun, address: str | None) -> None:
         # No time limit on a sample (RLlib's is 60 s, past which it drops what was played): a fragment of the
         # paper's horizon, 8,192 steps, takes minutes on a CPU. A runner lost with its node answers with an error.
         settings.env_runners(sample_timeout_s=None)
-        algo = settings.build_algo()
+        try:
+            algo = settings.build_algo()
+        except Exception as exc:  # noqa: BLE001 - whatever a runner's death makes RLlib raise (an IndexError, ...)
+            raise BackendUnavailableError(
+                f"Expected RLlib's {runners} env runners to start on the Ray cluster, but they did not "
+                f"({type(exc).__name__}: {str(exc).strip().splitlines()[0] if str(exc).strip() else ''}); every node "
+                "needs retrokit, RLlib and the benchmark's ROMs, and Ray's logs of the runners say what failed."
+            ) from None
         try:
             start = run.timesteps
             saved = run.resume_state()

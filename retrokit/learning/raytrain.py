@@ -6,8 +6,11 @@ first, a clear error if nothing answers), registers the env, builds RLlib's
 algorithm and learns in this process, while ``--env-runners`` env runners (one
 CPU each, wherever the cluster has one) play: runner ``i`` (RLlib's
 ``worker_index``, from 1) plays training level ``(i - 1) mod L`` with the
-config's ``train_envs_per_level`` envs, so every level is played by as many
-runners, and every update is over all of them (the paper's joint training).
+config's ``train_envs_per_level`` envs (1 if the config has no such key), so
+every level is played by as many runners, and every update is over all of
+them (the paper's joint training). Before anything starts, the runners' env
+is made once here (a bad option is one line), and the cluster must have a
+CPU for each runner (RLlib would wait for the others without end).
 
 A runner's env is the level's env (:func:`retrokit.envs.env.make` with the
 benchmark's rules and the config's native preprocessing) as the learner sees it
@@ -170,8 +173,6 @@ def make_env(spec: dict[str, Any], context: Any) -> Any:  # RLlib's EnvContext -
 
 def train(run: TrainRun, address: str | None) -> None:
     """Train the run's agent on Ray (see the module's doc); the run's checkpoints and curve as the local backend's."""
-    from ray.rllib.core import DEFAULT_MODULE_ID
-    from ray.rllib.utils.metrics import ENV_RUNNER_RESULTS, NUM_ENV_STEPS_SAMPLED_LIFETIME
     from ray.tune.registry import register_env
 
     from retrokit.benchmark.ray_backend import connected, on_this_node
@@ -184,48 +185,70 @@ def train(run: TrainRun, address: str | None) -> None:
     with connected(address, runners) as ray:
         name = f"retrokit-{uuid.uuid4().hex}"
         log = ray.remote(EpisodeLog).options(name=name, **on_this_node(ray)).remote()
-        spec = {"levels": [(level.game, level.state) for level in training.levels], "options": options,
-                "scenario": scenario, "task": run.task, "reward_scale": config["reward_scale"], "log": name}
-        register_env(name, partial(make_env, spec))
-        settings = agent.algorithm_config(config, name, runners, config.get("train_envs_per_level", 1), training.seed)
-        settings.fault_tolerance(restart_failed_env_runners=True,
-                                 delay_between_env_runner_restarts_s=RESTART_DELAY_SECONDS)
-        # No time limit on a sample (RLlib's is 60 s, past which it drops what was played): a fragment of the
-        # paper's horizon, 8,192 steps, takes minutes on a CPU. A runner lost with its node answers with an error.
-        settings.env_runners(sample_timeout_s=None)
         try:
-            algo = settings.build_algo()
-        except Exception as exc:  # noqa: BLE001 - whatever a runner's death makes RLlib raise (an IndexError, ...)
-            raise BackendUnavailableError(
-                f"Expected RLlib's {runners} env runners to start on the Ray cluster, but they did not "
-                f"({type(exc).__name__}: {str(exc).strip().splitlines()[0] if str(exc).strip() else ''}); every node "
-                "needs retrokit, RLlib and the benchmark's ROMs, and Ray's logs of the runners say what failed."
-            ) from None
-        try:
-            start = run.timesteps
-            saved = run.resume_state()
-            if saved is not None:
-                agent.restore(algo, *saved)
-            elif training.init is not None:
-                agent.restore(algo, training.init.read_weights(), None)
-            space = next(iter(algo.learner_group.foreach_learner(
-                lambda learner: learner.module[DEFAULT_MODULE_ID].observation_space))).get()
-            spec_ = {"shape": list(space.shape), "dtype": str(space.dtype),
-                     "options": algorithm(training.agent).observation_options(config)}
-            made_by = library()
-
-            def save(timesteps: int) -> None:
-                run.save(timesteps, agent.weights_of(algo), agent.state_of(algo), spec_, made_by)
-
-            timesteps = start
-            while timesteps < training.timesteps:
-                result = algo.train()
-                timesteps = start + int(result[ENV_RUNNER_RESULTS][NUM_ENV_STEPS_SAMPLED_LIFETIME])
-                for level, reward, steps in ray.get(log.take.remote()):
-                    run.episode(level, reward, steps, timesteps)
-                if run.updated(timesteps) and timesteps < training.timesteps:
-                    save(timesteps)
-            save(timesteps)
+            spec = {"levels": [(level.game, level.state) for level in training.levels], "options": options,
+                    "scenario": scenario, "task": run.task, "reward_scale": config["reward_scale"], "log": name}
+            register_env(name, partial(make_env, spec))
+            algo = _build(agent.algorithm_config(config, name, runners, config.get("train_envs_per_level", 1),
+                                                 training.seed), runners)
+            try:
+                _train(run, agent, algo, log)
+            finally:
+                algo.stop()
         finally:
-            algo.stop()
             ray.kill(log)
+
+
+def _build(settings: Any, runners: int) -> Any:  # RLlib's AlgorithmConfig -> its Algorithm
+    """The algorithm of ``settings``, with the fault tolerance of a run over a cluster.
+
+    Raises:
+        BackendUnavailableError: The env runners did not start.
+    """
+    settings.fault_tolerance(restart_failed_env_runners=True, delay_between_env_runner_restarts_s=RESTART_DELAY_SECONDS)
+    # No time limit on a sample (RLlib's is 60 s, past which it drops what was played): a fragment of the
+    # paper's horizon, 8,192 steps, takes minutes on a CPU. A runner lost with its node answers with an error.
+    settings.env_runners(sample_timeout_s=None)
+    try:
+        return settings.build_algo()
+    except Exception as exc:  # noqa: BLE001 - whatever a runner's death makes RLlib raise (an IndexError, ...)
+        first = str(exc).strip().splitlines()[0] if str(exc).strip() else ""
+        raise BackendUnavailableError(
+            f"Expected RLlib's {runners} env runners to start on the Ray cluster, but they did not "
+            f"({type(exc).__name__}: {first}); every node needs retrokit, RLlib and the benchmark's ROMs, and "
+            "Ray's logs of the runners say what failed."
+        ) from None
+
+
+def _train(run: TrainRun, agent: ModuleType, algo: Any, log: Any) -> None:
+    """The training loop: an update, its episodes into the curve, a checkpoint when due; until the timesteps."""
+    import ray
+    from ray.rllib.core import DEFAULT_MODULE_ID
+    from ray.rllib.utils.metrics import ENV_RUNNER_RESULTS, NUM_ENV_STEPS_SAMPLED_LIFETIME
+
+    training = run.training
+    start = run.timesteps
+    saved = run.resume_state()
+    if saved is not None:
+        agent.restore(algo, *saved)
+    elif training.init is not None:
+        agent.restore(algo, training.init.read_weights(), None)
+    space = next(iter(algo.learner_group.foreach_learner(
+        lambda learner: learner.module[DEFAULT_MODULE_ID].observation_space))).get()
+    observation = {"shape": list(space.shape), "dtype": str(space.dtype),
+                   "options": algorithm(training.agent).observation_options(training.config.values)}
+    made_by = library()
+
+    def save(timesteps: int) -> None:
+        run.save(timesteps, agent.weights_of(algo), agent.state_of(algo), observation, made_by)
+
+    timesteps = start
+    while timesteps < training.timesteps:
+        result = algo.train()
+        # RLlib's count of this algorithm's timesteps (absent after an update no runner could sample for)
+        timesteps = start + int(result.get(ENV_RUNNER_RESULTS, {}).get(NUM_ENV_STEPS_SAMPLED_LIFETIME, timesteps - start))
+        for level, reward, steps in ray.get(log.take.remote()):
+            run.episode(level, reward, steps, timesteps)
+        if run.updated(timesteps) and timesteps < training.timesteps:
+            save(timesteps)
+    save(timesteps)

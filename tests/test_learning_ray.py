@@ -101,7 +101,8 @@ weighing, modules = rllib_ppo.weights_of, []
 
 
 def weights_of(algorithm):
-    modules[:] = [rllib_ppo._first(algorithm, lambda learner: learner.module[DEFAULT_MODULE_ID])]
+    found = algorithm.learner_group.foreach_learner(lambda learner: learner.module[DEFAULT_MODULE_ID])
+    modules[:] = [next(iter(found)).get()]  # the driver's learner: the module object itself
     runners = algorithm.env_runner_group
     results.setdefault("runners", []).append([runners.num_healthy_remote_workers(), runners.num_remote_worker_restarts()])
     return weighing(algorithm)

@@ -48,7 +48,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--resume", action="store_true", help="continue the killed run in --out from its last checkpoint")
     parser.add_argument("--checkpoint-every", type=float, default=DEFAULT_CHECKPOINT_SECONDS, metavar="SECONDS",
                         help=f"seconds between checkpoints; 0: after every update (default: {DEFAULT_CHECKPOINT_SECONDS:g})")
-    add_backend_options(parser, "this machine's processes")
+    add_backend_options(parser, "this machine's processes", "RLlib's, pip install 'ray[rllib]'; PPO only")
     parser.add_argument("--env-runners", type=int, default=None, metavar="N",
                         help="with --backend ray: RLlib's env runners, a multiple of the levels (default: one a level)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar or lines")

@@ -6,7 +6,8 @@ RLlib's env runners cost seconds each): a head with no CPU (the driver, which le
 each of the two env runners is on its own node. The runs are the CLI's, in the child, with
 ``TrainRun.save`` wrapped so that the events happen at a checkpoint, never after a sleep: the joint run's
 first checkpoint adds a third node and removes a node holding an env runner; the killed run's first
-checkpoint raises ``KeyboardInterrupt`` (Ctrl-C), then it is resumed. Tiny config: what is tested is the
+checkpoint raises ``KeyboardInterrupt`` (Ctrl-C), then it is resumed; it starts from the joint run's policy
+(``--init``). Tiny config: what is tested is the
 plumbing, never how well PPO learns.
 """
 
@@ -109,6 +110,19 @@ def weights_of(algorithm):
 
 
 rllib_ppo.weights_of = weights_of
+restoring = rllib_ppo.restore
+
+
+def restore(algorithm, weights, state):
+    """RLlib's restore, then whether the learner's network holds the weights given, tensor for tensor."""
+    import io
+    restoring(algorithm, weights, state)
+    now, given = (torch.load(io.BytesIO(data), weights_only=True) for data in (weighing(algorithm), weights))
+    same = set(now) == set(given) and all(torch.equal(now[key], given[key]) for key in given)
+    results.setdefault("restored", []).append({"state": state is not None, "same": same})
+
+
+rllib_ppo.restore = restore
 
 
 def run(*args):
@@ -142,9 +156,10 @@ def no_rom_here(spec, context):
 making, raytrain.make_env = raytrain.make_env, no_rom_here
 results["runners_fail"] = train("runners-fail")
 raytrain.make_env = making
-results["killed_run"] = train("killed")
-results["other_backend"] = run("--out", str(folder / "killed"), "--resume")
-results["resumed"] = train("killed", "--resume")
+start = ("--init", str(folder / "joint"))  # the killed run starts from the joint run's policy
+results["killed_run"] = train("killed", *start)
+results["other_backend"] = run("--out", str(folder / "killed"), "--resume", *start)
+results["resumed"] = train("killed", "--resume", *start)
 ray.shutdown()
 cluster.shutdown()
 (folder / "results.json").write_text(json.dumps(results))
@@ -242,8 +257,10 @@ def test_the_ray_policy_is_the_local_ppo_network_evaluate_loads(folder, common, 
     venv.close()
 
 
-def test_resume_on_ray_continues_and_another_backend_is_refused(folder, cluster) -> None:
+def test_init_and_resume_on_ray_load_the_weights_and_another_backend_is_refused(folder, cluster) -> None:
     killed, resumed = cluster["killed_run"], cluster["resumed"]
+    # --init loaded the joint policy's weights, the resume the checkpoint's weights and optimizer state
+    assert cluster["restored"] == [{"state": False, "same": True}, {"state": True, "same": True}]
     assert killed["code"] == 130 and "add --resume" in killed["stderr"]
     other = cluster["other_backend"]
     assert other["code"] == 2 and "backend, env_runners differ" in other["stderr"], other["stderr"]

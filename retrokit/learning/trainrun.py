@@ -237,7 +237,9 @@ class TrainRun:
             raise self._damaged(RUN_FILE, f"it is not JSON ({type(exc).__name__})") from None
         if not isinstance(saved, dict) or not isinstance(saved.get("settings"), dict) or "checkpoint" not in saved:
             raise self._damaged(RUN_FILE, "it does not map 'settings' and 'checkpoint'")
-        check_same_settings(self.path, saved["settings"], self.settings)
+        # a run.json written before the backend was a setting is a local run's
+        settings = {"backend": "local", "env_runners": None, **saved["settings"]}
+        check_same_settings(self.path, settings, self.settings)
         checkpoint = saved["checkpoint"]
         if checkpoint is not None:
             problem = _checkpoint_problem(checkpoint, self.episodes, self.training.timesteps)

@@ -123,8 +123,8 @@ class TaskEnv(gymnasium.Wrapper):
         self.view = TaskView(env, task, reward_scale, 1, ended)
         self.action_space = self.view.action_space
 
-    # The infos (every RAM field) are read here and not passed on: the replay would keep them, 8 bytes a field
-    # a transition (Dasher's fields would add 6% to the frames).
+    # The infos (every RAM field) are read here and not passed on: Rainbow's replay (and RLlib's episodes) would
+    # keep them, 8 bytes a field a transition (Dasher's fields would add 6% to the frames).
 
     def reset(self, **kwargs: Any):
         obs, info = self.env.reset(**kwargs)

@@ -306,9 +306,13 @@ def test_no_ray_process_is_left_behind(cluster) -> None:
     (("--backend", "ray", "--env-runners", str(10**12)), "up to 4096, got 1000000000000"),
     (("--backend", "ray", "--agent", "rainbow", "--agent-config", "quick"), "trains locally only for now"),
     (("--ray-address", "127.0.0.1:1"), "Expected --ray-address and --env-runners with --backend ray only"),
-], ids=["unreachable", "malformed", "runners-not-a-multiple", "no-runners", "runners-huge", "rainbow", "address-without-ray"])
-def test_bad_ray_options_are_one_line(folder, common, args, message) -> None:
+    (("--backend", "ray"), "Expected room for the 2 env runners of a local Ray (about 600 MiB each"),
+], ids=["unreachable", "malformed", "runners-not-a-multiple", "no-runners", "runners-huge", "rainbow",
+        "address-without-ray", "local-ray-out-of-memory"])
+def test_bad_ray_options_are_one_line(folder, common, args, message, monkeypatch) -> None:
     """Refused before the folder is claimed, and before Ray or RLlib is imported."""
+    if "--ray-address" not in args:  # a local Ray: its 2 runners must fit in memory (1 GiB here: they do not)
+        monkeypatch.setattr("retrokit.envs.memory.available_memory", lambda: 1 << 30)
     base = [a for a in common if a not in ("--agent-config", str(folder / "tiny.yaml"))]
     if "--agent" not in args:
         base += ["--agent-config", str(folder / "tiny.yaml")]

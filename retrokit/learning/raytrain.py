@@ -50,15 +50,19 @@ AGENTS = {
 }
 #: The most env runners a run asks for: the paper's 188 workers as 4 runners a level need 188; more is a typo.
 MAX_ENV_RUNNERS = 4096
+#: What an env runner's process takes: 535 MB resident measured (torch, RLlib, SB3 and the emulator), rounded up.
+RUNNER_BYTES = 600 << 20
 #: Seconds RLlib waits before starting a failed env runner again (its default, 60, would idle the run that long).
 RESTART_DELAY_SECONDS = 2.0
 
 
-def check(training: Training) -> None:
-    """Refuse, before anything starts, an agent RLlib does not train here, or env runners that leave levels out.
+def check(training: Training, address: str | None) -> None:
+    """Refuse, before anything starts (Ray, RLlib's import, the run folder), what the run could not do.
 
     Raises:
-        InvalidArgumentError: The agent has no RLlib module, or ``env_runners`` is not a multiple of the levels.
+        InvalidArgumentError: The agent has no RLlib module, ``env_runners`` is not a multiple of the levels, a
+            local Ray's runners would not fit in this machine's memory, or the env cannot be made.
+        BackendUnavailableError: Nothing answers at ``address``.
     """
     if training.agent not in AGENTS:
         raise InvalidArgumentError(
@@ -71,12 +75,35 @@ def check(training: Training) -> None:
             f"Expected --env-runners to be a multiple of the {levels} level(s) trained on (so each level has as many "
             f"runners) up to {MAX_ENV_RUNNERS}, got {runners}; use {levels} (the default) or {2 * levels}."
         )
+    if address:
+        from retrokit.benchmark.ray_backend import check_address
+
+        check_address(address)
+    else:
+        _check_local_memory(runners)
     # The env every runner makes, made here once: a bad option is this process's one-line error, not the death of
     # every runner, which RLlib reports as an IndexError of its own.
     from retrokit.envs.env import make
 
     options, scenario = env_options(training)
     make(training.levels[0].game, training.levels[0].state, scenario, **options).close()
+
+
+def _check_local_memory(runners: int) -> None:
+    """Refuse a local Ray whose runners would not fit in this machine's memory (each is a process of its own).
+
+    Raises:
+        InvalidArgumentError: They would not.
+    """
+    from retrokit.envs.memory import available_memory
+
+    room = available_memory()
+    if room is not None and runners * RUNNER_BYTES > room:
+        raise InvalidArgumentError(
+            f"Expected room for the {runners} env runners of a local Ray (about {RUNNER_BYTES >> 20} MiB each: "
+            f"torch and RLlib in every runner's process), but this machine has {room >> 20:,} MiB available; "
+            "use a Ray cluster (--ray-address), fewer levels (--levels), or --backend local."
+        )
 
 
 def env_options(training: Training) -> tuple[dict[str, Any], Any]:

@@ -366,12 +366,9 @@ def train(training: Training, out: Path, *, resume: bool = False, progress: bool
     module = algorithm(training.agent)
     training.benchmark.check_levels(list(training.levels))
     if training.backend == "ray":
-        from retrokit.benchmark.ray_backend import check_address
         from retrokit.learning import raytrain
 
-        raytrain.check(training)
-        if ray_address:
-            check_address(ray_address)  # before the folder is claimed (a typo leaves nothing), and RLlib imported
+        raytrain.check(training, ray_address)  # before RLlib's import and the folder's claim: a typo leaves nothing
         raytrain.require(training.agent)
     else:
         module.require()

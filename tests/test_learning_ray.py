@@ -8,8 +8,7 @@ each of the two env runners is on its own node. The runs are the CLI's, in the c
 first checkpoint adds a third node and removes a node holding an env runner; the killed run's first
 checkpoint raises ``KeyboardInterrupt`` (Ctrl-C), then it is resumed; it starts from the joint run's policy
 (``--init``). Between them, a run asks for more runners than the cluster has CPUs, and one's runners cannot
-make their env. Tiny config: what is tested is the
-plumbing, never how well PPO learns.
+make their env. Tiny config: what is tested is the plumbing, never how well PPO learns.
 """
 
 from __future__ import annotations

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 
@@ -56,6 +57,16 @@ def test_a_new_run_never_takes_a_used_folder_and_resume_needs_one(saved, tmp_pat
     other = Training(training.benchmark, training.levels, "ppo", training.config, 2000, seed=3)
     with pytest.raises(RunFolderError, match="timesteps differ"):
         TrainRun(saved, other, resume=True, progress=False)
+
+
+def test_the_backend_is_a_setting_and_an_older_run_json_is_a_local_runs(saved, training) -> None:
+    on_ray = dataclasses.replace(training, backend="ray", env_runners=3)
+    with pytest.raises(RunFolderError, match="backend, env_runners differ"):
+        TrainRun(saved, on_ray, resume=True, progress=False)
+    _edit_run(saved, lambda data: [data["settings"].pop(key) for key in ("backend", "env_runners")])
+    TrainRun(saved, training, resume=True, progress=False).close()
+    with pytest.raises(RunFolderError, match="backend, env_runners differ"):
+        TrainRun(saved, on_ray, resume=True, progress=False)
 
 
 def test_a_folder_in_use_is_refused(saved, training) -> None:

@@ -24,13 +24,19 @@ load, the ratios from the same run carry over better.
    levels at ``--budget`` timesteps a level: each run's score and final score per level and overall. Run
    folders go to ``--out``; a run whose folder holds a complete ``summary.json`` is read, not run again.
 
-3. The learning check (``--learning``): ``retrokit evaluate --benchmark dasher --agent ppo --agent-config quick
+3. Ray (``--ray``): ``retrokit train`` of PPO (``--config``) on the dasher benchmark's training levels, on the
+   local backend (SB3 over the native vector env) and on ``--backend ray`` (RLlib's env runners on a local Ray,
+   one a level), for ``--ray-updates`` updates each, in this process: the steady timesteps/s of each (from the
+   second update on), their ratio, the Ray run's seconds split into its env runners' sampling and its
+   learner's updates, and from those what the paper's joint training (188 envs) costs on N machines.
+
+4. The learning check (``--learning``): ``retrokit evaluate --benchmark dasher --agent ppo --agent-config quick
    --levels Zone1.Act2 --timesteps 120000`` and the same with ``--agent random``; PPO's last 20% of episodes must
    score at least 1.5 times random's mean. ``--learning-runs PPO_DIR RANDOM_DIR`` reads two such folders instead.
 
 Usage: python tools/bench_learning.py [--envs 4] [--timesteps 2048] [--rounds 3] [--config quick]
        [--no-speed] [--scores [--budget 10000] [--train-timesteps 30000] [--out DIR]]
-       [--learning | --learning-runs P R]
+       [--ray [--ray-updates 4]] [--learning | --learning-runs P R]
 """
 
 from __future__ import annotations
@@ -227,6 +233,71 @@ def paper_cost(timesteps_per_second: float, measured: str) -> None:
               f"at {timesteps_per_second:.1f} timesteps/s ({measured}), {budget / timesteps_per_second / 3600:.1f} h a level")
 
 
+def train_rate(backend: str, config_name: str, updates: int, folder: Path) -> tuple[float, dict[str, float], int]:
+    """``retrokit train`` of PPO on the dasher training levels for ``updates`` updates: the steady timesteps/s
+    (from the end of the first update to the last) and, on Ray, the seconds of sampling and of learning after
+    the first update, and the timesteps after it."""
+    from ray.rllib.algorithms.ppo import ppo as rllib_ppo_algorithm
+    from ray.rllib.core.learner.learner_group import LearnerGroup
+
+    from retrokit.cli import main
+    from retrokit.learning.config import load_config
+    from retrokit.learning.trainrun import TrainRun
+
+    config = load_config("ppo", config_name).values
+    per_update = config["horizon"] * config["train_envs_per_level"] * len(dasher()[0].train)
+    marks: list[tuple[float, int]] = []
+    spent = {"sampling": 0.0, "learning": 0.0}
+
+    def timed(kind: str, call):
+        def wrapper(*args, **kwargs):
+            start = time.perf_counter()
+            try:
+                return call(*args, **kwargs)
+            finally:
+                if marks:  # after the first update
+                    spent[kind] += time.perf_counter() - start
+        return wrapper
+
+    updated = TrainRun.updated
+    patches = [(TrainRun, "updated", lambda run, steps: marks.append((time.perf_counter(), steps)) or updated(run, steps)),
+               (rllib_ppo_algorithm, "synchronous_parallel_sample",
+                timed("sampling", rllib_ppo_algorithm.synchronous_parallel_sample)),
+               (LearnerGroup, "update", timed("learning", LearnerGroup.update))]
+    saved = [(owner, name, getattr(owner, name)) for owner, name, _ in patches]
+    for owner, name, value in patches:
+        setattr(owner, name, value)
+    try:
+        code = main(["train", "--benchmark", "dasher", "--agent", "ppo", "--agent-config", config_name,
+                     "--timesteps", str(per_update * updates), "--checkpoint-every", "1e9", "--no-progress",
+                     "--backend", backend, "--out", str(folder / backend)])
+    finally:
+        for owner, name, value in saved:
+            setattr(owner, name, value)
+    assert code == 0 and len(marks) >= 2, f"train --backend {backend} failed ({code})"
+    (t0, s0), (t1, s1) = marks[0], marks[-1]
+    return (s1 - s0) / (t1 - t0), spent, s1 - s0
+
+
+def ray_speed(config_name: str, updates: int) -> None:
+    """Part 3: the local and Ray backends' training rates, their ratio, and the paper's joint training's cost."""
+    folder = Path(tempfile.mkdtemp(prefix="bench-learning-ray-"))
+    print(f"ray: PPO ({config_name} config) trained on dasher's 3 training levels, {updates} updates; {load()}")
+    local, _, _ = train_rate("local", config_name, updates, folder)
+    ray_rate, spent, steps = train_rate("ray", config_name, updates, folder)
+    print(f"local (SB3, native vector env): {local:.1f} timesteps/s; ray (RLlib, 3 env runners): {ray_rate:.1f} "
+          f"timesteps/s; ray/local {ray_rate / local:.2f}x; {load()}")
+    sampling, learning = steps / spent["sampling"], steps / spent["learning"]
+    print(f"ray's update cycle: sampling {spent['sampling']:.1f} s ({sampling:.1f} timesteps/s), learning "
+          f"{spent['learning']:.1f} s ({learning:.1f} timesteps/s of the learner)")
+    cores = os.cpu_count() or 1
+    per_core = sampling / min(3, cores)  # the 3 runners shared this machine's cores with the learner
+    for machines in (1, 10, 47, 94):
+        rate = 1 / (1 / (per_core * cores * machines) + 1 / learning)
+        print(f"{machines:>3} machines of {cores} cores: {rate:,.0f} timesteps/s; 100M timesteps in "
+              f"{1e8 / rate / 3600:,.1f} h, 400M in {4e8 / rate / 3600:,.1f} h (the learner: {learning:.0f}/s)")
+
+
 def command(*args: str) -> list[str]:
     return [sys.executable, "-m", "retrokit", *args]
 
@@ -318,12 +389,16 @@ def main() -> int:
     parser.add_argument("--levels", default="test", help="scores: the levels (test, or LEVEL,...)")
     parser.add_argument("--workers", type=int, default=2, help="scores: evaluate's workers")
     parser.add_argument("--out", type=Path, default=None, help="scores: the run folders (kept; finished runs reused)")
+    parser.add_argument("--ray", action="store_true", help="train on the local and the Ray backends (needs RLlib)")
+    parser.add_argument("--ray-updates", type=int, default=4, help="ray: the updates of each run")
     parser.add_argument("--learning", action="store_true", help="run the learning check (about 10^5 timesteps)")
     parser.add_argument("--learning-runs", nargs=2, type=Path, metavar=("PPO_DIR", "RANDOM_DIR"),
                         help="read the learning check from these run folders")
     args = parser.parse_args()
     if not args.no_speed:
         speed(args.envs, args.timesteps, args.rounds, args.config)
+    if args.ray:
+        ray_speed(args.config, args.ray_updates)
     if args.scores:
         out = args.out or Path(tempfile.mkdtemp(prefix="bench-learning-scores-"))
         scores(out, args.budget, args.train_timesteps, args.agent_configs.split(","), args.levels, args.workers)

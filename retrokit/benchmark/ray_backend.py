@@ -20,7 +20,9 @@ import logging
 import os
 import queue
 import socket
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from typing import Any
 
 from retrokit.benchmark.level import LevelDone, LevelFailed, LevelRestarted, LevelTask, Message, Started, run_level
 from retrokit.benchmark.watchdog import Watchdog
@@ -74,11 +76,26 @@ def run_ray(tasks: list[LevelTask], handle: Callable[[Message], None], workers: 
         address: An existing cluster's address (``ray://host:10001``, ``host:6379`` or ``auto``).
         watchdog: Stops a level whose agent stalls.
     """
+    with connected(address, workers) as ray:
+        from ray.util.queue import Empty, Queue
+
+        _play_all(ray, Queue, Empty, tasks, handle, watchdog)
+
+
+@contextmanager
+def connected(address: str | None, cpus: int) -> Iterator[Any]:
+    """Ray, connected to the cluster at ``address`` (checked first), or to a new local Ray of ``cpus`` CPUs.
+
+    Every use of Ray goes through here (``evaluate``'s levels, ``train``'s env runners): a Ray this process
+    already joined is used as it is; one started here is shut down on leaving.
+
+    Raises:
+        BackendUnavailableError: Ray is not installed, or the address is malformed, unreachable, or no Ray.
+    """
     if importlib.util.find_spec("ray") is not None and address:
         check_address(address)
     try:
         import ray
-        from ray.util.queue import Empty, Queue
     except ImportError:
         raise BackendUnavailableError(
             f"Expected Ray for --backend ray, but it is not installed; run `{install_extra('ray')}`."
@@ -90,14 +107,14 @@ def run_ray(tasks: list[LevelTask], handle: Callable[[Message], None], workers: 
             if address:
                 ray.init(address=address, logging_level=logging.WARNING, log_to_driver=False)
             else:
-                ray.init(num_cpus=max(1, workers), include_dashboard=False, logging_level=logging.WARNING,
+                ray.init(num_cpus=max(1, cpus), include_dashboard=False, logging_level=logging.WARNING,
                          log_to_driver=False)
         except (ConnectionError, RuntimeError, ValueError) as exc:
             raise BackendUnavailableError(
                 f"Expected a Ray cluster at {address or 'a new local Ray'}, but it could not start or connect: {exc}."
             ) from None
     try:
-        _play_all(ray, Queue, Empty, tasks, handle, watchdog)
+        yield ray
     finally:
         if started:
             ray.shutdown()
@@ -106,7 +123,7 @@ def run_ray(tasks: list[LevelTask], handle: Callable[[Message], None], workers: 
 def _play_all(ray, queue_type, empty_error, tasks: list[LevelTask], handle: Callable[[Message], None],
               watchdog: Watchdog) -> None:
     """Run ``tasks`` on the connected Ray, retrying a level whose node is lost (see :data:`NODE_RETRIES`)."""
-    messages = queue_type(actor_options=_on_this_node(ray))
+    messages = queue_type(actor_options=on_this_node(ray))
     play = ray.remote(num_cpus=1, max_retries=0)(_play)
     pending: dict = {}  # a running task's ref -> its task
     attempts: dict[str, int] = {}  # level -> its attempt now playing (messages of earlier ones are stale)
@@ -171,8 +188,8 @@ def _play_all(ray, queue_type, empty_error, tasks: list[LevelTask], handle: Call
             watchdog.stop(level)
 
 
-def _on_this_node(ray) -> dict:
-    """Ray options that keep an actor on this process's node: the message queue must outlive any other node."""
+def on_this_node(ray) -> dict:
+    """Ray options that keep an actor on this process's node: a message queue must outlive any other node."""
     from ray.util.scheduling_strategies import NodeAffinitySchedulingStrategy
 
     try:

@@ -56,3 +56,11 @@ def add_learning_options(parser) -> None:  # an argparse parser
                         help="a learning agent's config: paper (the default), quick, or a YAML file (a changed copy)")
     parser.add_argument("--init", default=None, metavar="PATH",
                         help="start from a trained policy: a `retrokit train` folder or its policy.json")
+
+
+def add_backend_options(parser, local: str, extra: str = "the extra retrokit-rl[ray]") -> None:  # an argparse parser
+    """Add ``--backend local|ray`` and ``--ray-address``, which ``evaluate`` and ``train`` share."""
+    parser.add_argument("--backend", choices=("local", "ray"), default="local",
+                        help=f"{local}, or Ray (default: local; Ray is {extra})")
+    parser.add_argument("--ray-address", default=None,
+                        help="an existing Ray cluster: HOST:PORT, ray://HOST:PORT or auto (default: start a local Ray)")

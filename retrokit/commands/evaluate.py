@@ -14,7 +14,7 @@ import os
 import sys
 from pathlib import Path
 
-from retrokit.commands._common import add_evaluation_options, add_learning_options
+from retrokit.commands._common import add_backend_options, add_evaluation_options, add_learning_options
 
 AGENT_NOTE = """\
 An agent is random, jerk, ppo, rainbow, or MODULE:CALLABLE (an importable module or a .py file), a callable
@@ -66,10 +66,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--stall-timeout", type=float, default=DEFAULT_STALL_SECONDS, metavar="SECONDS",
                         help="stop a level whose agent takes no timestep for this long, and fail it "
                         f"(default: {DEFAULT_STALL_SECONDS:g})")
-    parser.add_argument("--backend", choices=("local", "ray"), default="local",
-                        help="local processes, or Ray (default: local; Ray is the extra retrokit-rl[ray])")
-    parser.add_argument("--ray-address", default=None,
-                        help="an existing Ray cluster: HOST:PORT, ray://HOST:PORT or auto (default: start a local Ray)")
+    add_backend_options(parser, "local processes")
     parser.add_argument("--out", type=Path, default=None, metavar="DIR", help="the run folder (required, except with --list)")
     parser.add_argument("--resume", action="store_true", help="continue the interrupted evaluation in --out")
     parser.add_argument("--gif", action="store_true", help="save a GIF of each level's best episode in --out/gifs")

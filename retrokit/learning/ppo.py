@@ -89,6 +89,18 @@ def build(venv: Any, config: Mapping[str, Any]) -> Any:  # an SB3 VecEnv -> a PP
     )  # fmt: skip
 
 
+def network(observation_space: Any, action_space: Any, config: Mapping[str, Any]) -> Any:  # spaces -> a torch module
+    """The network of ``config`` alone: the ``ActorCriticCnnPolicy`` that :func:`build`'s ``CnnPolicy`` is.
+
+    RLlib's PPO (:mod:`.rllib_ppo`) trains this very module, so its weights are the ones :func:`weights_of`
+    writes and :func:`load_weights` reads, whichever backend trained them.
+    """
+    from stable_baselines3.common.policies import ActorCriticCnnPolicy
+
+    rate = float(config["learning_rate"])
+    return ActorCriticCnnPolicy(observation_space, action_space, lambda _: rate)
+
+
 def weights_of(model: Any) -> bytes:
     """The model's network as a ``torch.save`` of its ``state_dict``."""
     import torch

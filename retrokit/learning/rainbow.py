@@ -35,10 +35,9 @@ import numpy as np
 
 from retrokit.errors import InvalidArgumentError
 from retrokit.learning.algorithms import VIEW_KEYS, Key, require_libraries
-from retrokit.learning.task import TaskView, image_options
+from retrokit.learning.task import TaskEnv, image_options  # TaskEnv: what rainbow.TaskEnv named
 
 if TYPE_CHECKING:
-    from retrokit.benchmark.definition import LearningTask
     from retrokit.learning.setup import LearnerSetup
     from retrokit.learning.trainrun import TrainRun
 
@@ -94,37 +93,6 @@ def library() -> str:
     import tianshou
 
     return f"{LIBRARY} {tianshou.__version__}"
-
-
-class TaskEnv(gymnasium.Wrapper):
-    """One env as the learner sees it (:class:`~retrokit.learning.task.TaskView`): the task's actions, its reward.
-
-    Args:
-        env: A level's env (``action_type="all"``), monitored or not.
-        task: The actions and x.
-        reward_scale: The learner's reward is the max-x reward times this.
-        on_episode: Called with ``(env, benchmark reward, steps)`` when an episode ends.
-    """
-
-    def __init__(self, env: gymnasium.Env, task: LearningTask, reward_scale: float,
-                 on_episode: Callable[[gymnasium.Env, float, int], None] | None = None) -> None:
-        super().__init__(env)
-        ended = None if on_episode is None else lambda _, reward, steps: on_episode(env, reward, steps)
-        self.view = TaskView(env, task, reward_scale, 1, ended)
-        self.action_space = self.view.action_space
-
-    # The infos (every RAM field) are read here and not passed on: the replay would keep them, 8 bytes a field
-    # a transition (Dasher's fields would add 6% to the frames).
-
-    def reset(self, **kwargs: Any):
-        obs, info = self.env.reset(**kwargs)
-        self.view.start(0, info)
-        return obs, {}
-
-    def step(self, action: Any):
-        obs, reward, terminated, truncated, info = self.env.step(self.view.buttons(np.asarray([action]))[0])
-        learned = self.view.rewards([reward], [info], [terminated or truncated])[0]
-        return obs, float(learned), terminated, truncated, {}
 
 
 @dataclass

@@ -14,7 +14,7 @@ the learner is given differs: its discrete choice pressed as the task's buttons
 (the same arrays :class:`~retrokit.envs.sonic.Discretizer` sends), and its reward
 the max-x reward times the config's ``reward_scale``. :class:`TaskView` does it
 for N envs at once (a vector env's, or one), so PPO's training and its test runs
-go through the same code.
+go through the same code; :class:`TaskEnv` is it as one Gymnasium env (Rainbow's envs, RLlib's env runners').
 """
 
 from __future__ import annotations
@@ -104,3 +104,34 @@ class TaskView:
             if dones[i] and self.on_episode is not None:
                 self.on_episode(i, float(self._returns[i]), int(self._steps[i]))
         return out
+
+
+class TaskEnv(gymnasium.Wrapper):
+    """One env as the learner sees it (:class:`~retrokit.learning.task.TaskView`): the task's actions, its reward.
+
+    Args:
+        env: A level's env (``action_type="all"``), monitored or not.
+        task: The actions and x.
+        reward_scale: The learner's reward is the max-x reward times this.
+        on_episode: Called with ``(env, benchmark reward, steps)`` when an episode ends.
+    """
+
+    def __init__(self, env: gymnasium.Env, task: LearningTask, reward_scale: float,
+                 on_episode: Callable[[gymnasium.Env, float, int], None] | None = None) -> None:
+        super().__init__(env)
+        ended = None if on_episode is None else lambda _, reward, steps: on_episode(env, reward, steps)
+        self.view = TaskView(env, task, reward_scale, 1, ended)
+        self.action_space = self.view.action_space
+
+    # The infos (every RAM field) are read here and not passed on: Rainbow's replay (and RLlib's episodes) would
+    # keep them, 8 bytes a field a transition (Dasher's fields would add 6% to the frames).
+
+    def reset(self, **kwargs: Any):
+        obs, info = self.env.reset(**kwargs)
+        self.view.start(0, info)
+        return obs, {}
+
+    def step(self, action: Any):
+        obs, reward, terminated, truncated, info = self.env.step(self.view.buttons(np.asarray([action]))[0])
+        learned = self.view.rewards([reward], [info], [terminated or truncated])[0]
+        return obs, float(learned), terminated, truncated, {}

@@ -19,6 +19,7 @@ the evaluation's) for its lifetime.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import hashlib
 import io
@@ -63,6 +64,8 @@ class Training:
         timesteps: Timesteps to train for, over all levels.
         seed: The run's seed.
         init: A policy to start from, if any.
+        backend: ``local`` (this machine's processes) or ``ray`` (RLlib's env runners on a Ray cluster).
+        env_runners: With ``ray``, the env runners (a multiple of the levels; see :mod:`.raytrain`).
     """
 
     benchmark: Benchmark
@@ -72,6 +75,8 @@ class Training:
     timesteps: int
     seed: int = 0
     init: SavedPolicy | None = None
+    backend: str = "local"
+    env_runners: int | None = None
 
     def settings(self) -> dict[str, Any]:
         """What determines the run, for ``run.json``; ``--resume`` requires the same."""
@@ -83,6 +88,9 @@ class Training:
             "timesteps": self.timesteps,
             "seed": self.seed,
             "init": None if self.init is None else {"policy": str(self.init.path.resolve()), "weights_sha256": self.init.sha256},
+            # the library that trains differs with the backend (RLlib's PPO is not SB3's): a resume keeps it
+            "backend": self.backend,
+            "env_runners": self.env_runners,
         }
 
 
@@ -229,7 +237,9 @@ class TrainRun:
             raise self._damaged(RUN_FILE, f"it is not JSON ({type(exc).__name__})") from None
         if not isinstance(saved, dict) or not isinstance(saved.get("settings"), dict) or "checkpoint" not in saved:
             raise self._damaged(RUN_FILE, "it does not map 'settings' and 'checkpoint'")
-        check_same_settings(self.path, saved["settings"], self.settings)
+        # a run.json written before the backend was a setting is a local run's
+        settings = {"backend": "local", "env_runners": None, **saved["settings"]}
+        check_same_settings(self.path, settings, self.settings)
         checkpoint = saved["checkpoint"]
         if checkpoint is not None:
             problem = _checkpoint_problem(checkpoint, self.episodes, self.training.timesteps)
@@ -335,22 +345,42 @@ def state_bytes(save: Any, value: Any) -> bytes:
 
 
 def train(training: Training, out: Path, *, resume: bool = False, progress: bool = True,
-          checkpoint_seconds: float = DEFAULT_CHECKPOINT_SECONDS) -> TrainRun:
+          checkpoint_seconds: float = DEFAULT_CHECKPOINT_SECONDS, ray_address: str | None = None) -> TrainRun:
     """Run ``training`` into ``out`` (see the module's doc); return the finished run (closed).
 
+    Args:
+        training: What to train, and on which backend.
+        out: The run folder.
+        resume: Continue the run in ``out``.
+        progress: Show progress.
+        checkpoint_seconds: Seconds between checkpoints.
+        ray_address: With the ``ray`` backend, a cluster's address (``None``: a new local Ray).
+
     Raises:
-        RetrokitError: A level, ROM or the library is missing, or the folder cannot be used (see :class:`TrainRun`).
+        RetrokitError: A level, ROM or the library is missing, the Ray cluster cannot be reached, or the folder
+            cannot be used (see :class:`TrainRun`).
         KeyboardInterrupt: Interrupted; the last checkpoint stays, for ``--resume``.
     """
     from retrokit.learning.algorithms import algorithm
 
     module = algorithm(training.agent)
     training.benchmark.check_levels(list(training.levels))
-    module.require()
-    run = TrainRun(out, training, resume=resume, progress=progress, checkpoint_seconds=checkpoint_seconds)
-    try:
-        module.train(run)
-        run.finish()
-    finally:
-        run.close()
+    if training.backend == "ray":
+        from retrokit.learning import raytrain
+
+        raytrain.check(training, ray_address)  # before RLlib's import and the folder's claim: a typo leaves nothing
+        raytrain.require(training.agent)
+    else:
+        module.require()
+    # on Ray, connected (and the cluster's CPUs checked) before the folder is claimed
+    with raytrain.cluster(training, ray_address) if training.backend == "ray" else contextlib.nullcontext():
+        run = TrainRun(out, training, resume=resume, progress=progress, checkpoint_seconds=checkpoint_seconds)
+        try:
+            if training.backend == "ray":
+                raytrain.train(run, ray_address)
+            else:
+                module.train(run)
+            run.finish()
+        finally:
+            run.close()
     return run

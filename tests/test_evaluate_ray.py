@@ -32,9 +32,12 @@ def test_ray_gives_the_local_summary_and_stops_a_stalled_level_keeping_the_other
     # Ray runs in a child, as a user runs it: importing Ray here would leave this test process a few hundred
     # MB larger, and the memory limits other tests check in their own children start from that size. The
     # local run plays meanwhile: most of the child's time is Ray starting, which waits more than it computes.
+    # Without --ray-address the run starts a Ray of its own, whatever cluster this machine knows of (ray.init()
+    # alone would join $RAY_ADDRESS, or the last cluster started here, e.g. another test's).
+    elsewhere = {**os.environ, "RAY_ADDRESS": "127.0.0.1:1"}
     with subprocess.Popen([sys.executable, "-m", "retrokit", *args, "--workers", "2", "--backend", "ray",
                            "--out", str(tmp_path / "ray")], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                          stdin=subprocess.DEVNULL, text=True) as child:
+                          stdin=subprocess.DEVNULL, text=True, env=elsewhere) as child:
         try:
             assert main([*args, "--workers", "1", "--out", str(tmp_path / "local")]) == 2
             _, stderr = child.communicate(timeout=240)

@@ -107,8 +107,10 @@ def connected(address: str | None, cpus: int) -> Iterator[Any]:
             if address:
                 ray.init(address=address, logging_level=logging.WARNING, log_to_driver=False)
             else:
-                ray.init(num_cpus=max(1, cpus), include_dashboard=False, logging_level=logging.WARNING,
-                         log_to_driver=False)
+                # "local": a new Ray of this run's own, never the last cluster started on this machine, which
+                # ray.init() without an address joins (/tmp/ray/ray_current_cluster, or $RAY_ADDRESS)
+                ray.init(address="local", num_cpus=max(1, cpus), include_dashboard=False,
+                         logging_level=logging.WARNING, log_to_driver=False)
         except (ConnectionError, RuntimeError, ValueError) as exc:
             raise BackendUnavailableError(
                 f"Expected a Ray cluster at {address or 'a new local Ray'}, but it could not start or connect: {exc}."

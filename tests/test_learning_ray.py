@@ -1,5 +1,5 @@
 """``retrokit train --backend ray``: PPO by RLlib's env runners on a 2-node Ray cluster that loses a node mid-run,
-its policy read by ``evaluate --init``, ``--resume`` on Ray, and the refusals.
+its policy read by ``evaluate --init``, ``--resume`` on Ray, Joint Rainbow on the same cluster, and the refusals.
 
 One child process holds one ``ray.cluster_utils`` cluster for every Ray run of the module (a Ray start and
 RLlib's env runners cost seconds each): a head with no CPU (the driver, which learns) and two 1-CPU nodes, so
@@ -37,10 +37,12 @@ if _ray is None or not (Path(_ray.origin).parent / "rllib").is_dir():
 from retrokit.learning.policy import read_policy
 
 REPO = Path(__file__).resolve().parent.parent
+pytestmark = pytest.mark.timeout(900)  # the cluster's runs, one child: 2 minutes on a quiet 2-core machine
 # Episodes of at most 30 steps, under a horizon of 32: every runner's env ends one in each fragment it plays.
 TINY = {"horizon": 32, "minibatch": 32, "epochs": 1, "frame_size": 36, "train_envs_per_level": 1}
 LEVELS = ("Dasher-Genesis/Zone1.Act1", "Dasher-Genesis/Zone2.Act1")
 TIMESTEPS = 256  # four updates of 2 runners x 32
+RAINBOW_TINY = {"frame_size": 36, "minibatch": 8, "learning_starts": 64, "target_update": 32, "replay": 1000}
 
 CLUSTER = r'''
 import json, logging, os, sys
@@ -160,6 +162,8 @@ start = ("--init", str(folder / "joint"))  # the killed run starts from the join
 results["killed_run"] = train("killed", *start)
 results["other_backend"] = run("--out", str(folder / "killed"), "--resume", *start)
 results["resumed"] = train("killed", "--resume", *start)
+# Joint Rainbow on the same cluster: RLlib's DQN on the local Rainbow's network (an iteration samples 1,000 steps)
+results["rainbow"] = train("rainbow", "--agent", "rainbow", "--agent-config", sys.argv[3], "--timesteps", "64")
 ray.shutdown()
 cluster.shutdown()
 (folder / "results.json").write_text(json.dumps(results))
@@ -188,8 +192,11 @@ def cluster(folder, common) -> dict:
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
     script = folder / "cluster.py"
     script.write_text(CLUSTER)
-    done = subprocess.run([sys.executable, str(script), str(folder), json.dumps(common)], env=env, cwd=folder,
-                          capture_output=True, text=True, timeout=600, stdin=subprocess.DEVNULL, check=False)
+    (folder / "rainbow-config").mkdir()
+    rainbow = tiny_config(folder / "rainbow-config", "rainbow", RAINBOW_TINY)
+    done = subprocess.run([sys.executable, str(script), str(folder), json.dumps(common), str(rainbow)], env=env,
+                          cwd=folder,
+                          capture_output=True, text=True, timeout=840, stdin=subprocess.DEVNULL, check=False)
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
     return json.loads((folder / "results.json").read_text())
 
@@ -271,6 +278,28 @@ def test_init_and_resume_on_ray_load_the_weights_and_another_backend_is_refused(
     assert timesteps == sorted(timesteps) and timesteps[-1] > cluster["killed"]  # went on from the checkpoint
 
 
+def test_joint_rainbow_trains_on_ray_and_evaluate_plays_its_policy(folder, cluster) -> None:
+    """RLlib's DQN trained the Rainbow on both nodes' runners; its policy is the local Rainbow's (evaluate loads it).
+
+    That the two networks give the same distributions is tests/test_learning_rllib_rainbow.py's.
+    """
+    done = cluster["rainbow"]
+    assert done["code"] == 0, done["stderr"]
+    out = folder / "rainbow"
+    policy = read_policy(out, "rainbow")
+    assert policy.meta["library"].startswith("ray[rllib] ") and policy.meta["timesteps"] >= 64
+    assert policy.meta["observation"]["shape"] == [4, 36, 36]
+    assert {row[1] for row in _episodes(out)} == set(LEVELS)
+    run = json.loads((out / "run.json").read_text())
+    assert run["settings"]["backend"] == "ray" and run["settings"]["agent"] == "rainbow"
+    played = retrokit_in_process(folder, "evaluate", "--agent", "rainbow", "--agent-config",
+                                 str(folder / "rainbow-config" / "tiny.yaml"), "--init", str(out), "--no-learn",
+                                 "--levels", "Zone1.Act2", "--timesteps", "40", "--workers", "1", "--no-progress",
+                                 "--out", str(folder / "rainbow-zero-shot"))
+    assert played.returncode == 0, played.stderr
+    assert json.loads((folder / "rainbow-zero-shot" / "summary.json").read_text())["complete"]
+
+
 def test_more_runners_than_the_cluster_has_cpus_is_refused(folder, cluster) -> None:
     refused = cluster["too_many"]
     assert refused["code"] == 2 and "Expected a CPU for each of the 4 env runners" in refused["stderr"]
@@ -304,10 +333,11 @@ def test_no_ray_process_is_left_behind(cluster) -> None:
     (("--backend", "ray", "--env-runners", "3"), "Expected --env-runners to be a multiple of the 2 level(s)"),
     (("--backend", "ray", "--env-runners", "0"), "Expected --env-runners to be a multiple"),
     (("--backend", "ray", "--env-runners", str(10**12)), "up to 4096, got 1000000000000"),
-    (("--backend", "ray", "--agent", "rainbow", "--agent-config", "quick"), "trains locally only for now"),
+    (("--backend", "ray", "--agent", "rainbow", "--agent-config", "paper"),
+     "Expected Rainbow's replay of 500,000 transitions (RLlib's, in the Ray driver) to fit in memory"),
     (("--ray-address", "127.0.0.1:1"), "Expected --ray-address and --env-runners with --backend ray only"),
     (("--backend", "ray"), "Expected room for the 2 env runners of a local Ray (about 600 MiB each"),
-], ids=["unreachable", "malformed", "runners-not-a-multiple", "no-runners", "runners-huge", "rainbow",
+], ids=["unreachable", "malformed", "runners-not-a-multiple", "no-runners", "runners-huge", "rainbow-replay",
         "address-without-ray", "local-ray-out-of-memory"])
 def test_bad_ray_options_are_one_line(folder, common, args, message, monkeypatch) -> None:
     """Refused before the folder is claimed, and before Ray or RLlib is imported."""

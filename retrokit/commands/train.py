@@ -21,6 +21,7 @@ EXAMPLES = [
     "retrokit train --benchmark dasher --agent rainbow --agent-config quick --timesteps 200000 --out runs/joint-rainbow",
     "retrokit train --benchmark sonic --agent ppo --timesteps 50000000 --checkpoint-every 1800 --out runs/sonic",
     "retrokit train --benchmark sonic --agent ppo --backend ray --ray-address auto --env-runners 47 --timesteps 100000000 --out runs/sonic-ray",
+    "retrokit train --benchmark dasher --agent rainbow --agent-config quick --backend ray --timesteps 200000 --out runs/joint-rainbow-ray",
 ]
 
 
@@ -48,7 +49,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     parser.add_argument("--resume", action="store_true", help="continue the killed run in --out from its last checkpoint")
     parser.add_argument("--checkpoint-every", type=float, default=DEFAULT_CHECKPOINT_SECONDS, metavar="SECONDS",
                         help=f"seconds between checkpoints; 0: after every update (default: {DEFAULT_CHECKPOINT_SECONDS:g})")
-    add_backend_options(parser, "this machine's processes", "RLlib's, pip install 'ray[rllib]'; PPO only")
+    add_backend_options(parser, "this machine's processes", "RLlib's, pip install 'ray[rllib]'")
     parser.add_argument("--env-runners", type=int, default=None, metavar="N",
                         help="with --backend ray: RLlib's env runners, a multiple of the levels (default: one a level)")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar or lines")

@@ -47,7 +47,11 @@ if TYPE_CHECKING:
 #: ``restore(algorithm, weights, state)`` (see :mod:`.rllib_ppo`).
 AGENTS = {
     "ppo": "retrokit.learning.rllib_ppo",
+    "rainbow": "retrokit.learning.rllib_rainbow",
 }
+#: The agents whose RLlib module has checks to make before Ray starts, in ``check(config)``: the Rainbow's
+#: replay lives in this process. (PPO's module imports RLlib, so it is not asked here.)
+PRE_CHECKS = {"rainbow"}
 #: The most env runners a run asks for: the paper's 188 workers as 4 runners a level need 188; more is a typo.
 MAX_ENV_RUNNERS = 4096
 #: What an env runner's process takes: 535 MB resident measured (torch, RLlib, SB3 and the emulator), rounded up.
@@ -60,21 +64,18 @@ def check(training: Training, address: str | None) -> None:
     """Refuse, before anything starts (Ray, RLlib's import, the run folder), what the run could not do.
 
     Raises:
-        InvalidArgumentError: The agent has no RLlib module, ``env_runners`` is not a multiple of the levels, a
-            local Ray's runners would not fit in this machine's memory, or the env cannot be made.
+        InvalidArgumentError: ``env_runners`` is not a multiple of the levels, a local Ray's runners (or the
+            agent's replay, in this process) would not fit in this machine's memory, or the env cannot be made.
         BackendUnavailableError: Nothing answers at ``address``.
     """
-    if training.agent not in AGENTS:
-        raise InvalidArgumentError(
-            f"Expected an agent that trains on Ray ({', '.join(AGENTS)}) with --backend ray, got --agent "
-            f"{training.agent}, which trains locally only for now; drop --backend ray."
-        )
     levels, runners = len(training.levels), training.env_runners
     if runners is None or not 1 <= runners <= MAX_ENV_RUNNERS or runners % levels:
         raise InvalidArgumentError(
             f"Expected --env-runners to be a multiple of the {levels} level(s) trained on (so each level has as many "
             f"runners) up to {MAX_ENV_RUNNERS}, got {runners}; use {levels} (the default) or {2 * levels}."
         )
+    if training.agent in PRE_CHECKS:
+        rllib_module(training.agent).check(training.config.values)
     if address:
         from retrokit.benchmark.ray_backend import check_address
 
@@ -216,8 +217,11 @@ def train(run: TrainRun, address: str | None) -> None:
             spec = {"levels": [(level.game, level.state) for level in training.levels], "options": options,
                     "scenario": scenario, "task": run.task, "reward_scale": config["reward_scale"], "log": name}
             register_env(name, partial(make_env, spec))
-            algo = _build(agent.algorithm_config(config, name, runners, config.get("train_envs_per_level", 1),
-                                                 training.seed), runners)
+            settings = agent.algorithm_config(config, name, runners, config.get("train_envs_per_level", 1),
+                                              training.seed)
+            # An iteration samples at least RLlib's minimum (DQN's: 1,000 steps), no more than the run has left
+            least = min(settings.min_sample_timesteps_per_iteration or 0, max(1, training.timesteps - run.timesteps))
+            algo = _build(settings.reporting(min_sample_timesteps_per_iteration=least), runners)
             try:
                 _train(run, agent, algo, log)
             finally:

@@ -74,6 +74,15 @@ def replay_bytes(config: Mapping[str, Any], size: int) -> int:
     return size * (frame * config["frame_stack"] + RLLIB_TRANSITION_EXTRA_BYTES)
 
 
+def check(config: Mapping[str, Any]) -> None:
+    """Refuse, before Ray starts, a replay that would not fit in this process's memory (the Ray driver's).
+
+    Raises:
+        InvalidArgumentError: It would not fit.
+    """
+    check_replay_fits(config["replay"], replay_bytes(config, config["replay"]), " (RLlib's, in the Ray driver)")
+
+
 def algorithm_config(config: Mapping[str, Any], env: str, runners: int, envs_per_runner: int, seed: int) -> Any:
     """RLlib's DQN (new API stack) configured as the Rainbow ``config``, on the registered env ``env``.
 
@@ -106,7 +115,7 @@ def algorithm_config(config: Mapping[str, Any], env: str, runners: int, envs_per
             "Expected 0 or more env runners, 1 or more envs a runner and a seed of 0 or more, whole numbers, got "
             f"{', '.join(repr(n) for n in counts)}."
         )
-    check_replay_fits(values["replay"], replay_bytes(values, values["replay"]), " (RLlib's, in the Ray driver)")
+    check(values)
     fragment = values["update_every"] * math.ceil(values["n_step"] / values["update_every"])
     return (
         DQNConfig()

@@ -7,6 +7,7 @@ folder keeps its made states next to its game.yaml).
 
 from __future__ import annotations
 
+import asyncio
 import json
 import os
 import struct
@@ -23,6 +24,7 @@ from retrokit.host.systems import all_systems, get_system
 from retrokit.movie import read_bk2
 from retrokit.studio.app import SCREEN_HEADER, create_app
 from retrokit.studio.play import key_map, pad_map
+from retrokit.studio.push import Screen, Subscriber
 from retrokit.studio.session import Session
 
 REPO = Path(__file__).resolve().parent.parent
@@ -127,6 +129,49 @@ def test_the_socket_sends_screens_with_the_documented_header(client, studio_sess
         assert later > frame  # the game runs: each screen is a newer frame
         pixels = np.frombuffer(data, np.uint8, offset=16).reshape(height, width, 3)
         assert pixels.std() > 0  # a picture, not a blank
+
+
+class RecordingPage(Subscriber):
+    """A page that notes the frame of every screen offered to it (its loop never runs: nothing is sent)."""
+
+    def __init__(self, loop: asyncio.AbstractEventLoop) -> None:
+        super().__init__(loop)
+        self.frames: list[int] = []
+
+    def offer_screen(self, screen: Screen) -> None:
+        self.frames.append(screen.frame)
+        super().offer_screen(screen)
+
+
+def test_a_page_that_comes_as_a_frame_ends_gets_that_frame_once(client, studio_session):
+    """A frame that ends between a page's arrival and its first-screen job is offered to it once, not twice.
+
+    A job holds the emulator thread while the page comes, then plays one frame, as the running loop's next
+    tick does when it falls there (the socket test above then saw the same frame twice, 1 run in 9 under load).
+    """
+    paused_at(client)
+    holding, arrived = threading.Event(), threading.Event()
+
+    def frame_after_arrival(s: Session) -> None:
+        holding.set()
+        arrived.wait()
+        s.advance(1)
+
+    loop = asyncio.new_event_loop()
+    page = RecordingPage(loop)
+    helper = threading.Thread(target=studio_session.call_blocking, args=(frame_after_arrival,))
+    helper.start()
+    try:
+        holding.wait()
+        studio_session.subscribe(page)  # its first-screen job waits behind the frame
+        arrived.set()
+        helper.join()
+        frame = studio_session.call_blocking(lambda s: s.frame)  # after the first-screen job
+    finally:
+        arrived.set()
+        studio_session.unsubscribe(page)
+        loop.close()
+    assert page.frames == [frame]
 
 
 def test_the_frame_loop_keeps_to_the_speed_asked(client, studio_session):

@@ -47,6 +47,7 @@ class Subscriber:
         self.screen: Screen | None = None
         self.messages: dict[str, dict[str, Any]] = {}
         self.sent = 0  # messages sent on the socket, screens included
+        self.screens = 0  # screens offered (see _offer_screen in retrokit.studio.session)
         self.acked: int | None = None  # how many of them the page says it handled; None: it does not say
         self._ready = asyncio.Event()
 
@@ -70,6 +71,7 @@ class Subscriber:
     def offer_screen(self, screen: Screen) -> None:
         """Make ``screen`` the next one to send (called from any thread)."""
         self.screen = screen
+        self.screens += 1
         self._wake_soon()
 
     def offer_message(self, message: dict[str, Any]) -> None:

@@ -450,7 +450,14 @@ class Session:
 
 
 def _offer_screen(session: Session, subscriber: Subscriber) -> None:
-    subscriber.offer_screen(Screen(session.frame, session.screen()))
+    """A new page's first screen (on the emulator thread), unless a frame played since it came offered one.
+
+    A running game's frame can end between :meth:`Session.subscribe` and this job, and offer the page that
+    frame's screen: offered again here, the page got the same frame twice (1 run of test_studio_server in 9
+    under load). Both run on this thread, so the count is not raced.
+    """
+    if subscriber.screens == 0:
+        subscriber.offer_screen(Screen(session.frame, session.screen()))
 
 
 def _error_message(exc: BaseException) -> dict[str, Any]:

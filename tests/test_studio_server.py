@@ -367,8 +367,10 @@ def test_a_replay_started_after_the_last_page_left_plays_to_its_end_when_the_gra
     """The page closes, a script replays a movie, and the grace period runs out in the middle: the replay goes on.
 
     The grace timer stopped the thread whatever ran on it, leaving the status ``replaying`` and not paused for
-    ever with no thread to play (1 run of this file in 3 under load, where the timer of the last socket test
-    fired in the next replay). A frame hook ends the grace period at the replay's first frame, on purpose.
+    ever with no thread to play. In this file the last socket test's timer fired 0.08 to 0.2 s before the
+    replay test's replay began: a little later, and that replay never ended (and the speed test, which the
+    first socket test's timer lands in, played no frame at 1x). A frame hook ends the grace period at the
+    replay's first frame, on purpose.
     """
     paused_at(client)
     post(client, "/api/movies/record")

@@ -131,6 +131,26 @@ def test_the_socket_sends_screens_with_the_documented_header(client, studio_sess
         assert pixels.std() > 0  # a picture, not a blank
 
 
+@pytest.mark.parametrize(("query", "acked"), [("&ack=1", 0), ("&ack=0", None), ("", None)], ids=["ack", "no-ack", "unsaid"])
+def test_a_page_that_says_it_acknowledges_is_held_to_the_window_from_its_first_message(
+    client, studio_session, query, acked
+):
+    """``/ws?ack=1`` (the studio's page) is windowed from the start, not from its first ack, which a loaded
+    machine read after a backlog of screens had gone out; a page that does not say so is never held back."""
+    paused_at(client)
+    with client.websocket_connect(f"ws://127.0.0.1:{PORT}/ws?token={TOKEN}{query}") as ws:
+        ws.receive()  # it has subscribed
+        [page] = studio_session._subscribers
+        assert page.acked == acked
+
+
+def test_a_bad_ack_parameter_is_a_clear_error_and_the_socket_closes(client):
+    with client.websocket_connect(f"ws://127.0.0.1:{PORT}/ws?token={TOKEN}&ack=yes") as ws:
+        error = json.loads(ws.receive_text())
+        assert error["kind"] == "InvalidArgumentError" and "Expected ack=1" in error["error"], error
+        assert ws.receive()["type"] == "websocket.close"
+
+
 class RecordingPage(Subscriber):
     """A page that notes the frame of every screen offered to it (its loop never runs: nothing is sent)."""
 

@@ -41,7 +41,7 @@ def frame_of(message: bytes) -> int:
 
 
 def test_a_slow_page_gets_the_newest_screens_and_its_pause_at_once(studio):
-    url = studio.origin.replace("http://", "ws://") + f"/ws?token={studio.token}"
+    url = studio.origin.replace("http://", "ws://") + f"/ws?token={studio.token}&ack=1"
     with websockets.connect(url, max_size=None) as ws:
         ws.send(json.dumps({"type": "resume"}))  # playing, whatever another test left
         received, lags = 0, []

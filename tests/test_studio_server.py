@@ -7,6 +7,7 @@ folder keeps its made states next to its game.yaml).
 
 from __future__ import annotations
 
+import asyncio
 import json
 import os
 import struct
@@ -23,6 +24,7 @@ from retrokit.host.systems import all_systems, get_system
 from retrokit.movie import read_bk2
 from retrokit.studio.app import SCREEN_HEADER, create_app
 from retrokit.studio.play import key_map, pad_map
+from retrokit.studio.push import Screen, Subscriber
 from retrokit.studio.session import Session
 
 REPO = Path(__file__).resolve().parent.parent
@@ -127,6 +129,69 @@ def test_the_socket_sends_screens_with_the_documented_header(client, studio_sess
         assert later > frame  # the game runs: each screen is a newer frame
         pixels = np.frombuffer(data, np.uint8, offset=16).reshape(height, width, 3)
         assert pixels.std() > 0  # a picture, not a blank
+
+
+@pytest.mark.parametrize(("query", "acked"), [("&ack=1", 0), ("&ack=0", None), ("", None)], ids=["ack", "no-ack", "unsaid"])
+def test_a_page_that_says_it_acknowledges_is_held_to_the_window_from_its_first_message(
+    client, studio_session, query, acked
+):
+    """``/ws?ack=1`` (the studio's page) is windowed from the start, not from its first ack, which a loaded
+    machine read after a backlog of screens had gone out; a page that does not say so is never held back."""
+    paused_at(client)
+    with client.websocket_connect(f"ws://127.0.0.1:{PORT}/ws?token={TOKEN}{query}") as ws:
+        ws.receive()  # it has subscribed
+        [page] = studio_session._subscribers
+        assert page.acked == acked
+
+
+def test_a_bad_ack_parameter_is_a_clear_error_and_the_socket_closes(client):
+    with client.websocket_connect(f"ws://127.0.0.1:{PORT}/ws?token={TOKEN}&ack=yes") as ws:
+        error = json.loads(ws.receive_text())
+        assert error["kind"] == "InvalidArgumentError" and "Expected ack=1" in error["error"], error
+        assert ws.receive()["type"] == "websocket.close"
+
+
+class RecordingPage(Subscriber):
+    """A page that notes the frame of every screen offered to it (its loop never runs: nothing is sent)."""
+
+    def __init__(self, loop: asyncio.AbstractEventLoop) -> None:
+        super().__init__(loop)
+        self.frames: list[int] = []
+
+    def offer_screen(self, screen: Screen) -> None:
+        self.frames.append(screen.frame)
+        super().offer_screen(screen)
+
+
+def test_a_page_that_comes_as_a_frame_ends_gets_that_frame_once(client, studio_session):
+    """A frame that ends between a page's arrival and its first-screen job is offered to it once, not twice.
+
+    A job holds the emulator thread while the page comes, then plays one frame, as the running loop's next
+    tick does when it falls there (the socket test above then saw the same frame twice, 1 run in 9 under load).
+    """
+    paused_at(client)
+    holding, arrived = threading.Event(), threading.Event()
+
+    def frame_after_arrival(s: Session) -> None:
+        holding.set()
+        arrived.wait()
+        s.advance(1)
+
+    loop = asyncio.new_event_loop()
+    page = RecordingPage(loop)
+    helper = threading.Thread(target=studio_session.call_blocking, args=(frame_after_arrival,))
+    helper.start()
+    try:
+        holding.wait()
+        studio_session.subscribe(page)  # its first-screen job waits behind the frame
+        arrived.set()
+        helper.join()
+        frame = studio_session.call_blocking(lambda s: s.frame)  # after the first-screen job
+    finally:
+        arrived.set()
+        studio_session.unsubscribe(page)
+        loop.close()
+    assert page.frames == [frame]
 
 
 def test_the_frame_loop_keeps_to_the_speed_asked(client, studio_session):
@@ -314,6 +379,41 @@ def test_record_a_movie_of_what_is_played_and_replay_it(client, studio_session, 
     post(client, "/api/play/speed", {"value": 1})
     assert client.get("/api/status").json()["paused"]  # a replay ends paused, at its last frame
     assert (ram(studio_session) == end).all()
+
+
+def test_a_replay_started_after_the_last_page_left_plays_to_its_end_when_the_grace_period_runs_out(
+    client, studio_session
+):
+    """The page closes, a script replays a movie, and the grace period runs out in the middle: the replay goes on.
+
+    The grace timer stopped the thread whatever ran on it, leaving the status ``replaying`` and not paused for
+    ever with no thread to play. In this file the last socket test's timer fired 0.08 to 0.2 s before the
+    replay test's replay began: a little later, and that replay never ended (and the speed test, which the
+    first socket test's timer lands in, played no frame at 1x). A frame hook ends the grace period at the
+    replay's first frame, on purpose.
+    """
+    paused_at(client)
+    post(client, "/api/movies/record")
+    post(client, "/api/play/step", {"frames": 10})
+    post(client, "/api/movies/stop", {"name": "graceful"})
+    with socket(client):
+        pass  # the last page leaves: paused, the grace period begins
+    assert studio_session.paused
+
+    def grace_over(s: Session) -> None:
+        remove()
+        s._leave()  # what the grace timer calls when it runs out
+
+    remove = studio_session.on_frame(grace_over)
+    start = studio_session.frame
+    post(client, "/api/play/speed", {"value": 8})
+    assert post(client, "/api/movies/play", {"name": "graceful"})["frames"] == 10
+    deadline = time.monotonic() + 120  # generous: a loaded machine is slow, never wrong
+    while studio_session.running and client.get("/api/status").json()["replaying"] and time.monotonic() < deadline:
+        time.sleep(0.05)
+    status = client.get("/api/status").json()
+    post(client, "/api/play/speed", {"value": 1})
+    assert not status["replaying"] and status["paused"] and status["frame"] == start + 10, status
 
 
 def test_a_movie_is_not_overwritten_unless_asked(client, studio_session):

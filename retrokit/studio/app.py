@@ -34,7 +34,7 @@ from starlette.websockets import WebSocket, WebSocketDisconnect
 
 from retrokit import errors
 from retrokit.studio.play import handle_message
-from retrokit.studio.push import Screen, Subscriber
+from retrokit.studio.push import Screen, Subscriber, acknowledges
 from retrokit.studio.security import Guard, session_of
 from retrokit.studio.session import Session
 
@@ -117,7 +117,13 @@ async def socket(websocket: WebSocket) -> None:
     """``/ws``: screens and messages out, commands in, until the page goes."""
     session = session_of(websocket)
     await websocket.accept()
-    subscriber = Subscriber(asyncio.get_running_loop())
+    try:
+        acks = acknowledges(websocket.query_params.get("ack"))
+    except errors.InvalidArgumentError as exc:  # told, then refused: the same URL would be refused again
+        await websocket.send_text(json.dumps({"type": "error", "error": str(exc), "kind": type(exc).__name__}))
+        await websocket.close(code=1008)
+        return
+    subscriber = Subscriber(asyncio.get_running_loop(), acknowledges=acks)
     session.subscribe(subscriber)
     sender = asyncio.create_task(_send(websocket, subscriber))
     try:

@@ -126,12 +126,18 @@ class Session:
         Jobs queued before it still run; later ones go to the next thread's queue.
         """
         with self._lock:
-            thread, jobs = self._thread, self._jobs
-            if thread is not None:
-                self._thread, self._jobs, self._stopped = None, queue.SimpleQueue(), thread
-                jobs.put(None)
+            thread = self._retire()
         if thread is not None and thread is not threading.current_thread():
             thread.join()
+
+    def _retire(self) -> threading.Thread | None:
+        """Make the running thread the last of its queue and return it (hold ``_lock``): it ends once the jobs
+        queued so far have run, and the next job starts a new thread, which waits for it."""
+        thread, jobs = self._thread, self._jobs
+        if thread is not None:
+            self._thread, self._jobs, self._stopped = None, queue.SimpleQueue(), thread
+            jobs.put(None)
+        return thread
 
     def close(self) -> None:
         """Stop the thread and close the emulator.
@@ -300,8 +306,22 @@ class Session:
         self._leave_timer.start()
 
     def _leave(self) -> None:
-        if not self._subscribers:
-            self.stop()
+        """The grace period after the last page is over: end the thread if it is idle, deciding on the thread."""
+        self.call_later(Session._end_if_idle)
+
+    def _end_if_idle(self) -> None:
+        """End the emulator thread if nothing runs on it: paused, no page, no job waiting (on the emulator thread).
+
+        Decided here, between jobs, and not on the grace timer's thread: a request that came after the last page
+        left (a replay, a resume by a script) un-pauses the session on this thread, and the timer's stop ended the
+        thread in the middle of it, the status saying ``replaying`` and not paused for ever with no thread left to
+        play (a replay started within the grace period froze when it ran out). Under ``_lock``, which every job is
+        queued under: a job queued meanwhile is either seen here (the thread stays) or goes to the next thread.
+        """
+        with self._lock:
+            idle = self.paused and not self._subscribers and self._jobs.empty()
+            if idle and self._thread is threading.current_thread():
+                self._retire()
 
     @property
     def subscribers(self) -> int:
@@ -430,7 +450,14 @@ class Session:
 
 
 def _offer_screen(session: Session, subscriber: Subscriber) -> None:
-    subscriber.offer_screen(Screen(session.frame, session.screen()))
+    """A new page's first screen (on the emulator thread), unless a frame played since it came offered one.
+
+    A running game's frame can end between :meth:`Session.subscribe` and this job, and offer the page that
+    frame's screen: offered again here, the page got the same frame twice (1 run of test_studio_server in 9
+    under load). Both run on this thread, so the count is not raced.
+    """
+    if subscriber.screens == 0:
+        subscriber.offer_screen(Screen(session.frame, session.screen()))
 
 
 def _error_message(exc: BaseException) -> dict[str, Any]:

@@ -57,7 +57,8 @@ export function decodeScreen(buffer) {
 export function connect() {
   const scheme = location.protocol === "https:" ? "wss" : "ws";
   // A browser cannot set headers on a WebSocket, so the token goes in the query, as the server allows.
-  ws = new WebSocket(`${scheme}://${location.host}/ws?token=${encodeURIComponent(token)}`);
+  // ack=1: this page acknowledges each message, so the server holds back from the first one (push.py).
+  ws = new WebSocket(`${scheme}://${location.host}/ws?token=${encodeURIComponent(token)}&ack=1`);
   ws.binaryType = "arraybuffer";
   ws.addEventListener("open", () => {
     retry = 250;

@@ -215,25 +215,33 @@ def test_evaluate_learns_from_scratch_and_from_the_trained_policy(folder, tiny, 
 
 
 def test_learning_updates_during_the_budget_and_zero_shot_never(folder, tiny, trained, monkeypatch) -> None:
-    """Played in this process, updates counted: one per 4 steps once 16 transitions are in; none zero-shot."""
+    """Played in this process, updates counted: one per 4 steps once 16 transitions are in; none zero-shot.
+
+    Between updates (before learning starts, and zero-shot) the noisy layers get new noise as often.
+    """
     from tianshou.algorithm.modelfree.rainbow import RainbowDQN
 
     from retrokit.benchmark.definition import load_benchmark
     from retrokit.benchmark.level import LevelDone, LevelTask, run_level
+    from retrokit.learning import rainbow
     from retrokit.learning.setup import prepare
 
-    updates = []
-    update = RainbowDQN.update
+    updates, draws = [], []
+    update, draw = RainbowDQN.update, rainbow.draw_noise
     monkeypatch.setattr(RainbowDQN, "update", lambda self, **kw: updates.append(1) or update(self, **kw))
+    monkeypatch.setattr(rainbow, "draw_noise", lambda network: draws.append(1) or draw(network))
     benchmark = load_benchmark("dasher")
     for learn in (True, False):
         updates.clear()
+        draws.clear()
         setup = prepare("rainbow", benchmark, tiny, trained, learn=learn)
         messages = []
         run_level(LevelTask(benchmark, benchmark.test[0], "rainbow", 40, 0, False, setup), messages.append)
         assert isinstance(messages[-1], LevelDone), messages[-1]
         # 40 steps in collections of 4: an update after each that ends at 16, 20, ..., 40 (the 41st step ends it)
         assert len(updates) == (7 if learn else 0)
+        # new noise after every collection of 4: the update's, else a draw of its own (before learning starts too)
+        assert len(draws) == (3 if learn else 10)
 
 
 def test_a_start_policy_of_another_network_fails_its_level_in_one_line(folder, tiny, trained) -> None:

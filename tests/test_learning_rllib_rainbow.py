@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import copy
 import io
+import itertools
 import os
 import sys
 
@@ -155,6 +156,32 @@ def test_the_module_is_the_local_network(change) -> None:
     np.testing.assert_allclose(torch.softmax(out["qf_logits"], -1).numpy(), ours, rtol=1e-5, atol=1e-6)
     atoms = np.linspace(config["v_min"], config["v_max"], config["atoms"])
     np.testing.assert_allclose(out["qf_preds"].numpy(), (ours * atoms).sum(-1), rtol=1e-4, atol=1e-5)
+
+
+def test_an_env_runner_draws_new_noise_every_update_every_steps() -> None:
+    """Acting (RLlib's exploration pass), the module draws new noise every ``update_every`` steps, before learning
+    starts too, as the local Rainbow does: between two draws it acts on one noise."""
+    import gymnasium
+    import torch
+    from ray.rllib.core.columns import Columns
+    from tianshou.utils.net.discrete import NoisyLinear
+
+    from retrokit.learning.rllib_rainbow_module import CONFIG, RainbowModule
+
+    config = tiny()
+    space = gymnasium.spaces.Box(0, 255, (4, 36, 36), np.uint8)
+    module = RainbowModule(observation_space=space, action_space=gymnasium.spaces.Discrete(7), inference_only=True,
+                           model_config={CONFIG: config})
+    layer = next(m for m in module.network.modules() if isinstance(m, NoisyLinear))
+    batch = {Columns.OBS: torch.zeros((1, *space.shape), dtype=torch.uint8)}
+    noises = []
+    with torch.no_grad():
+        for t in range(2 * config["update_every"]):
+            noises.append(layer.eps_p.clone())
+            module.forward_exploration(batch, t=t)
+    changed = [not torch.equal(a, b) for a, b in itertools.pairwise(noises)]
+    every = config["update_every"]
+    assert changed == [(i + 1) % every == 0 for i in range(len(changed))]
 
 
 @pytest.mark.parametrize(("change", "message"), [

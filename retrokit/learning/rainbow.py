@@ -255,9 +255,13 @@ def run_steps(learner: Learner, collector: Any, buffer: Any, config: Mapping[str
     while not until(steps):
         collector.collect(n_step=config["update_every"] * envs)
         steps += config["update_every"] * envs
-        if not learn and config["noisy"]:
-            draw_noise(learner.network)  # zero-shot: new noise as often as updates would draw it
-        if learn and len(buffer) >= config["learning_starts"]:
+        updating = learn and len(buffer) >= config["learning_starts"]
+        if config["noisy"] and not updating:
+            # New noise as often as an update draws it (Tianshou's update does), before learning starts too, as
+            # Hessel et al.'s agent does: one draw for all of it acted on one fixed policy, standing still for whole
+            # 1,000-step episodes (the paper config's 20,000 steps before learning scored 0 on every Dasher level)
+            draw_noise(learner.network)
+        if updating:
             with policy_within_training_step(learner.policy), torch_train_mode(learner.policy):
                 for _ in range(envs):
                     learner.algorithm.update(buffer=buffer, sample_size=config["minibatch"])

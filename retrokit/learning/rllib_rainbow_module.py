@@ -51,6 +51,7 @@ class RainbowModule(DefaultDQNTorchRLModule):
         # Exploration is the noisy layers' (epsilon 0, as the local Rainbow): greedy on the noisy network.
         self.epsilon_schedule = Scheduler(fixed_value_or_schedule=0.0, framework="torch")
         self.network = rainbow.build_network(config, tuple(self.observation_space.shape), int(self.action_space.n))
+        self.noisy, self.redraw_every, self.acted = config["noisy"], config["update_every"], 0
 
     def get_non_inference_attributes(self) -> list[str]:
         return ["_target_network"]
@@ -72,10 +73,19 @@ class RainbowModule(DefaultDQNTorchRLModule):
 
     def _forward_train(self, batch: dict[str, Any]) -> dict[str, Any]:
         # New noise for the online and the target network at each update, as Tianshou's Rainbow draws it; the env
-        # runners act on the last update's noise, synced with the weights (the noise is a parameter).
+        # runners get it with the weights (the noise is a parameter), and draw their own in between.
         rainbow.draw_noise(self.network)
         rainbow.draw_noise(self._target_network)
         return super()._forward_train(batch)
+
+    def _forward_exploration(self, batch: dict[str, Any], t: int) -> dict[str, Any]:
+        # An env runner draws new noise every update_every steps, as the local Rainbow acts: before learning starts
+        # too, where one draw (no update syncs another) acted on one fixed policy for all of it. Updates' noise
+        # comes with the weights after each sync.
+        self.acted += 1
+        if self.noisy and self.acted % self.redraw_every == 0:
+            rainbow.draw_noise(self.network)
+        return super()._forward_exploration(batch, t)
 
     def _qf_forward_helper(self, batch: dict[str, Any], encoder: Any, head: Any) -> dict[str, Any]:
         """The Q-values, logits, probabilities and atoms of ``encoder`` (a network of ``build_network``).

@@ -194,9 +194,14 @@ def cluster(folder, common) -> dict:
     script.write_text(CLUSTER)
     (folder / "rainbow-config").mkdir()
     rainbow = tiny_config(folder / "rainbow-config", "rainbow", RAINBOW_TINY)
-    done = subprocess.run([sys.executable, str(script), str(folder), json.dumps(common), str(rainbow)], env=env,
-                          cwd=folder,
-                          capture_output=True, text=True, timeout=840, stdin=subprocess.DEVNULL, check=False)
+    try:
+        done = subprocess.run([sys.executable, str(script), str(folder), json.dumps(common), str(rainbow)], env=env,
+                              cwd=folder, capture_output=True, text=True, timeout=840, stdin=subprocess.DEVNULL,
+                              check=False)
+    except subprocess.TimeoutExpired as expired:  # what the child had done by then, not only that it took long
+        output = "".join(part.decode(errors="replace") if isinstance(part, bytes) else part or ""
+                         for part in (expired.stdout, expired.stderr))
+        pytest.fail(f"the cluster's runs took over {expired.timeout} s; they printed:\n{output[-6000:]}")
     assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
     return json.loads((folder / "results.json").read_text())
 

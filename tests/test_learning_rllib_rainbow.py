@@ -267,7 +267,9 @@ def rllib_distributions(algorithm, obs: np.ndarray, *, means: bool = False) -> n
         with torch.no_grad():
             return module._qf_forward_helper({Columns.OBS: torch.as_tensor(obs)}, network, None)["qf_probs"].numpy()
 
-    return rr._first(algorithm.learner_group.foreach_learner(probabilities))
+    from retrokit.learning.raytrain import on_learners
+
+    return on_learners(algorithm, probabilities)
 
 
 def no_noise(network) -> None:

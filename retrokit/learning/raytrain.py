@@ -163,6 +163,25 @@ def library() -> str:
     return f"ray[rllib] {ray.__version__}"
 
 
+def on_learners(algorithm: Any, call: Any, **kwargs: Any) -> Any:  # RLlib's Algorithm
+    """``call(learner, **kwargs)`` on every learner of ``algorithm``; the first's answer (all hold one network).
+
+    Raises:
+        Exception: A learner's call raised it (a :class:`~retrokit.errors.PolicyFileError` of a load, ...).
+    """
+    answers = [result.get() for result in algorithm.learner_group.foreach_learner(call, **kwargs)]
+    if not answers:
+        raise RuntimeError("RLlib's algorithm has no learner")
+    return answers[0]
+
+
+def load_learners(algorithm: Any, load: Any, **kwargs: Any) -> None:  # RLlib's Algorithm
+    """``load(learner, **kwargs)`` on every learner, then the learners' weights sent to every env runner."""
+    on_learners(algorithm, load, **kwargs)
+    algorithm.env_runner_group.sync_weights(from_worker_or_learner_group=algorithm.learner_group,
+                                            inference_only=True)
+
+
 class EpisodeLog:
     """A Ray actor on the driver's node that collects the runners' finished episodes until the driver takes them."""
 

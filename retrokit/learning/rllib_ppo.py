@@ -32,6 +32,7 @@ from ray.rllib.core.rl_module.rl_module import RLModuleSpec
 from ray.rllib.core.rl_module.torch import TorchRLModule
 
 from retrokit.learning import ppo
+from retrokit.learning.raytrain import load_learners, on_learners
 from retrokit.learning.trainrun import state_bytes
 
 #: The PPO config's keys as RLlib's ``PPOConfig`` arguments: key -> (the ``PPOConfig`` method, its argument).
@@ -121,21 +122,15 @@ def algorithm_config(config: Mapping[str, Any], env: str, runners: int, envs_per
     )  # fmt: skip
 
 
-def _first(algorithm: Algorithm, call: Any) -> Any:
-    """``call(learner)`` on the algorithm's learners; the first's answer (every learner holds the same network)."""
-    for result in algorithm.learner_group.foreach_learner(call):
-        return result.get()
-    raise RuntimeError("RLlib's algorithm has no learner")
-
-
 def weights_of(algorithm: Algorithm) -> bytes:
     """The learner's network as :func:`retrokit.learning.ppo.weights_of` writes it (its ``state_dict``)."""
-    return _first(algorithm, lambda learner: state_bytes(torch.save, learner.module[DEFAULT_MODULE_ID].policy.state_dict()))
+    return on_learners(algorithm,
+                       lambda learner: state_bytes(torch.save, learner.module[DEFAULT_MODULE_ID].policy.state_dict()))
 
 
 def state_of(algorithm: Algorithm) -> bytes:
     """The learner's training state: its Adam's ``state_dict``."""
-    return _first(algorithm, lambda learner: state_bytes(torch.save, learner.get_optimizer().state_dict()))
+    return on_learners(algorithm, lambda learner: state_bytes(torch.save, learner.get_optimizer().state_dict()))
 
 
 def restore(algorithm: Algorithm, weights: bytes, state: bytes | None) -> None:
@@ -151,8 +146,5 @@ def restore(algorithm: Algorithm, weights: bytes, state: bytes | None) -> None:
         if optimizer is not None:
             learner.get_optimizer().load_state_dict(optimizer)
 
-    for result in algorithm.learner_group.foreach_learner(load):
-        result.get()
-    algorithm.env_runner_group.sync_weights(from_worker_or_learner_group=algorithm.learner_group,
-                                            inference_only=True)
+    load_learners(algorithm, load)
 

@@ -169,13 +169,6 @@ def _optimizer(learner: Any) -> Any:
     return learner.get_optimizer(DEFAULT_MODULE_ID)
 
 
-def _first(results: Any) -> Any:
-    """The value of the first learner's call (``foreach_learner`` gives every learner's: the same)."""
-    for result in results:
-        return result.get()  # raises the learner's error, if it failed
-    raise InvalidArgumentError("Expected a learner in the RLlib algorithm, found none.")
-
-
 def _network_state(learner: Any) -> dict[str, Any]:
     """A learner's network's tensors, named as the local Rainbow's network names them."""
     return {name: tensor.detach().cpu().clone() for name, tensor in _module(learner).network.state_dict().items()}
@@ -189,9 +182,10 @@ def weights_of(algorithm: Any) -> bytes:
     """The learner's network as a ``torch.save`` of its ``state_dict``: the local Rainbow's network loads it."""
     import torch
 
+    from retrokit.learning.raytrain import on_learners
     from retrokit.learning.trainrun import state_bytes
 
-    return state_bytes(torch.save, _first(algorithm.learner_group.foreach_learner(_network_state)))
+    return state_bytes(torch.save, on_learners(algorithm, _network_state))
 
 
 def state_of(algorithm: Any) -> bytes:
@@ -202,9 +196,10 @@ def state_of(algorithm: Any) -> bytes:
     """
     import torch
 
+    from retrokit.learning.raytrain import on_learners
     from retrokit.learning.trainrun import state_bytes
 
-    return state_bytes(torch.save, _first(algorithm.learner_group.foreach_learner(_optimizer_state)))
+    return state_bytes(torch.save, on_learners(algorithm, _optimizer_state))
 
 
 def restore(algorithm: Any, weights: bytes, state: bytes | None) -> None:
@@ -217,12 +212,11 @@ def restore(algorithm: Any, weights: bytes, state: bytes | None) -> None:
             state is not this optimizer's.
     """
     from retrokit.learning.ppo import load_tensors
+    from retrokit.learning.raytrain import load_learners
 
     load_tensors(weights, "the weights to restore")  # a damaged file is refused here, before any learner
     optimizer = None if state is None else load_tensors(state, "the optimizer state to restore")
-    _first(algorithm.learner_group.foreach_learner(_load, weights=weights, optimizer=optimizer))
-    algorithm.env_runner_group.sync_weights(from_worker_or_learner_group=algorithm.learner_group,
-                                            inference_only=True)
+    load_learners(algorithm, _load, weights=weights, optimizer=optimizer)
 
 
 def _load(learner: Any, weights: bytes, optimizer: dict[str, Any] | None) -> None:

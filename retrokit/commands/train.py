@@ -36,8 +36,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "retrokit's vector env, every update over all of them), writing checkpoints, the learning curve "
         "(curve.csv, curve.png) and the policy (policy.json and its weights) into --out. `retrokit evaluate "
         "--agent ppo --init DIR` fine-tunes the policy on the test levels. Needs the extra retrokit-rl[train]. With "
-        "--backend ray (PPO), RLlib trains it: --env-runners env runners spread over a Ray cluster's CPUs, each "
-        "playing one training level; a runner lost with its node starts again on the nodes left.",
+        "--backend ray, RLlib trains it (PPO, or Rainbow by its DQN): --env-runners env runners spread over a Ray "
+        "cluster's CPUs, each playing one training level; a runner lost with its node starts again on the nodes "
+        "left.",
     )
     parser.add_argument("--benchmark", default="dasher", help="sonic, dasher, another cartridge's, or a YAML file (default: dasher)")
     parser.add_argument("--agent", default="ppo", help="the learning agent: ppo or rainbow (default: ppo)")
